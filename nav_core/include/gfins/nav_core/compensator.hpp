@@ -1,0 +1,112 @@
+// Misalignment compensation between the front end and Chen's mechanization (paper §5).
+//
+//  kNone   outputs pass through; the solver uses the nominal geometry (Table 1).
+//  kPaper  the paper's two-step compensator on the outputs, then the nominal solver:
+//          location (eqs. (27)/(28)): s* = s** − C [Δf_j·θ_j], Δf_j = ω×(ω×Δρ_j) + ω̇×Δρ_j
+//            (eq. (22) with its misprint ω×ω̇×Δρ read as ω×(ω×Δρ)), ω and ω̇ from the previous
+//            step, as the paper's compensator has no better estimate;
+//          orientation (eqs. (29)/(30)): s = C⁻¹ s*, per set.
+//          Exact at rest; under rotation eqs. (23)-(26) leave a first-order residual, because C
+//          mixes the other sensors' rigid-body terms, which sit at other positions
+//          (docs/paper-errata.md).
+//  kExact  outputs pass through; the solver is built from the calibrated geometry θ*_j, ρ*_j
+//          (misaligned_geometry), so the 6×6 inversion itself removes the misalignment and stays
+//          exact under rotation.
+#pragma once
+
+#include <cstdint>
+
+#include "gfins/nav_core/geometry.hpp"
+#include "gfins/nav_core/misalignment.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::nav {
+
+enum class CompensatorKind : std::uint8_t { kNone = 0, kPaper = 1, kExact = 2 };
+
+constexpr const char* to_string(CompensatorKind k) {
+  switch (k) {
+    case CompensatorKind::kNone:
+      return "none";
+    case CompensatorKind::kPaper:
+      return "paper";
+    case CompensatorKind::kExact:
+      return "exact";
+  }
+  return "unknown";
+}
+
+template <typename T>
+class Compensator {
+ public:
+  using Outputs = Vec6<T>;
+
+  Compensator() = default;
+
+  /// Fails with kSingular when a set matrix C of eq. (14)/(15) cannot be inverted (angles near
+  /// 45° or more are outside the small-angle model anyway).
+  static Result<Compensator> create(CompensatorKind kind, const ArrayGeometry<T, 6>& nominal,
+                                    const Misalignment<T>& m) {
+    Compensator c;
+    c.kind_ = kind;
+    c.theta_b_ = nominal.theta_b;
+    c.drho_b_ = m.drho_b;
+    c.c_beta_ = set_matrix(m.orientation.beta);
+    c.c_alpha_ = set_matrix(m.orientation.alpha);
+    const T det_b = c.c_beta_.determinant();
+    const T det_a = c.c_alpha_.determinant();
+    if (!(std::abs(det_b) > T(0.5)) || !(std::abs(det_a) > T(0.5))) {
+      return Status(ErrorCode::kSingular,
+                    "compensator: an orientation-error set matrix (eq. 14/15) is near singular; "
+                    "the angles are outside the small-angle model");
+    }
+    c.c_beta_inv_ = c.c_beta_.inverse();
+    c.c_alpha_inv_ = c.c_alpha_.inverse();
+    return c;
+  }
+
+  CompensatorKind kind() const { return kind_; }
+
+  /// The geometry the solver must be built from for this compensator.
+  static ArrayGeometry<T, 6> solver_geometry(CompensatorKind kind,
+                                             const ArrayGeometry<T, 6>& nominal,
+                                             const Misalignment<T>& m) {
+    return kind == CompensatorKind::kExact ? misaligned_geometry(nominal, m) : nominal;
+  }
+
+  /// s (compensated) from s** (front-end output); w_b and wdot_b are the latest estimates.
+  void apply(const Outputs& s_raw, const Vec3<T>& w_b, const Vec3<T>& wdot_b, Outputs& s) const {
+    if (kind_ != CompensatorKind::kPaper) {
+      s = s_raw;
+      return;
+    }
+    apply_set(kSetBeta, c_beta_, c_beta_inv_, s_raw, w_b, wdot_b, s);
+    apply_set(kSetAlpha, c_alpha_, c_alpha_inv_, s_raw, w_b, wdot_b, s);
+  }
+
+ private:
+  void apply_set(const std::array<int, 3>& set, const Mat3<T>& c, const Mat3<T>& c_inv,
+                 const Outputs& s_raw, const Vec3<T>& w, const Vec3<T>& wdot, Outputs& s) const {
+    Vec3<T> df_theta;  // Δf_j·θ_j, eq. (22)
+    Vec3<T> s2;        // s** of the set
+    for (int i = 0; i < 3; ++i) {
+      const auto j = static_cast<std::size_t>(set[static_cast<std::size_t>(i)]);
+      const Vec3<T>& d = drho_b_[j];
+      df_theta(i) = theta_b_[j].dot(w.cross(w.cross(d)) + wdot.cross(d));
+      s2(i) = s_raw(static_cast<Eigen::Index>(j));
+    }
+    const Vec3<T> s_star = s2 - c * df_theta;  // eqs. (27)/(28)
+    const Vec3<T> s_ideal = c_inv * s_star;    // eqs. (29)/(30)
+    for (int i = 0; i < 3; ++i) s(set[static_cast<std::size_t>(i)]) = s_ideal(i);
+  }
+
+  CompensatorKind kind_ = CompensatorKind::kNone;
+  std::array<Vec3<T>, 6> theta_b_{};
+  std::array<Vec3<T>, 6> drho_b_{};
+  Mat3<T> c_beta_ = Mat3<T>::Identity();
+  Mat3<T> c_alpha_ = Mat3<T>::Identity();
+  Mat3<T> c_beta_inv_ = Mat3<T>::Identity();
+  Mat3<T> c_alpha_inv_ = Mat3<T>::Identity();
+};
+
+}  // namespace gfins::nav

@@ -1,0 +1,78 @@
+// Front end: ADC counts → volts → specific force along each sensitive axis, per sensor.
+//
+// The QA-1100 output current through its load resistor gives a voltage P = SF (f·θ + b) with SF
+// in V/g and b in g (paper eq. (21)); so f·θ = P/SF − b. The result is in m/s² with g the
+// standard gravity, the unit the scale factors are expressed in. Scale factor and bias are the
+// calibrated ones; orientation and location errors are the compensator's job.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gfins/nav_core/geometry.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::nav {
+
+/// Full-scale code of a 24-bit two's-complement converter.
+inline constexpr std::int32_t kAdcCodeMax = (1 << 23) - 1;
+inline constexpr std::int32_t kAdcCodeMin = -(1 << 23);
+
+template <typename T, int N = kNumSensors>
+struct FrontEndParams {
+  std::array<T, N> volts_per_count{};  // ADC LSB per channel, V (Vref / (gain · 2^23))
+  std::array<T, N> scale_v_per_g{};    // SF_aj, V/g (paper Table 6)
+  std::array<T, N> bias_g{};           // b_aj, g (paper Table 6)
+};
+
+template <typename T, int N = kNumSensors>
+class FrontEnd {
+ public:
+  using Outputs = Eigen::Matrix<T, N, 1>;
+
+  FrontEnd() = default;
+
+  /// Fails with kInvalidArgument when a scale factor or LSB is zero, negative or not finite.
+  static Result<FrontEnd> create(const FrontEndParams<T, N>& p) {
+    FrontEnd fe;
+    const T g = static_cast<T>(kStandardGravity);
+    for (int j = 0; j < N; ++j) {
+      const auto i = static_cast<std::size_t>(j);
+      const T sf = p.scale_v_per_g[i];
+      const T lsb = p.volts_per_count[i];
+      if (!(sf > T(0)) || !(lsb > T(0)) || !std::isfinite(sf) || !std::isfinite(lsb) ||
+          !std::isfinite(p.bias_g[i])) {
+        return Status(ErrorCode::kInvalidArgument,
+                      "front end: a scale factor or ADC LSB is not a positive finite number");
+      }
+      fe.gain_(j) = lsb * g / sf;
+      fe.offset_(j) = p.bias_g[i] * g;
+    }
+    fe.params_ = p;
+    return fe;
+  }
+
+  /// s**_j = (counts_j · LSB_j / SF_j − b_j) · g (m/s²). Returns a mask of the channels whose
+  /// code sits at the converter's full scale (saturated: the value is not a measurement).
+  std::uint32_t convert(const std::array<std::int32_t, N>& counts, Outputs& s) const {
+    std::uint32_t saturated = 0;
+    for (int j = 0; j < N; ++j) {
+      const std::int32_t c = counts[static_cast<std::size_t>(j)];
+      if (c >= kAdcCodeMax || c <= kAdcCodeMin) saturated |= 1u << j;
+      s(j) = gain_(j) * static_cast<T>(c) - offset_(j);
+    }
+    return saturated;
+  }
+
+  /// Inverse of convert (without rounding to integers): the counts a specific force gives.
+  T counts_for(int j, T s_mps2) const { return (s_mps2 + offset_(j)) / gain_(j); }
+
+  const FrontEndParams<T, N>& params() const { return params_; }
+
+ private:
+  Outputs gain_ = Outputs::Ones();    // m/s² per count
+  Outputs offset_ = Outputs::Zero();  // m/s²
+  FrontEndParams<T, N> params_{};
+};
+
+}  // namespace gfins::nav

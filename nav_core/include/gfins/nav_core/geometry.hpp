@@ -1,0 +1,122 @@
+// Accelerometer array geometry and the linear map from the six outputs to [ω̇; f].
+//
+// Sensor j sits at rho_b[j] (m, body frame, from the array centre o_b) and senses along the unit
+// axis theta_b[j]. Its specific force is the one of the centre plus the rigid-body terms
+// (paper eq. (22), with the misprint ω×ω̇×Δρ read as ω×(ω×Δρ); see docs/paper-errata.md):
+//
+//   s_j = θ_j·f + (ρ_j×θ_j)·ω̇ + θ_j·(ω×(ω×ρ_j))
+//
+// where f = C_n^b (r̈_n − g_n) is the specific force at the centre. Stacking N ≥ 6 sensors gives
+// s = H [ω̇; f] + c(ω) with row j of H = [(ρ_j×θ_j)ᵀ  θ_jᵀ]. The centripetal term is a quadratic
+// form in ω: c_j(ω) = (θ_j·ω)(ρ_j·ω) − (θ_j·ρ_j)|ω|², i.e. a fixed N×6 matrix times the monomials
+// m(ω) = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy]. Hence, with M = (HᵀH)⁻¹Hᵀ precomputed at start-up,
+//
+//   [ω̇; f] = M s − K m(ω),   K = M Q.
+//
+// For Table 1 M = [S/(2ρ); T/2] and −K m(ω) = [0; ρ(ωyωz, ωxωz, ωxωy)], which is the paper's
+// eq. (4) (with C_i^b on its left side, misprint fixed) once gravity is added back (eq. (5)).
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "gfins/nav_core/math.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::nav {
+
+/// Number of accelerometers of the paper's array; the solver accepts any N ≥ 6.
+inline constexpr int kNumSensors = 6;
+
+/// Positions (m) and unit sensitive axes of an array of N accelerometers, body frame.
+template <typename T, int N = kNumSensors>
+struct ArrayGeometry {
+  static_assert(N >= 6, "six outputs are the minimum that determine [ω̇; f]");
+  std::array<Vec3<T>, N> rho_b{};
+  std::array<Vec3<T>, N> theta_b{};
+
+  template <typename U>
+  ArrayGeometry<U, N> cast() const {
+    ArrayGeometry<U, N> g;
+    for (int j = 0; j < N; ++j) {
+      g.rho_b[static_cast<std::size_t>(j)] = rho_b[static_cast<std::size_t>(j)].template cast<U>();
+      g.theta_b[static_cast<std::size_t>(j)] =
+          theta_b[static_cast<std::size_t>(j)].template cast<U>();
+    }
+    return g;
+  }
+};
+
+/// The paper's Table 1 (Chen's cube configuration) with half-size rho_m (m).
+template <typename T>
+ArrayGeometry<T, 6> table1_geometry(T rho_m) {
+  const T r = rho_m;
+  const T k = T(1) / std::sqrt(T(2));
+  ArrayGeometry<T, 6> g;
+  g.rho_b = {Vec3<T>(0, 0, -r), Vec3<T>(0, -r, 0), Vec3<T>(-r, 0, 0),
+             Vec3<T>(r, 0, 0),  Vec3<T>(0, r, 0),  Vec3<T>(0, 0, r)};
+  g.theta_b = {Vec3<T>(k, k, 0),  Vec3<T>(k, 0, k),  Vec3<T>(0, k, k),
+               Vec3<T>(0, -k, k), Vec3<T>(-k, 0, k), Vec3<T>(-k, k, 0)};
+  return g;
+}
+
+/// Monomials m(ω) = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy] of the centripetal term.
+template <typename T>
+Vec6<T> centripetal_monomials(const Vec3<T>& w) {
+  Vec6<T> m;
+  m << w.x() * w.x(), w.y() * w.y(), w.z() * w.z(), w.y() * w.z(), w.x() * w.z(), w.x() * w.y();
+  return m;
+}
+
+/// Largest condition number of the (column-scaled) design H accepted by default. Table 1 has 1;
+/// a geometry near 1e3 loses three digits, which float32 cannot afford.
+inline constexpr double kDefaultMaxCondition = 100.0;
+
+/// The precomputed inversion of the array equations: [ω̇; f] = M s − K m(ω).
+template <typename T, int N = kNumSensors>
+class ArraySolver {
+ public:
+  using Outputs = Eigen::Matrix<T, N, 1>;
+  using MapMatrix = Eigen::Matrix<T, 6, N>;
+
+  /// Builds M and K from a geometry, computing in double whatever T is. Fails with kSingular
+  /// when the design is singular or its condition number exceeds max_condition; fails with
+  /// kInvalidArgument when an axis is not near unit length (|‖θ‖−1| > 0.1: the calibrated
+  /// axes θ* of eq. (23) carry gains of a few percent, so they are not exactly unit) or the array
+  /// has no size. The condition number is that of H with its ω̇ columns scaled by the mean lever
+  /// arm, so it does not depend on the unit of length.
+  static Result<ArraySolver> create(const ArrayGeometry<T, N>& geometry,
+                                    double max_condition = kDefaultMaxCondition);
+
+  /// Angular acceleration ω̇ (rad/s², body) and specific force f (m/s², body, at o_b) from the
+  /// outputs s (m/s², along each axis) and the current angular rate ω (rad/s, body).
+  void solve(const Outputs& s, const Vec3<T>& w, Vec3<T>& wdot_b, Vec3<T>& f_b) const {
+    const Vec6<T> u = m_ * s - k_ * centripetal_monomials(w);
+    wdot_b = u.template head<3>();
+    f_b = u.template tail<3>();
+  }
+
+  /// The linear part M s (ω-independent); the integrator reuses it across predictor/corrector.
+  Vec6<T> linear_part(const Outputs& s) const { return m_ * s; }
+  /// The centripetal correction K m(ω) that solve() subtracts.
+  Vec6<T> centripetal_part(const Vec3<T>& w) const { return k_ * centripetal_monomials(w); }
+
+  const MapMatrix& m() const { return m_; }
+  const Mat6<T>& k() const { return k_; }
+  double condition_number() const { return condition_; }
+  const ArrayGeometry<T, N>& geometry() const { return geometry_; }
+
+  /// Forward model: the outputs an ideal array with this geometry gives for (ω̇, f, ω).
+  Outputs predict(const Vec3<T>& wdot_b, const Vec3<T>& f_b, const Vec3<T>& w) const;
+
+ private:
+  MapMatrix m_ = MapMatrix::Zero();
+  Mat6<T> k_ = Mat6<T>::Zero();
+  double condition_ = 0.0;
+  ArrayGeometry<T, N> geometry_{};
+};
+
+extern template class ArraySolver<float, 6>;
+extern template class ArraySolver<double, 6>;
+
+}  // namespace gfins::nav

@@ -1,0 +1,119 @@
+// Strapdown integrator of the gyro-free array: ω from ω̇, attitude, velocity and position.
+//
+// Scheme (docs/math.md derives it and states its order). Samples s_k arrive at t_k; the state
+// after step k refers to t_k. Over [t_{k-1}, t_k], with h = t_k − t_{k-1}:
+//   1. angular rate, Heun (trapezoid with an Euler predictor), because ω̇ depends on ω through the
+//      centripetal term (eq. (4)/(6) for Table 1, K m(ω) in general):
+//        ω̇_p = u_k − K_top m(ω_{k-1} + h ω̇_{k-1});  ω_k = ω_{k-1} + h/2 (ω̇_{k-1} + ω̇_p)
+//   2. [ω̇_k; f_k] = u_k − K m(ω_k) with u_k = M s_k (eqs. (4)-(6))
+//   3. attitude, two-sample rotation vector for ω linear over the step (eq. (1) integrated):
+//        φ = h/2 (ω_{k-1} + ω_k) + h²/12 ω_{k-1} × ω_k;   q_k = q_{k-1} ⊗ exp(φ), normalised
+//   4. a_k = C(q_k) f_k + g_n(r_{k-1}) (gravity added back with the current attitude, eq. (5))
+//   5. v_k = v_{k-1} + h/2 (a_{k-1} + a_k)
+//      r_k = r_{k-1} + h v_{k-1} + h²/6 (2 a_{k-1} + a_k)   (exact for a linear in t)
+// Every stage is second order in h; velocity and position are accumulated with compensated
+// (Kahan) summation so that small increments are not lost in float32 over long runs.
+#pragma once
+
+#include <cstdint>
+
+#include "gfins/nav_core/geometry.hpp"
+#include "gfins/nav_core/gravity.hpp"
+#include "gfins/nav_core/nav_state.hpp"
+
+namespace gfins::nav {
+
+/// Vector sum with Kahan compensation: the rounding error of each addition is carried into the
+/// next one. Requires IEEE arithmetic as written (never build nav_core with -ffast-math).
+template <typename T>
+struct CompensatedVec3 {
+  Vec3<T> sum = Vec3<T>::Zero();
+  Vec3<T> carry = Vec3<T>::Zero();
+
+  void reset(const Vec3<T>& v) {
+    sum = v;
+    carry.setZero();
+  }
+  void add(const Vec3<T>& delta) {
+    const Vec3<T> y = delta - carry;
+    const Vec3<T> t = sum + y;
+    carry = (t - sum) - y;
+    sum = t;
+  }
+};
+
+template <typename T, int N = kNumSensors>
+class Strapdown {
+ public:
+  using Solver = ArraySolver<T, N>;
+  using Outputs = typename Solver::Outputs;
+
+  Strapdown() = default;
+  Strapdown(const Solver& solver, const GravityModel<T>& gravity)
+      : solver_(solver), gravity_(gravity) {}
+
+  /// Replaces the array solver (for a new calibration) without touching the state.
+  void set_solver(const Solver& solver) { solver_ = solver; }
+  const Solver& solver() const { return solver_; }
+  const GravityModel<T>& gravity() const { return gravity_; }
+
+  /// Starts integration at the first sample: `initial` gives t, attitude, ω, v and r; s0 are the
+  /// compensated outputs of that sample, from which ω̇ and f at t0 are computed.
+  void initialize(const NavState<T>& initial, const Outputs& s0) {
+    state_ = initial;
+    state_.status |= nav_status::kAligned;
+    state_.q_nb.normalize();
+    solver_.solve(s0, state_.w_b, state_.wdot_b, state_.f_b);
+    state_.a_n = state_.q_nb * state_.f_b + gravity_.g_n(state_.r_n);
+    v_.reset(state_.v_n);
+    r_.reset(state_.r_n);
+  }
+
+  /// Advances to the sample s_k taken dt_s after the previous one.
+  void step(const Outputs& s_k, T dt_s, std::int64_t t_ns, std::uint32_t seq) {
+    const T h = dt_s;
+    const Vec3<T> w0 = state_.w_b;
+    const Vec3<T> wdot0 = state_.wdot_b;
+    const Vec3<T> a0 = state_.a_n;
+    const Vec3<T> v0 = v_.sum;
+
+    const Vec6<T> u = solver_.linear_part(s_k);
+    const Mat6<T>& k = solver_.k();
+    const Vec3<T> w_pred = w0 + h * wdot0;
+    const Vec3<T> wdot_pred =
+        u.template head<3>() - k.template topRows<3>() * centripetal_monomials(w_pred);
+    const Vec3<T> w1 = w0 + (h / T(2)) * (wdot0 + wdot_pred);
+    const Vec6<T> full = u - k * centripetal_monomials(w1);
+
+    const Vec3<T> phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * w0.cross(w1);
+    Quat<T> q1 = state_.q_nb * quat_from_rotation_vector(phi);
+    q1.normalize();
+
+    const Vec3<T> f1 = full.template tail<3>();
+    const Vec3<T> a1 = q1 * f1 + gravity_.g_n(r_.sum);
+    v_.add((h / T(2)) * (a0 + a1));
+    r_.add(h * v0 + (h * h / T(6)) * (T(2) * a0 + a1));
+
+    state_.t_ns = t_ns;
+    state_.seq = seq;
+    state_.q_nb = q1;
+    state_.w_b = w1;
+    state_.wdot_b = full.template head<3>();
+    state_.f_b = f1;
+    state_.a_n = a1;
+    state_.v_n = v_.sum;
+    state_.r_n = r_.sum;
+  }
+
+  const NavState<T>& state() const { return state_; }
+  NavState<T>& mutable_state() { return state_; }
+
+ private:
+  Solver solver_{};  // owned copy (a few hundred bytes), so the integrator can be copied
+  GravityModel<T> gravity_{};
+  NavState<T> state_{};
+  CompensatedVec3<T> v_{};
+  CompensatedVec3<T> r_{};
+};
+
+}  // namespace gfins::nav

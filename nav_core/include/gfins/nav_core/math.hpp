@@ -1,0 +1,84 @@
+// Fixed-size linear algebra vocabulary of the navigation core and the few rotation helpers the
+// integrator needs. Everything is templated on the scalar: float on the target, double for the
+// host reference (DESIGN.md). No function here allocates.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace gfins::nav {
+
+template <typename T>
+using Vec3 = Eigen::Matrix<T, 3, 1>;
+template <typename T>
+using Mat3 = Eigen::Matrix<T, 3, 3>;
+template <typename T>
+using Vec6 = Eigen::Matrix<T, 6, 1>;
+template <typename T>
+using Mat6 = Eigen::Matrix<T, 6, 6>;
+template <typename T>
+using Quat = Eigen::Quaternion<T>;
+
+/// Standard gravity, the "g" of the accelerometer scale factors in V/g (paper Table 6).
+inline constexpr double kStandardGravity = 9.80665;
+
+/// [v×]: the matrix with skew(v) * w == v.cross(w).
+template <typename T>
+Mat3<T> skew(const Vec3<T>& v) {
+  Mat3<T> m;
+  m << T(0), -v.z(), v.y(), v.z(), T(0), -v.x(), -v.y(), v.x(), T(0);
+  return m;
+}
+
+/// Quaternion of the rotation vector `phi` (rad): exp(phi/2). Below 0.1 rad a Taylor series is
+/// used; its truncation error (|phi|^6/46080 in the scalar part) is below the float and double
+/// rounding of the terms kept, and it avoids sin/cos on the per-sample path (a 1 kHz step rotates
+/// by far less than 0.1 rad for any rate below 100 rad/s).
+template <typename T>
+Quat<T> quat_from_rotation_vector(const Vec3<T>& phi) {
+  const T a2 = phi.squaredNorm();
+  T c;  // cos(|phi|/2)
+  T s;  // sin(|phi|/2)/|phi|
+  if (a2 < T(0.01)) {
+    const T x = a2 / T(4);  // (|phi|/2)^2
+    c = T(1) - x / T(2) + x * x / T(24) - x * x * x / T(720);
+    s = (T(1) - x / T(6) + x * x / T(120) - x * x * x / T(5040)) / T(2);
+  } else {
+    const T a = std::sqrt(a2);
+    c = std::cos(a / T(2));
+    s = std::sin(a / T(2)) / a;
+  }
+  return Quat<T>(c, s * phi.x(), s * phi.y(), s * phi.z());
+}
+
+/// Rotation vector of a unit quaternion (inverse of quat_from_rotation_vector), with the
+/// rotation angle folded into [0, pi].
+template <typename T>
+Vec3<T> rotation_vector_from_quat(const Quat<T>& q_in) {
+  Quat<T> q = q_in;
+  if (q.w() < T(0)) q.coeffs() = -q.coeffs();
+  const T sn = q.vec().norm();
+  if (sn < T(1e-6)) return T(2) * q.vec() / q.w();  // angle/sin(angle/2) -> 2/w
+  const T angle = T(2) * std::atan2(sn, q.w());
+  return (angle / sn) * q.vec();
+}
+
+/// Roll, pitch, yaw (rad, aerospace Z-Y-X sequence) of the body-to-navigation rotation q_nb.
+template <typename T>
+Vec3<T> euler_from_quat(const Quat<T>& q_nb) {
+  const Mat3<T> c = q_nb.toRotationMatrix();
+  const T sp = std::clamp(-c(2, 0), T(-1), T(1));
+  return Vec3<T>(std::atan2(c(2, 1), c(2, 2)), std::asin(sp), std::atan2(c(1, 0), c(0, 0)));
+}
+
+/// q_nb of roll, pitch, yaw (rad, Z-Y-X sequence).
+template <typename T>
+Quat<T> quat_from_euler(T roll, T pitch, T yaw) {
+  return Quat<T>(Eigen::AngleAxis<T>(yaw, Vec3<T>::UnitZ()) *
+                 Eigen::AngleAxis<T>(pitch, Vec3<T>::UnitY()) *
+                 Eigen::AngleAxis<T>(roll, Vec3<T>::UnitX()));
+}
+
+}  // namespace gfins::nav

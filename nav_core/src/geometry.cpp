@@ -1,0 +1,6 @@
+#include "gfins/nav_core/geometry_impl.hpp"
+
+namespace gfins::nav {
+template class ArraySolver<float, 6>;
+template class ArraySolver<double, 6>;
+}  // namespace gfins::nav
