@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# Flash/RAM footprint of the float32 navigation core on a bare-metal Cortex-M4F, and the proof
+# that its per-sample step calls no soft-float double routine.
+#
+# Usage: scripts/embedded_size.sh [build-dir]      (default: build/cortex-m4f)
+#   Build first:  cmake --preset cortex-m4f && cmake --build --preset cortex-m4f
+#
+# Prints
+#   1. `size` (text/data/bss) of the probe program nav_core/baremetal (gfins_nav_baremetal.elf)
+#      and of the objects of libgfins_nav_core.a (which hold both the float and the double
+#      instantiations; the program links only the float one, with --gc-sections);
+#   2. the largest symbols of the program;
+#   3. every soft-float double routine (__aeabi_d*, __*df2/3, __aeabi_f2d, ...) and double libm
+#      function the program contains, with the call path that reaches it from main, and then the
+#      same walk from the per-sample step gfins_nav_step(): it must reach none.
+# Exit status: 0 when the step is free of double arithmetic, 1 when it is not, 2 on usage errors.
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${1:-${root}/build/cortex-m4f}"
+elf="${build}/nav_core/baremetal/gfins_nav_baremetal.elf"
+lib="${build}/nav_core/libgfins_nav_core.a"
+prefix="${GFINS_ARM_PREFIX:-arm-none-eabi-}"
+
+for f in "${elf}" "${lib}"; do
+  if [[ ! -f "${f}" ]]; then
+    echo "embedded_size.sh: ${f} not found; build the cortex-m4f preset first" >&2
+    exit 2
+  fi
+done
+
+echo "== Probe program (float32 pipeline, paper compensator, static storage) =="
+"${prefix}size" "${elf}"
+echo
+echo "== Navigation core library objects (float + double instantiations) =="
+"${prefix}size" -t "${lib}"
+echo
+echo "== Largest symbols of the program (bytes, type, name) =="
+"${prefix}nm" -C --size-sort -S --radix=d "${elf}" | tail -n 15 | cut -c 10-160
+echo
+
+# Call graph from the disassembly: direct calls (bl) and tail calls (b.w / b to the start of
+# another function). Indirect calls (blx rN) cannot be followed and are reported.
+read -r -d '' callgraph_py <<'PY' || true
+import re, sys
+
+func_re = re.compile(r"^[0-9a-f]+ <([^>]+)>:$")
+call_re = re.compile(r"^\s*[0-9a-f]+:\s+(b[a-z.]*|bl|blx)\s+[0-9a-f]+ <([^>+]+)>")
+indirect_re = re.compile(r"^\s*[0-9a-f]+:\s+blx\s+r\d+")
+graph, indirect, cur = {}, set(), None
+for line in sys.stdin:
+    m = func_re.match(line.strip())
+    if m:
+        cur = m.group(1)
+        graph.setdefault(cur, set())
+        continue
+    if cur is None:
+        continue
+    m = call_re.match(line)
+    if m and m.group(2) != cur:
+        graph[cur].add(m.group(2))
+    elif indirect_re.match(line):
+        indirect.add(cur)
+
+soft_double = re.compile(
+    r"^(__aeabi_(c?d[a-z0-9]+|cdr[a-z0-9]+|[a-z0-9]+2d)|__[a-z]+df[23]|__extendsfdf2|"
+    r"__truncdfsf2|__float[a-z]*df|__fix[a-z]*df[a-z]*|"
+    r"(sin|cos|tan|asin|acos|atan|atan2|sqrt|exp|log|pow|fmod|hypot|floor|ceil|round)|"
+    r"(__ieee754_|__kernel_)\w*[^f])$")
+
+def walk(root):
+    """Breadth-first: the first path found to each reachable function."""
+    parent, order = {root: None}, [root]
+    for f in order:
+        for g in sorted(graph.get(f, ())):
+            if g not in parent:
+                parent[g] = f
+                order.append(g)
+    return parent
+
+def path(parent, f):
+    p = []
+    while f is not None:
+        p.append(f)
+        f = parent[f]
+    return " <- ".join(p)
+
+def demangle_all(names):
+    import subprocess
+    out = subprocess.run(["c++filt"], input="\n".join(names), capture_output=True, text=True)
+    return out.stdout.split("\n")
+
+present = sorted(f for f in graph if soft_double.match(f))
+print("== Soft-float double routines in the program ==")
+print("  " + (" ".join(present) if present else "(none)"))
+print()
+print("== Reached from main (one-time configuration may use double) ==")
+from_main = walk("main")
+users = sorted(f for f in from_main
+               if not soft_double.match(f) and any(soft_double.match(g) for g in graph[f]))
+for name, dem in zip(users, demangle_all(users)):
+    print("  " + dem[:150])
+print()
+print("== Reached from the per-sample step gfins_nav_step ==")
+from_step = walk("gfins_nav_step")
+bad = [f for f in present if f in from_step]
+print("  functions reachable from the step: %d" % len(from_step))
+verbose = len(sys.argv) > 1 and sys.argv[1] == "-v"
+for f, dem in zip(sorted(from_step), demangle_all(sorted(from_step))):
+    if verbose:
+        print("    " + dem[:150])
+    if f in indirect:
+        print("  note: %s makes an indirect call (not followed)" % f)
+if bad:
+    for f in bad:
+        print("  SOFT DOUBLE: " + path(from_step, f))
+    sys.exit(1)
+print("  no soft-float double routine is reachable: the step runs on the FPU in single precision")
+PY
+"${prefix}objdump" -d --no-show-raw-insn "${elf}" |
+  python3 -c "${callgraph_py}" ${GFINS_SIZE_VERBOSE:+-v}
