@@ -39,14 +39,31 @@ constexpr const char* to_string(CompensatorKind k) {
 template <typename T>
 class Compensator {
  public:
+  /// Largest orientation error accepted (rad). Eqs. (14)/(15) are first-order in the angles; at
+  /// 0.2 rad their second-order terms reach 2 % and the model no longer describes the array.
+  static constexpr double kMaxAngleRad = 0.2;
+
   using Outputs = Vec6<T>;
 
   Compensator() = default;
 
-  /// Fails with kSingular when a set matrix C of eq. (14)/(15) cannot be inverted (angles near
-  /// 45° or more are outside the small-angle model anyway).
+  /// Fails with kInvalidArgument when an angle is outside the small-angle model or a value is not
+  /// finite, and with kSingular when a set matrix C of eq. (14)/(15) cannot be inverted.
   static Result<Compensator> create(CompensatorKind kind, const ArrayGeometry<T, 6>& nominal,
                                     const Misalignment<T>& m) {
+    for (std::size_t i = 0; i < 6; ++i) {
+      const T b = m.orientation.beta[i];
+      const T a = m.orientation.alpha[i];
+      if (!std::isfinite(a) || !std::isfinite(b) || std::abs(a) > T(kMaxAngleRad) ||
+          std::abs(b) > T(kMaxAngleRad)) {
+        return Status(ErrorCode::kInvalidArgument,
+                      "compensator: an orientation error is not finite or exceeds 0.2 rad "
+                      "(11.5 deg), outside the small-angle model of eqs. (14)/(15)");
+      }
+      if (!std::isfinite(m.drho_b[i].squaredNorm())) {
+        return Status(ErrorCode::kInvalidArgument, "compensator: a location error is not finite");
+      }
+    }
     Compensator c;
     c.kind_ = kind;
     c.theta_b_ = nominal.theta_b;

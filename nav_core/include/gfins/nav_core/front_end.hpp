@@ -23,6 +23,17 @@ struct FrontEndParams {
   std::array<T, N> volts_per_count{};  // ADC LSB per channel, V (Vref / (gain · 2^23))
   std::array<T, N> scale_v_per_g{};    // SF_aj, V/g (paper Table 6)
   std::array<T, N> bias_g{};           // b_aj, g (paper Table 6)
+
+  template <typename U>
+  FrontEndParams<U, N> cast() const {
+    FrontEndParams<U, N> o;
+    for (std::size_t j = 0; j < static_cast<std::size_t>(N); ++j) {
+      o.volts_per_count[j] = static_cast<U>(volts_per_count[j]);
+      o.scale_v_per_g[j] = static_cast<U>(scale_v_per_g[j]);
+      o.bias_g[j] = static_cast<U>(bias_g[j]);
+    }
+    return o;
+  }
 };
 
 template <typename T, int N = kNumSensors>
