@@ -1,0 +1,171 @@
+// The calibration of one six-accelerometer board, as stored on disk (docs/calibration-file.md)
+// and converted to the navigation core's configuration (nav::PipelineConfig parts).
+//
+// Host/firmware code (not nav_core): std::string and friends are fine here. The values are kept
+// in the units of the file so that a save/load round trip is bit-exact:
+//   - orientation errors in degrees (the file's unit, as in the paper's Table 6). Radians → degrees
+//     → radians is not the identity in binary64 (for roughly 7 % of values no double in degrees
+//     maps back to the same double in radians), so the radians the navigation core uses are made
+//     only at the conversion to nav::Misalignment<T> (misalignment() below);
+//   - lengths in m, scale factors in V/g, biases in g, ADC LSB in V/count, as in the file.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <numbers>
+#include <string>
+
+#include "gfins/nav_core/compensator.hpp"
+#include "gfins/nav_core/front_end.hpp"
+#include "gfins/nav_core/geometry.hpp"
+#include "gfins/nav_core/misalignment.hpp"
+#include "gfins/nav_core/pipeline.hpp"
+
+namespace gfins::calib_file {
+
+/// The format version this build reads and writes (docs/calibration-file.md, versioning).
+inline constexpr std::int64_t kFormatVersion = 1;
+inline constexpr std::size_t kNumSensors = 6;
+
+/// Acceptance bounds of the values (validate()); the doc lists the same numbers.
+inline constexpr double kMaxAngleDeg = 10.0;           // small-angle model of eqs. (14)/(15)
+inline constexpr double kMaxAbsBiasG = 1.0;            // a 1 g bias is a broken sensor, not a bias
+inline constexpr double kMaxRhoM = 10.0;               // array half-size
+inline constexpr double kMaxPositionM = 10.0;          // custom geometry positions
+inline constexpr double kMaxLocationErrorOfRho = 0.5;  // |Δρ component| ≤ ρ/2
+inline constexpr double kAxisUnitTolerance = 1e-6;     // nominal axes are unit vectors
+inline constexpr double kMaxAdcLsbV = 1.0;             // V/count; a 24-bit ADC is ~1e-7
+inline constexpr std::size_t kMaxDeviceIdLength = 64;
+inline constexpr std::size_t kMaxSourceLength = 256;
+
+enum class GeometryKind : std::uint8_t {
+  kTable1 = 0,  // the paper's Table 1 (Chen's cube) with half-size rho_m
+  kCustom = 1,  // positions and axes given explicitly
+};
+
+/// Nominal geometry of the array, body frame FRD at the array centre.
+struct GeometrySpec {
+  GeometryKind kind = GeometryKind::kTable1;
+  double rho_m = 0.1;  // cube half-size (Table 1); for a custom array its characteristic size
+  std::array<std::array<double, 3>, kNumSensors> positions_m{};  // kCustom only
+  std::array<std::array<double, 3>, kNumSensors> axes{};         // kCustom only, unit vectors
+
+  bool operator==(const GeometrySpec&) const = default;
+};
+
+/// One accelerometer (index j = sensor j+1 of Table 1). Model: P = SF (f·θ + b), paper eq. (21).
+struct SensorCalibration {
+  double adc_lsb_v_per_count = 0.0;                // V/count of its ADC channel
+  double scale_v_per_g = 0.0;                      // SF_aj, V/g
+  double scale_sigma_v_per_g = 0.0;                // 1σ
+  double bias_g = 0.0;                             // b_aj, g
+  double bias_sigma_g = 0.0;                       // 1σ
+  std::array<double, 3> location_error_m{};        // Δρ_j, m, body frame (eq. (19))
+  std::array<double, 3> location_error_sigma_m{};  // 1σ per component
+
+  bool operator==(const SensorCalibration&) const = default;
+};
+
+/// The six orientation errors of one set, in nav::AngleIndex order: xy, xz, yx, yz, zx, zy
+/// (paper eqs. (14)/(15) and Table 6).
+struct SetOrientation {
+  std::array<double, 6> angle_deg{};
+  std::array<double, 6> angle_sigma_deg{};  // 1σ
+
+  bool operator==(const SetOrientation&) const = default;
+};
+
+struct CalibrationData {
+  std::string device_id;    // [A-Za-z0-9._-], 1..64 characters
+  std::string created_utc;  // "YYYY-MM-DDTHH:MM:SSZ"
+  std::string source;       // free text: where the data came from (printable ASCII, may be empty)
+  GeometrySpec geometry{};
+  std::array<SensorCalibration, kNumSensors> sensors{};
+  SetOrientation beta{};   // set {2, 3, 5}: Δβ (nav::kSetBeta)
+  SetOrientation alpha{};  // set {1, 4, 6}: Δα (nav::kSetAlpha)
+  nav::CompensatorKind compensator = nav::CompensatorKind::kExact;
+
+  bool operator==(const CalibrationData&) const = default;
+};
+
+/// The first value outside its documented domain: `key` is its path in the file
+/// ("sensor.3.scale_v_per_g"), `problem` says what is wrong. Empty key means none.
+struct Problem {
+  std::string key;
+  std::string problem;
+  bool found() const { return !key.empty(); }
+};
+Problem validate(const CalibrationData& data);
+
+/// The canonical serialisation the checksum covers (docs/calibration-file.md): one line
+/// "key=value\n" per value in a fixed order, doubles as the 16 hex digits of their IEEE-754
+/// binary64 bit pattern, so it is the same on every machine and for every text formatting.
+std::string canonical_serialisation(const CalibrationData& data);
+/// FNV-1a 64-bit over canonical_serialisation(data).
+std::uint64_t checksum(const CalibrationData& data);
+/// FNV-1a 64-bit of arbitrary bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
+std::uint64_t fnv1a64(const std::string& bytes);
+
+/// Current time as "YYYY-MM-DDTHH:MM:SSZ" (UTC).
+std::string utc_now_iso8601();
+
+const char* to_string(GeometryKind kind);
+
+// --- Conversion to the navigation core's configuration ------------------------------------
+
+inline constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+template <typename T>
+nav::ArrayGeometry<T, 6> nominal_geometry(const CalibrationData& d) {
+  if (d.geometry.kind == GeometryKind::kTable1) {
+    return nav::table1_geometry<double>(d.geometry.rho_m).cast<T>();
+  }
+  nav::ArrayGeometry<T, 6> g;
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    const auto& p = d.geometry.positions_m[j];
+    const auto& a = d.geometry.axes[j];
+    g.rho_b[j] = nav::Vec3<T>(static_cast<T>(p[0]), static_cast<T>(p[1]), static_cast<T>(p[2]));
+    g.theta_b[j] = nav::Vec3<T>(static_cast<T>(a[0]), static_cast<T>(a[1]), static_cast<T>(a[2]));
+  }
+  return g;
+}
+
+template <typename T>
+nav::FrontEndParams<T, 6> front_end_params(const CalibrationData& d) {
+  nav::FrontEndParams<T, 6> p;
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    p.volts_per_count[j] = static_cast<T>(d.sensors[j].adc_lsb_v_per_count);
+    p.scale_v_per_g[j] = static_cast<T>(d.sensors[j].scale_v_per_g);
+    p.bias_g[j] = static_cast<T>(d.sensors[j].bias_g);
+  }
+  return p;
+}
+
+/// Orientation errors in radians (computed in double, then rounded to T) and location errors.
+template <typename T>
+nav::Misalignment<T> misalignment(const CalibrationData& d) {
+  nav::Misalignment<T> m;
+  for (std::size_t i = 0; i < 6; ++i) {
+    m.orientation.beta[i] = static_cast<T>(d.beta.angle_deg[i] * kRadPerDeg);
+    m.orientation.alpha[i] = static_cast<T>(d.alpha.angle_deg[i] * kRadPerDeg);
+  }
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    const auto& e = d.sensors[j].location_error_m;
+    m.drho_b[j] = nav::Vec3<T>(static_cast<T>(e[0]), static_cast<T>(e[1]), static_cast<T>(e[2]));
+  }
+  return m;
+}
+
+/// Fills the calibration parts of a pipeline configuration (nominal geometry, front end,
+/// misalignment, compensator); the rest (gravity, rates, alignment) is left as it was.
+template <typename T>
+void apply_to(const CalibrationData& d, nav::PipelineConfig<T>& config) {
+  config.nominal = nominal_geometry<T>(d);
+  config.front_end = front_end_params<T>(d);
+  config.misalignment = misalignment<T>(d);
+  config.compensator = d.compensator;
+}
+
+}  // namespace gfins::calib_file

@@ -1,0 +1,92 @@
+// The list of values of a calibration file, in the order of the canonical serialisation.
+//
+// One visitor walks this list to write the TOML table, another to read it, a third to build the
+// canonical text the checksum covers and a fourth to validate ranges, so the four can never
+// disagree about which keys exist. The key paths are the file's dotted TOML keys.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+
+#include "gfins/calib_file/calibration_data.hpp"
+
+namespace gfins::calib_file::detail {
+
+/// What a value must satisfy (validate()).
+enum class Domain : std::uint8_t {
+  kAdcLsb,    // finite, 0 < x ≤ kMaxAdcLsbV
+  kScale,     // finite, x > 0
+  kSigma,     // finite, x ≥ 0
+  kBias,      // finite, |x| ≤ kMaxAbsBiasG
+  kAngle,     // finite, |x| ≤ kMaxAngleDeg
+  kLocation,  // finite, |x| ≤ kMaxLocationErrorOfRho · ρ
+  kRho,       // finite, 0 < x ≤ kMaxRhoM
+  kPosition,  // finite, |x| ≤ kMaxPositionM
+  kAxis,      // finite, unit length within kAxisUnitTolerance
+  kDeviceId,  // [A-Za-z0-9._-]{1,64}
+  kUtc,       // YYYY-MM-DDTHH:MM:SSZ
+  kSource,    // printable ASCII, ≤ kMaxSourceLength
+};
+
+/// Order of the angle keys: nav::AngleIndex (xy, xz, yx, yz, zx, zy).
+inline constexpr std::array<const char*, 6> kAngleNames = {"xy", "xz", "yx", "yz", "zx", "zy"};
+
+/// Units the file states in its [units] table; a reader rejects any other unit.
+struct UnitEntry {
+  const char* key;
+  const char* unit;
+};
+inline constexpr std::array<UnitEntry, 5> kUnits = {{
+    {"units.length", "m"},
+    {"units.scale_factor", "V/g"},
+    {"units.bias", "g"},
+    {"units.angle", "deg"},
+    {"units.adc_lsb", "V/count"},
+}};
+
+inline const char* to_string_compensator(nav::CompensatorKind k) { return nav::to_string(k); }
+
+/// D is CalibrationData or const CalibrationData. V has the methods
+///   text(key, std::string&, Domain), unit(key, const char* unit),
+///   geometry_kind(key, GeometryKind&), compensator(key, nav::CompensatorKind&),
+///   number(key, double&, Domain), vec3(key, std::array<double, 3>&, Domain).
+/// Geometry's kind is visited before the keys that depend on it, so a reader sees it in time.
+template <typename D, typename V>
+void visit_fields(D& d, V& v) {
+  v.text("device_id", d.device_id, Domain::kDeviceId);
+  v.text("created_utc", d.created_utc, Domain::kUtc);
+  v.text("source", d.source, Domain::kSource);
+  for (const UnitEntry& u : kUnits) v.unit(u.key, u.unit);
+  v.geometry_kind("geometry.name", d.geometry.kind);
+  v.number("geometry.rho_m", d.geometry.rho_m, Domain::kRho);
+  if (d.geometry.kind == GeometryKind::kCustom) {
+    for (std::size_t j = 0; j < kNumSensors; ++j) {
+      const std::string p = "geometry.sensor." + std::to_string(j + 1) + ".";
+      v.vec3(p + "position_m", d.geometry.positions_m[j], Domain::kPosition);
+      v.vec3(p + "axis", d.geometry.axes[j], Domain::kAxis);
+    }
+  }
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    const std::string p = "sensor." + std::to_string(j + 1) + ".";
+    auto& s = d.sensors[j];
+    v.number(p + "adc_lsb_v_per_count", s.adc_lsb_v_per_count, Domain::kAdcLsb);
+    v.number(p + "scale_v_per_g", s.scale_v_per_g, Domain::kScale);
+    v.number(p + "scale_sigma_v_per_g", s.scale_sigma_v_per_g, Domain::kSigma);
+    v.number(p + "bias_g", s.bias_g, Domain::kBias);
+    v.number(p + "bias_sigma_g", s.bias_sigma_g, Domain::kSigma);
+    v.vec3(p + "location_error_m", s.location_error_m, Domain::kLocation);
+    v.vec3(p + "location_error_sigma_m", s.location_error_sigma_m, Domain::kSigma);
+  }
+  const auto visit_set = [&v](const std::string& p, auto& set) {
+    for (std::size_t i = 0; i < 6; ++i) {
+      v.number(p + kAngleNames[i] + "_deg", set.angle_deg[i], Domain::kAngle);
+      v.number(p + kAngleNames[i] + "_sigma_deg", set.angle_sigma_deg[i], Domain::kSigma);
+    }
+  };
+  visit_set("orientation.beta.", d.beta);
+  visit_set("orientation.alpha.", d.alpha);
+  v.compensator("compensator", d.compensator);
+}
+
+}  // namespace gfins::calib_file::detail

@@ -1,0 +1,77 @@
+// Shared fixtures of the calibration-file tests: a CalibrationData carrying the paper's Table 6
+// and helpers for temporary directories.
+#pragma once
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "gfins/calib_file/calibration_data.hpp"
+
+namespace gfins::calib_file::testing {
+
+/// Table 6 of the paper (SF V/g, bias g, angles deg) with made-up uncertainties, LSB and Δρ.
+inline CalibrationData table6_data() {
+  CalibrationData d;
+  d.device_id = "gfins-test-01";
+  d.created_utc = "2024-05-01T12:34:56Z";
+  d.source = "paper Table 6";
+  d.geometry.kind = GeometryKind::kTable1;
+  d.geometry.rho_m = 0.1;
+  const double sf[6] = {0.509874, 0.332572, 0.500242, 2.493301, 0.339215, 2.476663};
+  const double b[6] = {-0.000731, -0.000242, 0.000867, -0.007977, -0.000891, -0.004691};
+  for (std::size_t j = 0; j < 6; ++j) {
+    SensorCalibration& s = d.sensors[j];
+    s.adc_lsb_v_per_count = 2.5 / 8388608.0;  // ±2.5 V over 24 bits
+    s.scale_v_per_g = sf[j];
+    s.scale_sigma_v_per_g = 1e-6;
+    s.bias_g = b[j];
+    s.bias_sigma_g = 2e-6;
+    s.location_error_m = {1e-4 * static_cast<double>(j), -2e-4, 0.0};
+    s.location_error_sigma_m = {5e-5, 5e-5, 5e-5};
+  }
+  d.beta.angle_deg = {1.117319, -0.175730, -0.581196, -0.738742, 2.454457, 2.482135};
+  d.alpha.angle_deg = {-2.654967, 2.596778, -0.838703, -0.737387, 0.119537, -1.451107};
+  d.beta.angle_sigma_deg = {0.04, 0.05, 0.06, 0.07, 0.08, 0.04};
+  d.alpha.angle_sigma_deg = {0.05, 0.06, 0.07, 0.08, 0.04, 0.05};
+  d.compensator = nav::CompensatorKind::kExact;
+  return d;
+}
+
+/// A fresh empty directory under the system temp dir, removed (recursively) on destruction.
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "gfins-calib-XXXXXX").string();
+    path_ = ::mkdtemp(tmpl.data());
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
+                                 std::filesystem::perm_options::add, ec);
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+inline void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+}  // namespace gfins::calib_file::testing

@@ -1,0 +1,240 @@
+// Every way a calibration file can be bad is refused with a message that names the file, the
+// problem and, where there is one, the key and line.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "calib_file/calib_test_data.hpp"
+#include "gfins/calib_file/calibration_file.hpp"
+
+namespace gfins::calib_file {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::table6_data;
+using testing::TempDir;
+using testing::write_text;
+
+// The 1-based line of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  EXPECT_NE(at, std::string::npos) << needle;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+}
+
+// The line of a dotted key in a file written by to_toml_text: "a.b.c" is "c = " after "[a.b]".
+int key_line(const std::string& text, const std::string& key) {
+  const auto dot = key.rfind('.');
+  if (dot == std::string::npos) return line_of(text, "\n" + key + " = ") + 1;
+  const std::string header = "[" + key.substr(0, dot) + "]\n";
+  const auto table_at = text.find(header);
+  EXPECT_NE(table_at, std::string::npos) << header;
+  return line_of(text, header) + line_of(text.substr(table_at), key.substr(dot + 1) + " = ") - 1;
+}
+
+std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+class LoadErrors : public ::testing::Test {
+ protected:
+  // Writes `text` as bad.toml and loads it; the load must fail.
+  FileStatus load_text(const std::string& text) {
+    write_text(path_, text);
+    const auto r = load_calibration_file(path_);
+    EXPECT_FALSE(r.is_ok());
+    // Every message names the file.
+    EXPECT_THAT(r.status().message(), HasSubstr("calibration file '" + path_.string() + "'"));
+    return r.status();
+  }
+
+  const TempDir dir_;
+  const std::filesystem::path path_ = dir_.path() / "bad.toml";
+  const std::string good_ = to_toml_text(table6_data());
+};
+
+TEST_F(LoadErrors, MissingFileIsAnIoErrorNamingTheOsReason) {
+  const auto r = load_calibration_file(dir_.path() / "absent.toml");
+  ASSERT_FALSE(r.is_ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kIoError);
+  EXPECT_THAT(r.status().message(), HasSubstr("absent.toml"));
+  EXPECT_THAT(r.status().message(), HasSubstr("No such file or directory"));
+}
+
+TEST_F(LoadErrors, FileCutInTheMiddleOfALineIsTruncated) {
+  const FileStatus s = load_text(good_.substr(0, good_.size() / 2));
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("truncated"));
+}
+
+TEST_F(LoadErrors, FileCutAtALineBoundaryBeforeTheEndMarkerIsTruncated) {
+  // Given the file without its last line: still valid TOML, so only the marker can tell
+  const std::string cut = good_.substr(0, good_.find(std::string(kEndMarker)));
+  const FileStatus s = load_text(cut);
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("truncated"));
+}
+
+TEST_F(LoadErrors, EmptyFileIsTruncated) {
+  const FileStatus s = load_text("");
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("truncated"));
+}
+
+TEST_F(LoadErrors, AChangedDigitIsACorruptionCaughtByTheChecksum) {
+  // Given Table 6 with one digit of SF_a2 changed (0.332572 → 0.332672): still valid, in range
+  const FileStatus s =
+      load_text(replace_once(good_, "scale_v_per_g = 0.332572", "scale_v_per_g = 0.332672"));
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("checksum mismatch"));
+  EXPECT_THAT(s.message(),
+              HasSubstr("line " + std::to_string(line_of(good_, "checksum = ")) + ":"));
+}
+
+TEST_F(LoadErrors, AnAlteredChecksumIsACorruption) {
+  const auto at = good_.find("fnv1a64:") + 8;
+  std::string text = good_;
+  text[at] = text[at] == '0' ? '1' : '0';
+  const FileStatus s = load_text(text);
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("checksum mismatch"));
+}
+
+TEST_F(LoadErrors, MissingChecksumIsRefused) {
+  const FileStatus s = load_text(replace_once(good_, "checksum = ", "# checksum = "));
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("integrity.checksum"));
+}
+
+TEST_F(LoadErrors, BrokenSyntaxNamesTheLineAndColumn) {
+  // Given a key whose '=' has been lost
+  const int line = line_of(good_, "bias_g = ");
+  const FileStatus s = load_text(replace_once(good_, "bias_g = ", "bias_g "));
+  EXPECT_EQ(s.code(), ErrorCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("TOML syntax error"));
+  EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) + ", column "));
+}
+
+TEST_F(LoadErrors, AnotherFormatVersionIsRefusedNamingBothVersions) {
+  const int line = line_of(good_, "format_version = 1");
+  const FileStatus s = load_text(replace_once(good_, "format_version = 1", "format_version = 2"));
+  EXPECT_EQ(s.code(), ErrorCode::kUnimplemented);
+  EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) +
+                                     ": format version 2 is "
+                                     "not supported (this build reads version 1)"));
+}
+
+TEST_F(LoadErrors, MissingVersionIsRefused) {
+  const FileStatus s = load_text(replace_once(good_, "format_version = 1", ""));
+  EXPECT_THAT(s.message(), HasSubstr("missing key 'format_version'"));
+}
+
+TEST_F(LoadErrors, MissingKeyIsNamed) {
+  const FileStatus s = load_text(replace_once(good_, "bias_g = -0.000242\n", ""));
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("missing key 'sensor.2.bias_g'"));
+}
+
+TEST_F(LoadErrors, UnknownKeyIsNamedWithItsLine) {
+  // Given a misspelt extra key (it would not be covered by the checksum)
+  const std::string text =
+      replace_once(good_, "bias_g = -0.000242\n", "bias_g = -0.000242\nbias_gg = 0.5\n");
+  const int line = line_of(text, "bias_gg");
+  const FileStatus s = load_text(text);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(),
+              HasSubstr("line " + std::to_string(line) + ": unknown key 'sensor.2.bias_gg'"));
+}
+
+TEST_F(LoadErrors, WrongTypeIsNamedWithItsLine) {
+  const int line = line_of(good_, "scale_v_per_g = 0.332572");
+  const FileStatus s =
+      load_text(replace_once(good_, "scale_v_per_g = 0.332572", "scale_v_per_g = '0.332572'"));
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) +
+                                     ": sensor.2.scale_v_per_g must be a number, found a string"));
+}
+
+TEST_F(LoadErrors, AnotherUnitIsRefused) {
+  // Given angles declared in radians: the values would be read 57× too large or too small
+  const FileStatus s = load_text(replace_once(good_, "angle = 'deg'", "angle = 'rad'"));
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("units.angle is \"rad\" but this format stores \"deg\""));
+}
+
+TEST_F(LoadErrors, UnknownCompensatorIsRefused) {
+  const FileStatus s = load_text(replace_once(good_, "compensator = 'exact'", "compensator = 'x'"));
+  EXPECT_THAT(s.message(), HasSubstr("compensator is \"x\": expected \"none\", \"paper\" or"));
+}
+
+// Out-of-range values are written with a valid checksum (to_toml_text does not validate), so
+// the range check, not the checksum, must catch them.
+class OutOfRange : public LoadErrors {
+ protected:
+  void expect_refused(const CalibrationData& d, const std::string& key, const std::string& what) {
+    const std::string text = to_toml_text(d);
+    const FileStatus s = load_text(text);
+    EXPECT_EQ(s.code(), ErrorCode::kOutOfRange) << s.message();
+    const int line = key_line(text, key);
+    EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) + ": " + key));
+    EXPECT_THAT(s.message(), HasSubstr(what));
+    // And saving the same data is refused before anything is written.
+    const auto out = dir_.path() / "refused.toml";
+    const FileStatus saved = save_calibration_file(out, d);
+    EXPECT_EQ(saved.code(), ErrorCode::kOutOfRange);
+    EXPECT_THAT(saved.message(), HasSubstr(key));
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+};
+
+TEST_F(OutOfRange, NegativeScaleFactor) {
+  CalibrationData d = table6_data();
+  d.sensors[2].scale_v_per_g = -0.500242;
+  expect_refused(d, "sensor.3.scale_v_per_g", "= -0.500242: must be a positive number");
+}
+
+TEST_F(OutOfRange, NaNBias) {
+  CalibrationData d = table6_data();
+  d.sensors[4].bias_g = std::numeric_limits<double>::quiet_NaN();
+  expect_refused(d, "sensor.5.bias_g", "must be a finite number");
+}
+
+TEST_F(OutOfRange, AngleBeyondTenDegrees) {
+  CalibrationData d = table6_data();
+  d.alpha.angle_deg[4] = 10.5;
+  expect_refused(d, "orientation.alpha.zx_deg", "= 10.5: must be within ±10 degrees");
+}
+
+TEST_F(OutOfRange, NegativeUncertainty) {
+  CalibrationData d = table6_data();
+  d.beta.angle_sigma_deg[1] = -0.01;
+  expect_refused(d, "orientation.beta.xz_sigma_deg", "must not be negative");
+}
+
+TEST_F(OutOfRange, InfiniteAdcLsb) {
+  CalibrationData d = table6_data();
+  d.sensors[0].adc_lsb_v_per_count = std::numeric_limits<double>::infinity();
+  expect_refused(d, "sensor.1.adc_lsb_v_per_count", "must be a finite number");
+}
+
+TEST_F(OutOfRange, LocationErrorBeyondHalfTheArray) {
+  CalibrationData d = table6_data();
+  d.sensors[5].location_error_m[1] = 0.06;  // ρ = 0.1 m
+  expect_refused(d, "sensor.6.location_error_m", "[1] = 0.06: a location error");
+}
+
+TEST_F(OutOfRange, BadDeviceIdAndTimestamp) {
+  CalibrationData d = table6_data();
+  d.device_id = "board 01";
+  expect_refused(d, "device_id", "\"board 01\" is not 1 to 64 characters");
+  d = table6_data();
+  d.created_utc = "2024-13-01T00:00:00Z";
+  expect_refused(d, "created_utc", "is not a UTC time YYYY-MM-DDTHH:MM:SSZ");
+}
+
+}  // namespace
+}  // namespace gfins::calib_file
