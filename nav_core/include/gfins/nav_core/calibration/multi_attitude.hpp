@@ -72,8 +72,10 @@ struct MultiAttitudeConfig {
   /// A sensor whose means span less than this over its attitudes is dead or disconnected (V).
   T min_output_span_v = T(1e-3);
   /// Condition number of the per-sensor design [1 a_jᵀ] above which the attitudes count as
-  /// coplanar (kSingular). Tables 2/3 give 3.2; four attitudes 10° apart give about 40.
-  T max_condition = T(1e3);
+  /// coplanar (kSingular). Six faces or a tetrahedron give √3, Tables 2/3 give 3.2; it grows as
+  /// 1/tilt when the poses approach a plane (four poses 1° off a plane: 57). Noise on the means is
+  /// amplified by up to this factor, hence the same limit as nav::kDefaultMaxCondition.
+  T max_condition = T(100);
   // Verdict thresholds (they do not fail the call).
   T max_rms_residual_g = T(2e-3);  // RMS residual per sensor / SF (g); Tables 4/5: ≤ 0.5 mg
   T max_chi2_per_dof = T(9);       // weighted residuals vs the stated σ
