@@ -175,7 +175,8 @@ class Maneuver final : public JetTrajectory {
     r_n[0] = k * (ramp + sinusoid(t, 3.0, 0.5, 0.0));
     r_n[1] = k * (sinusoid(t, 4.0, 0.3, 0.0) + sinusoid(t, 0.5, 2.1, 0.0));
     r_n[2] = k * (sinusoid(t, -1.5, 0.8, 0.0) + sinusoid(t, 0.2, 3.3, 0.0));
-    // Euler angles (rad), Z-Y-X: roll ≤ 26°, pitch ≤ 17°, yaw drifting at 0.1 rad/s with a swing.
+    // Euler angles (rad), Z-Y-X: |roll| ≤ 26°, |pitch| ≤ 18°, yaw drifting at 0.1 rad/s with a
+    // swing.
     const JetD roll = k * (sinusoid(t, 0.35, 1.3, 0.2) + sinusoid(t, 0.10, 4.1, 0.3));
     const JetD pitch = k * (sinusoid(t, 0.25, 0.9, 0.5) + sinusoid(t, 0.05, 3.7, 0.0));
     const JetD yaw = k * (0.1 * t + sinusoid(t, 0.5, 0.6, 1.0));

@@ -116,9 +116,13 @@ std::unique_ptr<Trajectory> make_coning(double half_angle_rad, double cone_rate_
 
 /// A smooth 6-DoF manoeuvre (sums of sinusoids/ramps in position and in the three Euler angles),
 /// amplitude scaled by `scale` (1 = a vehicle-like motion: metres, tens of degrees, ~1 rad/s).
-/// At scale 1: r_n(0) = 0; |ω_b| ≤ about 1.2 rad/s, |ω̇_b| ≤ about 3 rad/s², |a_n| ≤ about
-/// 4 m/s² (the exact formulas are in trajectory.cpp). Meant for t ≥ 0 (the cruise ramp uses
-/// exp(−t/τ), which grows without bound for large negative t).
+/// At scale 1: r_n(0) = 0; peaks over the first minute |ω_b| 0.97 rad/s, |ω̇_b| 2.5 rad/s²,
+/// |a_n| 3.8 m/s², roll up to 26°, pitch up to 18°, a 2 m/s northward cruise (the exact formulas
+/// are in trajectory.cpp). Meant for t ≥ 0 (the cruise ramp uses exp(−t/τ), which grows without
+/// bound for large negative t).
+///
+/// Cost of at(), -O2 on the development machine: about 0.1 µs (constant acceleration), 0.3 µs
+/// (spin, coning) and 0.7 µs (manoeuvre: 17 sin/cos pairs and one exp).
 std::unique_ptr<Trajectory> make_maneuver(double scale = 1.0);
 
 }  // namespace gfins::sim
