@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,6 +43,9 @@ struct Case {
   std::string label;
   std::function<std::unique_ptr<Trajectory>()> make;
 };
+
+// Names the case in gtest's failure messages instead of dumping its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
 
 Quatd some_attitude() { return nav::quat_from_euler(0.3, -0.7, 2.1); }
 
