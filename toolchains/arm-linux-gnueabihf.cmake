@@ -8,5 +8,8 @@
 # The compiler's defaults are the armhf baseline; a Cortex-A7 board may add
 # -DCMAKE_CXX_FLAGS="-mcpu=cortex-a7 -mfpu=neon-vfpv4" (never -ffast-math).
 set(CMAKE_SYSTEM_PROCESSOR arm)
+# GCC's note that passing some Eigen structs by value changed ABI in GCC 7.1 concerns linking
+# with objects from GCC < 7, which a Debian 12 build never does.
+set(CMAKE_CXX_FLAGS_INIT "-Wno-psabi")
 set(GFINS_CROSS_TRIPLE arm-linux-gnueabihf)
 include(${CMAKE_CURRENT_LIST_DIR}/debian-cross-linux.cmake)

@@ -27,8 +27,10 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 set(GFINS_M4F_CPU_FLAGS "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16")
 set(GFINS_M4F_COMMON_FLAGS "${GFINS_M4F_CPU_FLAGS} -ffunction-sections -fdata-sections")
 set(CMAKE_C_FLAGS_INIT "${GFINS_M4F_COMMON_FLAGS}")
+# -Wno-psabi: GCC's note that passing some Eigen structs by value changed ABI in GCC 7.1 is about
+# linking with objects from GCC < 7, which this build never does.
 set(CMAKE_CXX_FLAGS_INIT
-    "${GFINS_M4F_COMMON_FLAGS} -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit")
+    "${GFINS_M4F_COMMON_FLAGS} -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit -Wno-psabi")
 set(CMAKE_ASM_FLAGS_INIT "${GFINS_M4F_CPU_FLAGS}")
 # newlib-nano (small printf/malloc) and stub system calls: nothing here calls them, but the C
 # runtime start files (crt0) need an implementation to link a program at all.
