@@ -1,0 +1,204 @@
+#include "csv.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <utility>
+
+namespace gfins::tools {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string::size_type begin = 0;
+  for (;;) {
+    const auto comma = line.find(',', begin);
+    cells.push_back(trim(line.substr(begin, comma - begin)));
+    if (comma == std::string::npos) return cells;
+    begin = comma + 1;
+  }
+}
+
+FileStatus bad(const std::string& what) { return FileStatus(ErrorCode::kInvalidArgument, what); }
+
+}  // namespace
+
+int CsvTable::column(const std::string& name) const {
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (header[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string CsvTable::where(const CsvRow& row) const {
+  return file + ":" + std::to_string(row.line) + ": ";
+}
+
+FileResult<double> CsvTable::number(const CsvRow& row, int col) const {
+  const std::string& text = row.cells[static_cast<std::size_t>(col)];
+  double x = 0.0;
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
+  if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
+      !std::isfinite(x)) {
+    return bad(where(row) + "column '" + header[static_cast<std::size_t>(col)] + "': \"" + text +
+               "\" is not a finite number");
+  }
+  return x;
+}
+
+FileResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int64_t lo,
+                                           std::int64_t hi) const {
+  const std::string& text = row.cells[static_cast<std::size_t>(col)];
+  std::int64_t x = 0;
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
+  if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() || x < lo ||
+      x > hi) {
+    return bad(where(row) + "column '" + header[static_cast<std::size_t>(col)] + "': \"" + text +
+               "\" is not an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return x;
+}
+
+FileResult<CsvTable> read_csv(const std::filesystem::path& path) {
+  CsvTable t;
+  t.file = path.string();
+  std::ifstream in(path);
+  if (!in) return FileStatus(ErrorCode::kIoError, t.file + ": cannot open");
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const std::string s = trim(line);
+    if (s.empty() || s[0] == '#') continue;
+    auto cells = split(s);
+    if (t.header.empty()) {
+      t.header = std::move(cells);
+      continue;
+    }
+    if (cells.size() != t.header.size()) {
+      return bad(t.file + ":" + std::to_string(n) + ": " + std::to_string(cells.size()) +
+                 " fields, the header has " + std::to_string(t.header.size()));
+    }
+    t.rows.push_back(CsvRow{n, std::move(cells)});
+  }
+  if (in.bad()) return FileStatus(ErrorCode::kIoError, t.file + ": read error");
+  if (t.header.empty()) return bad(t.file + ": empty (no header row)");
+  if (t.rows.empty()) return bad(t.file + ": no data rows after the header");
+  return t;
+}
+
+FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
+  auto table = read_csv(path);
+  if (!table.is_ok()) return table.status();
+  const CsvTable& t = table.value();
+  const int c_sensor = t.column("sensor");
+  const int c_attitude = t.column("attitude");
+  const int c_mean = t.column("mean_v");
+  const int c_std = t.column("std_v");
+  const int c_count = t.column("count");
+  if (c_sensor < 0 || c_attitude < 0 || c_mean < 0) {
+    return bad(t.file + ": the header must name the columns sensor, attitude, mean_v");
+  }
+  if ((c_std < 0) != (c_count < 0)) {
+    return bad(t.file + ": columns std_v and count go together (σ of a mean = std_v/√count)");
+  }
+  std::vector<MeanRow> rows;
+  std::set<std::pair<int, int>> seen;
+  for (const CsvRow& r : t.rows) {
+    MeanRow m;
+    m.line = r.line;
+    const auto sensor = t.integer(r, c_sensor, 1, 6);
+    if (!sensor.is_ok()) return sensor.status();
+    const auto attitude = t.integer(r, c_attitude, 1, 1000);
+    if (!attitude.is_ok()) return attitude.status();
+    const auto mean = t.number(r, c_mean);
+    if (!mean.is_ok()) return mean.status();
+    m.sensor = static_cast<int>(sensor.value());
+    m.attitude = static_cast<int>(attitude.value());
+    m.mean_v = mean.value();
+    if (c_std >= 0) {
+      const auto sd = t.number(r, c_std);
+      if (!sd.is_ok()) return sd.status();
+      const auto count = t.integer(r, c_count, 1, 1'000'000'000);
+      if (!count.is_ok()) return count.status();
+      if (sd.value() < 0.0) return bad(t.where(r) + "std_v must not be negative");
+      m.std_v = sd.value();
+      m.count = static_cast<std::uint32_t>(count.value());
+    }
+    if (!seen.insert({m.sensor, m.attitude}).second) {
+      return bad(t.where(r) + "sensor " + std::to_string(m.sensor) + " attitude " +
+                 std::to_string(m.attitude) + " appears twice");
+    }
+    rows.push_back(m);
+  }
+  return rows;
+}
+
+FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
+  auto table = read_csv(path);
+  if (!table.is_ok()) return table.status();
+  const CsvTable& t = table.value();
+  const int c_att = t.column("attitude");
+  const std::array<int, 3> c_f = {t.column("fx_g"), t.column("fy_g"), t.column("fz_g")};
+  if (c_att < 0 || c_f[0] < 0 || c_f[1] < 0 || c_f[2] < 0) {
+    return bad(t.file + ": the header must name the columns attitude, fx_g, fy_g, fz_g");
+  }
+  std::vector<Pose> poses;
+  std::set<int> seen;
+  for (const CsvRow& r : t.rows) {
+    Pose p;
+    p.line = r.line;
+    const auto att = t.integer(r, c_att, 1, 1000);
+    if (!att.is_ok()) return att.status();
+    p.attitude = static_cast<int>(att.value());
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto f = t.number(r, c_f[k]);
+      if (!f.is_ok()) return f.status();
+      p.f_b_g[k] = f.value();
+    }
+    const double norm = std::hypot(p.f_b_g[0], p.f_b_g[1], p.f_b_g[2]);
+    // At rest the specific force is 1 g; 10 % covers a local gravity model and rounding.
+    if (std::fabs(norm - 1.0) > 0.1) {
+      return bad(t.where(r) + "|f| = " + std::to_string(norm) +
+                 " g: a static pose senses 1 g (give the specific force in g, not m/s²)");
+    }
+    if (!seen.insert(p.attitude).second) {
+      return bad(t.where(r) + "attitude " + std::to_string(p.attitude) + " appears twice");
+    }
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+FileResult<Recording> read_recording(const std::filesystem::path& path) {
+  auto table = read_csv(path);
+  if (!table.is_ok()) return table.status();
+  const CsvTable& t = table.value();
+  std::array<int, 6> c{};
+  for (std::size_t j = 0; j < 6; ++j) {
+    c[j] = t.column("v" + std::to_string(j + 1));
+    if (c[j] < 0) return bad(t.file + ": the header must name the columns v1 … v6 (volts)");
+  }
+  Recording rec;
+  rec.samples_v.reserve(t.rows.size());
+  for (const CsvRow& r : t.rows) {
+    std::array<double, 6> s{};
+    for (std::size_t j = 0; j < 6; ++j) {
+      const auto v = t.number(r, c[j]);
+      if (!v.is_ok()) return v.status();
+      s[j] = v.value();
+    }
+    rec.samples_v.push_back(s);
+  }
+  return rec;
+}
+
+}  // namespace gfins::tools
