@@ -1,0 +1,27 @@
+// One ADC frame as it crosses the sample seam: what the ADC driver produces on the board, what
+// the host simulation and the replay produce on the PC (DESIGN.md, data flow).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace gfins::hal {
+
+inline constexpr int kAdcChannels = 6;
+
+/// Bits of RawSample::flags.
+namespace sample_flags {
+inline constexpr std::uint32_t kCrcError = 1u << 0;   // frame CRC mismatch: counts not valid
+inline constexpr std::uint32_t kSaturated = 1u << 1;  // a channel at full scale
+inline constexpr std::uint32_t kLateRead = 1u << 2;   // read after the next data-ready edge
+inline constexpr std::uint32_t kSynthetic = 1u << 3;  // produced by a simulation, not hardware
+}  // namespace sample_flags
+
+struct RawSample {
+  std::uint32_t seq = 0;  // ADC sample counter (wraps at 2^32)
+  std::int64_t t_ns = 0;  // data-ready edge, CLOCK_MONOTONIC ns (scenario time in simulation)
+  std::array<std::int32_t, kAdcChannels> counts{};  // 24-bit two's complement, sign-extended
+  std::uint32_t flags = 0;                          // sample_flags bits
+};
+
+}  // namespace gfins::hal

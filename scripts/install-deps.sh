@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs every Debian package the project needs to build, test, benchmark and plot.
+# Idempotent and non-interactive; run as root on Debian 12. Skips apt entirely when all
+# packages are present already.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build git pkg-config
+  libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libgpiod-dev gpiod can-utils
+  libtomlplusplus-dev libcli11-dev libspdlog-dev
+  python3 python3-matplotlib python3-numpy
+  clang-format clang-tidy valgrind
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${#missing[@]} package(s): ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: must run as root to install packages (try: sudo $0)" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"
