@@ -50,10 +50,13 @@ class Strapdown {
 
   Strapdown() = default;
   Strapdown(const Solver& solver, const GravityModel<T>& gravity)
-      : solver_(solver), gravity_(gravity) {}
+      : solver_(solver), gravity_(gravity), wdot_free_of_w_(wdot_independent_of_rate(solver)) {}
 
   /// Replaces the array solver (for a new calibration) without touching the state.
-  void set_solver(const Solver& solver) { solver_ = solver; }
+  void set_solver(const Solver& solver) {
+    solver_ = solver;
+    wdot_free_of_w_ = wdot_independent_of_rate(solver);
+  }
   const Solver& solver() const { return solver_; }
   const GravityModel<T>& gravity() const { return gravity_; }
 
@@ -79,11 +82,22 @@ class Strapdown {
 
     const Vec6<T> u = solver_.linear_part(s_k);
     const Mat6<T>& k = solver_.k();
-    const Vec3<T> w_pred = w0 + h * wdot0;
-    const Vec3<T> wdot_pred =
-        u.template head<3>() - k.template topRows<3>() * centripetal_monomials(w_pred);
+    // When K's top rows are zero (a symmetric array such as Table 1, where ω̇ = S s/(2ρ) of
+    // eq. (4)/(6) has no centripetal term) the predictor is exact and ω̇ needs no product: same
+    // values as the general case, which would subtract exact zeros, for a third fewer operations.
+    Vec3<T> wdot_pred = u.template head<3>();
+    if (!wdot_free_of_w_) {
+      const Vec3<T> w_pred = w0 + h * wdot0;
+      wdot_pred -= k.template topRows<3>() * centripetal_monomials(w_pred);
+    }
     const Vec3<T> w1 = w0 + (h / T(2)) * (wdot0 + wdot_pred);
-    const Vec6<T> full = u - k * centripetal_monomials(w1);
+    const Vec6<T> m1 = centripetal_monomials(w1);
+    Vec6<T> full = u;
+    if (wdot_free_of_w_) {
+      full.template tail<3>() -= k.template bottomRows<3>() * m1;
+    } else {
+      full -= k * m1;
+    }
 
     const Vec3<T> phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * w0.cross(w1);
     Quat<T> q1 = state_.q_nb * quat_from_rotation_vector(phi);
@@ -109,8 +123,14 @@ class Strapdown {
   NavState<T>& mutable_state() { return state_; }
 
  private:
+  /// True when ω̇ does not depend on ω (the top three rows of K are exactly zero).
+  static bool wdot_independent_of_rate(const Solver& solver) {
+    return (solver.k().template topRows<3>().array() == T(0)).all();
+  }
+
   Solver solver_{};  // owned copy (a few hundred bytes), so the integrator can be copied
   GravityModel<T> gravity_{};
+  bool wdot_free_of_w_ = false;
   NavState<T> state_{};
   CompensatedVec3<T> v_{};
   CompensatedVec3<T> r_{};
