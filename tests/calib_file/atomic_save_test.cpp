@@ -118,6 +118,16 @@ TEST(AtomicSaveCommit, AReadOnlyDirectoryRefusesTheSaveAndKeepsTheOldFile) {
   EXPECT_TRUE(load_calibration_file(path).is_ok());
 }
 
+TEST(AtomicSaveCommit, ADirectoryNobodyMayCreateFilesInIsARealOsFailure) {
+  // sysfs refuses file creation even to root, so this runs whoever runs the tests.
+  if (!std::filesystem::is_directory("/sys/kernel")) GTEST_SKIP() << "no sysfs mounted";
+  const FileStatus s = save_calibration_file("/sys/gfins-cal.toml", table6_data());
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_EQ(s.code(), ErrorCode::kIoError);
+  EXPECT_THAT(s.message(), HasSubstr("creating the temporary file failed"));
+  EXPECT_FALSE(std::filesystem::exists("/sys/gfins-cal.toml"));
+}
+
 TEST(AtomicSaveCommit, ASavedFileIsWorldReadable) {
   const TempDir dir;
   const auto path = dir.path() / "cal.toml";
