@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <numbers>
+#include <random>
 #include <string>
 
 #include "calib_file/calib_test_data.hpp"
@@ -217,6 +218,86 @@ TEST(CalibrateCli, BaseFileKeepsLocationErrorsAndIdentity) {
   EXPECT_EQ(d.value().sensors[3].location_error_m, b.sensors[3].location_error_m);
   EXPECT_EQ(d.value().sensors[3].adc_lsb_v_per_count, b.sensors[3].adc_lsb_v_per_count);
   EXPECT_NE(d.value().sensors[3].scale_v_per_g, b.sensors[3].scale_v_per_g);
+}
+
+// A recording simulated with the solver's own model, P = SF (b + θ*·f) (paper eq. (16) with
+// T = 1), Table 6 as truth, the twelve poses of Tables 2/3 held 3 s each with 1 s linear turns
+// between them, at 100 Hz with Gaussian noise.
+constexpr double kRecordingRateHz = 100.0;
+constexpr double kRecordingNoiseV = 1e-4;
+// Each pose keeps ≥ 2.4 s of settled samples (≥ 240) after the detector's trimming, so a mean is
+// known to 1e-4/√240 ≈ 6.5e-6 V. Through the smallest SF (0.33 V/g) that is 2e-5 g, and an angle
+// error of 2e-5 rad ≈ 1.1e-3°. The tolerances are about 8 of those σ (the noise is seeded, so
+// the outcome is deterministic; 8σ keeps it independent of the seed).
+constexpr double kRecScaleTolVPerG = 1e-4;
+constexpr double kRecBiasTolG = 2e-4;
+constexpr double kRecAngleTolDeg = 1e-2;
+
+TEST(CalibrateCli, ARawRecordingIsCutIntoStaticPosesAndCalibrated) {
+  // Given a recording of the twelve poses with Table 6 as the truth
+  const TempDir dir;
+  const CalibrationData truth = testing::table6_data();
+  const nav::Misalignment<double> m = misalignment<double>(truth);
+  const auto axes = nav::misaligned_geometry(nav::table1_geometry<double>(1.0), m).theta_b;
+  const double k = 1.0 / std::numbers::sqrt2;
+  const double poses[12][3] = {{-k, 0, k}, {k, 0, -k},  {k, 0, k},  {-k, 0, -k},
+                               {0, k, k},  {0, -k, -k}, {0, -k, k}, {0, k, -k},
+                               {k, k, 0},  {-k, -k, 0}, {-k, k, 0}, {k, -k, 0}};
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, kRecordingNoiseV);
+  std::string csv = "t_s,v1,v2,v3,v4,v5,v6\n";
+  int n = 0;
+  const auto emit = [&](const nav::Vec3<double>& f) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", n++ / kRecordingRateHz);
+    csv += buf;
+    for (std::size_t j = 0; j < 6; ++j) {
+      const auto& s = truth.sensors[j];
+      const double v = s.scale_v_per_g * (s.bias_g + axes[j].dot(f)) + noise(rng);
+      std::snprintf(buf, sizeof buf, ",%.9f", v);
+      csv += buf;
+    }
+    csv += "\n";
+  };
+  for (int p = 0; p < 12; ++p) {
+    const nav::Vec3<double> f(poses[p][0], poses[p][1], poses[p][2]);
+    for (int i = 0; i < 300; ++i) emit(f);
+    if (p == 11) break;
+    const nav::Vec3<double> next(poses[p + 1][0], poses[p + 1][1], poses[p + 1][2]);
+    for (int i = 1; i < 100; ++i) emit(f + (next - f) * (i / 100.0));
+  }
+  const auto rec = dir.path() / "rec.csv";
+  write_text(rec, csv);
+  // When calibrated from the recording
+  const auto out = dir.path() / "rec.toml";
+  const RunResult r = run_cli(dir, "--recording " + rec.string() +
+                                       " --rate 100 --nominal-sf 0.5 0.33 0.5 2.5 0.34 2.5 "
+                                       "--device-id rec --adc-lsb 1e-7 -o " +
+                                       out.string());
+  // Then twelve intervals are found, matched to the twelve poses, and Table 6 comes back
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("12 static intervals"));
+  EXPECT_THAT(r.output, HasSubstr("interval 12: "));
+  EXPECT_THAT(r.output, HasSubstr("pose T3.6"));
+  const auto d = load_calibration_file(out);
+  ASSERT_TRUE(d.is_ok()) << d.status().message();
+  for (std::size_t j = 0; j < 6; ++j) {
+    EXPECT_NEAR(d.value().sensors[j].scale_v_per_g, truth.sensors[j].scale_v_per_g,
+                kRecScaleTolVPerG)
+        << j;
+    EXPECT_NEAR(d.value().sensors[j].bias_g, truth.sensors[j].bias_g, kRecBiasTolG) << j;
+    EXPECT_NEAR(d.value().beta.angle_deg[j], truth.beta.angle_deg[j], kRecAngleTolDeg) << j;
+    EXPECT_NEAR(d.value().alpha.angle_deg[j], truth.alpha.angle_deg[j], kRecAngleTolDeg) << j;
+  }
+}
+
+TEST(CalibrateCli, ARecordingWithoutARateIsRefused) {
+  const TempDir dir;
+  write_text(dir.path() / "r.csv", "v1,v2,v3,v4,v5,v6\n0,0,0,0,0,0\n");
+  const RunResult r = run_cli(dir, "--recording " + (dir.path() / "r.csv").string() +
+                                       " --nominal-sf 1 --device-id b --adc-lsb 1e-7 --dry-run");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--rate (Hz) is required with --recording"));
 }
 
 }  // namespace

@@ -135,6 +135,89 @@ std::string fmt(const char* format, double x) {
 
 }  // namespace
 
+FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
+                                                     const std::optional<std::vector<Pose>>& poses,
+                                                     const RecordingOptions& options,
+                                                     const std::string& recording_file) {
+  calib::StaticDetectorConfig<double> cfg;
+  cfg.sample_rate_hz = options.rate_hz;
+  cfg.window_s = options.window_s;
+  cfg.min_still_s = options.min_still_s;
+  cfg.max_std_v.fill(options.still_std_v);
+  auto created = calib::StaticDetector<double>::create(cfg);
+  if (!created.is_ok()) return bad(recording_file + ": " + created.status().message());
+  calib::StaticDetector<double>& detector = created.value();
+  for (const auto& sample : rec.samples_v) (void)detector.push(sample);
+  (void)detector.finish();
+
+  CalibrationRun run;
+  const auto intervals = detector.intervals();
+  run.notes.push_back(recording_file + ": " + std::to_string(rec.samples_v.size()) +
+                      " samples at " + fmt("%g", options.rate_hz) + " Hz, " +
+                      std::to_string(intervals.size()) + " static intervals, " +
+                      std::to_string(detector.rejected().size()) + " poses rejected");
+  for (const auto& r : detector.rejected()) {
+    run.notes.push_back("rejected pose at " +
+                        fmt("%.2f", static_cast<double>(r.start_index) / options.rate_hz) +
+                        " s: " + calib::to_string(r.reason));
+  }
+  if (detector.dropped() > 0) {
+    return bad(recording_file + ": more static intervals than the detector holds (" +
+               std::to_string(calib::kMaxAttitudes) + ")");
+  }
+
+  std::vector<std::array<double, 3>> expected;
+  std::vector<std::string> labels;
+  if (poses) {
+    for (const Pose& p : *poses) {
+      expected.push_back(p.f_b_g);
+      labels.push_back("P" + std::to_string(p.attitude));
+    }
+  } else {
+    const auto t2 = calib::table2_attitudes<double>();
+    const auto t3 = calib::table3_attitudes<double>();
+    for (std::size_t j = 0; j < 6; ++j) {
+      expected.push_back(t2[j]);
+      labels.push_back("T2." + std::to_string(j + 1));
+    }
+    for (std::size_t j = 0; j < 6; ++j) {
+      expected.push_back(t3[j]);
+      labels.push_back("T3." + std::to_string(j + 1));
+    }
+  }
+  calib::PoseAssignmentConfig<double> assign;
+  assign.nominal_scale_v_per_g = options.nominal_scale_v_per_g;
+  std::vector<calib::AttitudeObservation<double>> obs(intervals.size());
+  std::vector<int> attitude_of(intervals.size(), -1);
+  const auto n = calib::intervals_to_observations<double>(
+      intervals, std::span<const std::array<double, 3>>(expected.data(), expected.size()), assign,
+      std::span<calib::AttitudeObservation<double>>(obs.data(), obs.size()),
+      std::span<int>(attitude_of.data(), attitude_of.size()));
+  if (!n.is_ok()) return bad(recording_file + ": " + n.status().message());
+  obs.resize(n.value());
+  for (std::size_t k = 0; k < intervals.size(); ++k) {
+    const auto& it = intervals[k];
+    const int a = attitude_of[k];
+    run.notes.push_back("interval " + std::to_string(k + 1) + ": " +
+                        fmt("%.2f", static_cast<double>(it.start_index) / options.rate_hz) + "-" +
+                        fmt("%.2f", static_cast<double>(it.end_index) / options.rate_hz) + " s, " +
+                        (a >= 0 ? "pose " + labels[static_cast<std::size_t>(a)]
+                                : std::string("no expected pose within 20 degrees: skipped")));
+    if (a >= 0) {
+      run.pose_labels.push_back(labels[static_cast<std::size_t>(a)]);
+      run.pose_f_b_g.push_back(expected[static_cast<std::size_t>(a)]);
+      run.pose_used_mask.push_back(calib::kAllSensors);
+    }
+  }
+  auto r = calib::calibrate_multi_attitude<double>(
+      std::span<const calib::AttitudeObservation<double>>(obs.data(), obs.size()));
+  if (!r.is_ok()) return solver_failure(r.status());
+  run.result = r.value();
+  run.method_text = "general solver over " + std::to_string(obs.size()) +
+                    " static intervals of a recording (weighted by their sample noise)";
+  return run;
+}
+
 FileResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
                                            const std::string& means_file) {
   return in.poses ? run_with_poses(in, means_file) : run_paper_layout(in, means_file);
@@ -197,6 +280,7 @@ std::vector<std::string> verdict_warnings(const calib::MultiAttitudeResult<doubl
 
 void print_report(std::ostream& out, const CalibrationRun& run) {
   const auto& r = run.result;
+  for (const std::string& n : run.notes) out << n << "\n";
   out << "method: " << run.method_text << "\n"
       << "poses: " << r.num_attitudes
       << ", largest condition number of a sensor's design: " << fmt("%.3g", r.max_condition_number)

@@ -11,6 +11,7 @@
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 #include "gfins/nav_core/calibration/multi_attitude.hpp"
+#include "gfins/nav_core/calibration/static_detector.hpp"
 
 namespace gfins::tools {
 
@@ -31,6 +32,7 @@ struct CalibrationRun {
   std::vector<std::string> pose_labels;           // "T2.1" (Table 2 pose 1), "P7" (poses file)
   std::vector<std::uint8_t> pose_used_mask;       // bit j: sensor j+1 recorded in that pose
   std::string method_text;
+  std::vector<std::string> notes;  // printed before the parameters (e.g. static intervals found)
 };
 
 /// Builds the observations and runs the solver. Fails (kInvalidArgument) naming the file line or
@@ -38,6 +40,21 @@ struct CalibrationRun {
 /// solver's Status otherwise.
 FileResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
                                            const std::string& means_file);
+
+/// A raw recording: the static detector (gfins::calib::StaticDetector) finds the poses, each
+/// pose is matched to the nearest expected attitude (the poses file, or the twelve of Tables 2
+/// and 3) using nominal scale factors, and the general solver runs on the interval means.
+struct RecordingOptions {
+  double rate_hz = 0.0;
+  double still_std_v = 2e-3;  // largest std of a still channel, V (2-3× the noise)
+  double window_s = 0.1;
+  double min_still_s = 2.0;
+  std::array<double, 6> nominal_scale_v_per_g{};  // to tell the poses apart (sign matters)
+};
+FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
+                                                     const std::optional<std::vector<Pose>>& poses,
+                                                     const RecordingOptions& options,
+                                                     const std::string& recording_file);
 
 /// What the calibration does not determine, taken from options or a previous file.
 struct FileSettings {

@@ -5,10 +5,12 @@
 // 3 the verdict is not good and --force was not given (nothing written), 4 the file could not
 // be written.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "calibrate.hpp"
 #include "csv.hpp"
@@ -32,6 +34,10 @@ int fail(int code, const std::string& message) {
 
 struct Options {
   std::string means;
+  std::string recording;
+  double rate_hz = 0.0;
+  double still_std_v = 2e-3;
+  std::vector<double> nominal_sf;
   std::string poses;
   std::string method = "auto";
   std::string output;
@@ -76,26 +82,50 @@ int settings_from(const Options& o, FileSettings& s) {
   return kExitOk;
 }
 
-int run(const Options& o) {
-  CalibrationInputs in;
-  const auto means = read_means(o.means);
-  if (!means.is_ok()) return fail(kExitInput, means.status().message());
-  in.means = means.value();
+// Runs the solver on the chosen input; kExitOk or the exit status of the failure.
+int calibrate(const Options& o, CalibrationInputs& in, FileResult<CalibrationRun>& out) {
   if (!o.poses.empty()) {
     const auto poses = read_poses(o.poses);
     if (!poses.is_ok()) return fail(kExitInput, poses.status().message());
     in.poses = poses.value();
   }
+  if (!o.recording.empty()) {
+    RecordingOptions ro;
+    ro.rate_hz = o.rate_hz;
+    ro.still_std_v = o.still_std_v;
+    if (o.rate_hz <= 0.0) return fail(kExitInput, "--rate (Hz) is required with --recording");
+    if (o.nominal_sf.size() == 1)
+      ro.nominal_scale_v_per_g.fill(o.nominal_sf[0]);
+    else if (o.nominal_sf.size() == 6)
+      std::copy_n(o.nominal_sf.begin(), 6, ro.nominal_scale_v_per_g.begin());
+    else
+      return fail(kExitInput, "--nominal-sf takes 1 or 6 values (V/g) with --recording");
+    const auto rec = read_recording(o.recording);
+    if (!rec.is_ok()) return fail(kExitInput, rec.status().message());
+    in.method = Method::kGeneral;
+    out = run_recording_calibration(rec.value(), in.poses, ro, o.recording);
+    return kExitOk;
+  }
+  const auto means = read_means(o.means);
+  if (!means.is_ok()) return fail(kExitInput, means.status().message());
+  in.means = means.value();
   in.method = o.method == "paper"                 ? Method::kPaper
               : o.method == "general" || in.poses ? Method::kGeneral
                                                   : Method::kPaper;
+  out = run_calibration(in, o.means);
+  return kExitOk;
+}
+
+int run(const Options& o) {
   FileSettings settings;
   if (const int rc = settings_from(o, settings); rc != kExitOk) return rc;
+  CalibrationInputs in;
+  FileResult<CalibrationRun> calibrated(FileStatus(ErrorCode::kUnimplemented, "not run"));
+  if (const int rc = calibrate(o, in, calibrated); rc != kExitOk) return rc;
+  const std::string input = o.recording.empty() ? o.means : o.recording;
   settings.source = "gfins-calibrate " +
                     std::string(in.method == Method::kPaper ? "paper" : "general") + " from " +
-                    std::filesystem::path(o.means).filename().string();
-
-  const auto calibrated = run_calibration(in, o.means);
+                    std::filesystem::path(input).filename().string();
   if (!calibrated.is_ok()) {
     const auto& st = calibrated.status();
     return fail(st.code() == ErrorCode::kInvalidArgument &&
@@ -138,11 +168,26 @@ int main(int argc, char** argv) {
       "errors, prints a report and writes the calibration file (docs/calibration-file.md).",
       "gfins-calibrate"};
   Options o;
-  app.add_option("--means", o.means,
-                 "CSV of mean outputs: sensor,attitude,mean_v[,std_v,count] (paper Tables 4/5; "
-                 "attitudes as in Tables 2/3 unless --poses)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  auto* means = app.add_option("--means", o.means,
+                               "CSV of mean outputs: sensor,attitude,mean_v[,std_v,count] (paper "
+                               "Tables 4/5; attitudes as in Tables 2/3 unless --poses)")
+                    ->check(CLI::ExistingFile);
+  auto* recording =
+      app.add_option("--recording", o.recording,
+                     "CSV of raw samples with columns v1..v6 (V); static poses found by the "
+                     "static detector, matched to --poses or to the 12 poses of Tables 2/3")
+          ->check(CLI::ExistingFile)
+          ->excludes(means);
+  means->excludes(recording);
+  app.add_option("--rate", o.rate_hz, "sample rate of --recording (Hz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--still-std-v", o.still_std_v,
+                 "largest standard deviation of a still channel (V), 2-3x the noise "
+                 "(--recording; default 2e-3)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--nominal-sf", o.nominal_sf,
+                 "nominal scale factor(s) in V/g, 1 or 6 values, to recognise the poses of a "
+                 "--recording");
   app.add_option("--poses", o.poses,
                  "CSV attitude,fx_g,fy_g,fz_g: specific force sensed in each pose (g, body)")
       ->check(CLI::ExistingFile);
@@ -168,6 +213,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitInput;
+  }
+  if (o.means.empty() == o.recording.empty()) {
+    return fail(kExitInput, "give one input: --means FILE or --recording FILE");
   }
   if (o.output.empty() && !o.dry_run) {
     return fail(kExitInput, "--output is required (or --dry-run)");
