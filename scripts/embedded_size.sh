@@ -39,6 +39,34 @@ echo "== Largest symbols of the program (bytes, type, name) =="
 "${prefix}nm" -C --size-sort -S --radix=d "${elf}" | tail -n 15 | cut -c 10-160
 echo
 
+echo "== Code bytes by origin (text symbols) =="
+"${prefix}nm" -C -S --radix=d "${elf}" | python3 -c '
+import re, sys
+cats = {}
+soft = re.compile(r"^(__aeabi_(c?d|cdr|[a-z0-9]+2d|d2)|__[a-z]+df[23]$|__extendsfdf2|__truncdfsf2)")
+for line in sys.stdin:
+    parts = line.split(None, 3)
+    if len(parts) < 4 or parts[2] not in "TtWw":
+        continue
+    size, name = int(parts[1]), parts[3].strip()
+    if "gfins" in name or name == "main":
+        cat = "gfins (navigation core + probe main)"
+    elif "Eigen::" in name and "double" in name:
+        cat = "Eigen in double (set-up: SVD and solver construction)"
+    elif "Eigen::" in name:
+        cat = "Eigen in float (kernels -Os did not inline)"
+    elif soft.match(name):
+        cat = "soft-float double (libgcc; set-up only)"
+    elif re.match(r"^(__ieee754_|__kernel_)?[a-z0-9_]+f$|^__kernel_rem_pio2f$|^__ieee754_rem_pio2f$", name):
+        cat = "libm single precision (sqrtf, sinf, cosf, atan2f)"
+    else:
+        cat = "C runtime, libm double, other"
+    cats[cat] = cats.get(cat, 0) + size
+for cat, size in sorted(cats.items(), key=lambda kv: -kv[1]):
+    print("  %7d  %s" % (size, cat))
+'
+echo
+
 # Call graph from the disassembly: direct calls (bl) and tail calls (b.w / b to the start of
 # another function). Indirect calls (blx rN) cannot be followed and are reported.
 read -r -d '' callgraph_py <<'PY' || true
