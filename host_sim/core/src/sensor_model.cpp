@@ -1,0 +1,108 @@
+#include "gfins/host_sim/sensor_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numbers>
+
+namespace gfins::sim {
+namespace {
+
+// Distinct, fixed stream ids so that the noise and the walk of each sensor come from separate
+// engines (splitmix64 constants: any odd 64-bit mixers would do).
+constexpr std::uint64_t kNoiseStream = 0x9E3779B97F4A7C15ull;
+constexpr std::uint64_t kWalkStream = 0xBF58476D1CE4E5B9ull;
+
+std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream, std::size_t sensor) {
+  // splitmix64 finaliser: neighbouring seeds give unrelated engine states.
+  std::uint64_t z = seed + stream * (static_cast<std::uint64_t>(sensor) + 1u);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+constexpr double kDefaultRateHz = 1000.0;
+
+}  // namespace
+
+AccelErrors AccelErrors::qa1100_typical() {
+  AccelErrors e;
+  e.scale_v_per_g = 1.33;          // 1.33 mA/g (datasheet 1.20-1.46 mA/g) × 1 kΩ load
+  e.bias_g = 0.0;                  // datasheet < 4 mg: calibrated per unit, so 0 by default
+  e.k2_g_per_g2 = 20e-6;           // datasheet < 20 µg/g²
+  e.noise_g = 70e-6;               // datasheet 70 µg rms in 10-500 Hz
+  e.bias_rw_g_per_sqrt_s = 10e-6;  // assumption (no datasheet figure), see docs
+  e.bias_tc_g_per_c = 30e-6;       // datasheet < 30 µg/°C
+  e.scale_tc_ppm_per_c = 180.0;    // datasheet < 180 ppm/°C
+  e.saturation_g = 60.0;           // datasheet ±60 g input range
+  return e;
+}
+
+SensorArrayModel::SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal,
+                                   const ArrayErrors& errors,
+                                   const nav::GravityModel<double>& gravity, double sample_rate_hz,
+                                   std::uint64_t seed)
+    : errors_(errors),
+      nominal_(nominal, gravity),
+      real_(nav::misaligned_geometry(nominal, errors.misalignment), gravity),
+      sample_rate_hz_(sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz) ? sample_rate_hz
+                                                                            : kDefaultRateHz),
+      sqrt_dt_s_(std::sqrt(1.0 / sample_rate_hz_)) {
+  for (std::size_t j = 0; j < 6; ++j) {
+    noise_rng_[j].seed(mix_seed(seed, kNoiseStream, j));
+    walk_rng_[j].seed(mix_seed(seed, kWalkStream, j));
+  }
+}
+
+SensorArrayModel::Volts SensorArrayModel::ideal_specific_force(const TruthState& x) const {
+  return nominal_.outputs(x);
+}
+
+SensorArrayModel::Volts SensorArrayModel::sensed_specific_force(const TruthState& x) const {
+  return real_.outputs(x);
+}
+
+SensorArrayModel::Volts SensorArrayModel::volts(const TruthState& x) {
+  const Volts s_mps2 = real_.outputs(x);
+  const double dtemp_c = errors_.temperature_c - errors_.reference_temperature_c;
+  Volts p;
+  for (std::size_t j = 0; j < 6; ++j) {
+    const AccelErrors& e = errors_.sensors[j];
+    // Both draws happen every sample, whatever the σ, so the streams stay aligned in time.
+    const double n_g = e.noise_g * noise_normal_[j](noise_rng_[j]);
+    walk_g_[j] += e.bias_rw_g_per_sqrt_s * sqrt_dt_s_ * walk_normal_[j](walk_rng_[j]);
+    const double a_g = s_mps2(static_cast<Eigen::Index>(j)) / nav::kStandardGravity;
+    const double a_in_g = std::clamp(a_g, -e.saturation_g, e.saturation_g);
+    const double bias_g = e.bias_g + e.bias_tc_g_per_c * dtemp_c + walk_g_[j];
+    const double sf_v_per_g = e.scale_v_per_g * (1.0 + e.scale_tc_ppm_per_c * 1e-6 * dtemp_c);
+    // paper eq. (21), P = SF (f·θ + b), plus the second-order term and the noise.
+    p(static_cast<Eigen::Index>(j)) =
+        sf_v_per_g * (a_in_g + e.k2_g_per_g2 * a_in_g * a_in_g + bias_g + n_g);
+  }
+  return p;
+}
+
+ArrayErrors SensorArrayModel::paper_table6() {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  ArrayErrors e;
+  // Table 6, sensors in Table 1 order (1..6); the table lists them as sets {2,3,5} and {1,4,6}.
+  const std::array<double, 6> sf = {0.509874, 0.332572, 0.500242, 2.493301, 0.339215, 2.476663};
+  const std::array<double, 6> bias = {-0.000731, -0.000242, 0.000867,
+                                      -0.007977, -0.000891, -0.004691};
+  for (std::size_t j = 0; j < 6; ++j) {
+    e.sensors[j].scale_v_per_g = sf[j];
+    e.sensors[j].bias_g = bias[j];
+  }
+  // Angle order xy, xz, yx, yz, zx, zy (nav::AngleIndex), degrees as printed in Table 6.
+  const std::array<double, 6> beta_deg = {1.117319,  -0.175730, -0.581196,
+                                          -0.738742, 2.454457,  2.482135};
+  const std::array<double, 6> alpha_deg = {-2.654967, 2.596778, -0.838703,
+                                           -0.737387, 0.119537, -1.451107};
+  for (std::size_t i = 0; i < 6; ++i) {
+    e.misalignment.orientation.beta[i] = beta_deg[i] * kDeg;
+    e.misalignment.orientation.alpha[i] = alpha_deg[i] * kDeg;
+  }
+  return e;
+}
+
+}  // namespace gfins::sim
