@@ -1,0 +1,143 @@
+// Google Benchmark: replay throughput of the navigation core from a raw-sample recording
+// (host_sim/replay.hpp), in samples/s and in multiples of real time at 1 kHz. Goal (issue
+// "Host simulation", Replay): ≥ 1000× real time on one core. Nothing here asserts a time.
+//
+// The recording is made once, before timing: 10 s at 1 kHz of the manoeuvre trajectory
+// (make_maneuver, preceded by 0.5 s at rest for alignment) through SensorArrayModel with Table 6
+// errors and QA-1100 class noise and AdcModel, encoded to the file format in memory. Timed:
+//   BM_Replay<T>           decoded samples → Replayer → NavPipeline<T> (exact compensator),
+//                          including the per-sample FNV-1a hash of the output;
+//   BM_DecodeAndReplay<T>  the same, starting from the file bytes (CRC checks and decoding);
+//   BM_Decode              file bytes → samples only.
+//
+//   build/<dir>/tests/bench/gfins_replay_bench --benchmark_repetitions=5
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "gfins/host_sim/adc_model.hpp"
+#include "gfins/host_sim/recording.hpp"
+#include "gfins/host_sim/replay.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/host_sim/trajectory.hpp"
+#include "gfins/nav_core/pipeline.hpp"
+
+namespace gfins::sim {
+namespace {
+
+constexpr double kRateHz = 1000.0;
+constexpr double kRhoM = 0.1;
+constexpr double kRestS = 0.5;
+constexpr std::uint32_t kSamples = 10000;  // 10 s of data per iteration
+constexpr std::uint32_t kAlignSamples = 400;
+
+struct Data {
+  ArrayErrors errors = SensorArrayModel::paper_table6();
+  AdcModel adc{AdcConfig{}};
+  std::vector<hal::RawSample> samples;
+  std::vector<std::uint8_t> file;
+
+  Data() {
+    for (auto& e : errors.sensors) e.noise_g = 70e-6;  // QA-1100 class, docs/sensor-model.md
+    const auto gravity = nav::GravityModel<double>::constant(nav::kStandardGravity);
+    SensorArrayModel sensors(nav::table1_geometry(kRhoM), errors, gravity, kRateHz, 7);
+    const auto rest = make_rest(Quatd::Identity());
+    const auto moving = make_maneuver(0.3);
+    for (std::uint32_t i = 0; i < kSamples; ++i) {
+      const double t_s = i / kRateHz;
+      const TruthState x = t_s < kRestS ? rest->at(t_s) : moving->at(t_s - kRestS);
+      samples.push_back(adc.sample(sensors.volts(x), i));
+    }
+    RecordingHeader h;
+    h.sample_rate_hz = kRateHz;
+    h.volts_per_count.fill(adc.volts_per_count());
+    h.geometry = nav::table1_geometry(kRhoM);
+    file = encode_recording(h, samples).value();
+  }
+
+  template <typename T>
+  nav::PipelineConfig<T> config() const {
+    nav::PipelineConfig<T> c;
+    c.nominal = nav::table1_geometry(static_cast<T>(kRhoM));
+    c.sample_rate_hz = kRateHz;
+    c.alignment_samples = kAlignSamples;
+    c.compensator = nav::CompensatorKind::kExact;
+    for (std::size_t i = 0; i < 6; ++i) {
+      c.misalignment.orientation.beta[i] = static_cast<T>(errors.misalignment.orientation.beta[i]);
+      c.misalignment.orientation.alpha[i] =
+          static_cast<T>(errors.misalignment.orientation.alpha[i]);
+      c.front_end.volts_per_count[i] = static_cast<T>(adc.volts_per_count());
+      c.front_end.scale_v_per_g[i] = static_cast<T>(errors.sensors[i].scale_v_per_g);
+      c.front_end.bias_g[i] = static_cast<T>(errors.sensors[i].bias_g);
+    }
+    return c;
+  }
+};
+
+const Data& data() {
+  static const Data d;
+  return d;
+}
+
+void set_rates(benchmark::State& state, std::uint64_t navigating) {
+  const auto n = static_cast<double>(state.iterations()) * kSamples;
+  state.SetItemsProcessed(static_cast<std::int64_t>(n));
+  state.counters["x_realtime"] = benchmark::Counter(n / kRateHz, benchmark::Counter::kIsRate);
+  state.counters["navigating"] = static_cast<double>(navigating);
+}
+
+template <typename T>
+void BM_Replay(benchmark::State& state) {
+  const Data& d = data();
+  const auto cfg = d.config<T>();
+  std::uint64_t navigating = 0;
+  for (auto _ : state) {
+    nav::NavPipeline<T> p;
+    if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
+    const ReplayReport r = replay(p, std::span<const hal::RawSample>(d.samples));
+    navigating = r.navigating;
+    benchmark::DoNotOptimize(r.output_hash);
+  }
+  set_rates(state, navigating);
+}
+
+template <typename T>
+void BM_DecodeAndReplay(benchmark::State& state) {
+  const Data& d = data();
+  const auto cfg = d.config<T>();
+  std::uint64_t navigating = 0;
+  for (auto _ : state) {
+    const auto rec = decode_recording(d.file);
+    if (!rec.is_ok()) state.SkipWithError("decode failed");
+    nav::NavPipeline<T> p;
+    if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
+    const ReplayReport r = replay(p, std::span<const hal::RawSample>(rec.value().samples));
+    navigating = r.navigating;
+    benchmark::DoNotOptimize(r.output_hash);
+  }
+  set_rates(state, navigating);
+}
+
+void BM_Decode(benchmark::State& state) {
+  const Data& d = data();
+  for (auto _ : state) {
+    const auto rec = decode_recording(d.file);
+    benchmark::DoNotOptimize(rec.value().samples.data());
+  }
+  set_rates(state, 0);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * d.file.size()));
+}
+
+BENCHMARK(BM_Replay<float>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Replay<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeAndReplay<float>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeAndReplay<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace gfins::sim
+
+BENCHMARK_MAIN();
