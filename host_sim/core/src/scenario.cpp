@@ -1,0 +1,437 @@
+// Scenario files (TOML, tomlplusplus) → gfins::sim::Scenario, and the trajectories they name.
+// Every error message has the form "FILE:LINE: key 'table.key': what is wrong".
+#include "gfins/host_sim/scenario.hpp"
+
+#include <toml++/toml.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "gfins/nav_core/math.hpp"
+
+namespace gfins::sim {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+/// Thrown inside the parser only; parse_scenario turns it into ParsedScenario::error.
+struct ScenarioParseError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const toml::node* node, const std::string& key,
+                         const std::string& what) const {
+    std::ostringstream os;
+    os << source_;
+    if (node != nullptr && node->source().begin.line > 0) os << ":" << node->source().begin.line;
+    os << ": key '" << key << "': " << what;
+    throw ScenarioParseError(os.str());
+  }
+
+  /// The sub-table `name` of the root; null when absent and not required.
+  const toml::table* table(const toml::table& root, const std::string& name, bool required) const {
+    const toml::node* n = root.get(name);
+    if (n == nullptr) {
+      if (required) fail(&root, name, "missing table [" + name + "]");
+      return nullptr;
+    }
+    if (!n->is_table()) fail(n, name, "expected a table, got " + type_name(*n));
+    return n->as_table();
+  }
+
+  /// Rejects keys not in `allowed` (typos would otherwise be silently ignored).
+  void only(const toml::table& t, const std::string& prefix,
+            std::initializer_list<const char*> allowed) const {
+    for (const auto& [k, v] : t) {
+      const std::string key(k.str());
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        fail(&v, prefix + key, "unknown key (allowed: " + list + ")");
+      }
+    }
+  }
+
+  double number(const toml::table& t, const std::string& prefix, const char* key,
+                std::optional<double> fallback, double lo, double hi) const {
+    const std::string full = prefix + key;
+    const toml::node* n = t.get(key);
+    if (n == nullptr) {
+      if (!fallback) fail(&t, full, "missing (required number)");
+      return *fallback;
+    }
+    double v = 0;
+    if (const auto* f = n->as_floating_point()) {
+      v = f->get();
+    } else if (const auto* i = n->as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(n, full, "expected a number, got " + type_name(*n));
+    }
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      std::ostringstream os;
+      os << "value " << v << " out of range [" << lo << ", " << hi << "]";
+      fail(n, full, os.str());
+    }
+    return v;
+  }
+
+  std::uint64_t integer(const toml::table& t, const std::string& prefix, const char* key,
+                        std::uint64_t fallback) const {
+    const toml::node* n = t.get(key);
+    if (n == nullptr) return fallback;
+    const auto* i = n->as_integer();
+    if (i == nullptr) fail(n, prefix + key, "expected an integer, got " + type_name(*n));
+    if (i->get() < 0) fail(n, prefix + key, "value out of range: must be ≥ 0");
+    return static_cast<std::uint64_t>(i->get());
+  }
+
+  std::string string(const toml::table& t, const std::string& prefix, const char* key,
+                     std::optional<std::string> fallback,
+                     std::initializer_list<const char*> choices = {}) const {
+    const std::string full = prefix + key;
+    const toml::node* n = t.get(key);
+    if (n == nullptr) {
+      if (!fallback) fail(&t, full, "missing (required string)");
+      return *fallback;
+    }
+    const auto* s = n->as_string();
+    if (s == nullptr) fail(n, full, "expected a string, got " + type_name(*n));
+    const std::string v = s->get();
+    if (choices.size() > 0 &&
+        std::none_of(choices.begin(), choices.end(), [&](const char* c) { return v == c; })) {
+      std::string list;
+      for (const char* c : choices) list += std::string(list.empty() ? "" : ", ") + c;
+      fail(n, full, "unknown value '" + v + "' (expected one of: " + list + ")");
+    }
+    return v;
+  }
+
+  /// An array of exactly `size` numbers, each within [lo, hi].
+  std::vector<double> numbers(const toml::table& t, const std::string& prefix, const char* key,
+                              std::size_t size, double lo, double hi, bool required) const {
+    const std::string full = prefix + key;
+    const toml::node* n = t.get(key);
+    if (n == nullptr) {
+      if (required) fail(&t, full, "missing (required array)");
+      return {};
+    }
+    const auto* a = n->as_array();
+    if (a == nullptr) fail(n, full, "expected an array of numbers, got " + type_name(*n));
+    if (a->size() != size) {
+      fail(n, full,
+           "expected " + std::to_string(size) + " numbers, got " + std::to_string(a->size()));
+    }
+    std::vector<double> out;
+    for (const auto& e : *a) {
+      double v = 0;
+      if (const auto* f = e.as_floating_point()) {
+        v = f->get();
+      } else if (const auto* i = e.as_integer()) {
+        v = static_cast<double>(i->get());
+      } else {
+        fail(&e, full, "expected an array of numbers, found a " + type_name(e));
+      }
+      if (!std::isfinite(v) || v < lo || v > hi) {
+        std::ostringstream os;
+        os << "element " << out.size() << " = " << v << " out of range [" << lo << ", " << hi
+           << "]";
+        fail(&e, full, os.str());
+      }
+      out.push_back(v);
+    }
+    return out;
+  }
+
+  static std::string type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::table:
+        return "a table";
+      case toml::node_type::array:
+        return "an array";
+      case toml::node_type::string:
+        return "a string";
+      case toml::node_type::integer:
+        return "an integer";
+      case toml::node_type::floating_point:
+        return "a floating-point number";
+      case toml::node_type::boolean:
+        return "a boolean";
+      default:
+        return "a date/time";
+    }
+  }
+
+ private:
+  std::string source_;
+};
+
+Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
+
+constexpr double kBig = 1e9;
+
+Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
+  Scenario s;
+  s.source = source;
+  s.name = std::filesystem::path(source).stem().string();
+  rd.only(root, "", {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration"});
+
+  // [scenario]
+  const toml::table& sc = *rd.table(root, "scenario", true);
+  rd.only(sc, "scenario.", {"name", "description", "duration_s", "rate_hz", "rho_m", "seed"});
+  s.name = rd.string(sc, "scenario.", "name", s.name);
+  s.description = rd.string(sc, "scenario.", "description", std::string());
+  s.duration_s = rd.number(sc, "scenario.", "duration_s", std::nullopt, 1e-3, 1e6);
+  s.rate_hz = rd.number(sc, "scenario.", "rate_hz", std::nullopt, 1.0, 1e5);
+  s.rho_m = rd.number(sc, "scenario.", "rho_m", 0.1, 1e-3, 10.0);
+  s.seed = rd.integer(sc, "scenario.", "seed", 1);
+
+  // [gravity]
+  if (const toml::table* g = rd.table(root, "gravity", false)) {
+    rd.only(*g, "gravity.", {"model", "magnitude_mps2", "latitude_deg", "height_m"});
+    const std::string model =
+        rd.string(*g, "gravity.", "model", std::string("down"), {"down", "up", "normal"});
+    s.gravity = model == "up"     ? GravityChoice::kUp
+                : model == "down" ? GravityChoice::kDown
+                                  : GravityChoice::kNormal;
+    s.gravity_mps2 = rd.number(*g, "gravity.", "magnitude_mps2", nav::kStandardGravity, 0.0, 30.0);
+    s.latitude_rad = rd.number(*g, "gravity.", "latitude_deg", 0.0, -90.0, 90.0) * kDegToRad;
+    s.height_m = rd.number(*g, "gravity.", "height_m", 0.0, -1e4, 1e5);
+  }
+
+  // [trajectory]
+  const toml::table& tr = *rd.table(root, "trajectory", true);
+  const std::string p = "trajectory.";
+  rd.only(
+      tr, p,
+      {"kind", "euler_deg", "accel_mps2", "axis_b", "rate_dps", "half_angle_deg", "cone_rate_hz",
+       "scale", "speed_mps", "turn_amplitude_m", "turn_period_s", "poses", "dwell_s"});
+  TrajectorySpec& t = s.trajectory;
+  t.kind = rd.string(tr, p, "kind", std::nullopt,
+                     {"rest", "constant_acceleration", "spin", "rate_table", "coning", "maneuver",
+                      "drive", "calibration_poses"});
+  if (const auto e = rd.numbers(tr, p, "euler_deg", 3, -360.0, 360.0, false); !e.empty()) {
+    t.euler0_rad = vec3(e) * kDegToRad;
+  }
+  const bool spin = t.kind == "spin" || t.kind == "rate_table";
+  if (t.kind == "constant_acceleration") {
+    t.accel_n_mps2 = vec3(rd.numbers(tr, p, "accel_mps2", 3, -1e3, 1e3, true));
+  }
+  if (spin) {
+    const auto ax = rd.numbers(tr, p, "axis_b", 3, -kBig, kBig, t.kind == "spin");
+    if (!ax.empty()) t.axis_b = vec3(ax);
+    if (!(t.axis_b.norm() > 0)) rd.fail(tr.get("axis_b"), p + "axis_b", "must not be zero");
+    t.rate_rps = rd.number(tr, p, "rate_dps", std::nullopt, -3600.0, 3600.0) * kDegToRad;
+  }
+  if (t.kind == "coning") {
+    t.half_angle_rad = rd.number(tr, p, "half_angle_deg", std::nullopt, 0.0, 89.0) * kDegToRad;
+    t.cone_rate_rps = rd.number(tr, p, "cone_rate_hz", std::nullopt, 0.0, 100.0) * 2.0 * M_PI;
+  }
+  if (t.kind == "maneuver") t.scale = rd.number(tr, p, "scale", 1.0, 0.0, 100.0);
+  if (t.kind == "drive") {
+    t.speed_mps = rd.number(tr, p, "speed_mps", 10.0, 0.1, 100.0);
+    t.turn_amplitude_m = rd.number(tr, p, "turn_amplitude_m", 20.0, 0.0, 1e4);
+    t.turn_period_s = rd.number(tr, p, "turn_period_s", 20.0, 1.0, 1e5);
+  }
+  if (t.kind == "calibration_poses") {
+    t.poses = rd.string(tr, p, "poses", std::string("both"), {"table2", "table3", "both"});
+    t.dwell_s = rd.number(tr, p, "dwell_s", 10.0, 1e-2, 1e5);
+  }
+
+  // [sensors]
+  if (const toml::table* se = rd.table(root, "sensors", false)) {
+    const std::string q = "sensors.";
+    rd.only(*se, q,
+            {"orientation", "beta_deg", "alpha_deg", "location_error_mm", "bias_mps2", "noise_mps2",
+             "noise_mg", "noise_distribution"});
+    const std::string orient =
+        rd.string(*se, q, "orientation", std::string("none"), {"none", "paper_table6", "custom"});
+    if (orient == "paper_table6") s.misalignment.orientation = paper_table6_orientation();
+    if (orient == "custom") {
+      // Bounded by the compensator's small-angle limit (0.2 rad = 11.5°).
+      const auto b = rd.numbers(*se, q, "beta_deg", 6, -11.0, 11.0, true);
+      const auto a = rd.numbers(*se, q, "alpha_deg", 6, -11.0, 11.0, true);
+      for (std::size_t i = 0; i < 6; ++i) {
+        s.misalignment.orientation.beta[i] = b[i] * kDegToRad;
+        s.misalignment.orientation.alpha[i] = a[i] * kDegToRad;
+      }
+    } else if (se->get("beta_deg") != nullptr || se->get("alpha_deg") != nullptr) {
+      rd.fail(se->get("beta_deg") != nullptr ? se->get("beta_deg") : se->get("alpha_deg"),
+              q + "beta_deg/alpha_deg", "given, but orientation is not \"custom\"");
+    }
+    if (const auto l = rd.numbers(*se, q, "location_error_mm", 18, -100.0, 100.0, false);
+        !l.empty()) {
+      for (std::size_t j = 0; j < 6; ++j) {
+        s.misalignment.drho_b[j] = Vec3d(l[3 * j], l[3 * j + 1], l[3 * j + 2]) * 1e-3;
+      }
+    }
+    if (const auto b = rd.numbers(*se, q, "bias_mps2", 6, -100.0, 100.0, false); !b.empty()) {
+      std::copy(b.begin(), b.end(), s.bias_mps2.begin());
+    }
+    if (se->get("noise_mps2") != nullptr && se->get("noise_mg") != nullptr) {
+      rd.fail(se->get("noise_mg"), q + "noise_mg", "give noise_mps2 or noise_mg, not both");
+    }
+    s.noise_mps2 = rd.number(*se, q, "noise_mps2", 0.0, 0.0, 100.0);
+    if (se->get("noise_mg") != nullptr) {
+      s.noise_mps2 = rd.number(*se, q, "noise_mg", 0.0, 0.0, 1e4) * 1e-3 * nav::kStandardGravity;
+    }
+    s.noise_uniform = rd.string(*se, q, "noise_distribution", std::string("gaussian"),
+                                {"gaussian", "uniform"}) == "uniform";
+  }
+
+  // [compensator]
+  if (const toml::table* c = rd.table(root, "compensator", false)) {
+    rd.only(*c, "compensator.", {"kind", "misalignment"});
+    const std::string k =
+        rd.string(*c, "compensator.", "kind", std::string("paper"), {"none", "paper", "exact"});
+    s.compensator = k == "none"    ? nav::CompensatorKind::kNone
+                    : k == "paper" ? nav::CompensatorKind::kPaper
+                                   : nav::CompensatorKind::kExact;
+    s.misalignment_source = rd.string(*c, "compensator.", "misalignment", std::string("true"),
+                                      {"true", "calibrated"}) == "true"
+                                ? MisalignmentSource::kTrue
+                                : MisalignmentSource::kCalibrated;
+  }
+
+  // [calibration]
+  if (const toml::table* c = rd.table(root, "calibration", false)) {
+    rd.only(*c, "calibration.", {"mean_noise_g", "scale_v_per_g", "seed"});
+    s.calibration.mean_noise_g = rd.number(*c, "calibration.", "mean_noise_g", 1e-3, 0.0, 0.1);
+    s.calibration.scale_v_per_g = rd.number(*c, "calibration.", "scale_v_per_g", 1.0, 1e-3, 1e3);
+    s.calibration.seed = rd.integer(*c, "calibration.", "seed", 7);
+  }
+  return s;
+}
+
+/// atan on jets: atan' = 1/(1+x²), atan'' = −2x/(1+x²)².
+JetD jet_atan(const JetD& x) {
+  const double d = 1.0 + x.val * x.val;
+  return chain(x, std::atan(x.val), 1.0 / d, -2.0 * x.val / (d * d));
+}
+
+class DriveTrajectory final : public JetTrajectory {
+ public:
+  DriveTrajectory(double v, double a, double period) : v_(v), a_(a), w_(2.0 * M_PI / period) {}
+  void pose(const JetD& t, JetVec3& r_n, JetQuat& q_nb) const override {
+    JetD s;
+    JetD c;
+    sin_cos(w_ * t, s, c);
+    r_n = {v_ * t, a_ * (1.0 - c), JetD(0.0)};
+    // Heading along the velocity: tan ψ = ẏ/ẋ = A Ω sin Ωt / v, written over jets so that ψ̇
+    // and ψ̈ follow exactly. Bank of a coordinated turn: tan φ = v ψ̇ / g.
+    const JetD psi = jet_atan(s * (a_ * w_ / v_));
+    const double k = a_ * w_ / v_;
+    // ψ̇ = k Ω cos Ωt / (1 + k² sin² Ωt), written over jets as well.
+    const JetD psi_dot = (k * w_) * c / (1.0 + (k * k) * s * s);
+    const JetD phi = jet_atan(psi_dot * (v_ / nav::kStandardGravity));
+    q_nb = jet_rot_z(psi) * jet_rot_x(phi);
+  }
+  std::string name() const override { return "drive"; }
+
+ private:
+  double v_;
+  double a_;
+  double w_;
+};
+
+}  // namespace
+
+nav::OrientationErrors<double> paper_table6_orientation() {
+  // Degrees, notes §2 (re-computed from Tables 4/5; Table 6 prints them truncated).
+  const std::array<double, 6> beta = {1.117153,  -0.175898, -0.581243,
+                                      -0.738730, 2.454474,  2.482132};
+  const std::array<double, 6> alpha = {-2.655023, 2.596927, -0.838685,
+                                       -0.737413, 0.119500, -1.451068};
+  nav::OrientationErrors<double> o;
+  for (std::size_t i = 0; i < 6; ++i) {
+    o.beta[i] = beta[i] * kDegToRad;
+    o.alpha[i] = alpha[i] * kDegToRad;
+  }
+  return o;
+}
+
+ParsedScenario parse_scenario(std::string_view toml_text, const std::string& source) {
+  ParsedScenario out;
+  try {
+    const toml::table root = toml::parse(toml_text, source);
+    out.scenario = parse_root(root, Reader(source), source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
+    out.error = os.str();
+  } catch (const ScenarioParseError& e) {
+    out.error = e.what();
+  }
+  return out;
+}
+
+ParsedScenario load_scenario(const std::string& file_or_name, const std::string& builtin_dir) {
+  std::filesystem::path path(file_or_name);
+  if (!std::filesystem::exists(path)) {
+    const auto builtin = std::filesystem::path(builtin_dir) / (file_or_name + ".toml");
+    if (!std::filesystem::exists(builtin)) {
+      ParsedScenario out;
+      out.error =
+          file_or_name + ": no such file, and no built-in scenario of that name in " + builtin_dir;
+      return out;
+    }
+    path = builtin;
+  }
+  std::ifstream in(path);
+  if (!in) {
+    ParsedScenario out;
+    out.error = path.string() + ": cannot read the file";
+    return out;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scenario(text.str(), path.string());
+}
+
+std::vector<std::string> builtin_scenarios(const std::string& builtin_dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(builtin_dir, ec)) {
+    if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, double period_s) {
+  return std::make_unique<DriveTrajectory>(speed_mps, amplitude_m, period_s);
+}
+
+std::unique_ptr<Trajectory> make_trajectory(const TrajectorySpec& t) {
+  const Quatd q0 = nav::quat_from_euler(t.euler0_rad.x(), t.euler0_rad.y(), t.euler0_rad.z());
+  if (t.kind == "rest" || t.kind == "calibration_poses") return make_rest(q0);
+  if (t.kind == "constant_acceleration") return make_constant_acceleration(t.accel_n_mps2, q0);
+  if (t.kind == "spin" || t.kind == "rate_table") return make_spin(t.axis_b, t.rate_rps, q0);
+  if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);
+  if (t.kind == "maneuver") return make_maneuver(t.scale);
+  if (t.kind == "drive") return make_drive(t.speed_mps, t.turn_amplitude_m, t.turn_period_s);
+  throw std::invalid_argument("unknown trajectory kind '" + t.kind + "'");
+}
+
+nav::GravityModel<double> gravity_model(const Scenario& s) {
+  switch (s.gravity) {
+    case GravityChoice::kDown:
+      return nav::GravityModel<double>::constant(s.gravity_mps2);
+    case GravityChoice::kUp:
+      // The paper's §6.3 frame has gravity along −z; the core's model is a signed constant.
+      return nav::GravityModel<double>::constant(-s.gravity_mps2);
+    case GravityChoice::kNormal:
+      return nav::GravityModel<double>::normal(s.latitude_rad, s.height_m);
+  }
+  return nav::GravityModel<double>::constant(s.gravity_mps2);
+}
+
+}  // namespace gfins::sim

@@ -1,0 +1,193 @@
+// Simulation scenarios: what moves, which errors the array has, what the navigation core is told,
+// described in TOML files (docs/simulation.md, "Scenario format"), and the run of one scenario
+// through the navigation core the firmware uses (nav::NavPipeline), without and with compensation.
+//
+// Host code: the standard library and exceptions are allowed here, but nothing escapes this
+// interface: parse errors come back as values whose message names the file, the key and the line.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gfins/host_sim/trajectory.hpp"
+#include "gfins/nav_core/calibration/multi_attitude.hpp"
+#include "gfins/nav_core/compensator.hpp"
+#include "gfins/nav_core/gravity.hpp"
+#include "gfins/nav_core/misalignment.hpp"
+
+namespace gfins::sim {
+
+/// The motion. Which fields matter depends on `kind` (docs/simulation.md lists them).
+struct TrajectorySpec {
+  std::string kind = "rest";         // rest | constant_acceleration | spin | rate_table | coning |
+                                     // maneuver | drive | calibration_poses
+  Vec3d euler0_rad = Vec3d::Zero();  // initial roll, pitch, yaw (file: degrees)
+  Vec3d accel_n_mps2 = Vec3d::Zero();  // constant_acceleration
+  Vec3d axis_b = Vec3d::UnitZ();       // spin, rate_table
+  double rate_rps = 0.0;               // spin, rate_table (file: deg/s)
+  double half_angle_rad = 0.0;         // coning (file: degrees)
+  double cone_rate_rps = 0.0;          // coning (file: Hz → rad/s)
+  double scale = 1.0;                  // maneuver
+  double speed_mps = 10.0;             // drive: forward speed
+  double turn_amplitude_m = 20.0;      // drive: lateral amplitude of the weave
+  double turn_period_s = 20.0;         // drive: period of one left-right weave
+  std::string poses = "both";          // calibration_poses: "table2" | "table3" | "both"
+  double dwell_s = 10.0;               // calibration_poses: time at rest in each pose
+};
+
+/// Where the compensator's misalignment comes from.
+enum class MisalignmentSource : std::uint8_t {
+  kTrue,        // the simulated (true) misalignment: the paper's §6.3 setting
+  kCalibrated,  // estimated by a simulated multi-attitude calibration (Tables 2/3 poses)
+};
+
+enum class GravityChoice : std::uint8_t {
+  kDown,    // constant |g| along +z of NED (the project's convention)
+  kUp,      // constant |g| along −z of the navigation frame (the paper's §6.3 inertial frame)
+  kNormal,  // WGS-84 normal gravity at a latitude and height
+};
+
+/// A simulated calibration: the twelve poses of Tables 2/3 held still, one mean per sensor and
+/// pose with white noise of `mean_noise_g` (1σ of each mean, g).
+struct CalibrationSpec {
+  double mean_noise_g = 1e-3;
+  double scale_v_per_g = 1.0;  // simulated SF of every sensor (V/g); the solver estimates it
+  std::uint64_t seed = 7;
+};
+
+struct Scenario {
+  std::string name;         // file stem or [scenario] name
+  std::string description;  // one line
+  std::string source;       // the file it came from, for messages
+
+  TrajectorySpec trajectory;
+  double duration_s = 10.0;
+  double rate_hz = 1000.0;
+  double rho_m = 0.1;  // Table 1 half-size
+
+  GravityChoice gravity = GravityChoice::kDown;
+  double gravity_mps2 = nav::kStandardGravity;  // kDown / kUp
+  double latitude_rad = 0.0;                    // kNormal
+  double height_m = 0.0;                        // kNormal
+
+  // Sensor errors (true values).
+  nav::Misalignment<double> misalignment{};
+  std::array<double, 6> bias_mps2{};
+  double noise_mps2 = 0.0;  // white noise per sensor and sample, 1σ
+  std::uint64_t seed = 1;
+
+  // What the navigation core is told.
+  nav::CompensatorKind compensator = nav::CompensatorKind::kPaper;
+  MisalignmentSource misalignment_source = MisalignmentSource::kTrue;
+  CalibrationSpec calibration;
+
+  bool noise_uniform = false;  // uniform noise of the same σ instead of Gaussian
+};
+
+/// Result of parsing: a scenario, or an error naming the file, the key and the line.
+struct ParsedScenario {
+  std::optional<Scenario> scenario;
+  std::string error;
+  bool ok() const { return scenario.has_value(); }
+};
+
+/// Parses TOML text; `source` names it in messages.
+ParsedScenario parse_scenario(std::string_view toml_text, const std::string& source);
+
+/// Loads a file, or a built-in scenario by name from `builtin_dir` (NAME.toml).
+ParsedScenario load_scenario(const std::string& file_or_name, const std::string& builtin_dir);
+
+/// Names of the built-in scenarios in a folder (file stems of *.toml), sorted.
+std::vector<std::string> builtin_scenarios(const std::string& builtin_dir);
+
+/// The paper's Table 6 orientation errors (rad), as computed from Tables 4/5 (notes §2).
+nav::OrientationErrors<double> paper_table6_orientation();
+
+/// The trajectory of a scenario. Throws std::invalid_argument for a kind it does not know
+/// (parse_scenario rejects those first).
+std::unique_ptr<Trajectory> make_trajectory(const TrajectorySpec& spec);
+
+/// A vehicle drive with turns: forward at speed v along north, weaving east
+/// y(t) = A (1 − cos Ωt), Ω = 2π/period, heading along the velocity ψ = atan(ẏ/v), with a bank
+/// angle φ = atan(v ψ̇ / g) as a coordinated turn.
+std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, double period_s);
+
+/// The gravity model of a scenario.
+nav::GravityModel<double> gravity_model(const Scenario& s);
+
+// ---- Running a scenario ---------------------------------------------------------------------
+
+/// One sample of one run: truth, estimate and their difference.
+struct SampleRecord {
+  double t_s = 0;
+  TruthState truth;
+  Quatd q_nb_est = Quatd::Identity();
+  Vec3d w_b_est = Vec3d::Zero();
+  Vec3d wdot_b_est = Vec3d::Zero();
+  Vec3d a_n_est = Vec3d::Zero();
+  Vec3d v_n_est = Vec3d::Zero();
+  Vec3d r_n_est = Vec3d::Zero();
+
+  Vec3d wdot_err_b() const { return wdot_b_est - truth.wdot_b; }  // angular accel error
+  Vec3d a_err_n() const { return a_n_est - truth.a_n; }           // linear accel error
+  Vec3d w_err_b() const { return w_b_est - truth.w_b; }
+  Vec3d v_err_n() const { return v_n_est - truth.v_n; }
+  Vec3d r_err_n() const { return r_n_est - truth.r_n; }
+  /// Small-angle attitude error (rad, body): 2 vec(q_true* ⊗ q_est).
+  Vec3d att_err_b() const;
+};
+
+struct RunSeries {
+  std::string label;  // "uncompensated" or "compensated (paper, true)" ...
+  std::vector<SampleRecord> samples;
+};
+
+/// Summary of a simulated multi-attitude calibration.
+struct CalibrationOutcome {
+  bool ran = false;
+  nav::OrientationErrors<double> estimated{};  // rad
+  nav::OrientationErrors<double> std_rad{};    // 1σ from the solver's covariance
+  std::array<double, 6> bias_est_g{};
+  std::array<double, 6> scale_est_v_per_g{};
+  double rms_angle_error_rad = 0;  // estimated − true, over the 12 angles
+};
+
+struct ScenarioOutcome {
+  RunSeries uncompensated;
+  RunSeries compensated;
+  CalibrationOutcome calibration;
+  nav::Misalignment<double> compensator_misalignment{};
+};
+
+/// Called with the fraction done (0..1) now and then; may be empty.
+using ProgressFn = std::function<void(double)>;
+
+/// Simulates a multi-attitude calibration of the array of `s` (true misalignment and biases),
+/// with its CalibrationSpec and seed. Throws std::runtime_error when the solver fails.
+CalibrationOutcome simulate_calibration(const Scenario& s);
+
+/// Runs a navigation scenario twice with the same noise realisation: without compensation and
+/// with the scenario's compensator. For a calibration_poses scenario only `calibration` is filled.
+/// Throws std::runtime_error when the core rejects the configuration.
+/// With `with_uncompensated` false only the compensated run is made (Monte-Carlo).
+ScenarioOutcome run_scenario(const Scenario& s, const ProgressFn& progress = {},
+                             bool with_uncompensated = true);
+
+/// Smallest and largest component over all samples (t > 0) of a vector series.
+struct Bounds {
+  double lo = 0;
+  double hi = 0;
+};
+Bounds linear_accel_bounds(const RunSeries& r);   // a_err_n, m/s²
+Bounds angular_accel_bounds(const RunSeries& r);  // wdot_err_b, rad/s²
+
+/// Writes a run as CSV: t, truth, estimate and errors. Throws std::runtime_error on I/O errors.
+void write_series_csv(const RunSeries& r, const std::string& path);
+
+}  // namespace gfins::sim

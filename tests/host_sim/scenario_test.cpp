@@ -1,0 +1,150 @@
+// Scenario files: the built-ins parse, and every kind of bad input is rejected with a message that
+// names the file, the key, the line and the problem.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "gfins/host_sim/scenario.hpp"
+
+namespace gfins::sim {
+namespace {
+
+const std::string kBuiltinDir = std::string(GFINS_TEST_DATA_DIR) + "/../../host_sim/scenarios";
+
+// A minimal valid file; the bad cases below each change one thing in it.
+const char* const kGood = R"(# comment
+[scenario]
+duration_s = 2.0
+rate_hz = 100.0
+rho_m = 0.35
+seed = 3
+
+[gravity]
+model = "up"
+
+[trajectory]
+kind = "constant_acceleration"
+accel_mps2 = [9.80665, 0.0, 0.0]
+
+[sensors]
+orientation = "paper_table6"
+noise_mps2 = 5e-4
+
+[compensator]
+kind = "exact"
+misalignment = "calibrated"
+)";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+
+void expect_error(const std::string& text, std::initializer_list<const char*> fragments) {
+  const ParsedScenario p = parse_scenario(text, "bad.toml");
+  ASSERT_FALSE(p.ok()) << "accepted:\n" << text;
+  for (const char* f : fragments) {
+    EXPECT_NE(p.error.find(f), std::string::npos)
+        << "message '" << p.error << "' lacks '" << f << "'";
+  }
+}
+
+TEST(ScenarioParse, GoodFileGivesEveryValue) {
+  // Given a complete file, when it is parsed, then every field has the value written.
+  const ParsedScenario p = parse_scenario(kGood, "good.toml");
+  ASSERT_TRUE(p.ok()) << p.error;
+  const Scenario& s = *p.scenario;
+  EXPECT_EQ(s.name, "good");
+  EXPECT_DOUBLE_EQ(s.duration_s, 2.0);
+  EXPECT_DOUBLE_EQ(s.rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(s.rho_m, 0.35);
+  EXPECT_EQ(s.seed, 3u);
+  EXPECT_EQ(s.gravity, GravityChoice::kUp);
+  EXPECT_EQ(s.trajectory.kind, "constant_acceleration");
+  EXPECT_DOUBLE_EQ(s.trajectory.accel_n_mps2.x(), 9.80665);
+  EXPECT_DOUBLE_EQ(s.noise_mps2, 5e-4);
+  EXPECT_EQ(s.compensator, nav::CompensatorKind::kExact);
+  EXPECT_EQ(s.misalignment_source, MisalignmentSource::kCalibrated);
+  // Table 6's Δβ_xy = 1.117153° (notes §2), stored in radians.
+  EXPECT_NEAR(s.misalignment.orientation.beta[0], 1.117153 * M_PI / 180.0, 1e-12);
+  // The gravity model "up" points along −z.
+  EXPECT_LT(gravity_model(s).g_n(Vec3d::Zero()).z(), 0.0);
+}
+
+TEST(ScenarioParse, EveryBuiltinScenarioParsesAndBuildsItsTrajectory) {
+  const auto names = builtin_scenarios(kBuiltinDir);
+  ASSERT_GE(names.size(), 9u) << kBuiltinDir;
+  for (const auto& n : names) {
+    const ParsedScenario p = load_scenario(n, kBuiltinDir);
+    ASSERT_TRUE(p.ok()) << p.error;
+    EXPECT_FALSE(p.scenario->description.empty()) << n;
+    const auto traj = make_trajectory(p.scenario->trajectory);
+    const TruthState x = traj->at(0.5);
+    EXPECT_TRUE(x.q_nb.coeffs().allFinite()) << n;
+  }
+}
+
+TEST(ScenarioParse, MissingRequiredKeyIsNamed) {
+  expect_error(replace(kGood, "duration_s = 2.0\n", ""),
+               {"bad.toml:", "scenario.duration_s", "missing"});
+  expect_error(replace(kGood, "accel_mps2 = [9.80665, 0.0, 0.0]\n", ""),
+               {"trajectory.accel_mps2", "missing"});
+  expect_error(replace(kGood,
+                       "[trajectory]\nkind = \"constant_acceleration\"\n"
+                       "accel_mps2 = [9.80665, 0.0, 0.0]\n",
+                       ""),
+               {"trajectory", "missing table"});
+}
+
+TEST(ScenarioParse, WrongTypeIsNamedWithItsLine) {
+  // rate_hz is on line 4 of kGood.
+  expect_error(replace(kGood, "rate_hz = 100.0", "rate_hz = \"fast\""),
+               {"bad.toml:4:", "scenario.rate_hz", "expected a number, got a string"});
+  expect_error(replace(kGood, "accel_mps2 = [9.80665, 0.0, 0.0]", "accel_mps2 = [9.8, \"x\", 0]"),
+               {"trajectory.accel_mps2", "expected an array of numbers"});
+  expect_error(replace(kGood, "accel_mps2 = [9.80665, 0.0, 0.0]", "accel_mps2 = [9.8, 0]"),
+               {"trajectory.accel_mps2", "expected 3 numbers, got 2"});
+  expect_error(replace(kGood, "seed = 3", "seed = 3.5"), {"scenario.seed", "expected an integer"});
+}
+
+TEST(ScenarioParse, UnknownTrajectoryAndOtherChoicesListTheAllowedOnes) {
+  expect_error(replace(kGood, "\"constant_acceleration\"", "\"loop_the_loop\""),
+               {"bad.toml:12:", "trajectory.kind", "unknown value 'loop_the_loop'", "coning"});
+  expect_error(replace(kGood, "kind = \"exact\"", "kind = \"magic\""),
+               {"compensator.kind", "unknown value 'magic'", "none, paper, exact"});
+  expect_error(replace(kGood, "misalignment = \"calibrated\"", "misalignment = \"guessed\""),
+               {"compensator.misalignment", "true, calibrated"});
+  expect_error(replace(kGood, "model = \"up\"", "model = \"sideways\""), {"gravity.model"});
+}
+
+TEST(ScenarioParse, OutOfRangeValueIsNamedWithItsRange) {
+  expect_error(replace(kGood, "rho_m = 0.35", "rho_m = -0.35"),
+               {"bad.toml:5:", "scenario.rho_m", "out of range"});
+  expect_error(replace(kGood, "rate_hz = 100.0", "rate_hz = 0"),
+               {"scenario.rate_hz", "out of range"});
+  expect_error(replace(kGood, "noise_mps2 = 5e-4", "noise_mps2 = nan"),
+               {"sensors.noise_mps2", "out of range"});
+  // Custom angles beyond the compensator's small-angle model (0.2 rad).
+  expect_error(replace(kGood, "orientation = \"paper_table6\"",
+                       "orientation = \"custom\"\nbeta_deg = [0, 0, 0, 0, 0, 20]\n"
+                       "alpha_deg = [0, 0, 0, 0, 0, 0]"),
+               {"sensors.beta_deg", "element 5 = 20 out of range"});
+}
+
+TEST(ScenarioParse, UnknownKeyAndSyntaxErrorAreReported) {
+  expect_error(replace(kGood, "rho_m = 0.35", "rho = 0.35"),
+               {"bad.toml:5:", "scenario.rho", "unknown key", "rho_m"});
+  expect_error(replace(kGood, "rho_m = 0.35", "rho_m = = 0.35"),
+               {"bad.toml:5:", "TOML syntax error"});
+}
+
+TEST(ScenarioParse, MissingFileOrNameIsReported) {
+  const ParsedScenario p = load_scenario("no-such-scenario", kBuiltinDir);
+  ASSERT_FALSE(p.ok());
+  EXPECT_NE(p.error.find("no-such-scenario"), std::string::npos) << p.error;
+}
+
+}  // namespace
+}  // namespace gfins::sim
