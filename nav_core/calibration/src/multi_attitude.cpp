@@ -435,18 +435,19 @@ Result<MultiAttitudeResult<T>> calibrate_paper_procedure(const PaperTableOutputs
       angle_place<T>(2 * pos.row + m, row, cols[static_cast<std::size_t>(m)],
                      signs[static_cast<std::size_t>(m)]);
     }
+    std::array<nav::Vec3<T>, 3> axis;  // nominal axes of the set, in the order of C's columns
+    for (std::size_t k = 0; k < 3; ++k) {
+      axis[k] = config.theta_b[static_cast<std::size_t>((*pos.set)[k])];
+    }
     for (int j = 0; j < 6; ++j) {
       const auto sj = static_cast<std::size_t>(j);
       const nav::Vec3<T> aj(att[sj][0], att[sj][1], att[sj][2]);
-      const auto axis = [&](int k) {
-        return config.theta_b[static_cast<std::size_t>((*pos.set)[static_cast<std::size_t>(k)])];
-      };
       a(j, 0) = T(1);
       for (int m = 0; m < 2; ++m) {
         const auto sm = static_cast<std::size_t>(m);
-        a(j, 1 + m) = signs[sm] * axis(cols[sm]).dot(aj);
+        a(j, 1 + m) = signs[sm] * axis[static_cast<std::size_t>(cols[sm])].dot(aj);
       }
-      y(j) = pi[sj] / sf - axis(pos.row).dot(aj);
+      y(j) = pi[sj] / sf - axis[static_cast<std::size_t>(pos.row)].dot(aj);
     }
     const Vec3<T> x = a.colPivHouseholderQr().solve(y);
     out.scale_v_per_g[si] = sf;
