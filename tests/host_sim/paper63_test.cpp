@@ -6,7 +6,7 @@
 // relative error of its own, so the distance |ours − paper| is compared with the span hi − lo of
 // the paper's pair for that figure; this is how the notes' "about 15 %" was measured. The bounds
 // after compensation are extremes of noise, so they vary from seed to seed: the test takes the
-// median over kSeeds seeds (a single seed can miss by up to 30 % of the span; docs/simulation.md
+// median over kSeeds seeds (a single seed can miss by up to 70 % of the span; docs/simulation.md
 // gives the per-seed spread).
 #include <gtest/gtest.h>
 

@@ -251,7 +251,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     const std::string q = "sensors.";
     rd.only(*se, q,
             {"orientation", "beta_deg", "alpha_deg", "location_error_mm", "bias_mps2", "noise_mps2",
-             "noise_mg", "noise_distribution"});
+             "noise_mg", "noise_distribution", "model", "temperature_c"});
     const std::string orient =
         rd.string(*se, q, "orientation", std::string("none"), {"none", "paper_table6", "custom"});
     if (orient == "paper_table6") s.misalignment.orientation = paper_table6_orientation();
@@ -283,6 +283,8 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     if (se->get("noise_mg") != nullptr) {
       s.noise_mps2 = rd.number(*se, q, "noise_mg", 0.0, 0.0, 1e4) * 1e-3 * nav::kStandardGravity;
     }
+    s.qa1100 = rd.string(*se, q, "model", std::string("paper"), {"paper", "qa1100"}) == "qa1100";
+    s.temperature_c = rd.number(*se, q, "temperature_c", 25.0, -55.0, 125.0);
     s.noise_uniform = rd.string(*se, q, "noise_distribution", std::string("gaussian"),
                                 {"gaussian", "uniform"}) == "uniform";
   }

@@ -8,6 +8,7 @@
 
 #include "gfins/host_sim/array_model.hpp"
 #include "gfins/host_sim/scenario.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
 namespace gfins::sim {
@@ -42,18 +43,33 @@ struct Stream {
 };
 
 Stream make_stream(const Scenario& s, const Trajectory& traj) {
-  const auto nominal = nav::table1_geometry<double>(s.rho_m);
-  const IdealArrayModel<6> model(nav::misaligned_geometry(nominal, s.misalignment),
-                                 gravity_model(s));
-  Noise noise(s.noise_mps2, s.noise_uniform, s.seed);
+  // The array's outputs come from the project's sensor model (sensor_model.hpp), in volts; the
+  // front end's division by the (known) scale factor brings them back to m/s². Gaussian white
+  // noise is the model's own; uniform noise (not in the model) is added here instead.
+  ArrayErrors errors;
+  errors.misalignment = s.misalignment;
+  errors.temperature_c = s.temperature_c;
+  const double g = nav::kStandardGravity;
+  for (std::size_t j = 0; j < 6; ++j) {
+    AccelErrors& e = errors.sensors[j];
+    if (s.qa1100) e = AccelErrors::qa1100_typical();
+    e.bias_g += s.bias_mps2[j] / g;
+    if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
+  }
+  SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
+                         s.seed);
+  Noise uniform(s.noise_uniform ? s.noise_mps2 : 0.0, true, s.seed);
   const auto steps = static_cast<std::size_t>(std::llround(s.duration_s * s.rate_hz));
   Stream st;
   st.truth.reserve(steps + 1);
   st.outputs.reserve(steps + 1);
   for (std::size_t k = 0; k <= steps; ++k) {
     const TruthState x = traj.at(static_cast<double>(k) / s.rate_hz);
-    Vec6d out = model.outputs(x) + noise.draw();
-    for (int j = 0; j < 6; ++j) out(j) += s.bias_mps2[static_cast<std::size_t>(j)];
+    const SensorArrayModel::Volts v = model.volts(x);
+    Vec6d out = uniform.draw();
+    for (int j = 0; j < 6; ++j) {
+      out(j) += v(j) / errors.sensors[static_cast<std::size_t>(j)].scale_v_per_g * g;
+    }
     st.truth.push_back(x);
     st.outputs.push_back(out);
   }

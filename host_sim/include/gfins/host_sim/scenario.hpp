@@ -88,6 +88,13 @@ struct Scenario {
   CalibrationSpec calibration;
 
   bool noise_uniform = false;  // uniform noise of the same σ instead of Gaussian
+
+  // The sensor model behind the outputs (SensorArrayModel, sensor_model.hpp): "paper" = unit-gain
+  // sensors with only the errors above (the paper's §6.3); "qa1100" = AccelErrors::qa1100_typical
+  // per sensor (K2, bias random walk, temperature coefficients, datasheet noise unless noise is
+  // given) on top of them. The front end divides by the true scale factor in both cases.
+  bool qa1100 = false;
+  double temperature_c = 25.0;  // array temperature (reference 25 °C)
 };
 
 /// Result of parsing: a scenario, or an error naming the file, the key and the line.
