@@ -7,7 +7,10 @@
 #include <limits>
 #include <random>
 
+#include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/front_end.hpp"
+#include "gfins/nav_core/geometry.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -21,6 +24,9 @@ constexpr double kLsbRel = 4.0 * std::numeric_limits<double>::epsilon();
 // Rounding to nearest leaves at most ½ LSB; the product v·counts_per_volt adds ≤ 1 ulp of a
 // number below 2^23, i.e. < 1e-9 LSB.
 constexpr double kHalfLsbSlack = 1e-9;
+// The front end's gain and offset products round at 1e-16 relative; 1e-6 of the half LSB is a
+// margin far above that and far below anything a wrong LSB or scale factor would give.
+constexpr double kFrontEndRounding = 1e-6;
 
 Volts all(double v) { return Volts::Constant(v); }
 
@@ -146,6 +152,40 @@ TEST(AdcModelTest, JitterHasTheConfiguredSigmaAndIsReproducible) {
   // (rounding to whole ns adds 1/12 ns², negligible), and the same seed gives the same stamps.
   EXPECT_NEAR(std::sqrt(s2 / kN), 200.0, 5.0 * 200.0 / std::sqrt(2.0 * kN));
   EXPECT_TRUE(same);
+}
+
+TEST(AdcModelTest, SensorAdcAndFrontEndCloseTheLoopWithinHalfAnLsb) {
+  // Given Table 6 scale factors and biases without noise or misalignment, a tilted array at rest,
+  // the default ADC and a front end configured with the same SF, b and volts_per_count(),
+  ArrayErrors errors = SensorArrayModel::paper_table6();
+  errors.misalignment = {};
+  const auto gravity = nav::GravityModel<double>::constant(nav::kStandardGravity);
+  SensorArrayModel sensors(nav::table1_geometry(0.1), errors, gravity, 1000.0, 9);
+  AdcModel adc(AdcConfig{});
+  nav::FrontEndParams<double> p;
+  for (std::size_t j = 0; j < 6; ++j) {
+    p.volts_per_count[j] = adc.volts_per_count();
+    p.scale_v_per_g[j] = errors.sensors[j].scale_v_per_g;
+    p.bias_g[j] = errors.sensors[j].bias_g;
+  }
+  const auto fe = nav::FrontEnd<double>::create(p);
+  ASSERT_TRUE(fe.is_ok());
+  const TruthState x =
+      make_rest(Quatd(Eigen::AngleAxisd(0.7, Vec3d(1, -2, 0.5).normalized())))->at(0.0);
+  // when the truth goes through sensors → ADC → front end,
+  const hal::RawSample s = adc.sample(sensors.volts(x), 0);
+  nav::FrontEnd<double>::Outputs out;
+  EXPECT_EQ(fe.value().convert(s.counts, out), 0u);
+  // then each output is the sensed specific force within ½ LSB, i.e. ½·LSB·g/SF_j m/s² (the
+  // only error left is quantisation).
+  const Volts truth = sensors.ideal_specific_force(x);
+  for (std::size_t j = 0; j < 6; ++j) {
+    const double half_lsb_mps2 =
+        0.5 * adc.volts_per_count() * nav::kStandardGravity / errors.sensors[j].scale_v_per_g;
+    EXPECT_NEAR(out(static_cast<Eigen::Index>(j)), truth(static_cast<Eigen::Index>(j)),
+                half_lsb_mps2 * (1.0 + kFrontEndRounding))
+        << "sensor " << j + 1;
+  }
 }
 
 }  // namespace

@@ -179,6 +179,45 @@ TEST(RecordingTest, CorruptByteIsReportedWithItsBlockOffset) {
   EXPECT_NE(rec.error().message.find("block 3"), std::string::npos) << rec.error().message;
 }
 
+TEST(RecordingTest, DamagedFilesOnDiskGiveTheSameErrorsAsInMemory) {
+  // Given a file cut mid-record and a file with a flipped byte, written to disk,
+  const auto image = good_image();
+  const std::string cut_path = temp_path("cut.gfr");
+  const std::string bad_path = temp_path("bad.gfr");
+  const std::size_t cut_at = block_offset(4) + 3 * kRecordingRecordBytes + 9;
+  auto bad = image;
+  bad[block_offset(1) + 40] ^= 0x01;
+  {
+    std::FILE* f = std::fopen(cut_path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(image.data(), 1, cut_at, f), cut_at);
+    std::fclose(f);
+    f = std::fopen(bad_path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(bad.data(), 1, bad.size(), f), bad.size());
+    std::fclose(f);
+  }
+  // when read through the streaming reader,
+  const auto cut = read_recording(cut_path);
+  const auto corrupt = read_recording(bad_path);
+  // then the offsets are those of the in-memory decoder: the broken record, the broken block.
+  ASSERT_FALSE(cut.is_ok());
+  EXPECT_EQ(cut.error().byte_offset, block_offset(4) + 3 * kRecordingRecordBytes);
+  ASSERT_FALSE(corrupt.is_ok());
+  EXPECT_EQ(corrupt.error().byte_offset, block_offset(1));
+  // and a reader streaming block by block returns the blocks before the damage first.
+  auto reader = RecordingReader::open(bad_path);
+  ASSERT_TRUE(reader.is_ok());
+  std::vector<hal::RawSample> block;
+  const auto first = reader.value().next_block(block);
+  ASSERT_TRUE(first.is_ok());
+  EXPECT_TRUE(first.value());
+  EXPECT_EQ(block.size(), kRecordsPerBlock);
+  EXPECT_FALSE(reader.value().next_block(block).is_ok());
+  std::filesystem::remove(cut_path);
+  std::filesystem::remove(bad_path);
+}
+
 TEST(RecordingTest, CorruptHeaderFailsItsCrc) {
   // Given a good file with one byte of the sample rate changed,
   auto image = good_image();

@@ -103,13 +103,19 @@ TYPED_TEST(ReplayTest, ReplayFromAFileEqualsReplayFromMemory) {
   ASSERT_TRUE(write_recording(path, h, f.samples).is_ok());
   const auto rec = read_recording(path);
   ASSERT_TRUE(rec.is_ok()) << rec.error().message;
-  std::filesystem::remove(path);
-  // when both are replayed,
+  // when both are replayed, and the file once more streamed block by block,
   const ReplayReport from_file = f.run<TypeParam>(rec.value().samples);
   const ReplayReport from_memory = f.run<TypeParam>(f.samples);
+  nav::NavPipeline<TypeParam> p;
+  ASSERT_TRUE(p.configure(f.config<TypeParam>()).is_ok());
+  const auto streamed = replay_recording(path, p);
+  std::filesystem::remove(path);
   // then the outputs are bit-identical.
+  ASSERT_TRUE(streamed.is_ok()) << streamed.error().message;
   EXPECT_EQ(from_file.output_hash, from_memory.output_hash);
+  EXPECT_EQ(streamed.value().output_hash, from_memory.output_hash);
   EXPECT_EQ(from_file.navigating, from_memory.navigating);
+  EXPECT_EQ(streamed.value().samples, kSamples);
 }
 
 TYPED_TEST(ReplayTest, GapsInTheSampleCounterAreReportedWithIndexAndSize) {

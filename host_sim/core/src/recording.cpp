@@ -239,99 +239,192 @@ RecordingResult<std::vector<std::uint8_t>> encode_recording(
 }
 
 RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes) {
-  auto head = decode_header(bytes);
-  if (!head.is_ok()) return head.error();
+  auto reader = RecordingReader::from_bytes(bytes);
+  if (!reader.is_ok()) return reader.error();
   Recording rec;
-  rec.header = head.value();
-  const std::uint64_t rpb = rec.header.records_per_block;
-  const bool count_known = rec.header.record_count != kRecordCountUnknown;
-  const std::uint64_t size = bytes.size();
-  std::uint64_t pos = kRecordingHeaderBytes;
-  std::uint64_t index = 0;  // records decoded so far
-  if (count_known) {
-    // Reserve only what the file can hold, so a corrupt count cannot ask for a huge buffer.
+  rec.header = reader.value().header();
+  if (rec.header.record_count != kRecordCountUnknown) {
+    // Reserve only what the bytes can hold, so a corrupt count cannot ask for a huge buffer.
     rec.samples.reserve(static_cast<std::size_t>(
-        std::min<std::uint64_t>(rec.header.record_count, size / kRecordingRecordBytes)));
+        std::min<std::uint64_t>(rec.header.record_count, bytes.size() / kRecordingRecordBytes)));
   }
-  for (std::uint64_t block = 0;; ++block) {
-    const std::uint64_t remaining = size - pos;
-    std::uint64_t n = 0;  // records in this block
-    if (count_known) {
-      n = std::min(rpb, rec.header.record_count - index);
-      if (n == 0) break;
-    } else {
-      if (remaining == 0) break;
-      const std::uint64_t full = rpb * kRecordingRecordBytes + kRecordingCrcBytes;
-      n = remaining >= full
-              ? rpb
-              : (remaining - std::min(remaining, kRecordingCrcBytes)) / kRecordingRecordBytes;
-      if (remaining < full &&
-          (n == 0 || n * kRecordingRecordBytes + kRecordingCrcBytes != remaining)) {
-        const std::uint64_t at = pos + (remaining / kRecordingRecordBytes) * kRecordingRecordBytes;
-        return error_at(ErrorCode::kDataLoss, at,
-                        "truncated: block " + std::to_string(block) + " at byte offset " +
-                            std::to_string(pos) + " ends inside a record or its CRC (file is " +
-                            std::to_string(size) + " bytes)");
-      }
-    }
-    const std::uint64_t need = n * kRecordingRecordBytes + kRecordingCrcBytes;
-    if (remaining < need) {
-      const std::uint64_t whole = std::min(n, remaining / kRecordingRecordBytes);
-      const std::uint64_t at = pos + whole * kRecordingRecordBytes;
-      return error_at(ErrorCode::kDataLoss, at,
-                      "truncated: the file ends at byte " + std::to_string(size) +
-                          " inside block " + std::to_string(block) + " (starts at byte offset " +
-                          std::to_string(pos) + ", needs " + std::to_string(need) +
-                          " bytes); header promises " + std::to_string(rec.header.record_count) +
-                          " records, " + std::to_string(index + whole) + " are complete");
-    }
-    const auto data = bytes.subspan(static_cast<std::size_t>(pos),
-                                    static_cast<std::size_t>(n * kRecordingRecordBytes));
-    const std::uint32_t stored = get_u32(data.data() + data.size());
-    const std::uint32_t computed = crc32(data);
-    if (stored != computed) {
-      return error_at(ErrorCode::kDataLoss, pos,
-                      "block " + std::to_string(block) + " (records " + std::to_string(index) +
-                          ".." + std::to_string(index + n - 1) + ") at byte offset " +
-                          std::to_string(pos) + ": CRC-32 mismatch (stored " + hex32(stored) +
-                          ", computed " + hex32(computed) + ")");
-    }
-    for (std::uint64_t i = 0; i < n; ++i) {
-      rec.samples.push_back(
-          decode_record(data.subspan(static_cast<std::size_t>(i * kRecordingRecordBytes))
-                            .first<kRecordingRecordBytes>()));
-    }
-    index += n;
-    pos += need;
-  }
-  if (pos != size) {
-    return error_at(ErrorCode::kDataLoss, pos,
-                    std::to_string(size - pos) + " bytes after the last of the " +
-                        std::to_string(index) + " records the header announces");
+  std::vector<hal::RawSample> block;
+  for (;;) {
+    auto more = reader.value().next_block(block);
+    if (!more.is_ok()) return more.error();
+    if (!more.value()) break;
+    rec.samples.insert(rec.samples.end(), block.begin(), block.end());
   }
   return rec;
 }
 
 RecordingResult<Recording> read_recording(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) {
+  auto reader = RecordingReader::open(path);
+  if (!reader.is_ok()) return reader.error();
+  Recording rec;
+  rec.header = reader.value().header();
+  std::vector<hal::RawSample> block;
+  for (;;) {
+    auto more = reader.value().next_block(block);
+    if (!more.is_ok()) return more.error();
+    if (!more.value()) break;
+    rec.samples.insert(rec.samples.end(), block.begin(), block.end());
+  }
+  return rec;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+RecordingReader::RecordingReader(RecordingReader&& other) noexcept
+    : file_(std::exchange(other.file_, nullptr)),
+      path_(std::move(other.path_)),
+      bytes_(other.bytes_),
+      size_(other.size_),
+      header_(other.header_),
+      pos_(other.pos_),
+      index_(other.index_),
+      block_(other.block_),
+      buffer_(std::move(other.buffer_)) {}
+
+RecordingReader& RecordingReader::operator=(RecordingReader&& other) noexcept {
+  if (this != &other) {
+    if (file_ != nullptr) std::fclose(file_);
+    file_ = std::exchange(other.file_, nullptr);
+    path_ = std::move(other.path_);
+    bytes_ = other.bytes_;
+    size_ = other.size_;
+    header_ = other.header_;
+    pos_ = other.pos_;
+    index_ = other.index_;
+    block_ = other.block_;
+    buffer_ = std::move(other.buffer_);
+  }
+  return *this;
+}
+
+RecordingReader::~RecordingReader() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+RecordingResult<Done> RecordingReader::read_at(std::uint64_t offset, std::size_t n,
+                                               std::uint8_t* dst) {
+  if (file_ == nullptr) {
+    std::memcpy(dst, bytes_.data() + offset, n);
+    return Done{};
+  }
+  if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
+      std::fread(dst, 1, n, file_) != n) {
+    return RecordingError{
+        ErrorCode::kIoError, offset,
+        "recording: read error in " + path_ + " at byte offset " + std::to_string(offset)};
+  }
+  return Done{};
+}
+
+RecordingResult<RecordingReader> RecordingReader::from_bytes(std::span<const std::uint8_t> bytes) {
+  RecordingReader r;
+  r.bytes_ = bytes;
+  r.size_ = bytes.size();
+  auto head = decode_header(bytes.first(std::min(bytes.size(), kRecordingHeaderBytes)));
+  if (!head.is_ok()) {
+    RecordingError e = head.error();
+    return e;
+  }
+  r.header_ = head.value();
+  return r;
+}
+
+RecordingResult<RecordingReader> RecordingReader::open(const std::string& path) {
+  RecordingReader r;
+  r.path_ = path;
+  r.file_ = std::fopen(path.c_str(), "rb");
+  if (r.file_ == nullptr) {
     return RecordingError{ErrorCode::kIoError, 0,
                           "recording: cannot open " + path + ": " + std::strerror(errno)};
   }
-  std::vector<std::uint8_t> bytes;
-  std::array<std::uint8_t, 65536> chunk{};
-  std::size_t got = 0;
-  while ((got = std::fread(chunk.data(), 1, chunk.size(), f)) > 0) {
-    bytes.insert(bytes.end(), chunk.begin(), chunk.begin() + static_cast<std::ptrdiff_t>(got));
+  if (std::fseek(r.file_, 0, SEEK_END) != 0) {
+    return RecordingError{ErrorCode::kIoError, 0, "recording: cannot seek in " + path};
   }
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) {
-    return RecordingError{
-        ErrorCode::kIoError, bytes.size(),
-        "recording: read error in " + path + " at byte offset " + std::to_string(bytes.size())};
+  const long end = std::ftell(r.file_);
+  if (end < 0) return RecordingError{ErrorCode::kIoError, 0, "recording: cannot size " + path};
+  r.size_ = static_cast<std::uint64_t>(end);
+  std::array<std::uint8_t, kRecordingHeaderBytes> head_bytes{};
+  const std::size_t n =
+      static_cast<std::size_t>(std::min<std::uint64_t>(r.size_, head_bytes.size()));
+  auto got = r.read_at(0, n, head_bytes.data());
+  if (!got.is_ok()) return got.error();
+  auto head = decode_header(std::span<const std::uint8_t>(head_bytes.data(), n));
+  if (!head.is_ok()) return head.error();
+  r.header_ = head.value();
+  return r;
+}
+
+RecordingResult<bool> RecordingReader::check_end() {
+  if (pos_ != size_) {
+    return error_at(ErrorCode::kDataLoss, pos_,
+                    std::to_string(size_ - pos_) + " bytes after the last of the " +
+                        std::to_string(index_) + " records the header announces");
   }
-  return decode_recording(bytes);
+  return false;
+}
+
+RecordingResult<bool> RecordingReader::next_block(std::vector<hal::RawSample>& out) {
+  out.clear();
+  const std::uint64_t rpb = header_.records_per_block;
+  const std::uint64_t remaining = size_ - pos_;
+  std::uint64_t n = 0;  // records in this block
+  if (header_.record_count != kRecordCountUnknown) {
+    n = std::min(rpb, header_.record_count - index_);
+    if (n == 0) return check_end();
+  } else {
+    if (remaining == 0) return false;
+    const std::uint64_t full = rpb * kRecordingRecordBytes + kRecordingCrcBytes;
+    n = remaining >= full
+            ? rpb
+            : (remaining - std::min(remaining, kRecordingCrcBytes)) / kRecordingRecordBytes;
+    if (remaining < full &&
+        (n == 0 || n * kRecordingRecordBytes + kRecordingCrcBytes != remaining)) {
+      const std::uint64_t at = pos_ + (remaining / kRecordingRecordBytes) * kRecordingRecordBytes;
+      return error_at(ErrorCode::kDataLoss, at,
+                      "truncated: block " + std::to_string(block_) + " at byte offset " +
+                          std::to_string(pos_) + " ends inside a record or its CRC (file is " +
+                          std::to_string(size_) + " bytes)");
+    }
+  }
+  const std::uint64_t need = n * kRecordingRecordBytes + kRecordingCrcBytes;
+  if (remaining < need) {
+    const std::uint64_t whole = std::min(n, remaining / kRecordingRecordBytes);
+    const std::uint64_t at = pos_ + whole * kRecordingRecordBytes;
+    return error_at(ErrorCode::kDataLoss, at,
+                    "truncated: the file ends at byte " + std::to_string(size_) + " inside block " +
+                        std::to_string(block_) + " (starts at byte offset " + std::to_string(pos_) +
+                        ", needs " + std::to_string(need) + " bytes); header promises " +
+                        std::to_string(header_.record_count) + " records, " +
+                        std::to_string(index_ + whole) + " are complete");
+  }
+  buffer_.resize(static_cast<std::size_t>(need));
+  auto got = read_at(pos_, buffer_.size(), buffer_.data());
+  if (!got.is_ok()) return got.error();
+  const auto data = std::span<const std::uint8_t>(buffer_).first(
+      static_cast<std::size_t>(n * kRecordingRecordBytes));
+  const std::uint32_t stored = get_u32(buffer_.data() + data.size());
+  const std::uint32_t computed = crc32(data);
+  if (stored != computed) {
+    return error_at(ErrorCode::kDataLoss, pos_,
+                    "block " + std::to_string(block_) + " (records " + std::to_string(index_) +
+                        ".." + std::to_string(index_ + n - 1) + ") at byte offset " +
+                        std::to_string(pos_) + ": CRC-32 mismatch (stored " + hex32(stored) +
+                        ", computed " + hex32(computed) + ")");
+  }
+  out.reserve(static_cast<std::size_t>(n));
+  for (std::uint64_t i = 0; i < n; ++i) {
+    out.push_back(decode_record(data.subspan(static_cast<std::size_t>(i * kRecordingRecordBytes))
+                                    .first<kRecordingRecordBytes>()));
+  }
+  index_ += n;
+  pos_ += need;
+  ++block_;
+  return true;
 }
 
 RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,

@@ -77,9 +77,32 @@ const ReplayReport& Replayer<T>::run(std::span<const hal::RawSample> samples) {
   return report_;
 }
 
+template <typename T>
+RecordingResult<ReplayReport> replay_recording(const std::string& path,
+                                               nav::NavPipeline<T>& pipeline,
+                                               typename Replayer<T>::Sink sink) {
+  auto reader = RecordingReader::open(path);
+  if (!reader.is_ok()) return reader.error();
+  Replayer<T> replayer(pipeline, std::move(sink));
+  std::vector<hal::RawSample> block;
+  for (;;) {
+    auto more = reader.value().next_block(block);
+    if (!more.is_ok()) return more.error();
+    if (!more.value()) break;
+    replayer.run(block);
+  }
+  return replayer.report();
+}
+
 template class Replayer<float>;
 template class Replayer<double>;
 template void hash_nav_state<float>(Fnv1a64&, const nav::NavState<float>&);
 template void hash_nav_state<double>(Fnv1a64&, const nav::NavState<double>&);
+template RecordingResult<ReplayReport> replay_recording<float>(const std::string&,
+                                                               nav::NavPipeline<float>&,
+                                                               Replayer<float>::Sink);
+template RecordingResult<ReplayReport> replay_recording<double>(const std::string&,
+                                                                nav::NavPipeline<double>&,
+                                                                Replayer<double>::Sink);
 
 }  // namespace gfins::sim

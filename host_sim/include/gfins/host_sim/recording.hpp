@@ -109,6 +109,45 @@ RecordingResult<Recording> read_recording(const std::string& path);
 RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,
                                       std::span<const hal::RawSample> samples);
 
+/// Streaming reader: the header at open, then one block at a time, with the same checks and
+/// error offsets as decode_recording (which is built on it). Memory use is one block, so a
+/// recording of any length can be replayed. Reads either a file or a caller-owned byte span
+/// (which must outlive the reader).
+class RecordingReader {
+ public:
+  static RecordingResult<RecordingReader> open(const std::string& path);
+  static RecordingResult<RecordingReader> from_bytes(std::span<const std::uint8_t> bytes);
+  RecordingReader(RecordingReader&& other) noexcept;
+  RecordingReader& operator=(RecordingReader&& other) noexcept;
+  RecordingReader(const RecordingReader&) = delete;
+  RecordingReader& operator=(const RecordingReader&) = delete;
+  ~RecordingReader();
+
+  const RecordingHeader& header() const { return header_; }
+
+  /// Replaces `out` with the samples of the next block. Returns false (and an empty `out`) at the
+  /// clean end of the recording, an error when the file is truncated or corrupt there.
+  RecordingResult<bool> next_block(std::vector<hal::RawSample>& out);
+
+  /// Records returned so far.
+  std::uint64_t records_read() const { return index_; }
+
+ private:
+  RecordingReader() = default;
+  RecordingResult<Done> read_at(std::uint64_t offset, std::size_t n, std::uint8_t* dst);
+  RecordingResult<bool> check_end();
+
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::span<const std::uint8_t> bytes_{};
+  std::uint64_t size_ = 0;
+  RecordingHeader header_{};
+  std::uint64_t pos_ = kRecordingHeaderBytes;
+  std::uint64_t index_ = 0;
+  std::uint64_t block_ = 0;
+  std::vector<std::uint8_t> buffer_;
+};
+
 /// Streaming writer: append samples as they come, one block written per records_per_block
 /// samples; close() writes the last partial block and patches record_count into the header.
 /// A file whose writer died before close() keeps record_count = kRecordCountUnknown and stays

@@ -18,9 +18,11 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gfins/hal/raw_sample.hpp"
+#include "gfins/host_sim/recording.hpp"
 #include "gfins/nav_core/nav_state.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
@@ -96,9 +98,24 @@ ReplayReport replay(nav::NavPipeline<T>& pipeline, std::span<const hal::RawSampl
   return r.run(samples);
 }
 
+/// Streams the recording at `path` block by block (memory: one block) through `pipeline`. On a
+/// truncated or corrupt file the error names its byte offset; the pipeline has then consumed
+/// every sample before the broken block (the checks of a block come before any of its samples
+/// is offered).
+template <typename T>
+RecordingResult<ReplayReport> replay_recording(const std::string& path,
+                                               nav::NavPipeline<T>& pipeline,
+                                               typename Replayer<T>::Sink sink = {});
+
 extern template class Replayer<float>;
 extern template class Replayer<double>;
 extern template void hash_nav_state<float>(Fnv1a64&, const nav::NavState<float>&);
 extern template void hash_nav_state<double>(Fnv1a64&, const nav::NavState<double>&);
+extern template RecordingResult<ReplayReport> replay_recording<float>(const std::string&,
+                                                                      nav::NavPipeline<float>&,
+                                                                      Replayer<float>::Sink);
+extern template RecordingResult<ReplayReport> replay_recording<double>(const std::string&,
+                                                                       nav::NavPipeline<double>&,
+                                                                       Replayer<double>::Sink);
 
 }  // namespace gfins::sim
