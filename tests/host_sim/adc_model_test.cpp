@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
 #include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/host_sim/trajectory.hpp"
@@ -186,6 +187,23 @@ TEST(AdcModelTest, SensorAdcAndFrontEndCloseTheLoopWithinHalfAnLsb) {
                 half_lsb_mps2 * (1.0 + kFrontEndRounding))
         << "sensor " << j + 1;
   }
+}
+
+TEST(AdcModelTest, NonPhysicalConfigurationsAreRefused) {
+  // Given configurations with a zero reference, a negative gain, a zero rate, negative jitter,
+  AdcConfig zero_vref;
+  zero_vref.vref_v = 0.0;
+  AdcConfig neg_gain;
+  neg_gain.gain = -1.0;
+  AdcConfig zero_rate;
+  zero_rate.sample_rate_hz = 0.0;
+  AdcConfig neg_jitter;
+  neg_jitter.jitter_ns_rms = -1.0;
+  // then no model is built from them.
+  EXPECT_THROW(AdcModel{zero_vref}, std::invalid_argument);
+  EXPECT_THROW(AdcModel{neg_gain}, std::invalid_argument);
+  EXPECT_THROW(AdcModel{zero_rate}, std::invalid_argument);
+  EXPECT_THROW(AdcModel{neg_jitter}, std::invalid_argument);
 }
 
 }  // namespace

@@ -284,6 +284,23 @@ TEST(RecordingTest, SamplesThatDoNotFitTheRecordAreRefused) {
   std::filesystem::remove(path);
 }
 
+TEST(RecordingTest, HeadersTheReaderWouldRefuseAreNotWritten) {
+  // Given headers with 0 records per block, 5 channels or version 2,
+  RecordingHeader zero = test_header();
+  zero.records_per_block = 0;
+  RecordingHeader five = test_header();
+  five.channel_count = 5;
+  RecordingHeader v2 = test_header();
+  v2.version = 2;
+  // then neither the encoder nor the writer produces a file from them.
+  for (const RecordingHeader& h : {zero, five, v2}) {
+    const auto e = encode_recording(h, test_samples());
+    ASSERT_FALSE(e.is_ok());
+    EXPECT_EQ(e.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_FALSE(RecordingWriter::open(temp_path("refused_header.gfr"), h).is_ok());
+  }
+}
+
 TEST(RecordingTest, MissingFileIsAnIoError) {
   const auto rec = read_recording(temp_path("does_not_exist.gfr"));
   ASSERT_FALSE(rec.is_ok());

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 #include "gfins/nav_core/geometry.hpp"
@@ -264,6 +265,14 @@ TEST(SensorModelTest, SameSeedSameVoltsOtherSeedOtherVolts) {
   // then same seed is bit-identical and another seed is not.
   EXPECT_TRUE(all_equal_ab);
   EXPECT_TRUE(any_diff_ac);
+}
+
+TEST(SensorModelTest, NonPositiveSampleRateIsRefused) {
+  // Given a zero and a NaN sample rate, then no model is built (the walk step would be infinite).
+  EXPECT_THROW(SensorArrayModel(kNominal, ArrayErrors{}, kGravity, 0.0, 1), std::invalid_argument);
+  EXPECT_THROW(SensorArrayModel(kNominal, ArrayErrors{}, kGravity,
+                                std::numeric_limits<double>::quiet_NaN(), 1),
+               std::invalid_argument);
 }
 
 }  // namespace

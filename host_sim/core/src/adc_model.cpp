@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
 
 #include "gfins/nav_core/front_end.hpp"
 
@@ -13,7 +14,14 @@ constexpr double kTwoPow23 = 8388608.0;  // 2^23: codes per vref at gain 1
 AdcModel::AdcModel(const AdcConfig& c)
     : config_(c),
       counts_per_volt_(c.gain * c.input_divider / c.vref_v * kTwoPow23),
-      jitter_rng_(c.jitter_seed) {}
+      jitter_rng_(c.jitter_seed) {
+  const auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (!positive(c.vref_v) || !positive(c.gain) || !positive(c.input_divider) ||
+      !positive(c.sample_rate_hz) || !(c.jitter_ns_rms >= 0.0)) {
+    throw std::invalid_argument(
+        "AdcModel: vref, gain, input divider and sample rate must be positive, jitter ≥ 0");
+  }
+}
 
 double AdcModel::volts_per_count() const { return 1.0 / counts_per_volt_; }
 

@@ -84,6 +84,20 @@ std::string hex32(std::uint32_t v) {
   return m.str();
 }
 
+// What a writer must refuse to write, because the reader would refuse to read it.
+std::optional<RecordingError> check_writable(const RecordingHeader& h) {
+  if (h.version != kRecordingVersion) {
+    return error_at(ErrorCode::kInvalidArgument, kOffVersion, "header version is not 1");
+  }
+  if (h.channel_count != hal::kAdcChannels) {
+    return error_at(ErrorCode::kInvalidArgument, kOffChannels, "header channel count is not 6");
+  }
+  if (h.records_per_block == 0) {
+    return error_at(ErrorCode::kInvalidArgument, kOffRecordsPerBlock, "records per block is 0");
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc) {
@@ -210,9 +224,7 @@ hal::RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes
 
 RecordingResult<std::vector<std::uint8_t>> encode_recording(
     RecordingHeader header, std::span<const hal::RawSample> samples) {
-  if (header.records_per_block == 0) {
-    return error_at(ErrorCode::kInvalidArgument, kOffRecordsPerBlock, "records per block is 0");
-  }
+  if (auto bad = check_writable(header)) return *bad;
   header.record_count = samples.size();
   const auto head = encode_header(header);
   std::vector<std::uint8_t> out(head.begin(), head.end());
@@ -476,9 +488,7 @@ RecordingError RecordingWriter::io_error(const char* what) const {
 
 RecordingResult<RecordingWriter> RecordingWriter::open(const std::string& path,
                                                        const RecordingHeader& header) {
-  if (header.records_per_block == 0) {
-    return error_at(ErrorCode::kInvalidArgument, kOffRecordsPerBlock, "records per block is 0");
-  }
+  if (auto bad = check_writable(header)) return *bad;
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) {
     return RecordingError{ErrorCode::kIoError, 0,

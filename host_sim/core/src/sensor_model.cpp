@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <stdexcept>
 
 namespace gfins::sim {
 namespace {
@@ -20,8 +21,6 @@ std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream, std::size_t sen
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
-
-constexpr double kDefaultRateHz = 1000.0;
 
 }  // namespace
 
@@ -45,9 +44,11 @@ SensorArrayModel::SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal,
     : errors_(errors),
       nominal_(nominal, gravity),
       real_(nav::misaligned_geometry(nominal, errors.misalignment), gravity),
-      sample_rate_hz_(sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz) ? sample_rate_hz
-                                                                            : kDefaultRateHz),
-      sqrt_dt_s_(std::sqrt(1.0 / sample_rate_hz_)) {
+      sample_rate_hz_(sample_rate_hz),
+      sqrt_dt_s_(std::sqrt(1.0 / sample_rate_hz)) {
+  if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz)) {
+    throw std::invalid_argument("SensorArrayModel: sample rate must be positive and finite");
+  }
   for (std::size_t j = 0; j < 6; ++j) {
     noise_rng_[j].seed(mix_seed(seed, kNoiseStream, j));
     walk_rng_[j].seed(mix_seed(seed, kWalkStream, j));

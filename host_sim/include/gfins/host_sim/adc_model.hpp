@@ -41,6 +41,8 @@ struct AdcConfig {
 
 class AdcModel {
  public:
+  /// Throws std::invalid_argument when vref, gain, divider or rate is not positive and finite,
+  /// or the jitter is negative.
   explicit AdcModel(const AdcConfig& c);
 
   /// One simultaneous conversion of the six channels at data-ready edge `seq`. Advances the

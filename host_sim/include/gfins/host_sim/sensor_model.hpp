@@ -65,7 +65,8 @@ class SensorArrayModel {
 
   /// `nominal` is the design geometry (e.g. nav::table1_geometry); the sensors sense along
   /// nav::misaligned_geometry(nominal, errors.misalignment). `sample_rate_hz` sets the random-walk
-  /// step; it must be positive (a non-positive rate is treated as 1 kHz, see the .cpp).
+  /// step. Throws std::invalid_argument when it is not positive and finite (host code, like
+  /// make_spin: a simulation set up wrong should stop, not run on a made-up rate).
   SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal, const ArrayErrors& errors,
                    const nav::GravityModel<double>& gravity, double sample_rate_hz,
                    std::uint64_t seed);
