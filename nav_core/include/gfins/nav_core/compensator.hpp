@@ -118,8 +118,8 @@ class Compensator {
   }
 
   CompensatorKind kind_ = CompensatorKind::kNone;
-  std::array<Vec3<T>, 6> theta_b_{};
-  std::array<Vec3<T>, 6> drho_b_{};
+  std::array<Vec3<T>, 6> theta_b_ = zero_vectors<T, 6>();
+  std::array<Vec3<T>, 6> drho_b_ = zero_vectors<T, 6>();
   Mat3<T> c_beta_ = Mat3<T>::Identity();
   Mat3<T> c_alpha_ = Mat3<T>::Identity();
   Mat3<T> c_beta_inv_ = Mat3<T>::Identity();

@@ -32,8 +32,8 @@ inline constexpr int kNumSensors = 6;
 template <typename T, int N = kNumSensors>
 struct ArrayGeometry {
   static_assert(N >= 6, "six outputs are the minimum that determine [ω̇; f]");
-  std::array<Vec3<T>, N> rho_b{};
-  std::array<Vec3<T>, N> theta_b{};
+  std::array<Vec3<T>, N> rho_b = zero_vectors<T, static_cast<std::size_t>(N)>();
+  std::array<Vec3<T>, N> theta_b = zero_vectors<T, static_cast<std::size_t>(N)>();
 
   template <typename U>
   ArrayGeometry<U, N> cast() const {

@@ -6,7 +6,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace gfins::nav {
 
@@ -20,6 +22,15 @@ template <typename T>
 using Mat6 = Eigen::Matrix<T, 6, 6>;
 template <typename T>
 using Quat = Eigen::Quaternion<T>;
+
+/// An array of N zero vectors. Eigen leaves fixed-size matrices uninitialised even when
+/// value-initialised (`std::array<Vec3, N> a{}` holds garbage), so members are defaulted with this.
+template <typename T, std::size_t N>
+std::array<Vec3<T>, N> zero_vectors() {
+  std::array<Vec3<T>, N> a;
+  a.fill(Vec3<T>::Zero());
+  return a;
+}
 
 /// Standard gravity, the "g" of the accelerometer scale factors in V/g (paper Table 6).
 inline constexpr double kStandardGravity = 9.80665;

@@ -45,15 +45,6 @@ Mat3<T> set_matrix(const std::array<T, 6>& d) {
   return c;
 }
 
-/// N zero vectors. `std::array<Vec3<T>, N> a{}` is NOT zero: value-initialising an Eigen matrix
-/// runs its default constructor, which leaves the coefficients uninitialised.
-template <typename T, std::size_t N>
-std::array<Vec3<T>, N> zero_vectors() {
-  std::array<Vec3<T>, N> a;
-  a.fill(Vec3<T>::Zero());
-  return a;
-}
-
 /// Misalignment of a six-sensor array: orientation (eqs. (14)/(15)) and location (eq. (19)).
 /// A default-constructed value is "no misalignment" (all angles and offsets zero).
 template <typename T>
