@@ -79,6 +79,7 @@ class Compensator {
     }
     c.c_beta_inv_ = c.c_beta_.inverse();
     c.c_alpha_inv_ = c.c_alpha_.inverse();
+    c.build_fused_form();
     return c;
   }
 
@@ -92,7 +93,23 @@ class Compensator {
   }
 
   /// s (compensated) from s** (front-end output); w_b and wdot_b are the latest estimates.
+  /// Since C⁻¹(s** − C Δfθ) = C⁻¹ s** − Δfθ and Δf_j·θ_j is linear in [m(ω); ω̇], eqs. (27)-(30)
+  /// collapse to s = P s** − D [m(ω); ω̇] with P (the two C⁻¹ blocks on their sensors) and D
+  /// built once in create(); apply_reference() keeps the step-by-step form the tests compare to.
   void apply(const Outputs& s_raw, const Vec3<T>& w_b, const Vec3<T>& wdot_b, Outputs& s) const {
+    if (kind_ != CompensatorKind::kPaper) {
+      s = s_raw;
+      return;
+    }
+    Eigen::Matrix<T, 9, 1> x;
+    x << centripetal_monomials(w_b), wdot_b;
+    s = p_ * s_raw - d_ * x;
+  }
+
+  /// The paper's sequence as printed (misprints fixed): location compensation (27)/(28), then
+  /// orientation compensation (29)/(30), set by set.
+  void apply_reference(const Outputs& s_raw, const Vec3<T>& w_b, const Vec3<T>& wdot_b,
+                       Outputs& s) const {
     if (kind_ != CompensatorKind::kPaper) {
       s = s_raw;
       return;
@@ -117,6 +134,30 @@ class Compensator {
     for (int i = 0; i < 3; ++i) s(set[static_cast<std::size_t>(i)]) = s_ideal(i);
   }
 
+  // P: C⁻¹ of each set scattered onto its sensors. D row j: Δf_j·θ_j = q_jᵀ m(ω) + (Δρ_j×θ_j)·ω̇,
+  // with q_j the centripetal quadratic form of geometry.hpp evaluated at Δρ_j instead of ρ_j.
+  void build_fused_form() {
+    p_.setZero();
+    const auto scatter = [this](const std::array<int, 3>& set, const Mat3<T>& c_inv) {
+      for (std::size_t i = 0; i < 3; ++i) {
+        for (std::size_t k = 0; k < 3; ++k) {
+          p_(set[i], set[k]) = c_inv(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k));
+        }
+      }
+    };
+    scatter(kSetBeta, c_beta_inv_);
+    scatter(kSetAlpha, c_alpha_inv_);
+    for (std::size_t j = 0; j < 6; ++j) {
+      const Vec3<T>& th = theta_b_[j];
+      const Vec3<T>& d = drho_b_[j];
+      const T td = th.dot(d);
+      const Vec3<T> dxt = d.cross(th);
+      d_.row(static_cast<Eigen::Index>(j)) << th.x() * d.x() - td, th.y() * d.y() - td,
+          th.z() * d.z() - td, th.y() * d.z() + th.z() * d.y(), th.x() * d.z() + th.z() * d.x(),
+          th.x() * d.y() + th.y() * d.x(), dxt.x(), dxt.y(), dxt.z();
+    }
+  }
+
   CompensatorKind kind_ = CompensatorKind::kNone;
   std::array<Vec3<T>, 6> theta_b_ = zero_vectors<T, 6>();
   std::array<Vec3<T>, 6> drho_b_ = zero_vectors<T, 6>();
@@ -124,6 +165,8 @@ class Compensator {
   Mat3<T> c_alpha_ = Mat3<T>::Identity();
   Mat3<T> c_beta_inv_ = Mat3<T>::Identity();
   Mat3<T> c_alpha_inv_ = Mat3<T>::Identity();
+  Mat6<T> p_ = Mat6<T>::Identity();
+  Eigen::Matrix<T, 6, 9> d_ = Eigen::Matrix<T, 6, 9>::Zero();
 };
 
 }  // namespace gfins::nav
