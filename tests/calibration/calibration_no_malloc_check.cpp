@@ -1,45 +1,18 @@
 // Proves the multi-attitude solver and the static detector never touch the heap (they must run
-// on the board). The solver's sources are compiled into this test with EIGEN_RUNTIME_NO_MALLOC,
-// so Eigen asserts on any allocation while it is forbidden; the linker then takes these
-// definitions and never extracts the same objects from libgfins_nav_calib.a. A counting global
-// operator new catches allocations outside Eigen too. Only the marked windows count.
-#define EIGEN_RUNTIME_NO_MALLOC
+// on the board). The solver's and the core's sources are compiled into this test executable with
+// EIGEN_RUNTIME_NO_MALLOC (tests/calibration/CMakeLists.txt), so Eigen asserts on any allocation
+// while it is forbidden; a counting global operator new catches allocations outside Eigen too.
+// Only the marked windows count.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
-#include "../../nav_core/calibration/src/multi_attitude.cpp"   // NOLINT: see above
-#include "../../nav_core/calibration/src/static_detector.cpp"  // NOLINT: see above
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "gfins/nav_core/calibration/multi_attitude.hpp"
+#include "gfins/nav_core/calibration/static_detector.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace gfins::calib {
 namespace {
 
-class NoAllocWindow {
- public:
-  NoAllocWindow() : start_(g_allocations.load()) { Eigen::internal::set_is_malloc_allowed(false); }
-  ~NoAllocWindow() { Eigen::internal::set_is_malloc_allowed(true); }
-  long allocations() const { return g_allocations.load() - start_; }
-
- private:
-  long start_;
-};
+using gfins::testing::NoAllocWindow;
 
 template <typename T>
 long allocations_for_calibration() {

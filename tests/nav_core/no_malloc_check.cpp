@@ -2,51 +2,16 @@
 // with EIGEN_RUNTIME_NO_MALLOC (Eigen asserts on any allocation while forbidden), and the global
 // operator new is replaced by a counting one, which catches allocations outside Eigen too.
 // Neither check is active while GoogleTest itself runs; only the windows marked below count.
-#ifndef EIGEN_RUNTIME_NO_MALLOC
-#error "this test must be compiled with EIGEN_RUNTIME_NO_MALLOC"
-#endif
-
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
 #include "gfins/nav_core/pipeline.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// The replacements pair malloc with free; GCC's -Wmismatched-new-delete cannot see that the
-// operator new it inlines next to them is this malloc-based one, so it is silenced here only.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
+#include "support/alloc_counter.hpp"
 
 namespace gfins::nav {
 namespace {
 
-// RAII window in which neither Eigen nor anything else may allocate.
-class NoAllocWindow {
- public:
-  NoAllocWindow() : start_(g_allocations.load()) { Eigen::internal::set_is_malloc_allowed(false); }
-  ~NoAllocWindow() { Eigen::internal::set_is_malloc_allowed(true); }
-  long allocations() const { return g_allocations.load() - start_; }
-
- private:
-  long start_;
-};
+using gfins::testing::g_allocations;
+using gfins::testing::NoAllocWindow;
 
 template <typename T>
 long allocations_for_full_run(CompensatorKind kind) {
