@@ -23,8 +23,10 @@
 #include <vector>
 
 #include "gfins/host_sim/array_model.hpp"
+#include "gfins/host_sim/covariance.hpp"
 #include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/scenario.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
@@ -393,6 +395,74 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
   return 0;
 }
 
+// Covariance analysis (docs/error-model.md): predicted 1σ envelopes of the twelve navigation
+// errors along the scenario's truth, and the error budget at chosen times. The scenario gives
+// trajectory, duration, rate, ρ, gravity and white noise (QA-1100 noise and bias random walk
+// with qa1100 = true); the constant-error σ come from the options.
+struct CovarianceOptions {
+  double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;
+  std::vector<double> times_s;
+};
+
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::string out_dir,
+                   bool do_plot) {
+  const sim::Scenario s = load_or_exit(name);
+  if (out_dir.empty()) out_dir = "sim-out/covariance-" + s.name;
+  make_dir_or_exit(out_dir);
+  const auto traj = sim::make_trajectory(s.trajectory);
+  sim::CovarianceSpec spec;
+  spec.trajectory = traj.get();
+  spec.geometry = nav::table1_geometry<double>(s.rho_m);
+  spec.gravity = sim::gravity_model(s);
+  spec.duration_s = s.duration_s;
+  spec.dt_s = 1.0 / s.rate_hz;
+  spec.decimation = static_cast<std::size_t>(std::max(1.0, std::round(s.rate_hz / 100.0)));
+  const double g = nav::kStandardGravity;
+  const sim::AccelErrors qa = sim::AccelErrors::qa1100_typical();
+  const double noise = s.noise_mps2 > 0 ? s.noise_mps2 : (s.qa1100 ? qa.noise_g * g : 0.0);
+  const double rw = c.bias_rw_ug_sqrt_s > 0 ? c.bias_rw_ug_sqrt_s * 1e-6 * g
+                                            : (s.qa1100 ? qa.bias_rw_g_per_sqrt_s * g : 0.0);
+  spec.noise.white_sigma_mps2.fill(noise);
+  spec.noise.bias_rw_mps2_sqrt_s.fill(rw);
+  spec.noise.bias_sigma_mps2.fill(c.bias_ug * 1e-6 * g);
+  spec.constants.scale_factor_sigma.fill(c.scale_ppm * 1e-6);
+  spec.constants.orientation_sigma_rad.fill(c.orientation_urad * 1e-6);
+  spec.constants.location_sigma_m.fill(c.location_mm * 1e-3);
+  std::vector<double> times = c.times_s;
+  if (times.empty()) times = {0.25 * s.duration_s, 0.5 * s.duration_s, s.duration_s};
+  std::printf(
+      "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
+      describe(s).c_str(), noise, c.bias_ug, rw);
+  const sim::CovarianceResult r = sim::propagate_covariance(spec);
+  sim::write_covariance_csv(r, out_dir + "/covariance.csv");
+  const sim::ErrorBudget b = sim::error_budget(spec, times);
+  sim::write_budget_csv(b, out_dir + "/budget.csv");
+  const std::size_t last = r.t_s.size() - 1;
+  const auto block = [&](std::size_t off) {
+    return std::sqrt(r.sigma[off][last] * r.sigma[off][last] +
+                     r.sigma[off + 1][last] * r.sigma[off + 1][last] +
+                     r.sigma[off + 2][last] * r.sigma[off + 2][last]);
+  };
+  std::printf(
+      "predicted 1 sigma at t = %.3g s: |phi| %.4g deg, |dr| %.4g m, |dv| %.4g m/s, "
+      "|dw| %.4g rad/s\nwritten: %s/covariance.csv, %s/budget.csv\n",
+      r.t_s[last], block(0) * 180.0 / M_PI, block(3), block(6), block(9), out_dir.c_str(),
+      out_dir.c_str());
+  if (do_plot) {
+    const char* env = std::getenv("GFINS_PYTHON");
+    const std::string python = env != nullptr                                ? env
+                               : std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3"
+                                                                             : "python3";
+    const std::string cmd =
+        python + " '" + std::string(GFINS_SCRIPTS_DIR) + "/plot_covariance.py' '" + out_dir + "'";
+    if (std::system(cmd.c_str()) != 0) {
+      std::fprintf(stderr, "gfins-sim: plotting failed (%s); the CSV files are written\n",
+                   cmd.c_str());
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -438,7 +508,19 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 100000))
       ->capture_default_str();
   mc->add_option("--seed0", mc_seed, "seed of the first run")->capture_default_str();
-  for (auto* c : {run_cmd, p63, mc}) {
+  CovarianceOptions cov_opts;
+  auto* cov = app.add_subcommand("covariance", "predicted 1-sigma envelopes and error budget");
+  cov->add_option("scenario", scenario_name, "file, or built-in name")
+      ->default_val("rest-calibrated");
+  cov->add_option("--bias-ug", cov_opts.bias_ug, "random-constant bias 1 sigma per sensor, ug");
+  cov->add_option("--bias-rw", cov_opts.bias_rw_ug_sqrt_s, "bias random walk, ug/sqrt(s)");
+  cov->add_option("--scale-ppm", cov_opts.scale_ppm, "residual scale-factor error 1 sigma, ppm");
+  cov->add_option("--orientation-urad", cov_opts.orientation_urad,
+                  "residual axis orientation error 1 sigma per axis, urad");
+  cov->add_option("--location-mm", cov_opts.location_mm,
+                  "residual location error 1 sigma per axis, mm");
+  cov->add_option("--at", cov_opts.times_s, "budget times, s (default T/4, T/2, T)");
+  for (auto* c : {run_cmd, p63, mc, cov}) {
     c->add_option("-o,--out", out_dir, "output folder (default sim-out/<name>)");
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
   }
@@ -449,6 +531,7 @@ int main(int argc, char** argv) {
     if (*run_cmd) return cmd_run(scenario_name, out_dir, !no_plot);
     if (*p63) return cmd_paper63(out_dir, !no_plot);
     if (*mc) return cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
+    if (*cov) return cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
     if (*list_cmd) {
       for (const auto& n : gfins::sim::builtin_scenarios(GFINS_SCENARIO_DIR)) {
         const auto p = gfins::sim::load_scenario(n, GFINS_SCENARIO_DIR);
