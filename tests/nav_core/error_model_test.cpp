@@ -197,6 +197,40 @@ TEST(ErrorModelTest, CentripetalBlockIsRhoTimesDeltaOmegaSquaredOfEq12) {
   EXPECT_LT(f_rate_rate.norm(), kRoundingTol);
 }
 
+// The equivalent output errors of the deterministic sources against the array model: a sensor
+// moved by Δρ, tilted by δθ (the array model uses θ as given, eq. (23)) or with gain 1 + ε. The
+// rigid-body output is linear in ρ_j, θ_j and the gain, so the first-order δs is exact.
+TEST(ErrorModelTest, EquivalentOutputErrorsMatchThePerturbedArray) {
+  const auto nominal = table1_geometry<double>(kRhoM);
+  const auto gravity = GravityModel<double>::constant(kStandardGravity);
+  const auto traj = sim::make_maneuver(1.0);
+  const sim::TruthState truth = traj->at(1.3);  // rotating and accelerating
+  const NavState<double> x = sim::truth_nav_state(truth, gravity);
+  const sim::IdealArrayModel<6> ideal(nominal, gravity);
+  const Vec6d s0 = ideal.outputs(truth);
+  constexpr int kJ = 2;
+  constexpr double kRoundingTol = 1e-12;  // m/s², rounding of outputs of ~10 m/s²
+
+  auto moved = nominal;
+  const Vec3<double> drho(1e-3, -2e-3, 0.5e-3);
+  moved.rho_b[kJ] += drho;
+  const Vec6d ds_loc = sim::IdealArrayModel<6>(moved, gravity).outputs(truth) - s0;
+  EXPECT_LT((location_ds<double, 6>(x, nominal, kJ, drho) - ds_loc).norm(), kRoundingTol);
+  EXPECT_GT(ds_loc.norm(), 1e3 * kRoundingTol);  // the motion makes it observable
+
+  auto tilted = nominal;
+  const Vec3<double> dtheta = nominal.theta_b[kJ].cross(Vec3<double>::UnitX()) * 1e-3;
+  tilted.theta_b[kJ] += dtheta;
+  const Vec6d ds_ori = sim::IdealArrayModel<6>(tilted, gravity).outputs(truth) - s0;
+  EXPECT_LT((orientation_ds<double, 6>(x, nominal, kJ, dtheta) - ds_ori).norm(), kRoundingTol);
+  EXPECT_GT(ds_ori.norm(), 1e3 * kRoundingTol);
+
+  constexpr double kEps = 1e-4;
+  Vec6d ds_sf = Vec6d::Zero();
+  ds_sf(kJ) = kEps * s0(kJ);
+  EXPECT_LT((scale_factor_ds<double, 6>(x, nominal, kJ, kEps) - ds_sf).norm(), kRoundingTol);
+}
+
 TEST(ErrorModelTest, RefusesNonPositiveStep) {
   const auto geometry = table1_geometry<double>(kRhoM);
   const Model model(ArraySolver<double>::create(geometry).value(),
