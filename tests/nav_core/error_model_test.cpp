@@ -58,8 +58,8 @@ NavState<double> initial_state(const sim::TruthState& x) {
 
 /// Runs the strapdown over the trajectory with bias_mps2 added to sensor kSensor and returns the
 /// navigation states at every sample.
-std::vector<NavState<double>> run(const sim::Trajectory& traj, double bias_mps2) {
-  const auto geometry = table1_geometry<double>(kRhoM);
+std::vector<NavState<double>> run(const sim::Trajectory& traj,
+                                  const ArrayGeometry<double, 6>& geometry, double bias_mps2) {
   const auto gravity = GravityModel<double>::constant(kStandardGravity);
   const sim::IdealArrayModel<6> array(geometry, gravity);
   Strapdown<double> nav(ArraySolver<double>::create(geometry).value(), gravity);
@@ -85,8 +85,8 @@ Errors difference(const NavState<double>& a, const NavState<double>& clean) {
 }
 
 /// The linear model's error after kDurationS for the constant δs = bias e_kSensor.
-Errors linear(const sim::Trajectory& traj, double bias_mps2) {
-  const auto geometry = table1_geometry<double>(kRhoM);
+Errors linear(const sim::Trajectory& traj, const ArrayGeometry<double, 6>& geometry,
+              double bias_mps2) {
   const auto gravity = GravityModel<double>::constant(kStandardGravity);
   const Model model(ArraySolver<double>::create(geometry).value(), gravity);
   Vec6d ds = Vec6d::Zero();
@@ -108,14 +108,15 @@ struct Case {
   Errors lin, plus, odd, even;
 };
 
-Case make_case(const sim::Trajectory& traj) {
-  const auto clean = run(traj, 0.0);
-  const auto plus = run(traj, kBiasMps2);
-  const auto minus = run(traj, -kBiasMps2);
+Case make_case(const sim::Trajectory& traj,
+               const ArrayGeometry<double, 6>& geometry = table1_geometry<double>(kRhoM)) {
+  const auto clean = run(traj, geometry, 0.0);
+  const auto plus = run(traj, geometry, kBiasMps2);
+  const auto minus = run(traj, geometry, -kBiasMps2);
   const Errors p = difference(plus.back(), clean.back());
   const Errors m = difference(minus.back(), clean.back());
   Case c;
-  c.lin = linear(traj, kBiasMps2);
+  c.lin = linear(traj, geometry, kBiasMps2);
   c.plus = p;
   c.odd = {(p.phi - m.phi) / 2, (p.dr - m.dr) / 2, (p.dv - m.dv) / 2, (p.dw - m.dw) / 2};
   c.even = {(p.phi + m.phi) / 2, (p.dr + m.dr) / 2, (p.dv + m.dv) / 2, (p.dw + m.dw) / 2};
@@ -144,36 +145,54 @@ class ErrorModelFirstOrderTest : public ::testing::Test {
     moving_ = std::make_unique<Case>(make_case(*traj));
     const auto rest = sim::make_rest(quat_from_euler(0.1, -0.05, 0.3));
     rest_ = std::make_unique<Case>(make_case(*rest));
+    // An asymmetric array (sensors moved off the cube by a few cm): K_w ≠ 0, so ω̇ depends on ω
+    // and the rate error couples to itself through −K_w J(ω) δω of the generalised eq. (13).
+    auto skewed = table1_geometry<double>(kRhoM);
+    skewed.rho_b[0] += Vec3<double>(0.03, 0.0, 0.0);
+    skewed.rho_b[2] += Vec3<double>(0.0, 0.02, 0.01);
+    skewed.rho_b[4] += Vec3<double>(-0.02, 0.0, 0.03);
+    general_ = std::make_unique<Case>(make_case(*traj, skewed));
   }
   static void TearDownTestSuite() {
     moving_.reset();
     rest_.reset();
+    general_.reset();
   }
   static std::unique_ptr<Case> moving_;
   static std::unique_ptr<Case> rest_;
+  static std::unique_ptr<Case> general_;
 };
 std::unique_ptr<Case> ErrorModelFirstOrderTest::moving_;
 std::unique_ptr<Case> ErrorModelFirstOrderTest::rest_;
+std::unique_ptr<Case> ErrorModelFirstOrderTest::general_;
 
 TEST_F(ErrorModelFirstOrderTest, AttitudeErrorMatchesToFirstOrder) {
   expect_first_order("phi", moving_->lin.phi, moving_->plus.phi, moving_->odd.phi,
                      moving_->even.phi);
   expect_first_order("phi", rest_->lin.phi, rest_->plus.phi, rest_->odd.phi, rest_->even.phi);
+  expect_first_order("phi", general_->lin.phi, general_->plus.phi, general_->odd.phi,
+                     general_->even.phi);
 }
 
 TEST_F(ErrorModelFirstOrderTest, PositionErrorMatchesToFirstOrder) {
   expect_first_order("dr", moving_->lin.dr, moving_->plus.dr, moving_->odd.dr, moving_->even.dr);
   expect_first_order("dr", rest_->lin.dr, rest_->plus.dr, rest_->odd.dr, rest_->even.dr);
+  expect_first_order("dr", general_->lin.dr, general_->plus.dr, general_->odd.dr,
+                     general_->even.dr);
 }
 
 TEST_F(ErrorModelFirstOrderTest, VelocityErrorMatchesToFirstOrder) {
   expect_first_order("dv", moving_->lin.dv, moving_->plus.dv, moving_->odd.dv, moving_->even.dv);
   expect_first_order("dv", rest_->lin.dv, rest_->plus.dv, rest_->odd.dv, rest_->even.dv);
+  expect_first_order("dv", general_->lin.dv, general_->plus.dv, general_->odd.dv,
+                     general_->even.dv);
 }
 
 TEST_F(ErrorModelFirstOrderTest, RateErrorMatchesToFirstOrder) {
   expect_first_order("dw", moving_->lin.dw, moving_->plus.dw, moving_->odd.dw, moving_->even.dw);
   expect_first_order("dw", rest_->lin.dw, rest_->plus.dw, rest_->odd.dw, rest_->even.dw);
+  expect_first_order("dw", general_->lin.dw, general_->plus.dw, general_->odd.dw,
+                     general_->even.dw);
 }
 
 // The Table 1 solver has K_w = 0 and K_f J δω = −ρ δω² (eq. (11)/(12) with the ρ factor the
