@@ -276,6 +276,24 @@ TEST(ErrorModelTest, FloatAgreesWithDouble) {
   ASSERT_TRUE(pf.is_ok() && pd.is_ok());
   constexpr double kFloatTol = 1e-5;  // float32 epsilon 1.2e-7 times entries up to ~30 (M)
   EXPECT_LT((pf.value().cast<double>() - pd.value()).cwiseAbs().maxCoeff(), kFloatTol);
+
+  // And the covariance of a noisy bias over 100 steps: float keeps 1e-4 relative.
+  SensorNoiseSpec<float, 6> nf;
+  SensorNoiseSpec<double, 6> nd;
+  nf.white_sigma_mps2.fill(1e-2f);
+  nd.white_sigma_mps2.fill(1e-2);
+  nf.bias_sigma_mps2[0] = 1e-3f;
+  nd.bias_sigma_mps2[0] = 1e-3;
+  auto p_f = ErrorModel<float, 6>::initial_covariance(nf);
+  auto p_d = Model::initial_covariance(nd);
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_TRUE(mf.propagate_covariance(x.cast<float>(), x.cast<float>(), nf, 1e-2f, p_f).is_ok());
+    ASSERT_TRUE(md.propagate_covariance(x, x, nd, 1e-2, p_d).is_ok());
+  }
+  constexpr double kFloatCovRelTol = 1e-4;  // 100 steps of float rounding (1.2e-7 each, ×~30)
+  for (int i = 0; i < err_idx::kNav; ++i) {
+    EXPECT_NEAR(static_cast<double>(p_f(i, i)) / p_d(i, i), 1.0, kFloatCovRelTol) << i;
+  }
 }
 
 }  // namespace
