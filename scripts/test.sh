@@ -6,6 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${GFINS_JOBS:-$(nproc)}
 start=$(date +%s)
+log_dir=$(mktemp -d)
+trap 'rm -rf "$log_dir"' EXIT
 step() { printf '\n=== %s (%s, +%ds)\n' "$*" "$(date +%T)" "$(($(date +%s) - start))"; }
 
 step "install packages"
@@ -19,14 +21,25 @@ cmake --preset host-debug >/dev/null
 cmake --build --preset host-debug -j "$jobs"
 
 step "host-debug (ASan + UBSan): unit tests"
-ctest --preset host-debug -j "$jobs"
+ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 
-step "host-release: build (tests, tools, benchmarks)"
+# Every unit test ran above under the sanitizers; the release build adds what needs optimised
+# code: the hour-long simulations, the heap checks with NDEBUG defined, the applications and
+# the benchmarks (built and run briefly so they cannot rot). The full release suite is
+# `ctest --preset host-release` after a full release build.
+step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
-cmake --build --preset host-release -j "$jobs"
+cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
+  gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
+  nav_core_no_malloc_check calibration_no_malloc_check
 
-step "host-release: all tests, including the hour-long runs (label long)"
-ctest --preset host-release -j "$jobs"
+step "host-release: hour-long runs (label long) and heap checks (label heap)"
+ctest --preset host-release -j "$jobs" -L 'long|heap' | tee "$log_dir/ctest-release.log"
+
+step "host-release: main job and benchmarks, smoke run"
+./build/host-release/host_sim/app/gfins-sim --duration 1 >/dev/null
+./build/host-release/tests/bench/gfins_nav_bench --benchmark_min_time=0.01 >/dev/null
+./build/host-release/tests/bench/gfins_replay_bench --benchmark_min_time=0.01 >/dev/null
 
 step "cortex-m4f: bare-metal build of the navigation core and the soft-double check"
 cmake --preset cortex-m4f >/dev/null
@@ -37,3 +50,6 @@ step "clang-tidy"
 ./scripts/check-tidy.sh build/host-release
 
 step "all checks passed"
+total=$(sed -n 's/.*tests passed, 0 tests failed out of \([0-9]*\).*/\1/p' "$log_dir"/ctest-*.log |
+  awk '{ n += $1 } END { print n + 0 }')
+echo "tests: $total passed, 0 failed"
