@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -177,6 +178,15 @@ void make_dir_or_exit(const std::string& dir) {
   }
 }
 
+/// Closes an output file. A failed write or close (disk full, I/O error) leaves the file
+/// incomplete, so it is an error, thrown like the library's CSV writers do (write_series_csv)
+/// and reported by main. The error flag is read first because fclose alone reports only the last
+/// flush (glibc returns 0 after an earlier ENOSPC).
+void close_output(std::FILE* f, const std::string& path) {
+  const bool write_failed = std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || write_failed) throw std::runtime_error("error writing " + path);
+}
+
 /// Calls scripts/plot_sim.py; a missing python3/matplotlib is reported, not fatal. The
 /// interpreter is $GFINS_PYTHON, else Debian's /usr/bin/python3 (python3-matplotlib), because a
 /// python3 first on PATH (pyenv, venv) often lacks matplotlib.
@@ -269,13 +279,14 @@ int cmd_run(const std::string& name, std::string out_dir, bool do_plot) {
   make_dir_or_exit(out_dir);
   std::printf("gfins-sim run %s\n", describe(s).c_str());
   const sim::ScenarioOutcome o = sim::run_scenario(s, tty_progress(s.name));
-  std::FILE* summary = std::fopen((out_dir + "/summary.txt").c_str(), "w");
+  const std::string summary_path = out_dir + "/summary.txt";
+  std::FILE* summary = std::fopen(summary_path.c_str(), "w");
   for (std::FILE* f : {stdout, summary}) {
     if (f == nullptr) continue;
     if (o.calibration.ran) print_calibration(f, s, o.calibration);
     if (!o.compensated.samples.empty()) print_run_table(f, o);
   }
-  if (summary != nullptr) std::fclose(summary);
+  if (summary != nullptr) close_output(summary, summary_path);
   if (o.compensated.samples.empty()) return 0;
   sim::write_series_csv(o.uncompensated, out_dir + "/uncompensated.csv");
   sim::write_series_csv(o.compensated, out_dir + "/compensated.csv");
@@ -302,9 +313,10 @@ int cmd_paper63(std::string out_dir, bool do_plot) {
       {"calibrated", "paper-6.3", true, "sigma 5e-4 m/s^2, calibrated (1 mg/pose)"},
       {"1mg-calibrated", "paper-6.3-1mg", true, "1 mg noise, calibrated (1 mg/pose)"},
   };
-  std::FILE* csv = std::fopen((out_dir + "/bounds.csv").c_str(), "w");
+  const std::string csv_path = out_dir + "/bounds.csv";
+  std::FILE* csv = std::fopen(csv_path.c_str(), "w");
   if (csv == nullptr) {
-    std::fprintf(stderr, "gfins-sim: cannot write %s/bounds.csv\n", out_dir.c_str());
+    std::fprintf(stderr, "gfins-sim: cannot write %s\n", csv_path.c_str());
     return 1;
   }
   std::fprintf(csv,
@@ -344,14 +356,15 @@ int cmd_paper63(std::string out_dir, bool do_plot) {
     sim::write_series_csv(o.uncompensated, out_dir + "/" + c.tag + "_before.csv");
     sim::write_series_csv(o.compensated, out_dir + "/" + c.tag + "_after.csv");
     if (o.calibration.ran && std::string(c.tag) == "calibrated") {
-      std::FILE* cf = std::fopen((out_dir + "/calibration.txt").c_str(), "w");
+      const std::string cf_path = out_dir + "/calibration.txt";
+      std::FILE* cf = std::fopen(cf_path.c_str(), "w");
       if (cf != nullptr) {
         print_calibration(cf, s, o.calibration);
-        std::fclose(cf);
+        close_output(cf, cf_path);
       }
     }
   }
-  std::fclose(csv);
+  close_output(csv, csv_path);
   std::printf(
       "\nlin: nav-frame linear acceleration error (m/s^2), ang: angular acceleration error "
       "(rad/s^2),\nmin/max over the three components and the samples t > 0; x: improvement "
@@ -376,7 +389,8 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
       r.t_s, r.rms_norm[static_cast<std::size_t>(sim::McQuantity::kRate)], 0.1 * t_end, t_end);
   const double a_slope = sim::loglog_slope(
       r.t_s, r.rms_norm[static_cast<std::size_t>(sim::McQuantity::kAttitude)], 0.1 * t_end, t_end);
-  std::FILE* f = std::fopen((out_dir + "/slopes.txt").c_str(), "w");
+  const std::string slopes_path = out_dir + "/slopes.txt";
+  std::FILE* f = std::fopen(slopes_path.c_str(), "w");
   for (std::FILE* o : {stdout, f}) {
     if (o == nullptr) continue;
     std::fprintf(o, "RMS calibration angle error over the runs: %.4f deg\n",
@@ -390,7 +404,7 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
                  r.rms_norm[0].back(), r.rms_norm[1].back() * 180.0 / M_PI, r.rms_norm[2].back(),
                  r.rms_norm[3].back());
   }
-  if (f != nullptr) std::fclose(f);
+  if (f != nullptr) close_output(f, slopes_path);
   if (do_plot) plot("montecarlo", out_dir);
   return 0;
 }
@@ -464,9 +478,9 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::str
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The program. Errors of files and scenarios come as exceptions from the library (and CLI11
+// setup); main turns any of them into a message and exit code 1.
+int sim_main(int argc, char** argv) {
   Options o;
   CLI::App app{"gfins-sim: a built-in scenario through the gyro-free navigation core"};
   std::vector<std::string> names;
@@ -528,22 +542,17 @@ int main(int argc, char** argv) {
   auto* list_cmd = app.add_subcommand("list", "list the built-in scenarios");
   app.require_subcommand(0, 1);
   CLI11_PARSE(app, argc, argv);
-  try {
-    if (*run_cmd) return cmd_run(scenario_name, out_dir, !no_plot);
-    if (*p63) return cmd_paper63(out_dir, !no_plot);
-    if (*mc) return cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
-    if (*cov) return cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
-    if (*list_cmd) {
-      for (const auto& n : gfins::sim::builtin_scenarios(GFINS_SCENARIO_DIR)) {
-        const auto p = gfins::sim::load_scenario(n, GFINS_SCENARIO_DIR);
-        std::printf("%-24s %s\n", n.c_str(),
-                    p.ok() ? p.scenario->description.c_str() : p.error.c_str());
-      }
-      return 0;
+  if (*run_cmd) return cmd_run(scenario_name, out_dir, !no_plot);
+  if (*p63) return cmd_paper63(out_dir, !no_plot);
+  if (*mc) return cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
+  if (*cov) return cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
+  if (*list_cmd) {
+    for (const auto& n : gfins::sim::builtin_scenarios(GFINS_SCENARIO_DIR)) {
+      const auto p = gfins::sim::load_scenario(n, GFINS_SCENARIO_DIR);
+      std::printf("%-24s %s\n", n.c_str(),
+                  p.ok() ? p.scenario->description.c_str() : p.error.c_str());
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "gfins-sim: %s\n", e.what());
-    return 1;
+    return 0;
   }
 
   const auto traj = scenarios().at(o.scenario)();
@@ -562,7 +571,7 @@ int main(int argc, char** argv) {
               traj->name().c_str(), o.duration_s, o.rate_hz, o.rho_m, o.scalar.c_str());
   const RunResult ideal =
       use_float ? run<float>(*traj, o, 0.0, csv) : run<double>(*traj, o, 0.0, csv);
-  if (csv != nullptr) std::fclose(csv);
+  if (csv != nullptr) close_output(csv, o.csv_path);
   RunResult noisy;
   if (noise > 0) {
     noisy =
@@ -586,4 +595,15 @@ int main(int argc, char** argv) {
       "sensor error grows as t in rate, t² in attitude and t⁴ in position (docs/math.md).\n",
       ideal.samples);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return sim_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gfins-sim: %s\n", e.what());
+    return 1;
+  }
 }

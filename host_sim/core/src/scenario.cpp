@@ -105,7 +105,7 @@ class Reader {
     }
     const auto* s = n->as_string();
     if (s == nullptr) fail(n, full, "expected a string, got " + type_name(*n));
-    const std::string v = s->get();
+    std::string v = s->get();  // not const: returned by move
     if (choices.size() > 0 &&
         std::none_of(choices.begin(), choices.end(), [&](const char* c) { return v == c; })) {
       std::string list;

@@ -284,7 +284,10 @@ void write_series_csv(const RunSeries& r, const std::string& path) {
     v3(x.r_err_n());
     std::fprintf(f, "\n");
   }
-  if (std::fclose(f) != 0) throw std::runtime_error("error writing " + path);
+  // The fprintf results above are not checked one by one: a failed write sets the error flag,
+  // and fclose alone reports only the last flush (glibc returns 0 after an earlier ENOSPC).
+  const bool write_failed = std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || write_failed) throw std::runtime_error("error writing " + path);
 }
 
 }  // namespace gfins::sim

@@ -159,9 +159,9 @@ int run(const Options& o) {
   return kExitOk;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The program. main turns an exception from anywhere in it (CLI11 setup, the solver, file
+// writing) into a message and kExitInput.
+int calibrate_main(int argc, char** argv) {
   CLI::App app{
       "Multi-attitude calibration of the six-accelerometer array (Hung, Fang & Lee 2007, §4.1).\n"
       "Reads mean outputs per sensor and pose, solves scale factors, biases and orientation\n"
@@ -220,9 +220,16 @@ int main(int argc, char** argv) {
   if (o.output.empty() && !o.dry_run) {
     return fail(kExitInput, "--output is required (or --dry-run)");
   }
+  return run(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
   try {
-    return run(o);
+    return calibrate_main(argc, argv);
   } catch (const std::exception& e) {
-    return fail(kExitInput, std::string("unexpected: ") + e.what());
+    std::fprintf(stderr, "gfins-calibrate: error: unexpected: %s\n", e.what());
+    return kExitInput;
   }
 }

@@ -111,7 +111,7 @@ T design_condition(const Design<T>& a) {
   Eigen::HouseholderQR<Design<T>> qr(a);
   const Mat4<T> r = qr.matrixQR().template topRows<4>().template triangularView<Eigen::Upper>();
   const Eigen::JacobiSVD<Mat4<T>> svd(r);
-  const Vec4<T> s = svd.singularValues();
+  const Vec4<T>& s = svd.singularValues();
   if (!(s(3) > T(0))) return std::numeric_limits<T>::infinity();
   return s(0) / s(3);
 }
@@ -244,7 +244,8 @@ Status solve_sensor(int i, std::span<const AttitudeObservation<T>> obs,
   const Mat4<T> cov_p = jac * cov_x * jac.transpose();
   for (int rr = 0; rr < 4; ++rr) {
     for (int cc = 0; cc < 4; ++cc) {
-      out.covariance[si][static_cast<std::size_t>(rr * 4 + cc)] = cov_p(rr, cc);
+      out.covariance[si][static_cast<std::size_t>(rr) * 4 + static_cast<std::size_t>(cc)] =
+          cov_p(rr, cc);
     }
   }
   out.scale_std_v_per_g[si] = std::sqrt(cov_p(0, 0));

@@ -157,10 +157,12 @@ class RecordingWriter {
   static RecordingResult<RecordingWriter> open(const std::string& path,
                                                const RecordingHeader& header);
   RecordingWriter(RecordingWriter&& other) noexcept;
+  // Both close an open writer (as close() does) without reporting errors: call close() to see
+  // them.
   RecordingWriter& operator=(RecordingWriter&& other) noexcept;
   RecordingWriter(const RecordingWriter&) = delete;
   RecordingWriter& operator=(const RecordingWriter&) = delete;
-  ~RecordingWriter();  // closes without reporting errors: call close() to see them
+  ~RecordingWriter();
 
   RecordingResult<Done> append(const hal::RawSample& s);
   RecordingResult<Done> close();
