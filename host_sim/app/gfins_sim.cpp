@@ -462,7 +462,9 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::str
       "|dw| %.4g rad/s\nwritten: %s/covariance.csv, %s/budget.csv\n",
       r.t_s[last], block(0) * 180.0 / M_PI, block(3), block(6), block(9), out_dir.c_str(),
       out_dir.c_str());
-  std::fflush(stdout);  // the summary first, then the plot script's own output
+  // The summary first, then the plot script's own output. Only the order depends on this flush:
+  // if stdout cannot be written the summary is lost either way, and there is nowhere to say so.
+  (void)std::fflush(stdout);
   if (do_plot) {
     const char* env = std::getenv("GFINS_PYTHON");
     const std::string python = env != nullptr                                ? env
