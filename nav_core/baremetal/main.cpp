@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 
+#include "gfins/nav_core/paper_table6.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
 namespace {
@@ -29,33 +30,21 @@ volatile float g_out[10];
 
 nav::NavPipeline<float> g_pipeline;
 
-constexpr float kDegToRad = 0.017453292519943295f;
-
 // Paper Table 6 (SF in V/g, bias in g, orientation errors in degrees), sensors 1..6 in Table 1
 // order, and an ADC full scale of ±16 g per channel (PGA gain matched to each load resistor).
 nav::PipelineConfig<float> make_config() {
   nav::PipelineConfig<float> c;
   c.nominal = nav::table1_geometry(0.1f);
-  constexpr std::array<float, 6> kSfVPerG = {0.509874f, 0.332572f, 0.500242f,
-                                             2.493301f, 0.339215f, 2.476663f};
-  constexpr std::array<float, 6> kBiasG = {-0.000731f, -0.000242f, 0.000867f,
-                                           -0.007977f, -0.000891f, -0.004691f};
+  namespace t6 = nav::paper_table6;
   constexpr float kFullScaleG = 16.0f;
   constexpr float kCodes = 8388608.0f;  // 2^23
   for (std::size_t j = 0; j < 6; ++j) {
-    c.front_end.scale_v_per_g[j] = kSfVPerG[j];
-    c.front_end.bias_g[j] = kBiasG[j];
-    c.front_end.volts_per_count[j] = kSfVPerG[j] * kFullScaleG / kCodes;
+    const auto sf = static_cast<float>(t6::kScaleVPerG[j]);
+    c.front_end.scale_v_per_g[j] = sf;
+    c.front_end.bias_g[j] = static_cast<float>(t6::kBiasG[j]);
+    c.front_end.volts_per_count[j] = sf * kFullScaleG / kCodes;
   }
-  // Order xy, xz, yx, yz, zx, zy (misalignment.hpp).
-  constexpr std::array<float, 6> kBetaDeg = {1.117319f,  -0.175730f, -0.581196f,
-                                             -0.738742f, 2.454457f,  2.482135f};
-  constexpr std::array<float, 6> kAlphaDeg = {-2.654967f, 2.596778f, -0.838703f,
-                                              -0.737387f, 0.119537f, -1.451107f};
-  for (std::size_t i = 0; i < 6; ++i) {
-    c.misalignment.orientation.beta[i] = kBetaDeg[i] * kDegToRad;
-    c.misalignment.orientation.alpha[i] = kAlphaDeg[i] * kDegToRad;
-  }
+  c.misalignment = t6::misalignment<float>();
   for (std::size_t j = 0; j < 6; ++j) {
     c.misalignment.drho_b[j] = nav::Vec3<float>(0.001f, -0.0005f, 0.0008f);  // m, assumed
   }

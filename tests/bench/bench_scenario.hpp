@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "gfins/nav_core/paper_table6.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
 namespace gfins::bench {
@@ -34,28 +35,15 @@ template <typename T>
 nav::PipelineConfig<T> make_config(nav::CompensatorKind kind) {
   nav::PipelineConfig<T> c;
   c.nominal = nav::table1_geometry(static_cast<T>(kRhoM));
-  // Sensors 1..6 in Table 1 order (Table 6 lists them by set).
-  constexpr std::array<double, 6> kSfVPerG = {0.509874, 0.332572, 0.500242,
-                                              2.493301, 0.339215, 2.476663};
-  constexpr std::array<double, 6> kBiasG = {-0.000731, -0.000242, 0.000867,
-                                            -0.007977, -0.000891, -0.004691};
+  namespace t6 = nav::paper_table6;
   constexpr double kFullScaleG = 16.0;
   constexpr double kCodes = 8388608.0;  // 2^23
   for (std::size_t j = 0; j < 6; ++j) {
-    c.front_end.scale_v_per_g[j] = static_cast<T>(kSfVPerG[j]);
-    c.front_end.bias_g[j] = static_cast<T>(kBiasG[j]);
-    c.front_end.volts_per_count[j] = static_cast<T>(kSfVPerG[j] * kFullScaleG / kCodes);
+    c.front_end.scale_v_per_g[j] = static_cast<T>(t6::kScaleVPerG[j]);
+    c.front_end.bias_g[j] = static_cast<T>(t6::kBiasG[j]);
+    c.front_end.volts_per_count[j] = static_cast<T>(t6::kScaleVPerG[j] * kFullScaleG / kCodes);
   }
-  // xy, xz, yx, yz, zx, zy (misalignment.hpp), degrees.
-  constexpr std::array<double, 6> kBetaDeg = {1.117319,  -0.175730, -0.581196,
-                                              -0.738742, 2.454457,  2.482135};
-  constexpr std::array<double, 6> kAlphaDeg = {-2.654967, 2.596778, -0.838703,
-                                               -0.737387, 0.119537, -1.451107};
-  constexpr double kDeg = std::numbers::pi / 180.0;
-  for (std::size_t i = 0; i < 6; ++i) {
-    c.misalignment.orientation.beta[i] = static_cast<T>(kBetaDeg[i] * kDeg);
-    c.misalignment.orientation.alpha[i] = static_cast<T>(kAlphaDeg[i] * kDeg);
-  }
+  c.misalignment = t6::misalignment<T>();
   for (std::size_t j = 0; j < 6; ++j) {
     const double sgn = (j % 2 == 0) ? 1.0 : -1.0;
     c.misalignment.drho_b[j] = nav::Vec3<T>(static_cast<T>(0.001 * sgn), static_cast<T>(-0.0005),

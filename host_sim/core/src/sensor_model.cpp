@@ -1,4 +1,5 @@
 #include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/nav_core/paper_table6.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -84,25 +85,12 @@ SensorArrayModel::Volts SensorArrayModel::volts(const TruthState& x) {
 }
 
 ArrayErrors SensorArrayModel::paper_table6() {
-  constexpr double kDeg = std::numbers::pi / 180.0;
   ArrayErrors e;
-  // Table 6, sensors in Table 1 order (1..6); the table lists them as sets {2,3,5} and {1,4,6}.
-  const std::array<double, 6> sf = {0.509874, 0.332572, 0.500242, 2.493301, 0.339215, 2.476663};
-  const std::array<double, 6> bias = {-0.000731, -0.000242, 0.000867,
-                                      -0.007977, -0.000891, -0.004691};
   for (std::size_t j = 0; j < 6; ++j) {
-    e.sensors[j].scale_v_per_g = sf[j];
-    e.sensors[j].bias_g = bias[j];
+    e.sensors[j].scale_v_per_g = nav::paper_table6::kScaleVPerG[j];
+    e.sensors[j].bias_g = nav::paper_table6::kBiasG[j];
   }
-  // Angle order xy, xz, yx, yz, zx, zy (nav::AngleIndex), degrees as printed in Table 6.
-  const std::array<double, 6> beta_deg = {1.117319,  -0.175730, -0.581196,
-                                          -0.738742, 2.454457,  2.482135};
-  const std::array<double, 6> alpha_deg = {-2.654967, 2.596778, -0.838703,
-                                           -0.737387, 0.119537, -1.451107};
-  for (std::size_t i = 0; i < 6; ++i) {
-    e.misalignment.orientation.beta[i] = beta_deg[i] * kDeg;
-    e.misalignment.orientation.alpha[i] = alpha_deg[i] * kDeg;
-  }
+  e.misalignment = nav::paper_table6::misalignment<double>();
   return e;
 }
 
