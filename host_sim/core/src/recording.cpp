@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <sstream>
+#include <utility>
 
 namespace gfins::sim {
 namespace {
@@ -250,6 +251,23 @@ RecordingResult<std::vector<std::uint8_t>> encode_recording(
   return out;
 }
 
+namespace {
+
+// Appends every block `reader` still holds to rec.samples; the first broken block ends the read
+// with its error (which names the byte offset).
+RecordingResult<Recording> read_remaining_blocks(RecordingReader& reader, Recording rec) {
+  std::vector<hal::RawSample> block;
+  for (;;) {
+    auto more = reader.next_block(block);
+    if (!more.is_ok()) return more.error();
+    if (!more.value()) break;
+    rec.samples.insert(rec.samples.end(), block.begin(), block.end());
+  }
+  return rec;
+}
+
+}  // namespace
+
 RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes) {
   auto reader = RecordingReader::from_bytes(bytes);
   if (!reader.is_ok()) return reader.error();
@@ -260,14 +278,7 @@ RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes)
     rec.samples.reserve(static_cast<std::size_t>(
         std::min<std::uint64_t>(rec.header.record_count, bytes.size() / kRecordingRecordBytes)));
   }
-  std::vector<hal::RawSample> block;
-  for (;;) {
-    auto more = reader.value().next_block(block);
-    if (!more.is_ok()) return more.error();
-    if (!more.value()) break;
-    rec.samples.insert(rec.samples.end(), block.begin(), block.end());
-  }
-  return rec;
+  return read_remaining_blocks(reader.value(), std::move(rec));
 }
 
 RecordingResult<Recording> read_recording(const std::string& path) {
@@ -275,14 +286,7 @@ RecordingResult<Recording> read_recording(const std::string& path) {
   if (!reader.is_ok()) return reader.error();
   Recording rec;
   rec.header = reader.value().header();
-  std::vector<hal::RawSample> block;
-  for (;;) {
-    auto more = reader.value().next_block(block);
-    if (!more.is_ok()) return more.error();
-    if (!more.value()) break;
-    rec.samples.insert(rec.samples.end(), block.begin(), block.end());
-  }
-  return rec;
+  return read_remaining_blocks(reader.value(), std::move(rec));
 }
 
 // ---------------------------------------------------------------------------------------------
