@@ -49,7 +49,8 @@ def plot_envelopes(out_dir):
     for i, (title, prefix, unit, scale) in enumerate(BLOCKS):
         for name in state_columns(header, prefix):
             y = [v * scale for v in column(rows, name)]
-            label = name.replace("sigma_", "")
+            # The column names carry the CSV's unit (rad, m, ...); the axis states the plotted one.
+            label = name.replace("sigma_", "").rsplit("_", 1)[0]
             axes[i][0].plot(t, y, label=label)
             pos = [(a, b) for a, b in zip(t, y) if a > 0 and b > 0]
             if pos:
