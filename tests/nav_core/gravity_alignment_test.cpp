@@ -52,8 +52,8 @@ TEST_F(AlignmentTest, RecoversRollAndPitchAtRest) {
   const double pitch = -0.4;
   const double yaw = 2.0;
   const auto q = quat_from_euler(roll, pitch, yaw);
-  StaticAligner<double> aligner(solver_);
-  for (int i = 0; i < 100; ++i) aligner.add(at_rest(q, kStandardGravity));
+  StaticAligner<double> aligner;
+  for (int i = 0; i < 100; ++i) aligner.add(solver_, at_rest(q, kStandardGravity));
   const auto r = aligner.finish(100);
   ASSERT_TRUE(r.is_ok());
   EXPECT_NEAR(r->roll_rad, roll, kAngleTol);
@@ -66,9 +66,9 @@ TEST_F(AlignmentTest, RecoversRollAndPitchAtRest) {
 }
 
 TEST_F(AlignmentTest, RefusesTooFewSamplesAndNonGravityInput) {
-  StaticAligner<double> aligner(solver_);
+  StaticAligner<double> aligner;
   EXPECT_EQ(aligner.finish(1).status().code(), ErrorCode::kFailedPrecondition);
-  for (int i = 0; i < 10; ++i) aligner.add(Vec6<double>::Zero());  // disconnected sensors
+  for (int i = 0; i < 10; ++i) aligner.add(solver_, Vec6<double>::Zero());  // disconnected sensors
   EXPECT_EQ(aligner.finish(20).status().code(), ErrorCode::kFailedPrecondition);
   EXPECT_EQ(aligner.finish(10).status().code(), ErrorCode::kInvalidArgument);
 }

@@ -22,21 +22,20 @@ struct AlignmentResult {
 
 /// Accumulates the array's specific force at o_b (ω = 0) over a window at rest. The mean is
 /// computed with a shifted sum (first sample as reference) so float32 keeps its precision over
-/// long windows.
+/// long windows. The aligner holds no solver of its own: the caller passes the one it navigates
+/// with, so a new calibration cannot leave alignment and navigation on different geometries.
 template <typename T, int N = kNumSensors>
 class StaticAligner {
  public:
   using Solver = ArraySolver<T, N>;
 
-  StaticAligner() = default;
-  explicit StaticAligner(const Solver& solver) : solver_(solver) {}
+  void reset() { *this = StaticAligner(); }
 
-  void reset() { *this = StaticAligner(solver_); }
-
-  void add(const typename Solver::Outputs& s) {
+  /// One sample at rest: compensated outputs s, mapped to [ω̇; f] by `solver` with ω = 0.
+  void add(const Solver& solver, const typename Solver::Outputs& s) {
     Vec3<T> wdot;
     Vec3<T> f;
-    solver_.solve(s, Vec3<T>::Zero(), wdot, f);
+    solver.solve(s, Vec3<T>::Zero(), wdot, f);
     if (count_ == 0) ref_ = f;
     const Vec3<T> d = f - ref_;
     sum_ += d;
@@ -86,7 +85,6 @@ class StaticAligner {
   }
 
  private:
-  Solver solver_{};
   Vec3<T> ref_ = Vec3<T>::Zero();
   Vec3<T> sum_ = Vec3<T>::Zero();
   T sum_sq_ = T(0);

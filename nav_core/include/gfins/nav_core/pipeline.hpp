@@ -69,7 +69,7 @@ class NavPipeline {
     front_end_ = fe.value();
     compensator_ = comp.value();
     strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
-    aligner_ = StaticAligner<T, 6>(solver.value());
+    aligner_.reset();
     period_s_ = static_cast<T>(1.0 / config.sample_rate_hz);
     phase_ = PipelinePhase::kAligning;
     configured_ = true;
@@ -144,7 +144,7 @@ class NavPipeline {
   void align(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
     Outputs s;
     compensator_.apply(s_raw, Vec3<T>::Zero(), Vec3<T>::Zero(), s);
-    aligner_.add(s);
+    aligner_.add(strapdown_.solver(), s);
     if (aligner_.count() < config_.alignment_samples) return;
     const auto result = aligner_.finish(config_.alignment_samples);
     if (!result.is_ok()) {
