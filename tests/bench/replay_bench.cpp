@@ -37,7 +37,7 @@ constexpr std::uint32_t kAlignSamples = 400;
 struct Data {
   ArrayErrors errors = SensorArrayModel::paper_table6();
   AdcModel adc{AdcConfig{}};
-  std::vector<hal::RawSample> samples;
+  std::vector<RawSample> samples;
   std::vector<std::uint8_t> file;
 
   Data() {
@@ -97,7 +97,7 @@ void BM_Replay(benchmark::State& state) {
   for (auto _ : state) {
     nav::NavPipeline<T> p;
     if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
-    const ReplayReport r = replay(p, std::span<const hal::RawSample>(d.samples));
+    const ReplayReport r = replay(p, std::span<const RawSample>(d.samples));
     navigating = r.navigating;
     benchmark::DoNotOptimize(r.output_hash);
   }
@@ -114,7 +114,7 @@ void BM_DecodeAndReplay(benchmark::State& state) {
     if (!rec.is_ok()) state.SkipWithError("decode failed");
     nav::NavPipeline<T> p;
     if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
-    const ReplayReport r = replay(p, std::span<const hal::RawSample>(rec.value().samples));
+    const ReplayReport r = replay(p, std::span<const RawSample>(rec.value().samples));
     navigating = r.navigating;
     benchmark::DoNotOptimize(r.output_hash);
   }

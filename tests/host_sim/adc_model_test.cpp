@@ -82,7 +82,7 @@ TEST(AdcModelTest, NegativeInputsAreTwosComplementCodes) {
   Volts v = all(0.0);
   v(0) = -lsb;
   v(1) = -1000.0 * lsb;
-  const hal::RawSample s = adc.sample(v, 0);
+  const RawSample s = adc.sample(v, 0);
   // then the counts are −1 (0xFFFFFF as 24 bits, sign-extended) and −1000.
   EXPECT_EQ(s.counts[0], -1);
   EXPECT_EQ(static_cast<std::uint32_t>(s.counts[0]) & 0xFFFFFFu, 0xFFFFFFu);
@@ -98,18 +98,18 @@ TEST(AdcModelTest, InputsBeyondFullScaleClipAndFlagSaturation) {
   Volts v = all(0.0);
   v(0) = 20.0;
   v(1) = -20.0;
-  const hal::RawSample s = adc.sample(v, 0);
+  const RawSample s = adc.sample(v, 0);
   // then the codes are the rails and the sample is flagged saturated,
-  EXPECT_EQ(s.counts[0], nav::kAdcCodeMax);
-  EXPECT_EQ(s.counts[1], nav::kAdcCodeMin);
-  EXPECT_NE(s.flags & hal::sample_flags::kSaturated, 0u);
+  EXPECT_EQ(s.counts[0], kAdcCodeMax);
+  EXPECT_EQ(s.counts[1], kAdcCodeMin);
+  EXPECT_NE(s.flags & sample_flags::kSaturated, 0u);
   bool sat = false;
   EXPECT_EQ(adc.code_for(std::numeric_limits<double>::quiet_NaN(), sat), 0);
   EXPECT_TRUE(sat);
   // while 0.999 of full scale is a plain code without the flag,
-  const hal::RawSample ok = adc.sample(all(0.999 * fs), 1);
-  EXPECT_EQ(ok.flags & hal::sample_flags::kSaturated, 0u);
-  EXPECT_LT(ok.counts[0], nav::kAdcCodeMax);
+  const RawSample ok = adc.sample(all(0.999 * fs), 1);
+  EXPECT_EQ(ok.flags & sample_flags::kSaturated, 0u);
+  EXPECT_LT(ok.counts[0], kAdcCodeMax);
   // and the front end agrees that the clipped channels are saturated.
   nav::FrontEndParams<double> p;
   p.volts_per_count.fill(adc.volts_per_count());
@@ -131,7 +131,7 @@ TEST(AdcModelTest, DataReadyTimeIsSeqOverRatePlusGroupDelay) {
   EXPECT_EQ(adc.sample(all(0.0), 7).t_ns, 7250000);
   EXPECT_EQ(adc.sample(all(0.0), 0xFFFFFFFFu).t_ns, 4294967295000000ll + 250000);
   // and every sample says it is synthetic.
-  EXPECT_NE(adc.sample(all(0.0), 1).flags & hal::sample_flags::kSynthetic, 0u);
+  EXPECT_NE(adc.sample(all(0.0), 1).flags & sample_flags::kSynthetic, 0u);
 }
 
 TEST(AdcModelTest, JitterHasTheConfiguredSigmaAndIsReproducible) {
@@ -174,7 +174,7 @@ TEST(AdcModelTest, SensorAdcAndFrontEndCloseTheLoopWithinHalfAnLsb) {
   const TruthState x =
       make_rest(Quatd(Eigen::AngleAxisd(0.7, Vec3d(1, -2, 0.5).normalized())))->at(0.0);
   // when the truth goes through sensors → ADC → front end,
-  const hal::RawSample s = adc.sample(sensors.volts(x), 0);
+  const RawSample s = adc.sample(sensors.volts(x), 0);
   nav::FrontEnd<double>::Outputs out;
   EXPECT_EQ(fe.value().convert(s.counts, out), 0u);
   // then each output is the sensed specific force within ½ LSB, i.e. ½·LSB·g/SF_j m/s² (the

@@ -26,10 +26,10 @@ RecordingHeader test_header() {
 }
 
 // Samples that exercise every field: negative and extreme codes, negative times, flags.
-std::vector<hal::RawSample> test_samples() {
-  std::vector<hal::RawSample> v;
+std::vector<RawSample> test_samples() {
+  std::vector<RawSample> v;
   for (std::size_t i = 0; i < kSamples; ++i) {
-    hal::RawSample s;
+    RawSample s;
     s.seq = 0xFFFFFFF0u + static_cast<std::uint32_t>(i);  // wraps through 0
     s.t_ns = -5000000 + static_cast<std::int64_t>(i) * 1000000;
     for (std::size_t j = 0; j < 6; ++j) {
@@ -42,7 +42,7 @@ std::vector<hal::RawSample> test_samples() {
   return v;
 }
 
-void expect_same(const std::vector<hal::RawSample>& a, const std::vector<hal::RawSample>& b) {
+void expect_same(const std::vector<RawSample>& a, const std::vector<RawSample>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].seq, b[i].seq) << i;
@@ -208,7 +208,7 @@ TEST(RecordingTest, DamagedFilesOnDiskGiveTheSameErrorsAsInMemory) {
   // and a reader streaming block by block returns the blocks before the damage first.
   auto reader = RecordingReader::open(bad_path);
   ASSERT_TRUE(reader.is_ok());
-  std::vector<hal::RawSample> block;
+  std::vector<RawSample> block;
   const auto first = reader.value().next_block(block);
   ASSERT_TRUE(first.is_ok());
   EXPECT_TRUE(first.value());
@@ -264,9 +264,9 @@ TEST(RecordingTest, TrailingBytesAfterTheAnnouncedRecordsAreAnError) {
 
 TEST(RecordingTest, SamplesThatDoNotFitTheRecordAreRefused) {
   // Given a count beyond 24 bits and a flag above bit 15,
-  hal::RawSample big;
+  RawSample big;
   big.counts[2] = 1 << 23;
-  hal::RawSample flag;
+  RawSample flag;
   flag.flags = 1u << 16;
   // then neither encodes (so no sample is ever silently changed).
   EXPECT_FALSE(encode_record(big).is_ok());
@@ -276,7 +276,7 @@ TEST(RecordingTest, SamplesThatDoNotFitTheRecordAreRefused) {
   const std::string path = temp_path("refused.gfr");
   auto w = RecordingWriter::open(path, test_header());
   ASSERT_TRUE(w.is_ok());
-  ASSERT_TRUE(w.value().append(hal::RawSample{}).is_ok());
+  ASSERT_TRUE(w.value().append(RawSample{}).is_ok());
   const auto r = w.value().append(big);
   ASSERT_FALSE(r.is_ok());
   EXPECT_EQ(r.error().byte_offset, kRecordingHeaderBytes + kRecordingRecordBytes);

@@ -26,7 +26,7 @@ constexpr std::uint32_t kSamples = 1500;  // 0.2 s aligning, 1.3 s navigating
 struct Fixture {
   ArrayErrors errors;
   AdcModel adc{AdcConfig{}};
-  std::vector<hal::RawSample> samples;
+  std::vector<RawSample> samples;
 
   Fixture() {
     errors = SensorArrayModel::paper_table6();
@@ -60,10 +60,10 @@ struct Fixture {
   }
 
   template <typename T>
-  ReplayReport run(const std::vector<hal::RawSample>& s) const {
+  ReplayReport run(const std::vector<RawSample>& s) const {
     nav::NavPipeline<T> p;
     EXPECT_TRUE(p.configure(config<T>()).is_ok());
-    return replay(p, std::span<const hal::RawSample>(s));
+    return replay(p, std::span<const RawSample>(s));
   }
 };
 
@@ -121,7 +121,7 @@ TYPED_TEST(ReplayTest, ReplayFromAFileEqualsReplayFromMemory) {
 TYPED_TEST(ReplayTest, GapsInTheSampleCounterAreReportedWithIndexAndSize) {
   // Given the stream with samples 700..702 and 1200 removed,
   const Fixture f;
-  std::vector<hal::RawSample> holes;
+  std::vector<RawSample> holes;
   for (const auto& s : f.samples) {
     if ((s.seq >= 700 && s.seq <= 702) || s.seq == 1200) continue;
     holes.push_back(s);
@@ -130,7 +130,7 @@ TYPED_TEST(ReplayTest, GapsInTheSampleCounterAreReportedWithIndexAndSize) {
   nav::NavPipeline<TypeParam> p;
   ASSERT_TRUE(p.configure(f.config<TypeParam>()).is_ok());
   std::vector<std::uint32_t> gap_states;
-  const ReplayReport r = replay(p, std::span<const hal::RawSample>(holes),
+  const ReplayReport r = replay(p, std::span<const RawSample>(holes),
                                 [&](std::uint64_t, const nav::NavState<TypeParam>& st) {
                                   if (st.status & nav::nav_status::kSampleGap) {
                                     gap_states.push_back(st.seq);
@@ -153,11 +153,11 @@ TYPED_TEST(ReplayTest, CrcErrorSamplesArePassedAsInvalid) {
   // Given one sample flagged with a frame CRC error,
   const Fixture f;
   auto s = f.samples;
-  s[900].flags |= hal::sample_flags::kCrcError;
+  s[900].flags |= sample_flags::kCrcError;
   // when replayed,
   nav::NavPipeline<TypeParam> p;
   ASSERT_TRUE(p.configure(f.config<TypeParam>()).is_ok());
-  const ReplayReport r = replay(p, std::span<const hal::RawSample>(s));
+  const ReplayReport r = replay(p, std::span<const RawSample>(s));
   // then the replayer and the pipeline both count it as rejected, and it is not navigated on.
   EXPECT_EQ(r.invalid, 1u);
   EXPECT_EQ(p.counters().rejected, 1u);

@@ -33,15 +33,15 @@ std::int32_t AdcModel::code_for(double volts, bool& saturated) const {
   }
   // Clip in double before converting, so that no out-of-range conversion ever happens.
   const double r = std::round(x);  // nearest, ties away from zero
-  const double hi = static_cast<double>(nav::kAdcCodeMax);
-  const double lo = static_cast<double>(nav::kAdcCodeMin);
+  const double hi = static_cast<double>(kAdcCodeMax);
+  const double lo = static_cast<double>(kAdcCodeMin);
   if (r >= hi) {
     saturated = true;
-    return nav::kAdcCodeMax;
+    return kAdcCodeMax;
   }
   if (r <= lo) {
     saturated = true;
-    return nav::kAdcCodeMin;
+    return kAdcCodeMin;
   }
   saturated = false;
   return static_cast<std::int32_t>(r);
@@ -54,18 +54,18 @@ std::int64_t AdcModel::nominal_time_ns(std::uint32_t seq) const {
          config_.group_delay_ns;
 }
 
-hal::RawSample AdcModel::sample(const Eigen::Matrix<double, 6, 1>& volts, std::uint32_t seq) {
-  hal::RawSample s;
+RawSample AdcModel::sample(const Eigen::Matrix<double, 6, 1>& volts, std::uint32_t seq) {
+  RawSample s;
   s.seq = seq;
   s.t_ns = nominal_time_ns(seq);
   if (config_.jitter_ns_rms > 0.0) {
     s.t_ns += std::llround(config_.jitter_ns_rms * jitter_normal_(jitter_rng_));
   }
-  s.flags = hal::sample_flags::kSynthetic;
+  s.flags = sample_flags::kSynthetic;
   for (std::size_t j = 0; j < 6; ++j) {
     bool saturated = false;
     s.counts[j] = code_for(volts(static_cast<Eigen::Index>(j)), saturated);
-    if (saturated) s.flags |= hal::sample_flags::kSaturated;
+    if (saturated) s.flags |= sample_flags::kSaturated;
   }
   return s;
 }

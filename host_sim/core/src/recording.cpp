@@ -90,7 +90,7 @@ std::optional<RecordingError> check_writable(const RecordingHeader& h) {
   if (h.version != kRecordingVersion) {
     return error_at(ErrorCode::kInvalidArgument, kOffVersion, "header version is not 1");
   }
-  if (h.channel_count != hal::kAdcChannels) {
+  if (h.channel_count != kAdcChannels) {
     return error_at(ErrorCode::kInvalidArgument, kOffChannels, "header channel count is not 6");
   }
   if (h.records_per_block == 0) {
@@ -158,7 +158,7 @@ RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> byt
     return error_at(ErrorCode::kInvalidArgument, kOffHeaderBytes, "header size is not 384");
   }
   h.channel_count = get_u16(p + kOffChannels);
-  if (h.channel_count != hal::kAdcChannels) {
+  if (h.channel_count != kAdcChannels) {
     return error_at(ErrorCode::kInvalidArgument, kOffChannels,
                     "channel count " + std::to_string(h.channel_count) + " is not 6");
   }
@@ -182,8 +182,7 @@ RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> byt
   return h;
 }
 
-RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(
-    const hal::RawSample& s) {
+RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s) {
   std::array<std::uint8_t, kRecordingRecordBytes> b{};
   if (s.flags > 0xFFFFu) {
     return error_at(ErrorCode::kOutOfRange, 0,
@@ -207,9 +206,9 @@ RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(
   return b;
 }
 
-hal::RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes) {
+RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes) {
   const std::uint8_t* p = bytes.data();
-  hal::RawSample s;
+  RawSample s;
   s.seq = get_u32(p + kRecSeq);
   s.t_ns = static_cast<std::int64_t>(get_u64(p + kRecTime));
   for (std::size_t j = 0; j < 6; ++j) {
@@ -223,8 +222,8 @@ hal::RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes
   return s;
 }
 
-RecordingResult<std::vector<std::uint8_t>> encode_recording(
-    RecordingHeader header, std::span<const hal::RawSample> samples) {
+RecordingResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
+                                                            std::span<const RawSample> samples) {
   if (auto bad = check_writable(header)) return *bad;
   header.record_count = samples.size();
   const auto head = encode_header(header);
@@ -256,7 +255,7 @@ namespace {
 // Appends every block `reader` still holds to rec.samples; the first broken block ends the read
 // with its error (which names the byte offset).
 RecordingResult<Recording> read_remaining_blocks(RecordingReader& reader, Recording rec) {
-  std::vector<hal::RawSample> block;
+  std::vector<RawSample> block;
   for (;;) {
     auto more = reader.next_block(block);
     if (!more.is_ok()) return more.error();
@@ -387,7 +386,7 @@ RecordingResult<bool> RecordingReader::check_end() {
   return false;
 }
 
-RecordingResult<bool> RecordingReader::next_block(std::vector<hal::RawSample>& out) {
+RecordingResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
   out.clear();
   const std::uint64_t rpb = header_.records_per_block;
   const std::uint64_t remaining = size_ - pos_;
@@ -447,7 +446,7 @@ RecordingResult<bool> RecordingReader::next_block(std::vector<hal::RawSample>& o
 }
 
 RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,
-                                      std::span<const hal::RawSample> samples) {
+                                      std::span<const RawSample> samples) {
   auto w = RecordingWriter::open(path, header);
   if (!w.is_ok()) return w.error();
   for (const auto& s : samples) {
@@ -514,7 +513,7 @@ RecordingResult<RecordingWriter> RecordingWriter::open(const std::string& path,
   return w;
 }
 
-RecordingResult<Done> RecordingWriter::append(const hal::RawSample& s) {
+RecordingResult<Done> RecordingWriter::append(const RawSample& s) {
   if (file_ == nullptr) {
     return RecordingError{ErrorCode::kFailedPrecondition, offset_, "recording: append after close"};
   }

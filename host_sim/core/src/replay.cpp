@@ -41,7 +41,7 @@ void hash_nav_state(Fnv1a64& h, const nav::NavState<T>& s) {
 }
 
 template <typename T>
-void Replayer<T>::step(const hal::RawSample& s) {
+void Replayer<T>::step(const RawSample& s) {
   const std::uint64_t index = report_.samples;
   if (have_last_ && s.seq != last_seq_ + 1u) {
     ReplayGap g;
@@ -54,9 +54,9 @@ void Replayer<T>::step(const hal::RawSample& s) {
   }
   last_seq_ = s.seq;
   have_last_ = true;
-  const bool valid = (s.flags & hal::sample_flags::kCrcError) == 0;
+  const bool valid = (s.flags & sample_flags::kCrcError) == 0;
   if (!valid) ++report_.invalid;
-  if ((s.flags & hal::sample_flags::kSaturated) != 0) ++report_.flagged_saturated;
+  if ((s.flags & sample_flags::kSaturated) != 0) ++report_.flagged_saturated;
   ++report_.samples;
   // A sample the pipeline rejects (invalid or saturated) leaves its state unchanged: it produced
   // no output, so it is neither hashed nor handed to the sink.
@@ -72,7 +72,7 @@ void Replayer<T>::step(const hal::RawSample& s) {
 }
 
 template <typename T>
-const ReplayReport& Replayer<T>::run(std::span<const hal::RawSample> samples) {
+const ReplayReport& Replayer<T>::run(std::span<const RawSample> samples) {
   for (const auto& s : samples) step(s);
   return report_;
 }
@@ -84,7 +84,7 @@ RecordingResult<ReplayReport> replay_recording(const std::string& path,
   auto reader = RecordingReader::open(path);
   if (!reader.is_ok()) return reader.error();
   Replayer<T> replayer(pipeline, std::move(sink));
-  std::vector<hal::RawSample> block;
+  std::vector<RawSample> block;
   for (;;) {
     auto more = reader.value().next_block(block);
     if (!more.is_ok()) return more.error();

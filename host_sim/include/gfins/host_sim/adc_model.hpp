@@ -1,11 +1,11 @@
 // The 6-channel, 24-bit simultaneous-sampling delta-sigma ADC (TI ADS131M06 class, DESIGN.md) as
-// a behavioural model: volts at the sensor outputs → one hal::RawSample per data-ready edge.
+// a behavioural model: volts at the sensor outputs → one RawSample per data-ready edge.
 //
 // Signal chain per channel (all channels sampled at the same instant):
 //
 //   v_adc = v_sensor · input_divider          resistive divider in front of the ADC pins
 //   code  = round(v_adc · gain / vref · 2^23)  round to nearest, ties away from zero
-//   code  clipped to [−2^23, 2^23 − 1]         nav::kAdcCodeMin / nav::kAdcCodeMax
+//   code  clipped to [−2^23, 2^23 − 1]         kAdcCodeMin / kAdcCodeMax
 //
 // so one count is vref / (gain · input_divider · 2^23) volts at the sensor (volts_per_count()).
 // Default: vref 1.2 V (ADS131M06 internal reference), gain 1, divider 1/8.33 → ±9.996 V full
@@ -25,7 +25,7 @@
 #include <cstdint>
 #include <random>
 
-#include "gfins/hal/raw_sample.hpp"
+#include "gfins/sample/raw_sample.hpp"
 
 namespace gfins::sim {
 
@@ -47,7 +47,7 @@ class AdcModel {
 
   /// One simultaneous conversion of the six channels at data-ready edge `seq`. Advances the
   /// jitter stream when jitter is enabled.
-  hal::RawSample sample(const Eigen::Matrix<double, 6, 1>& volts, std::uint32_t seq);
+  RawSample sample(const Eigen::Matrix<double, 6, 1>& volts, std::uint32_t seq);
 
   /// Volts at the sensor per count: vref / (gain · input_divider · 2^23). What
   /// nav::FrontEndParams::volts_per_count needs.

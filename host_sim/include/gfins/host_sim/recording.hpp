@@ -1,4 +1,4 @@
-// Raw-sample recordings: a compact little-endian binary file of hal::RawSample values with the
+// Raw-sample recordings: a compact little-endian binary file of RawSample values with the
 // context needed to replay them (sample rate, ADC LSB, array geometry). The byte layout is
 // specified in docs/recording-format.md; this header is its implementation.
 //
@@ -22,8 +22,8 @@
 #include <utility>
 #include <vector>
 
-#include "gfins/hal/raw_sample.hpp"
 #include "gfins/nav_core/geometry.hpp"
+#include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::sim {
@@ -45,7 +45,7 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0);
 struct RecordingHeader {
   std::uint16_t version = kRecordingVersion;
   double sample_rate_hz = 1000.0;
-  std::uint16_t channel_count = hal::kAdcChannels;
+  std::uint16_t channel_count = kAdcChannels;
   std::uint32_t records_per_block = kDefaultRecordsPerBlock;
   std::uint64_t record_count = kRecordCountUnknown;  // filled in by the writer's close()
   std::array<double, 6> volts_per_count{};           // ADC LSB per channel, V at the sensor
@@ -83,7 +83,7 @@ struct Done {};
 
 struct Recording {
   RecordingHeader header;
-  std::vector<hal::RawSample> samples;
+  std::vector<RawSample> samples;
 };
 
 /// The header's 384 bytes (CRC included).
@@ -93,13 +93,12 @@ RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> byt
 
 /// One 32-byte record. Fails (kOutOfRange) when a count is outside 24-bit two's complement or
 /// flags has bits above 15: the record could not hold them exactly.
-RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(
-    const hal::RawSample& s);
-hal::RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes);
+RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
+RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes);
 
 /// The whole file in memory (header with record_count set, every block and its CRC).
-RecordingResult<std::vector<std::uint8_t>> encode_recording(
-    RecordingHeader header, std::span<const hal::RawSample> samples);
+RecordingResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
+                                                            std::span<const RawSample> samples);
 /// Parses a whole file image; errors name the byte offset (docs/recording-format.md).
 RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes);
 
@@ -107,7 +106,7 @@ RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes)
 RecordingResult<Recording> read_recording(const std::string& path);
 /// Writes a whole recording at once (through RecordingWriter).
 RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,
-                                      std::span<const hal::RawSample> samples);
+                                      std::span<const RawSample> samples);
 
 /// Streaming reader: the header at open, then one block at a time, with the same checks and
 /// error offsets as decode_recording (which is built on it). Memory use is one block, so a
@@ -127,7 +126,7 @@ class RecordingReader {
 
   /// Replaces `out` with the samples of the next block. Returns false (and an empty `out`) at the
   /// clean end of the recording, an error when the file is truncated or corrupt there.
-  RecordingResult<bool> next_block(std::vector<hal::RawSample>& out);
+  RecordingResult<bool> next_block(std::vector<RawSample>& out);
 
   /// Records returned so far.
   std::uint64_t records_read() const { return index_; }
@@ -164,7 +163,7 @@ class RecordingWriter {
   RecordingWriter& operator=(const RecordingWriter&) = delete;
   ~RecordingWriter();
 
-  RecordingResult<Done> append(const hal::RawSample& s);
+  RecordingResult<Done> append(const RawSample& s);
   RecordingResult<Done> close();
   std::uint64_t records_written() const { return records_; }
 

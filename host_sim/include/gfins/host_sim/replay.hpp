@@ -1,4 +1,4 @@
-// Replay: drives nav::NavPipeline<T> from a recorded (or any) stream of hal::RawSample values.
+// Replay: drives nav::NavPipeline<T> from a recorded (or any) stream of RawSample values.
 //
 // Driven by sample index, never by wall-clock: sample i is offered as soon as sample i − 1 has
 // been processed, with the t_ns and seq it carries. The pipeline itself is deterministic, so the
@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "gfins/hal/raw_sample.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/nav_core/nav_state.hpp"
 #include "gfins/nav_core/pipeline.hpp"
+#include "gfins/sample/raw_sample.hpp"
 
 namespace gfins::sim {
 
@@ -72,10 +72,10 @@ class Replayer {
       : pipeline_(pipeline), sink_(std::move(sink)) {}
 
   /// Offers one sample (index = how many were offered before). Call in stream order.
-  void step(const hal::RawSample& s);
+  void step(const RawSample& s);
 
   /// Offers every sample of `samples` in order; returns the report so far.
-  const ReplayReport& run(std::span<const hal::RawSample> samples);
+  const ReplayReport& run(std::span<const RawSample> samples);
 
   const ReplayReport& report() const { return report_; }
   /// Hash of the output so far (same as report().output_hash).
@@ -92,7 +92,7 @@ class Replayer {
 
 /// Convenience: a fresh replay of `samples` through `pipeline`; returns the report.
 template <typename T>
-ReplayReport replay(nav::NavPipeline<T>& pipeline, std::span<const hal::RawSample> samples,
+ReplayReport replay(nav::NavPipeline<T>& pipeline, std::span<const RawSample> samples,
                     typename Replayer<T>::Sink sink = {}) {
   Replayer<T> r(pipeline, std::move(sink));
   return r.run(samples);

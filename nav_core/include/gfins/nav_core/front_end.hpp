@@ -10,13 +10,10 @@
 #include <cstdint>
 
 #include "gfins/nav_core/geometry.hpp"
+#include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::nav {
-
-/// Full-scale code of a 24-bit two's-complement converter.
-inline constexpr std::int32_t kAdcCodeMax = (1 << 23) - 1;
-inline constexpr std::int32_t kAdcCodeMin = -(1 << 23);
 
 template <typename T, int N = kNumSensors>
 struct FrontEndParams {

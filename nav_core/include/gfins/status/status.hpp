@@ -60,18 +60,25 @@ class [[nodiscard]] Status {
   constexpr Status() = default;
   /// `message` must have static storage duration (a literal).
   constexpr Status(ErrorCode code, const char* message) : code_(code), message_(message) {}
+  /// Same, with the operating system's error number (errno) of the call that failed, for the
+  /// Linux backends; 0 means none.
+  constexpr Status(ErrorCode code, const char* message, int os_error)
+      : code_(code), message_(message), os_error_(os_error) {}
 
   static constexpr Status ok() { return Status(); }
 
   constexpr bool is_ok() const { return code_ == ErrorCode::kOk; }
   constexpr ErrorCode code() const { return code_; }
   constexpr const char* message() const { return message_; }
+  /// errno of the failed OS call (0 when the error did not come from the OS).
+  constexpr int os_error() const { return os_error_; }
 
   friend constexpr bool operator==(const Status& a, const Status& b) { return a.code_ == b.code_; }
 
  private:
   ErrorCode code_ = ErrorCode::kOk;
   const char* message_ = "";
+  int os_error_ = 0;
 };
 
 /// A value or the Status explaining why there is none. T must be default-constructible; no

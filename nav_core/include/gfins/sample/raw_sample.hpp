@@ -1,13 +1,19 @@
 // One ADC frame as it crosses the sample seam: what the ADC driver produces on the board, what
-// the host simulation and the replay produce on the PC (DESIGN.md, data flow).
+// the host simulation and the replay produce on the PC, and the one input of the navigation
+// pipeline (DESIGN.md, data flow). A std-only vocabulary type shared by every layer, like Status.
 #pragma once
 
 #include <array>
 #include <cstdint>
 
-namespace gfins::hal {
+namespace gfins {
 
 inline constexpr int kAdcChannels = 6;
+
+/// Code range of a 24-bit two's-complement converter (ADS131M06 datasheet §8.5.1.9: output data
+/// are 24-bit two's complement, positive full scale 7FFFFFh, negative full scale 800000h).
+inline constexpr std::int32_t kAdcCodeMax = (1 << 23) - 1;
+inline constexpr std::int32_t kAdcCodeMin = -(1 << 23);
 
 /// Bits of RawSample::flags.
 namespace sample_flags {
@@ -24,4 +30,4 @@ struct RawSample {
   std::uint32_t flags = 0;                          // sample_flags bits
 };
 
-}  // namespace gfins::hal
+}  // namespace gfins
