@@ -193,6 +193,37 @@ TEST(CalibrateCli, AHeaderDifferingInOneNameSaysWhichNamesAreAccepted) {
   EXPECT_THAT(r.output, HasSubstr("found: sensor, attitude, mean"));
 }
 
+TEST(CalibrateCli, BothRoutesUseAndNameTheStatedSigma) {
+  // Given Tables 4/5 with a std_v of 2 mV over 1000 samples stated for every mean
+  const TempDir dir;
+  std::string csv = read_text(kGolden);
+  std::string with_sigma;
+  std::size_t line_start = 0;
+  bool header = true;
+  while (line_start < csv.size()) {
+    const std::size_t end = csv.find('\n', line_start);
+    std::string line = csv.substr(line_start, end - line_start);
+    line_start = end == std::string::npos ? csv.size() : end + 1;
+    if (line.empty() || line[0] == '#') continue;
+    with_sigma += line + (header ? ",std_v,count\n" : ",0.002,1000\n");
+    header = false;
+  }
+  const auto means = dir.path() / "sigma.csv";
+  write_text(means, with_sigma);
+  for (const char* method : {"paper", "general"}) {
+    // When calibrated by either route
+    const RunResult r =
+        run_cli(dir, "--means " + means.string() + " --method " + method + " --dry-run");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // Then the report says the σ are the stated ones, for every sensor
+    EXPECT_THAT(r.output, HasSubstr("from the stated σ of every mean (std_v/√count")) << method;
+    EXPECT_THAT(r.output, Not(HasSubstr("residuals of the fit"))) << method;
+  }
+  // And without std_v/count it says the σ come from 2 residual dof
+  const RunResult r = run_cli(dir, "--means " + kGolden + " --dry-run");
+  EXPECT_THAT(r.output, HasSubstr("no σ stated with the means, so from the fit residuals"));
+}
+
 TEST(CalibrateCli, ADryRunNeedsNeitherAdcLsbNorDeviceIdNorGravity) {
   const TempDir dir;
   const RunResult r = run_cli(dir, "--means " + kGolden + " --dry-run");

@@ -50,6 +50,10 @@ FileResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
                    std::to_string(j + 1) + " (Tables 4/5 need all 36)");
       }
       p.mean_v[i][j] = at[i][j]->mean_v;
+      // σ of the mean from std_v and count where given: both routes use it (issue 11).
+      if (at[i][j]->count > 0) {
+        p.sigma_v[i][j] = at[i][j]->std_v / std::sqrt(static_cast<double>(at[i][j]->count));
+      }
     }
   }
   CalibrationRun run;
@@ -132,6 +136,27 @@ std::string fmt(const char* format, double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, x);
   return buf;
+}
+
+// Which σ the ± figures below are: the report says it once, in words, for all sensors.
+std::string sigma_statement(const calib::MultiAttitudeResult<double>& r) {
+  int stated = 0;
+  int residual = 0;
+  for (const auto src : r.covariance_source) {
+    stated += src == calib::CovarianceSource::kStatedSigma ? 1 : 0;
+    residual += src == calib::CovarianceSource::kResiduals ? 1 : 0;
+  }
+  if (stated == 6) {
+    return "uncertainties (± 1σ): from the stated σ of every mean (std_v/√count of the input), "
+           "propagated through the fit";
+  }
+  if (residual == 6) {
+    return "uncertainties (± 1σ): no σ stated with the means, so from the fit residuals (n − 4 "
+           "degrees of freedom per sensor: with 6 poses a Student-t with 2 dof, only ~90 % of "
+           "true values within 3σ); give std_v and count for honest uncertainties";
+  }
+  return "uncertainties (± 1σ): per sensor as the last column says (stated σ where every mean "
+         "of the sensor has one, else residuals)";
 }
 
 }  // namespace
@@ -368,6 +393,7 @@ void print_report(std::ostream& out, const CalibrationRun& run) {
       << "poses: " << r.num_attitudes
       << ", largest condition number of a sensor's design: " << fmt("%.3g", r.max_condition_number)
       << "\n\n";
+  out << sigma_statement(r) << "\n\n";
   out << "sensor set   SF (V/g)              bias (g)                RMS resid (mg)  cond   "
          "uncertainty from\n";
   for (std::size_t j = 0; j < 6; ++j) {
