@@ -77,8 +77,8 @@ void run_hour_at_rest(const Quat<double>& q_nb, bool level) {
   const auto check = [&](bool ok, const char* what, double t, double value, double bound) {
     if (ok) return;
     if (violations++ == 0) {
-      first_violation = std::string(what) + " at t = " + std::to_string(t) + " s: " +
-                        std::to_string(value) + " > bound " + std::to_string(bound);
+      first_violation = std::string(what) + " at t = " + std::to_string(t) +
+                        " s: " + std::to_string(value) + " > bound " + std::to_string(bound);
     }
   };
   NavErrors e;
@@ -102,8 +102,7 @@ void run_hour_at_rest(const Quat<double>& q_nb, bool level) {
       "rad/s (bound %.3e), attitude %.3e rad, velocity %.3e m/s, position %.3e m, |q|-1 %.1e; "
       "small-angle laws checked every second up to %.0f s\n",
       sizeof(T) == 4 ? "float32" : "double ", level ? "level " : "tilted", dwdot, df, e.rate_rps,
-      rate_bound(t), e.attitude_rad, e.velocity_mps, e.position_m, max_norm_err,
-      checked_until_s);
+      rate_bound(t), e.attitude_rad, e.velocity_mps, e.position_m, max_norm_err, checked_until_s);
   EXPECT_EQ(violations, 0) << first_violation;
   EXPECT_GE(checked_until_s, kMinCheckedS);
   EXPECT_LT(max_norm_err, 4 * std::numeric_limits<T>::epsilon());
