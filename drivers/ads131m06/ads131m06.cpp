@@ -71,16 +71,15 @@ Status Ads131m06::make_table(const Ads131m06Config& c,
   // MODE: 24-bit words (the reset default, so a chip that resets keeps the frame size the driver
   // reads and its STATUS.RESET bit stays visible), CCITT CRC, RESET written 0 to clear it, SPI
   // timeout kept on as after reset, DRDY on the most lagging channel, level format.
-  std::uint16_t mode =
-      static_cast<std::uint16_t>((static_cast<unsigned>(reg::kDriverWordLength)
-                                  << reg::mode::kWlengthShift) |
-                                 reg::mode::kTimeout);
+  std::uint16_t mode = static_cast<std::uint16_t>(
+      (static_cast<unsigned>(reg::kDriverWordLength) << reg::mode::kWlengthShift) |
+      reg::mode::kTimeout);
   if (c.input_crc) mode = static_cast<std::uint16_t>(mode | reg::mode::kRxCrcEn);
   std::uint16_t gain1 = 0;
   std::uint16_t gain2 = 0;
   for (int ch = 0; ch < reg::kChannels; ++ch) {
-    const auto v = static_cast<std::uint16_t>(gain_code[static_cast<std::size_t>(ch)]
-                                              << reg::gain_shift(ch));
+    const auto v =
+        static_cast<std::uint16_t>(gain_code[static_cast<std::size_t>(ch)] << reg::gain_shift(ch));
     if (ch < 4) {
       gain1 = static_cast<std::uint16_t>(gain1 | v);
     } else {
@@ -199,8 +198,9 @@ Status Ads131m06::configure() {
   const unsigned wl = (st.value() & reg::status::kWlengthMask) >> reg::status::kWlengthShift;
   if ((st.value() & reg::status::kReset) != 0 ||
       wl != static_cast<unsigned>(reg::kDriverWordLength)) {
-    return Status(ErrorCode::kDataLoss, "adc: STATUS after configuration shows RESET or a "
-                                        "word length other than 24 bits");
+    return Status(ErrorCode::kDataLoss,
+                  "adc: STATUS after configuration shows RESET or a "
+                  "word length other than 24 bits");
   }
   return Status::ok();
 }
@@ -243,7 +243,7 @@ Status Ads131m06::recover() {
   ++failed_recoveries_;
   // Stay in kRecover (the next read_sample tries again) until too many attempts failed.
   state_ = failed_recoveries_ >= config_.max_recovery_attempts ? Ads131m06State::kFailed
-                                                                : Ads131m06State::kRecover;
+                                                               : Ads131m06State::kRecover;
   return st;
 }
 
@@ -271,7 +271,8 @@ Result<RawSample> Ads131m06::read_sample(std::int64_t timeout_ns) {
     if (!st.is_ok()) return st;
   }
   if (state_ != Ads131m06State::kRun) {
-    return Status(ErrorCode::kFailedPrecondition, "adc: not running (start() failed or not called)");
+    return Status(ErrorCode::kFailedPrecondition,
+                  "adc: not running (start() failed or not called)");
   }
   for (int attempt = 0; attempt < kMaxEdgesPerRead; ++attempt) {
     const Result<hal::DataReadyEdge> edge = drdy_.wait_edge(timeout_ns);
@@ -333,8 +334,9 @@ Result<RawSample> Ads131m06::read_sample(std::int64_t timeout_ns) {
         ++counters_.chip_resets;
         const Status rs = recover();
         if (!rs.is_ok()) return rs;
-        return Status(ErrorCode::kDataLoss, "adc: chip reset detected (STATUS.RESET); "
-                                            "registers written again");
+        return Status(ErrorCode::kDataLoss,
+                      "adc: chip reset detected (STATUS.RESET); "
+                      "registers written again");
       }
       if ((status & reg::status::kCrcErr) != 0) ++counters_.input_crc_errors;
       // DRDYn = 1: new data for channel n since the last read (§8.6 STATUS). None set: this
@@ -357,8 +359,9 @@ Result<RawSample> Ads131m06::read_sample(std::int64_t timeout_ns) {
           ++counters_.register_mismatches;
           const Status rs = recover();
           if (!rs.is_ok()) return rs;
-          return Status(ErrorCode::kDataLoss, "adc: register re-verification failed; "
-                                              "registers written again");
+          return Status(ErrorCode::kDataLoss,
+                        "adc: register re-verification failed; "
+                        "registers written again");
         }
       }
     }

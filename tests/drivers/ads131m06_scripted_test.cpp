@@ -58,7 +58,8 @@ Bytes din(std::uint16_t command, std::initializer_list<std::uint16_t> data = {})
 }
 
 // DOUT: response, six 24-bit codes (MSB first), CRC over the 21 bytes before it.
-Bytes dout(std::uint16_t response, std::initializer_list<std::uint32_t> codes24 = {0, 0, 0, 0, 0, 0},
+Bytes dout(std::uint16_t response,
+           std::initializer_list<std::uint32_t> codes24 = {0, 0, 0, 0, 0, 0},
            bool corrupt = false) {
   Bytes b;
   put16(b, response);
@@ -194,8 +195,8 @@ TEST_F(Ads131m06Scripted, DataFrameIsDecodedWithSignExtension) {
   EXPECT_EQ(s->seq, 41u);
   EXPECT_EQ(s->t_ns, 123456789);
   EXPECT_EQ(s->counts[0], 1);
-  EXPECT_EQ(s->counts[1], 8388607);    // positive full scale
-  EXPECT_EQ(s->counts[2], -8388608);   // negative full scale
+  EXPECT_EQ(s->counts[1], 8388607);   // positive full scale
+  EXPECT_EQ(s->counts[2], -8388608);  // negative full scale
   EXPECT_EQ(s->counts[3], -1);
   EXPECT_EQ(s->counts[4], 0x123456);
   EXPECT_EQ(s->counts[5], 0xABCDEF - 0x1000000);

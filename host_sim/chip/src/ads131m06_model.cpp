@@ -23,7 +23,8 @@ void Ads131m06Model::reset_registers() {
   regs_[reg::addr(reg::Reg::kGain1)] = reg::kGainResetValue;
   regs_[reg::addr(reg::Reg::kGain2)] = reg::kGainResetValue;
   regs_[reg::addr(reg::Reg::kCfg)] = reg::kCfgResetValue;
-  for (int ch = 0; ch < reg::kChannels; ++ch) regs_[reg::channel_reg(ch, 3)] = reg::kGcalMsbResetValue;
+  for (int ch = 0; ch < reg::kChannels; ++ch)
+    regs_[reg::channel_reg(ch, 3)] = reg::kGcalMsbResetValue;
   new_data_ = false;
   crc_err_ = false;
   locked_ = false;
@@ -34,7 +35,9 @@ void Ads131m06Model::reset_registers() {
 
 void Ads131m06Model::power_on_reset() { reset_registers(); }
 
-void Ads131m06Model::upset_register(reg::Reg r, std::uint16_t value) { regs_[reg::addr(r)] = value; }
+void Ads131m06Model::upset_register(reg::Reg r, std::uint16_t value) {
+  regs_[reg::addr(r)] = value;
+}
 
 void Ads131m06Model::stick_channel(int ch, std::int32_t code) {
   stuck_[static_cast<std::size_t>(ch)] = true;
@@ -105,7 +108,8 @@ bool Ads131m06Model::convert_codes(const Codes& codes) {
 
 bool Ads131m06Model::convert(const PinVolts& pin_volts) {
   Codes c{};
-  for (std::size_t ch = 0; ch < c.size(); ++ch) c[ch] = code_for(static_cast<int>(ch), pin_volts[ch]);
+  for (std::size_t ch = 0; ch < c.size(); ++ch)
+    c[ch] = code_for(static_cast<int>(ch), pin_volts[ch]);
   return convert_codes(c);
 }
 
@@ -166,8 +170,8 @@ Status Ads131m06Model::do_transfer(std::span<const std::uint8_t> tx, std::span<s
       break;
     case Pending::kMultiRead:
       reg::put_word16(word(n++), static_cast<std::uint16_t>(reg::kRregMultiAckBase |
-                                                           (multi_addr_ << reg::cmd::kAddrShift) |
-                                                           (multi_count_ - 1)));
+                                                            (multi_addr_ << reg::cmd::kAddrShift) |
+                                                            (multi_count_ - 1)));
       break;
   }
   if (pending_ == Pending::kMultiRead) {

@@ -58,9 +58,9 @@ struct Ads131m06Config {
   double clkin_hz = 8.192e6;  // CLKIN, nominal for high-resolution mode (§6.3)
   ads131m06::PowerMode power_mode = ads131m06::PowerMode::kHighResolution;
   std::array<std::uint8_t, ads131m06::kChannels> pga_gain{1, 1, 1, 1, 1, 1};  // 1,2,4..128
-  double vref_v = 1.2;     // internal reference (§8.3.4): full scale ±vref/gain at the pins
-  bool input_crc = true;   // MODE.RX_CRC_EN: the chip rejects DIN frames with a bad CRC
-  std::uint32_t verify_every_frames = 1000;  // one register re-read per this many frames; 0 off
+  double vref_v = 1.2;    // internal reference (§8.3.4): full scale ±vref/gain at the pins
+  bool input_crc = true;  // MODE.RX_CRC_EN: the chip rejects DIN frames with a bad CRC
+  std::uint32_t verify_every_frames = 1000;   // one register re-read per this many frames; 0 off
   std::uint32_t timeouts_before_recover = 3;  // consecutive data-ready timeouts
   std::uint32_t max_recovery_attempts = 3;    // consecutive failed recoveries before kFailed
   std::uint32_t stuck_after_frames = 200;     // identical codes in a row → stuck; 0 off

@@ -67,15 +67,15 @@ inline constexpr std::uint16_t kChanCntMask = 0x0F00;
 
 // STATUS register (§8.6, Table 8-12) — also the response word to NULL (Table 8-11).
 namespace status {
-inline constexpr std::uint16_t kLock = 1u << 15;      // interface locked (LOCK command)
-inline constexpr std::uint16_t kFResync = 1u << 14;   // ADC resynchronised
-inline constexpr std::uint16_t kRegMap = 1u << 13;    // register map CRC changed
-inline constexpr std::uint16_t kCrcErr = 1u << 12;    // input CRC error in a previous frame
-inline constexpr std::uint16_t kCrcType = 1u << 11;   // mirrors MODE.CRC_TYPE
-inline constexpr std::uint16_t kReset = 1u << 10;     // mirrors MODE.RESET: a reset happened
-inline constexpr std::uint16_t kWlengthShift = 8;     // mirrors MODE.WLENGTH[1:0]
+inline constexpr std::uint16_t kLock = 1u << 15;     // interface locked (LOCK command)
+inline constexpr std::uint16_t kFResync = 1u << 14;  // ADC resynchronised
+inline constexpr std::uint16_t kRegMap = 1u << 13;   // register map CRC changed
+inline constexpr std::uint16_t kCrcErr = 1u << 12;   // input CRC error in a previous frame
+inline constexpr std::uint16_t kCrcType = 1u << 11;  // mirrors MODE.CRC_TYPE
+inline constexpr std::uint16_t kReset = 1u << 10;    // mirrors MODE.RESET: a reset happened
+inline constexpr std::uint16_t kWlengthShift = 8;    // mirrors MODE.WLENGTH[1:0]
 inline constexpr std::uint16_t kWlengthMask = 0x0300;
-inline constexpr std::uint16_t kDrdyMask = 0x003F;    // DRDY5..0: new data for channel n
+inline constexpr std::uint16_t kDrdyMask = 0x003F;  // DRDY5..0: new data for channel n
 }  // namespace status
 
 // MODE register (§8.6).
@@ -122,7 +122,11 @@ inline constexpr std::array<std::uint32_t, 8> kOsrValues = {128,  256,  512,  10
 
 /// PWR[1:0] (§8.3.5): CLKIN must follow §6.3 for the chosen mode (nominal 8.192 / 4.096 /
 /// 2.048 MHz for HR / LP / VLP).
-enum class PowerMode : std::uint8_t { kVeryLowPower = 0b00, kLowPower = 0b01, kHighResolution = 0b10 };
+enum class PowerMode : std::uint8_t {
+  kVeryLowPower = 0b00,
+  kLowPower = 0b01,
+  kHighResolution = 0b10
+};
 
 /// PGAGAINn[2:0] (§8.3.3): gain = 2^code, code 0..7 (gain 1..128). GAINn registers hold four
 /// 3-bit fields at bits 4n..4n+2 (channel 0-3 in GAIN1, 4-5 in GAIN2).
@@ -134,12 +138,12 @@ constexpr int gain_shift(int channel) { return 4 * (channel % 4); }
 // the frame that FOLLOWS the command.
 // ---------------------------------------------------------------------------------------------
 namespace cmd {
-inline constexpr std::uint16_t kNull = 0x0000;     // response: STATUS register
-inline constexpr std::uint16_t kReset = 0x0011;    // response: kResetAck
-inline constexpr std::uint16_t kStandby = 0x0022;  // response: 0022h
-inline constexpr std::uint16_t kWakeup = 0x0033;   // response: 0033h
-inline constexpr std::uint16_t kLock = 0x0555;     // response: 0555h
-inline constexpr std::uint16_t kUnlock = 0x0655;   // response: 0655h
+inline constexpr std::uint16_t kNull = 0x0000;      // response: STATUS register
+inline constexpr std::uint16_t kReset = 0x0011;     // response: kResetAck
+inline constexpr std::uint16_t kStandby = 0x0022;   // response: 0022h
+inline constexpr std::uint16_t kWakeup = 0x0033;    // response: 0033h
+inline constexpr std::uint16_t kLock = 0x0555;      // response: 0555h
+inline constexpr std::uint16_t kUnlock = 0x0655;    // response: 0655h
 inline constexpr std::uint16_t kRregBase = 0xA000;  // 101a aaaa annn nnnn
 inline constexpr std::uint16_t kWregBase = 0x6000;  // 011a aaaa annn nnnn
 inline constexpr std::uint16_t kOpcodeMask = 0xE000;
@@ -181,7 +185,7 @@ constexpr std::uint8_t command_count(std::uint16_t command) {
 // channel, CRC of everything before it. Commands, responses, registers and CRCs are 16 bits,
 // MSB aligned and zero padded to the word size; conversion data are 24 bits (§8.5.1.9).
 // ---------------------------------------------------------------------------------------------
-inline constexpr std::size_t kFrameWords = kChannels + 2;  // 8
+inline constexpr std::size_t kFrameWords = kChannels + 2;         // 8
 inline constexpr WordLength kDriverWordLength = WordLength::k24;  // the reset default
 inline constexpr std::size_t kWordBytes = word_bytes(kDriverWordLength);
 inline constexpr std::size_t kFrameBytes = kFrameWords * kWordBytes;  // 24

@@ -72,7 +72,9 @@ class Qa1100FrontEnd {
 
   const Channels& channels() const { return channels_; }
   /// One count in volts across the load resistor (the sensor output), V.
-  double volts_per_count(int j) const { return pin_volts_per_count_[idx(j)] / channels_[idx(j)].divider; }
+  double volts_per_count(int j) const {
+    return pin_volts_per_count_[idx(j)] / channels_[idx(j)].divider;
+  }
   /// SF_j = K1 · R_L, V/g (nominal; calibration replaces it).
   double scale_v_per_g(int j) const { return channels_[idx(j)].scale_v_per_g(); }
   /// Counts per g of specific force (nominal SF, zero bias).
