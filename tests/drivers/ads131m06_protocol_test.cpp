@@ -81,3 +81,25 @@ TEST(Ads131m06Protocol, OsrTableGivesTheDatasheetRates) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Ads131m06Protocol, RegisterTableEncodesGainsAndClockAsTheDatasheetSays) {
+  // Table 8-12: PGAGAINn[2:0] at bits 4n+2..4n of GAIN1 (n = 0..3) and GAIN2 (n = 4, 5); code
+  // = log2(gain). CLOCK: CHn_EN bits 13:8, OSR[2:0] bits 4:2, PWR[1:0] bits 1:0.
+  gfins::drivers::Ads131m06Config c;
+  c.pga_gain = {1, 2, 4, 8, 16, 128};
+  c.sample_rate_hz = 250.0;  // OSR 16384 = code 111b
+  c.power_mode = gfins::drivers::ads131m06::PowerMode::kHighResolution;
+  c.input_crc = false;
+  std::array<gfins::drivers::RegisterSetting, gfins::drivers::Ads131m06::kTableSize> t{};
+  ASSERT_TRUE(gfins::drivers::Ads131m06::make_table(c, t).is_ok());
+  EXPECT_EQ(t[0].value, 0x0110);  // MODE: WLENGTH 01b, TIMEOUT; RX_CRC_EN off; RESET cleared
+  EXPECT_EQ(t[1].value, 0x3210);  // GAIN1: 011b 010b 001b 000b
+  EXPECT_EQ(t[2].value, 0x0074);  // GAIN2: PGAGAIN5 = 111b, PGAGAIN4 = 100b
+  EXPECT_EQ(t[3].value, 0x7F1E);  // CLOCK: 7F00h | 111b << 2 | 10b
+  c.pga_gain[0] = 3;
+  EXPECT_FALSE(gfins::drivers::Ads131m06::make_table(c, t).is_ok());
+}
+
+}  // namespace

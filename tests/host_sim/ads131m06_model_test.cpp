@@ -82,11 +82,11 @@ TEST(Ads131m06Model, SingleAndMultipleRegisterReads) {
 
 TEST(Ads131m06Model, WriteOfTwoRegistersIsAcknowledged) {
   Ads131m06Model m;
-  xfer(m, din(0x6201, {0x0123, 0x0045}));  // WREG GAIN1, GAIN2
+  xfer(m, din(0x6201, {0x0123, 0x0045}));            // WREG GAIN1, GAIN2
   EXPECT_EQ(word(xfer(m, din(0x0000)), 0), 0x4201);  // 010a aaaa ammm mmmm, m = 1
   EXPECT_EQ(m.reg(gfins::drivers::ads131m06::Reg::kGain1), 0x0123);
   EXPECT_EQ(m.reg(gfins::drivers::ads131m06::Reg::kGain2), 0x0045);
-  EXPECT_EQ(m.gain(1), 4);  // PGAGAIN1 = 010b
+  EXPECT_EQ(m.gain(1), 4);   // PGAGAIN1 = 010b
   EXPECT_EQ(m.gain(5), 16);  // PGAGAIN5 = 100b
 }
 
@@ -95,9 +95,9 @@ TEST(Ads131m06Model, InputCrcErrorBlocksCommandsButNotWreg) {
   xfer(m, din(0x6100, {0x1110}));  // MODE: RX_CRC_EN on
   xfer(m, din(0x0000));
   xfer(m, din(0x0022, {}, /*with_crc=*/false));  // STANDBY with a zero (wrong) CRC
-  EXPECT_FALSE(m.standby());                      // not executed
+  EXPECT_FALSE(m.standby());                     // not executed
   const Bytes rx = xfer(m, din(0x0000));
-  EXPECT_EQ(word(rx, 0) & 0x1000, 0x1000);        // CRC_ERR, answered like NULL
+  EXPECT_EQ(word(rx, 0) & 0x1000, 0x1000);               // CRC_ERR, answered like NULL
   EXPECT_EQ(word(xfer(m, din(0x0000)), 0) & 0x1000, 0);  // cleared once STATUS went out
   xfer(m, din(0x6200, {0x0007}, /*with_crc=*/false));    // WREG with a wrong CRC: executes
   EXPECT_EQ(m.reg(gfins::drivers::ads131m06::Reg::kGain1), 0x0007);
@@ -106,7 +106,7 @@ TEST(Ads131m06Model, InputCrcErrorBlocksCommandsButNotWreg) {
 TEST(Ads131m06Model, LockAllowsOnlyNullUnlockAndRreg) {
   Ads131m06Model m;
   xfer(m, din(0x0555));
-  EXPECT_EQ(word(xfer(m, din(0x6200, {0x0003})), 0), 0x0555);  // LOCK ack
+  EXPECT_EQ(word(xfer(m, din(0x6200, {0x0003})), 0), 0x0555);        // LOCK ack
   EXPECT_EQ(m.reg(gfins::drivers::ads131m06::Reg::kGain1), 0x0000);  // WREG refused
   EXPECT_TRUE(m.locked());
   xfer(m, din(0x0655));

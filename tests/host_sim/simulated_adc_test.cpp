@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <array>
-#include <memory>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/chip/simulated_adc.hpp"
