@@ -253,7 +253,7 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   }
   run.notes.push_back(recording_file + ": " + std::to_string(rec.samples_v.size()) +
                       " samples at " + fmt("%g", options.rate_hz) + " Hz, " +
-                      std::to_string(intervals.size()) + " still intervals, " +
+                      std::to_string(intervals.size()) + " static intervals, " +
                       std::to_string(usable.size()) + " usable, " + std::to_string(refused.size()) +
                       " poses refused");
   for (const auto& r : refused) run.notes.push_back(r);
