@@ -73,10 +73,10 @@ std::uint64_t get_u64(const std::uint8_t* p) {
 }
 double get_f64(const std::uint8_t* p) { return std::bit_cast<double>(get_u64(p)); }
 
-RecordingError error_at(ErrorCode code, std::uint64_t offset, const std::string& what) {
+HostError error_at(ErrorCode code, std::uint64_t offset, const std::string& what) {
   std::ostringstream m;
   m << "recording: " << what << " (byte offset " << offset << ")";
-  return RecordingError{code, offset, m.str()};
+  return HostError{code, m.str(), offset};
 }
 
 std::string hex32(std::uint32_t v) {
@@ -86,7 +86,7 @@ std::string hex32(std::uint32_t v) {
 }
 
 // What a writer must refuse to write, because the reader would refuse to read it.
-std::optional<RecordingError> check_writable(const RecordingHeader& h) {
+std::optional<HostError> check_writable(const RecordingHeader& h) {
   if (h.version != kRecordingVersion) {
     return error_at(ErrorCode::kInvalidArgument, kOffVersion, "header version is not 1");
   }
@@ -129,7 +129,7 @@ std::array<std::uint8_t, kRecordingHeaderBytes> encode_header(const RecordingHea
   return b;
 }
 
-RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes) {
+HostResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < kRecordingHeaderBytes) {
     return error_at(ErrorCode::kDataLoss, bytes.size(),
                     "truncated header: the file ends after " + std::to_string(bytes.size()) +
@@ -182,7 +182,7 @@ RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> byt
   return h;
 }
 
-RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s) {
+HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s) {
   std::array<std::uint8_t, kRecordingRecordBytes> b{};
   if (s.flags > 0xFFFFu) {
     return error_at(ErrorCode::kOutOfRange, 0,
@@ -222,8 +222,8 @@ RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> byt
   return s;
 }
 
-RecordingResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
-                                                            std::span<const RawSample> samples) {
+HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
+                                                       std::span<const RawSample> samples) {
   if (auto bad = check_writable(header)) return *bad;
   header.record_count = samples.size();
   const auto head = encode_header(header);
@@ -237,7 +237,7 @@ RecordingResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader head
     for (std::size_t i = first; i < first + n; ++i) {
       const auto rec = encode_record(samples[i]);
       if (!rec.is_ok()) {
-        RecordingError e = rec.error();
+        HostError e = rec.error();
         e.byte_offset = out.size();
         return e;
       }
@@ -254,7 +254,7 @@ namespace {
 
 // Appends every block `reader` still holds to rec.samples; the first broken block ends the read
 // with its error (which names the byte offset).
-RecordingResult<Recording> read_remaining_blocks(RecordingReader& reader, Recording rec) {
+HostResult<Recording> read_remaining_blocks(RecordingReader& reader, Recording rec) {
   std::vector<RawSample> block;
   for (;;) {
     auto more = reader.next_block(block);
@@ -267,7 +267,7 @@ RecordingResult<Recording> read_remaining_blocks(RecordingReader& reader, Record
 
 }  // namespace
 
-RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes) {
+HostResult<Recording> decode_recording(std::span<const std::uint8_t> bytes) {
   auto reader = RecordingReader::from_bytes(bytes);
   if (!reader.is_ok()) return reader.error();
   Recording rec;
@@ -280,7 +280,7 @@ RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes)
   return read_remaining_blocks(reader.value(), std::move(rec));
 }
 
-RecordingResult<Recording> read_recording(const std::string& path) {
+HostResult<Recording> read_recording(const std::string& path) {
   auto reader = RecordingReader::open(path);
   if (!reader.is_ok()) return reader.error();
   Recording rec;
@@ -324,47 +324,46 @@ RecordingReader::~RecordingReader() {
   if (file_ != nullptr) (void)std::fclose(file_);
 }
 
-RecordingResult<Done> RecordingReader::read_at(std::uint64_t offset, std::size_t n,
-                                               std::uint8_t* dst) {
+HostStatus RecordingReader::read_at(std::uint64_t offset, std::size_t n, std::uint8_t* dst) {
   if (file_ == nullptr) {
     std::memcpy(dst, bytes_.data() + offset, n);
     return Done{};
   }
   if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
       std::fread(dst, 1, n, file_) != n) {
-    return RecordingError{
-        ErrorCode::kIoError, offset,
-        "recording: read error in " + path_ + " at byte offset " + std::to_string(offset)};
+    return HostError{
+        ErrorCode::kIoError,
+        "recording: read error in " + path_ + " at byte offset " + std::to_string(offset), offset};
   }
   return Done{};
 }
 
-RecordingResult<RecordingReader> RecordingReader::from_bytes(std::span<const std::uint8_t> bytes) {
+HostResult<RecordingReader> RecordingReader::from_bytes(std::span<const std::uint8_t> bytes) {
   RecordingReader r;
   r.bytes_ = bytes;
   r.size_ = bytes.size();
   auto head = decode_header(bytes.first(std::min(bytes.size(), kRecordingHeaderBytes)));
   if (!head.is_ok()) {
-    RecordingError e = head.error();
+    HostError e = head.error();
     return e;
   }
   r.header_ = head.value();
   return r;
 }
 
-RecordingResult<RecordingReader> RecordingReader::open(const std::string& path) {
+HostResult<RecordingReader> RecordingReader::open(const std::string& path) {
   RecordingReader r;
   r.path_ = path;
   r.file_ = std::fopen(path.c_str(), "rb");
   if (r.file_ == nullptr) {
-    return RecordingError{ErrorCode::kIoError, 0,
-                          "recording: cannot open " + path + ": " + std::strerror(errno)};
+    return HostError{ErrorCode::kIoError,
+                     "recording: cannot open " + path + ": " + std::strerror(errno), 0};
   }
   if (std::fseek(r.file_, 0, SEEK_END) != 0) {
-    return RecordingError{ErrorCode::kIoError, 0, "recording: cannot seek in " + path};
+    return HostError{ErrorCode::kIoError, "recording: cannot seek in " + path, 0};
   }
   const long end = std::ftell(r.file_);
-  if (end < 0) return RecordingError{ErrorCode::kIoError, 0, "recording: cannot size " + path};
+  if (end < 0) return HostError{ErrorCode::kIoError, "recording: cannot size " + path, 0};
   r.size_ = static_cast<std::uint64_t>(end);
   std::array<std::uint8_t, kRecordingHeaderBytes> head_bytes{};
   const std::size_t n =
@@ -377,7 +376,7 @@ RecordingResult<RecordingReader> RecordingReader::open(const std::string& path) 
   return r;
 }
 
-RecordingResult<bool> RecordingReader::check_end() {
+HostResult<bool> RecordingReader::check_end() {
   if (pos_ != size_) {
     return error_at(ErrorCode::kDataLoss, pos_,
                     std::to_string(size_ - pos_) + " bytes after the last of the " +
@@ -386,7 +385,7 @@ RecordingResult<bool> RecordingReader::check_end() {
   return false;
 }
 
-RecordingResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
+HostResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
   out.clear();
   const std::uint64_t rpb = header_.records_per_block;
   const std::uint64_t remaining = size_ - pos_;
@@ -445,8 +444,8 @@ RecordingResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
   return true;
 }
 
-RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,
-                                      std::span<const RawSample> samples) {
+HostStatus write_recording(const std::string& path, const RecordingHeader& header,
+                           std::span<const RawSample> samples) {
   auto w = RecordingWriter::open(path, header);
   if (!w.is_ok()) return w.error();
   for (const auto& s : samples) {
@@ -489,19 +488,20 @@ RecordingWriter::~RecordingWriter() {
   if (file_ != nullptr) (void)close();
 }
 
-RecordingError RecordingWriter::io_error(const char* what) const {
-  return RecordingError{ErrorCode::kIoError, offset_,
-                        std::string("recording: ") + what + " at byte offset " +
-                            std::to_string(offset_) + ": " + std::strerror(errno)};
+HostError RecordingWriter::io_error(const char* what) const {
+  return HostError{ErrorCode::kIoError,
+                   std::string("recording: ") + what + " at byte offset " +
+                       std::to_string(offset_) + ": " + std::strerror(errno),
+                   offset_};
 }
 
-RecordingResult<RecordingWriter> RecordingWriter::open(const std::string& path,
-                                                       const RecordingHeader& header) {
+HostResult<RecordingWriter> RecordingWriter::open(const std::string& path,
+                                                  const RecordingHeader& header) {
   if (auto bad = check_writable(header)) return *bad;
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) {
-    return RecordingError{ErrorCode::kIoError, 0,
-                          "recording: cannot create " + path + ": " + std::strerror(errno)};
+    return HostError{ErrorCode::kIoError,
+                     "recording: cannot create " + path + ": " + std::strerror(errno), 0};
   }
   RecordingWriter w(f, header);
   const auto head = encode_header(w.header_);
@@ -513,13 +513,13 @@ RecordingResult<RecordingWriter> RecordingWriter::open(const std::string& path,
   return w;
 }
 
-RecordingResult<Done> RecordingWriter::append(const RawSample& s) {
+HostStatus RecordingWriter::append(const RawSample& s) {
   if (file_ == nullptr) {
-    return RecordingError{ErrorCode::kFailedPrecondition, offset_, "recording: append after close"};
+    return HostError{ErrorCode::kFailedPrecondition, "recording: append after close", offset_};
   }
   const auto rec = encode_record(s);
   if (!rec.is_ok()) {
-    RecordingError e = rec.error();
+    HostError e = rec.error();
     e.byte_offset = offset_ + block_.size();
     return e;
   }
@@ -529,7 +529,7 @@ RecordingResult<Done> RecordingWriter::append(const RawSample& s) {
   return Done{};
 }
 
-RecordingResult<Done> RecordingWriter::flush_block() {
+HostStatus RecordingWriter::flush_block() {
   if (block_.empty()) return Done{};
   std::array<std::uint8_t, 4> crc{};
   put_u32(crc.data(), crc32(block_));
@@ -543,7 +543,7 @@ RecordingResult<Done> RecordingWriter::flush_block() {
   return Done{};
 }
 
-RecordingResult<Done> RecordingWriter::close() {
+HostStatus RecordingWriter::close() {
   if (file_ == nullptr) return Done{};
   auto flushed = flush_block();
   if (flushed.is_ok()) {
