@@ -1,10 +1,12 @@
 #include "gfins/drivers/linux/spawn.hpp"
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 extern char** environ;  // POSIX: the caller's environment, handed to the child unchanged
@@ -52,6 +54,13 @@ Result<ProcessExit> run_program(std::span<const std::string> argv, const SpawnOp
     // glibc ≥ 2.29: the child changes directory between fork and exec.
     const int rc = posix_spawn_file_actions_addchdir_np(fa.get(), options.cwd.c_str());
     if (rc != 0) return Status(ErrorCode::kInvalidArgument, "spawn: working directory", rc);
+  }
+  for (const auto& [fd, path] :
+       {std::pair{1, &options.stdout_path}, std::pair{2, &options.stderr_path}}) {
+    if (path->empty()) continue;
+    const int rc = posix_spawn_file_actions_addopen(fa.get(), fd, path->c_str(),
+                                                    O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (rc != 0) return Status(ErrorCode::kInvalidArgument, "spawn: output redirection", rc);
   }
   pid_t pid = 0;
   // glibc reports a failed exec (ENOENT, EACCES) as the return value of posix_spawn.

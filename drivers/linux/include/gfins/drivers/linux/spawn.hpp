@@ -27,6 +27,9 @@ struct SpawnOptions {
   std::string cwd;
   /// Look `argv[0]` up in PATH when it holds no '/' (execvp rules); otherwise it is a path.
   bool search_path = true;
+  /// Files (created or truncated) that receive the child's stdout / stderr; empty: inherited.
+  std::string stdout_path;
+  std::string stderr_path;
 };
 
 /// Runs argv[0] with arguments argv[1..] and waits for it. Fails (kInvalidArgument) on an empty
