@@ -1,6 +1,6 @@
-// Raw-sample recordings: a compact little-endian binary file of RawSample values with the
-// context needed to replay them (sample rate, ADC LSB, array geometry). The byte layout is
-// specified in docs/recording-format.md; this header is its implementation.
+// Raw-sample recordings, the host's file layer: a compact little-endian binary file of RawSample
+// values with the context needed to replay them (sample rate, ADC LSB, array geometry). The byte
+// layout is specified in docs/recording-format.md; this header is its implementation.
 //
 //   header (384 bytes, CRC-32 at byte 380)
 //   block 0: records_per_block × 32-byte records, then the CRC-32 of those record bytes
@@ -24,49 +24,36 @@
 
 #include "gfins/host_sim/error.hpp"
 #include "gfins/nav_core/geometry.hpp"
+#include "gfins/recording/codec.hpp"
 #include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::sim {
 
-inline constexpr std::array<char, 8> kRecordingMagic = {'G', 'F', 'I', 'N', 'S', 'R', 'A', 'W'};
-inline constexpr std::uint16_t kRecordingVersion = 1;
-inline constexpr std::size_t kRecordingHeaderBytes = 384;
-inline constexpr std::size_t kRecordingRecordBytes = 32;
-inline constexpr std::size_t kRecordingCrcBytes = 4;
-inline constexpr std::uint32_t kDefaultRecordsPerBlock = 256;
-/// record_count of a file whose writer never closed it: the reader takes every complete block.
-inline constexpr std::uint64_t kRecordCountUnknown = ~std::uint64_t{0};
+// The format itself (constants, header, records, CRC) is the codec of nav_core/recording,
+// shared with the board; this file is the host's layer on top: whole images and files.
+inline constexpr auto kRecordingMagic = recording::kMagic;
+inline constexpr std::uint16_t kRecordingVersion = recording::kVersion;
+inline constexpr std::size_t kRecordingHeaderBytes = recording::kHeaderBytes;
+inline constexpr std::size_t kRecordingRecordBytes = recording::kRecordBytes;
+inline constexpr std::size_t kRecordingCrcBytes = recording::kCrcBytes;
+inline constexpr std::uint32_t kDefaultRecordsPerBlock = recording::kDefaultRecordsPerBlock;
+inline constexpr std::uint64_t kRecordCountUnknown = recording::kRecordCountUnknown;
 
-/// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
-/// of zlib and PNG. crc32("123456789") = 0xCBF43926. `crc` continues a previous call.
-std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0);
+using RecordingHeader = recording::Header;
+using recording::crc32;
+using recording::decode_record;
+using recording::encode_header;
 
-/// What a recording says about how its samples were made.
-struct RecordingHeader {
-  std::uint16_t version = kRecordingVersion;
-  double sample_rate_hz = 1000.0;
-  std::uint16_t channel_count = kAdcChannels;
-  std::uint32_t records_per_block = kDefaultRecordsPerBlock;
-  std::uint64_t record_count = kRecordCountUnknown;  // filled in by the writer's close()
-  std::array<double, 6> volts_per_count{};           // ADC LSB per channel, V at the sensor
-  nav::ArrayGeometry<double, 6> geometry{};          // ρ_j (m) and θ_j, body frame
-};
+/// decode_header of the codec with a message naming what is wrong and where.
+HostResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes);
+/// encode_record of the codec with a message naming the sample.
+HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
 
 struct Recording {
   RecordingHeader header;
   std::vector<RawSample> samples;
 };
-
-/// The header's 384 bytes (CRC included).
-std::array<std::uint8_t, kRecordingHeaderBytes> encode_header(const RecordingHeader& h);
-/// Checks magic, version, sizes and the header CRC.
-HostResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes);
-
-/// One 32-byte record. Fails (kOutOfRange) when a count is outside 24-bit two's complement or
-/// flags has bits above 15: the record could not hold them exactly.
-HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
-RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes);
 
 /// The whole file in memory (header with record_count set, every block and its CRC).
 HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
