@@ -49,6 +49,12 @@ for deb in "$debs"/*.deb; do
   touch "$stamp"
 done
 
+# The package's postinst would run depmod; do it on the unpacked tree (modules.dep gives the
+# initramfs its module load order).
+if [ ! -e "$root/lib/modules/$kver/modules.dep" ]; then
+  vb_require depmod:kmod
+  depmod -b "$root" "$kver" || vb_die "depmod on the unpacked $image failed"
+fi
 [ -e "$root/boot/vmlinuz-$kver" ] || vb_die "$image holds no /boot/vmlinuz-$kver"
 [ -d "$root/lib/modules/$kver/kernel" ] || vb_die "$image holds no /lib/modules/$kver"
 tarball=$(compgen -G "$root/usr/src/linux-source-$series.tar.*" | head -n 1 || true)

@@ -11,9 +11,9 @@ mount -t tmpfs tmpfs /tmp
 mount -t tmpfs tmpfs /run
 mkdir -p /var/lib/gfins /dev/shm
 echo "VBOARD-BOOTED uptime=$(cut -d' ' -f1 /proc/uptime)"
-for m in /lib/modules/*.ko; do
-  insmod "$m" || echo "VBOARD-CHECK FAIL insmod $(basename "$m"): module did not load"
-done
+while read -r m; do
+  insmod "/lib/modules/$m" || echo "VBOARD-CHECK FAIL insmod $m: module did not load"
+done </lib/modules/load-order
 mount -t configfs none /sys/kernel/config ||
   echo "VBOARD-CHECK FAIL mount configfs"
 sh /vboard/vm-test.sh

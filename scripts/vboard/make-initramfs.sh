@@ -49,16 +49,35 @@ for applet in $(/bin/busybox --list); do
   [ "$applet" = busybox ] || ln -sf /bin/busybox "$stage/bin/$applet"
 done
 
-# Module load order is the dependency order (modinfo -F depends): configfs before gpio-sim,
-# can before can-raw and can-dev, can-dev before vcan.
-i=0
-for m in fs/configfs/configfs.ko net/can/can.ko net/can/can-raw.ko drivers/net/can/dev/can-dev.ko \
-  drivers/net/can/vcan.ko; do
-  [ -e "$moddir/$m" ] || vb_die "kernel module $m missing from linux-image-$kver"
-  i=$((i + 1))
-  cp "$moddir/$m" "$stage/lib/modules/$i-$(basename "$m")"
+# Kernel modules, with their dependencies from the image's modules.dep, in load order (a
+# module after everything it depends on): CAN and vcan, configfs for gpio-sim, and virtio-pci
+# + 9p for the service-manager stage's root file system. /lib/modules/load-order lists them.
+wanted=(configfs can can-raw can-dev vcan virtio_pci 9pnet_virtio 9p)
+moddep=$vboard_cache/root/$kver/lib/modules/$kver/modules.dep
+[ -e "$moddep" ] || vb_die "no modules.dep in linux-image-$kver"
+declare -A placed=()
+order=()
+place() { # place MODULE_PATH (relative to lib/modules/<kver>): its dependencies first
+  local path=$1 dep
+  [ -n "${placed[$path]:-}" ] && return
+  placed[$path]=1
+  for dep in $(sed -n "s|^$path: *||p" "$moddep"); do place "$dep"; done
+  order+=("$path")
+}
+for m in "${wanted[@]}"; do
+  path=$(awk -F: -v m="$m" '{ n = $1; sub(/.*\//, "", n); sub(/\.ko.*$/, "", n); gsub(/-/, "_", n)
+                             mm = m; gsub(/-/, "_", mm); if (n == mm) { print $1; exit } }' "$moddep")
+  [ -n "$path" ] || vb_die "kernel module $m is not in linux-image-$kver (modules.dep)"
+  place "$path"
 done
-cp "$gpio_sim_ko" "$stage/lib/modules/$((i + 1))-gpio-sim-oot.ko"
+: >"$stage/lib/modules/load-order"
+for path in "${order[@]}"; do
+  [ -e "$moddir/../$path" ] || vb_die "kernel module $path missing from linux-image-$kver"
+  cp "$moddir/../$path" "$stage/lib/modules/"
+  basename "$path" >>"$stage/lib/modules/load-order"
+done
+cp "$gpio_sim_ko" "$stage/lib/modules/"
+echo gpio-sim-oot.ko >>"$stage/lib/modules/load-order"
 
 # A dynamic program and the libraries ldd lists, at the same paths as on the host.
 copy_with_libs() {
