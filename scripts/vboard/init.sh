@@ -14,6 +14,18 @@ echo "VBOARD-BOOTED uptime=$(cut -d' ' -f1 /proc/uptime)"
 while read -r m; do
   insmod "/lib/modules/$m" || echo "VBOARD-CHECK FAIL insmod $m: module did not load"
 done </lib/modules/load-order
+# Service-manager stage: the root file system is a Debian root shared by the host over 9p;
+# systemd becomes PID 1 there (scripts/vboard/service/).
+if grep -q 'vboard.root=9p' /proc/cmdline; then
+  mkdir -p /newroot
+  if mount -t 9p -o trans=virtio,version=9p2000.L,msize=262144,cache=loose vroot /newroot; then
+    umount /sys /proc
+    mount --move /dev /newroot/dev 2>/dev/null || umount /dev
+    exec switch_root /newroot /lib/systemd/systemd
+  fi
+  echo "VBOARD-CHECK FAIL 9p-root: cannot mount the shared root (tag vroot)"
+  poweroff -f
+fi
 mount -t configfs none /sys/kernel/config ||
   echo "VBOARD-CHECK FAIL mount configfs"
 sh /vboard/vm-test.sh
