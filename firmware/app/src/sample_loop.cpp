@@ -110,8 +110,14 @@ SampleLoop::Cycle SampleLoop::step() {
 void SampleLoop::update_adc_counters(std::uint32_t sample) {
   const AdcCounters c = adc_.counters();
   if (c.crc_errors != adc_seen_.crc_errors) {
+    const std::uint32_t before = health_.crc_errors;
     health_.crc_errors += c.crc_errors - adc_seen_.crc_errors;
     events_.set(status_bits::kCrcError, sample);
+    if (before == 0 || sample - last_log_ >= kLogEverySamples) {
+      last_log_ = sample;
+      log(LogLevel::kWarn, 0, "ADC frame CRC error: sample skipped (CRC errors: {})",
+          health_.crc_errors);
+    }
   }
   if (c.chip_resets != adc_seen_.chip_resets) {
     health_.adc_resets += c.chip_resets - adc_seen_.chip_resets;
@@ -214,6 +220,14 @@ void SampleLoop::on_sample(const RawSample& s) {
 void SampleLoop::build_epoch(const RawSample& s) {
   const std::uint32_t k = sample_index_;
   epoch_.nav = pipeline_.state();
+  // Every epoch refers to the sample just read (its edge time and counter). When the core did
+  // not step on it (aligning, or the sample was rejected) the values are the last state held,
+  // and a rejected sample is flagged as such.
+  epoch_.nav.t_ns = s.t_ns;
+  epoch_.nav.seq = s.seq;
+  if ((s.flags & sample_flags::kCrcError) != 0 || health_.saturated_mask != 0) {
+    epoch_.nav.status |= nav::nav_status::kInputInvalid;
+  }
   nav::Vec6<float> f;
   pipeline_.front_end().convert(last_counts_, f);
   for (std::size_t j = 0; j < kAdcChannels; ++j) epoch_.accel_mps2[j] = f(static_cast<int>(j));
@@ -236,7 +250,6 @@ void SampleLoop::build_epoch(const RawSample& s) {
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
   epoch_.health = health_;
-  (void)s;
 }
 
 // ---- Commands -------------------------------------------------------------------------------
@@ -391,6 +404,7 @@ void SampleLoop::capture_finish() {
     }
   }
   capture_.active = false;
+  last_capture_ = r.capture;
   log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}",
       r.capture.pose, r.capture.channels[0].count, r.capture.motion ? 1 : 0);
   send_response(r);

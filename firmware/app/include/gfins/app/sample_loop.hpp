@@ -85,6 +85,8 @@ class SampleLoop {
   std::uint32_t cal_id() const { return cal_.cal_id; }
   bool calibrated() const { return cal_.calibrated; }
   bool capture_active() const { return capture_.active; }
+  /// The result of the last finished calibration capture (also sent as response frames).
+  const CaptureResult& last_capture() const { return last_capture_; }
 
   /// Executes one decoded command (the CAN path calls it; tests may too). Fills `r` with the
   /// immediate response; nothing changes when the command is rejected.
@@ -133,6 +135,7 @@ class SampleLoop {
   StuckDetector stuck_{};
   LatchedBits events_{};
   Capture capture_{};
+  CaptureResult last_capture_{};
   Epoch epoch_{};
   LatencyHistogram latency_{};
   std::array<std::int32_t, kAdcChannels> last_counts_{};
