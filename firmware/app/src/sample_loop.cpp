@@ -235,6 +235,7 @@ void SampleLoop::build_epoch(const RawSample& s) {
   std::uint32_t bits = events_.get(k);
   if (!cal_.calibrated) bits |= status_bits::kUncalibrated;
   if (aligned) bits |= status_bits::kAligned;
+  if ((epoch_.nav.status & nav::nav_status::kInputInvalid) != 0) bits |= status_bits::kInputInvalid;
   if ((epoch_.nav.status & nav::nav_status::kCompensated) != 0) bits |= status_bits::kCompensated;
   if (health_.stuck_mask != 0) bits |= status_bits::kStuckChannel;
   if (capture_.active) bits |= status_bits::kCaptureActive;
