@@ -11,6 +11,8 @@
 #include "fields.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 
+#include "gfins/checksum/fnv1a.hpp"
+
 namespace gfins::calib_file {
 namespace {
 
@@ -202,14 +204,7 @@ std::string canonical_serialisation(const CalibrationData& data, std::int64_t ve
   return c.out;
 }
 
-std::uint64_t fnv1a64(const std::string& bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (const char c : bytes) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
+std::uint64_t fnv1a64(const std::string& bytes) { return gfins::fnv1a64(bytes); }
 
 std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
   return fnv1a64(canonical_serialisation(data, version));
