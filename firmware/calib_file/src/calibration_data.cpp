@@ -211,7 +211,8 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
 }
 
 std::uint32_t calibration_id(const CalibrationData& data) {
-  const auto id = static_cast<std::uint32_t>(checksum(data) & 0xFFFFFFFFu);
+  const std::uint64_t h = checksum(data);
+  const auto id = static_cast<std::uint32_t>((h ^ (h >> 32)) & 0xFFFFFFFFu);
   return id == 0 ? 1u : id;
 }
 
