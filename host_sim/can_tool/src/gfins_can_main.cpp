@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <numbers>
@@ -197,9 +198,15 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
     return rc;
   }
   const fs::path py = script.empty() ? find_script("plot_can.py") : fs::path(script);
+  // $GFINS_PYTHON, else Debian's /usr/bin/python3 (python3-matplotlib): a python3 first on PATH
+  // (pyenv, venv) often lacks matplotlib.
+  const char* env_python = std::getenv("GFINS_PYTHON");
+  const std::string python = env_python != nullptr && *env_python != '\0' ? env_python
+                             : fs::exists("/usr/bin/python3")             ? "/usr/bin/python3"
+                                                                          : "python3";
   const std::vector<std::string> argv{
-      "python3", py.string(), "--csv",   csv.string(),
-      "--out",   png,         "--title", fs::path(log).filename().string()};
+      python,  py.string(), "--csv",   csv.string(),
+      "--out", png,         "--title", fs::path(log).filename().string()};
   std::string detail;
   const Status s = run_without_shell(argv, &detail);
   std::error_code ec;
