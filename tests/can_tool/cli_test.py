@@ -7,6 +7,7 @@
 - a hostile file name (spaces, quotes, ';', newline, leading '-') is just a name;
 - --help lists the exit codes, --version prints the version;
 - csv/json/line/table views produce one record per epoch;
+- can-utils' log2asc converts a log frame for frame;
 - plot writes a PNG (when the build can start the plot script).
 """
 import argparse
@@ -107,6 +108,17 @@ def main():
     for view in ('line', 'table'):
         r = run([exe, 'decode', clean, '--view', view])
         check(r.returncode == 0 and len(r.stdout) > 100, f'{view} view')
+
+    # can-utils reads our logs: log2asc converts every line (one "Rx" record per frame).
+    log2asc = shutil.which('log2asc')
+    check(log2asc is not None, 'log2asc (can-utils) not installed')
+    if log2asc:
+        r = run([log2asc, '-I', clean, 'can0'])
+        rx = [l for l in r.stdout.decode().splitlines() if ' Rx ' in l]
+        check(r.returncode == 0 and len(rx) == len(data.splitlines()),
+              f'log2asc: {len(rx)} records for {len(data.splitlines())} lines')
+        check(rx and rx[0].split()[-8:] == ['40', '4B', '4C', '00', '00', '00', '02', '0A'],
+              'log2asc: first frame data differ')
 
     # plot
     png = os.path.join(a.workdir, 'plot.png')
