@@ -19,9 +19,8 @@ constexpr double kLogSeconds = 3600.0;
 std::FILE* hour_log() {
   static std::FILE* f = [] {
     std::FILE* t = std::tmpfile();
-    if (t == nullptr ||
-        !gfins::can_tool::write_synthetic_log(t, kLogSeconds, gfins::can::kDefaultSampleRateHz,
-                                              0)) {
+    if (t == nullptr || !gfins::can_tool::write_synthetic_log(
+                            t, kLogSeconds, gfins::can::kDefaultSampleRateHz, 0)) {
       std::fputs("can_decode_bench: cannot write the temporary log\n", stderr);
       std::abort();
     }
@@ -36,10 +35,9 @@ void BM_DecodeOneHourLog(benchmark::State& state) {
   std::uint64_t epochs = 0;
   for (auto _ : state) {
     std::rewind(f);
-    gfins::can_tool::StreamDecoder dec([&](const gfins::can_tool::DecodedEpoch& e) {
-      benchmark::DoNotOptimize(e.values.data());
-    },
-                                       nullptr);
+    gfins::can_tool::StreamDecoder dec(
+        [&](const gfins::can_tool::DecodedEpoch& e) { benchmark::DoNotOptimize(e.values.data()); },
+        nullptr);
     gfins::can_tool::for_each_line(
         f, [&](std::uint64_t n, std::string_view l) { dec.feed_line(n, l); });
     dec.finish();
@@ -51,8 +49,8 @@ void BM_DecodeOneHourLog(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(lines);
   state.counters["epochs"] = static_cast<double>(epochs);
   // Seconds of bus traffic decoded per second of decoding.
-  state.counters["x_real_time"] = benchmark::Counter(kLogSeconds * static_cast<double>(state.iterations()),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["x_real_time"] = benchmark::Counter(
+      kLogSeconds * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_DecodeOneHourLog)->Unit(benchmark::kSecond)->Iterations(3);
 

@@ -15,14 +15,14 @@
 int main(int argc, char** argv) {
   using namespace gfins::can_tool;
   if (argc < 2) {
-    std::fputs("usage: gfins-can-gen dbc [node] | icd | budget | log SECONDS\n", stderr);
+    std::fprintf(stderr, "usage: gfins-can-gen dbc [node] | icd | budget | log SECONDS\n");
     return 1;
   }
   std::string text;
   if (std::strcmp(argv[1], "dbc") == 0) {
     const int node = argc > 2 ? std::atoi(argv[2]) : 0;
     if (node < 0 || node > gfins::can::kMaxNodeId) {
-      std::fputs("gfins-can-gen: node id must be 0..15\n", stderr);
+      std::fprintf(stderr, "gfins-can-gen: node id must be 0..15\n");
       return 1;
     }
     text = generate_dbc(static_cast<std::uint8_t>(node));
@@ -33,12 +33,12 @@ int main(int argc, char** argv) {
   } else if (std::strcmp(argv[1], "log") == 0) {
     const double seconds = argc > 2 ? std::atof(argv[2]) : 10.0;
     if (!(seconds > 0.0 && seconds <= 86400.0)) {
-      std::fputs("gfins-can-gen: log duration must be in (0, 86400] s\n", stderr);
+      std::fprintf(stderr, "gfins-can-gen: log duration must be in (0, 86400] s\n");
       return 1;
     }
     if (!write_synthetic_log(stdout, seconds, gfins::can::kDefaultSampleRateHz, 0) ||
         std::fflush(stdout) != 0) {
-      std::fputs("gfins-can-gen: write failed\n", stderr);
+      std::fprintf(stderr, "gfins-can-gen: write failed\n");
       return 2;
     }
     return 0;
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0) {
-    std::fputs("gfins-can-gen: write failed\n", stderr);
+    std::fprintf(stderr, "gfins-can-gen: write failed\n");
     return 2;
   }
   return 0;

@@ -75,13 +75,13 @@ void print_summary(const Summary& s, std::FILE* out) {
     std::fprintf(out, "  %-20s %llu\n", to_string(static_cast<IssueKind>(k)),
                  static_cast<unsigned long long>(s.issues[k]));
   }
-  std::fputs("  frames per message:", out);
+  std::fprintf(out, "  frames per message:");
   for (std::size_t m = 0; m < s.per_message.size(); ++m) {
     if (s.per_message[m] == 0) continue;
     std::fprintf(out, " %s=%llu", std::string(can::kMessages[m].name).c_str(),
                  static_cast<unsigned long long>(s.per_message[m]));
   }
-  std::fputc('\n', out);
+  std::putc('\n', out);
 }
 
 /// Decodes every source into `view`; returns the exit code.
@@ -153,9 +153,15 @@ std::FILE* open_output(const std::string& path) {
   return std::fopen(path.c_str(), "wb");
 }
 
+/// Flushes/closes the view's output; false (after a message) when anything written was lost.
 bool close_output(std::FILE* f, const std::string& path) {
-  if (f == stdout) return std::fflush(stdout) == 0;
-  if (std::fclose(f) != 0) {
+  const bool write_error = std::ferror(f) != 0;
+  if (f == stdout) {
+    if (std::fflush(stdout) == 0 && !write_error) return true;
+    std::fprintf(stderr, "gfins-can: cannot write to stdout\n");
+    return false;
+  }
+  if (std::fclose(f) != 0 || write_error) {
     std::fprintf(stderr, "gfins-can: cannot write '%s': %s\n", path.c_str(), std::strerror(errno));
     return false;
   }
@@ -233,7 +239,8 @@ int run_cmd(const CmdOptions& o, can::Command c) {
                  bus.status().message());
     return kExitInput;
   }
-  c.token = static_cast<std::uint8_t>(o.token >= 0 ? o.token : std::random_device{}() & 0xFF);
+  c.token = static_cast<std::uint8_t>(o.token >= 0 ? static_cast<unsigned>(o.token)
+                                                   : std::random_device{}() & 0xFFu);
   CommandTimeouts t;
   t.response = std::chrono::milliseconds(o.timeout_ms);
   const CommandOutcome r = run_command(**bus, c, static_cast<std::uint8_t>(o.node), t);
@@ -345,8 +352,8 @@ int main_impl(int argc, char** argv) {
       return kExitInput;
     }
     const std::string text = generate_dbc(dbc_node);
-    std::fwrite(text.data(), 1, text.size(), out);
-    return close_output(out, dbc_out) ? kExitOk : kExitInput;
+    const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
+    return close_output(out, dbc_out) && written ? kExitOk : kExitInput;
   }
   if (realign->parsed()) {
     c.opcode = can::Opcode::kRealign;

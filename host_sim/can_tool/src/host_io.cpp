@@ -83,11 +83,11 @@ std::filesystem::path find_script(const std::string& name) {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    const fs::path installed = exe.parent_path() / ".." / "share" / "gfins" / "scripts" / name;
+    fs::path installed = exe.parent_path() / ".." / "share" / "gfins" / "scripts" / name;
     if (fs::exists(installed, ec)) return installed;
   }
 #ifdef GFINS_SCRIPTS_DIR
-  const fs::path source = fs::path(GFINS_SCRIPTS_DIR) / name;
+  fs::path source = fs::path(GFINS_SCRIPTS_DIR) / name;
   if (fs::exists(source, ec)) return source;
 #endif
   return fs::path(name);

@@ -47,18 +47,18 @@ class LineView final : public View {
 class CsvView final : public View {
  public:
   explicit CsvView(std::FILE* out) : out_(out) {
-    std::fputs("node,line,log_time_s", out_);
+    std::fprintf(out_, "node,line,log_time_s");
     for (const Column& c : columns()) std::fprintf(out_, ",%s", c.header.c_str());
-    std::fputc('\n', out_);
+    std::putc('\n', out_);
   }
   void epoch(const DecodedEpoch& e) override {
     std::fprintf(out_, "%u,%llu,%.6f", e.node_id, static_cast<unsigned long long>(e.line),
                  static_cast<double>(e.log_time_us) * 1e-6);
     for (double v : e.values) {
-      std::fputc(',', out_);
+      std::putc(',', out_);
       if (!std::isnan(v)) std::fprintf(out_, "%.10g", v);
     }
-    std::fputc('\n', out_);
+    std::putc('\n', out_);
   }
 
  private:
@@ -81,7 +81,7 @@ class JsonView final : public View {
         std::fprintf(out_, ",\"%s\":%.10g", name.c_str(), e.values[i]);
       }
     }
-    std::fputs("}\n", out_);
+    std::fprintf(out_, "}\n");
   }
 
  private:
@@ -109,7 +109,7 @@ class TableView final : public View {
  private:
   static constexpr std::chrono::milliseconds kRefresh{100};
   void draw() {
-    std::fputs("\x1b[H\x1b[2J", out_);  // cursor home, clear screen (ANSI)
+    std::fprintf(out_, "\x1b[H\x1b[2J");  // cursor home, clear screen (ANSI)
     std::fprintf(out_, "gfins-can  node %u  epoch counter %u  line %llu  log time %.6f s\n\n",
                  latest_.node_id, latest_.counter, static_cast<unsigned long long>(latest_.line),
                  static_cast<double>(latest_.log_time_us) * 1e-6);
@@ -124,7 +124,8 @@ class TableView final : public View {
       std::fprintf(out_, "  %-14s %16s %s\n", std::string(cols[i].signal->name).c_str(),
                    v.empty() ? "n/a" : v.c_str(), std::string(cols[i].signal->unit).c_str());
     }
-    std::fflush(out_);
+    // A failed write shows again in ferror() when the output is closed (close_output).
+    static_cast<void>(std::fflush(out_));
   }
   std::FILE* out_;
   DecodedEpoch latest_;
