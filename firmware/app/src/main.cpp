@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <chrono>
+#include <ctime>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -63,7 +65,12 @@ int run(const gfins::app::FwConfig& cfg) {
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  const std::clock_t cpu0 = std::clock();
+  const auto wall0 = std::chrono::steady_clock::now();
   while (!g_stop.load(std::memory_order_relaxed) && !board.finished()) loop->step();
+  const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   drain.stop();
   const HealthCounters& h = loop->health();
@@ -80,10 +87,14 @@ int run(const gfins::app::FwConfig& cfg) {
   spdlog::info("final state t {:.3f} s: v_n [{:.4f} {:.4f} {:.4f}] m/s, r_n [{:.4f} {:.4f} {:.4f}] m",
                static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),
                st.r_n.y(), st.r_n.z());
-  if (loop->latency().count() > 0) {
+  // Latency and CPU use mean something only against the wall clock (not in fast pacing).
+  if (loop->latency().count() > 0 && !(cfg.board == BoardKind::kSim && cfg.pacing == Pacing::kFast)) {
     spdlog::info("latency edge → CAN: p50 {} µs, p99 {} µs, max {:.1f} µs over {} epochs",
                  loop->latency().quantile_us(0.5), loop->latency().quantile_us(0.99),
                  static_cast<double>(loop->latency().max_ns()) * 1e-3, loop->latency().count());
+    spdlog::info("CPU use {:.2f} % of one core over {:.1f} s ({:.3f} s of CPU; the whole process, "
+                 "including on the simulated board its sensor and chip models)",
+                 100.0 * cpu_s / wall_s, wall_s, cpu_s);
   }
   board.close();
   return 0;
