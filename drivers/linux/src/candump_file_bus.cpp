@@ -2,9 +2,10 @@
 
 #include <fcntl.h>
 
+#include <algorithm>
 #include <cerrno>
 
-#include "gfins/drivers/lnx/candump_line.hpp"
+#include "gfins/can/candump.hpp"
 
 namespace gfins::drivers::lnx {
 
@@ -12,12 +13,12 @@ Result<std::unique_ptr<CandumpFileBus>> CandumpFileBus::open(const CandumpFileBu
                                                              hal::Clock& clock, Os& os) {
   if (config.path.empty()) return Status(ErrorCode::kInvalidArgument, "candump file: empty path");
   hal::CanFrame probe;
-  char line[kCandumpLineMax];
-  if (format_candump_line(line, 0, config.interface, probe) == 0) {
+  char line[can::kMaxCandumpLine];
+  if (can::format_candump_line(line, 0, 0, config.interface, probe) == 0) {
     return Status(ErrorCode::kInvalidArgument,
                   "candump file: interface name must be 1..15 characters without spaces");
   }
-  if (config.buffer_bytes < kCandumpLineMax) {
+  if (config.buffer_bytes < kLineMax) {
     return Status(ErrorCode::kInvalidArgument, "candump file: buffer smaller than one line");
   }
   const std::string path(config.path);
@@ -86,16 +87,18 @@ Status CandumpFileBus::flush() {
 
 Status CandumpFileBus::do_send(const hal::CanFrame& f) {
   // On a failed flush the buffered frames are counted as dropped; this one still gets a chance.
-  if (capacity_ - used_ < kCandumpLineMax) (void)flush();
-  const std::int64_t t_ns = clock_.now_ns();
-  const std::size_t n =
-      format_candump_line(std::span<char>(buffer_.get() + used_, capacity_ - used_),
-                          t_ns < 0 ? 0 : t_ns, interface_, f);
+  if (capacity_ - used_ < kLineMax) (void)flush();
+  // candump prints the kernel's struct timeval: whole microseconds, the rest truncated.
+  const std::int64_t t_ns = std::max<std::int64_t>(clock_.now_ns(), 0);
+  const std::size_t n = can::format_candump_line(
+      std::span<char>(buffer_.get() + used_, capacity_ - used_ - 1), t_ns / 1000000000,
+      static_cast<std::uint32_t>(t_ns % 1000000000 / 1000), interface_, f);
   if (n == 0) {
     ++counters_.tx_dropped;
     return Status(ErrorCode::kInvalidArgument, "candump file: frame cannot be formatted");
   }
   used_ += n;
+  buffer_[used_++] = '\n';
   ++pending_frames_;
   return Status::ok();
 }

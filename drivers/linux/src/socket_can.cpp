@@ -174,6 +174,7 @@ Status SocketCan::write_frame(const hal::CanFrame& f) {
 }
 
 Status SocketCan::do_send(const hal::CanFrame& f) {
+  if (tx_size_ > 0) flush_tx();  // older frames go first; this may find the interface down
   if (state_ == hal::CanBusState::kDown) {
     ++counters_.tx_dropped;
     return Status(ErrorCode::kUnavailable, "socketcan: interface down, frame dropped");
@@ -182,13 +183,10 @@ Status SocketCan::do_send(const hal::CanFrame& f) {
     ++counters_.tx_dropped;
     return Status(ErrorCode::kUnavailable, "socketcan: bus-off, frame dropped");
   }
-  if (tx_size_ > 0) {  // keep the order: older frames go first
-    flush_tx();
-    if (tx_size_ > 0) {
-      if (tx_push(f)) return Status::ok();
-      ++counters_.tx_dropped;
-      return Status(ErrorCode::kResourceExhausted, "socketcan: tx queue full, frame dropped");
-    }
+  if (tx_size_ > 0) {  // the kernel still refuses: wait behind the older frames
+    if (tx_push(f)) return Status::ok();
+    ++counters_.tx_dropped;
+    return Status(ErrorCode::kResourceExhausted, "socketcan: tx queue full, frame dropped");
   }
   const Status s = write_frame(f);
   if (s.is_ok()) return s;
@@ -206,6 +204,7 @@ void SocketCan::flush_tx() {
   while (tx_size_ > 0 && state_ != hal::CanBusState::kDown) {
     const Status s = write_frame(tx_[tx_head_]);
     if (s.code() == ErrorCode::kResourceExhausted) return;  // still full: try next cycle
+    if (state_ == hal::CanBusState::kDown) return;          // go_down() dropped the queue
     if (!s.is_ok()) ++counters_.tx_dropped;                 // a frame the kernel refuses
     tx_head_ = (tx_head_ + 1) % tx_capacity_;
     --tx_size_;
