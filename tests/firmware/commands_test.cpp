@@ -145,10 +145,11 @@ TEST_F(Commands, CaptureAveragesNSamplesPerChannel) {
     // float storage of the result: 2^-24 relative, plus the running-mean rounding
     EXPECT_NEAR(cap.channels[j].mean_counts, mean, 1e-6 * std::abs(mean) + 1e-3);
     EXPECT_NEAR(cap.channels[j].std_counts, sd, 1e-4 * sd);
-    // The scenario's white noise is 1 mg per sensor at 1 V/g = 1e-3 V = 1e-3/lsb codes; the
+    // The scenario's white noise is 1 mg per sensor: 1e-3 g · SF (V/g) / lsb (V/count) codes; the
     // sample standard deviation of N = 500 has a relative spread of 1/sqrt(2N) = 3.2 %: 15 % is
     // 4.7 sigma (false failure 2.6e-6 per channel).
-    EXPECT_NEAR(cap.channels[j].std_counts, 1e-3 / lsb, 0.15e-3 / lsb);
+    const double sigma_counts = 1e-3 * rig_->factory.sensors[j].scale_v_per_g / lsb;
+    EXPECT_NEAR(cap.channels[j].std_counts, sigma_counts, 0.15 * sigma_counts);
   }
 }
 

@@ -50,7 +50,7 @@ std::vector<nav::NavState<float>> host_only_run(const SimRig& rig) {
   std::vector<nav::NavState<float>> out;
   out.reserve(rig.tap->samples().size());
   for (const RawSample& s : rig.tap->samples()) {
-    p->process(s.counts, s.t_ns, s.seq, (s.flags & sample_flags::kCrcError) == 0);
+    p->process(s);
     out.push_back(p->state());
   }
   return out;

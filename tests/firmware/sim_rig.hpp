@@ -43,9 +43,9 @@ struct SimRig {
   /// `scenario`: a name in host_sim/scenarios; `seconds`: run length (samples = seconds·rate+1).
   SimRig(const std::string& scenario, double seconds, const sim_board::FaultPlan& faults = {},
          std::size_t can_capacity = 1u << 16) {
-    const sim::ParsedScenario p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
-    if (!p.ok()) throw std::runtime_error(p.error);
-    s = *p.scenario;
+    const auto p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
+    if (!p.is_ok()) throw std::runtime_error(p.error().message);
+    s = p.value();
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;

@@ -105,12 +105,12 @@ struct SimParts {
 
 BoardResult make_sim_board(const FwConfig& c) {
   BoardResult out;
-  const sim::ParsedScenario parsed = sim::load_scenario(c.sim_scenario, scenario_dir(c));
-  if (!parsed.ok()) {
-    out.error = parsed.error;
+  const auto parsed = sim::load_scenario(c.sim_scenario, scenario_dir(c));
+  if (!parsed.is_ok()) {
+    out.error = parsed.error().message;
     return out;
   }
-  const sim::Scenario s = *parsed.scenario;
+  const sim::Scenario s = parsed.value();
   if (s.rate_hz != c.sample_rate_hz) {
     out.error = "scenario " + s.name + " runs at " + std::to_string(s.rate_hz) +
                 " Hz but adc.sample_rate_hz is " + std::to_string(c.sample_rate_hz);
@@ -119,6 +119,10 @@ BoardResult make_sim_board(const FwConfig& c) {
   const double duration = c.sim_duration_s > 0 ? c.sim_duration_s : s.duration_s;
   auto parts = std::make_shared<SimParts>();
   parts->stream = sim_board::make_scenario_stream(s);
+  if (!parts->stream) {
+    out.error = "scenario " + s.name + ": its trajectory cannot be built";
+    return out;
+  }
   parts->adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
   if (const Status st = parts->adc->start(); !st.is_ok()) {
     out.error = std::string("simulated ADC start: ") + st.message();

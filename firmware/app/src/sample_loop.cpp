@@ -209,9 +209,10 @@ void SampleLoop::on_sample(const RawSample& s) {
   }
   if (!crc_ok || saturated != 0) ++health_.rejected_samples;
 
-  // A CRC error means the counts are not a measurement: the pipeline skips the sample and
-  // integrates across the hole with the next good one; it rejects saturated samples itself.
-  pipeline_.process(s.counts, s.t_ns, s.seq, crc_ok);
+  // A CRC error means the counts are not a measurement: the pipeline skips the sample (and a
+  // saturated one) and integrates across the hole with the next good one.
+  if (crc_ok && saturated == 0) last_good_ = s;
+  pipeline_.process(s);
   if (capture_.active && crc_ok) capture_add(s);
   build_epoch(s);
 }
@@ -292,7 +293,7 @@ Status SampleLoop::reconfigure_keep_navigation(const nav::PipelineConfig<float>&
   if (const Status s = pipeline_.configure(cfg); !s.is_ok()) return s;
   // configure() restarts alignment; a running navigation continues from its current state
   // with the new compensation instead.
-  if (navigating) pipeline_.start_at(state, last_counts_);
+  if (navigating) pipeline_.start_at(state, last_good_);
   return Status::ok();
 }
 

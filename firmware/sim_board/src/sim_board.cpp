@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "gfins/host_sim/chip/simulated_adc.hpp"
+#include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 
 namespace gfins::sim_board {
@@ -171,37 +172,49 @@ Result<hal::CanFrame> MemoryCanBus::do_receive(std::int64_t /*timeout_ns*/) {
 
 namespace {
 
+// The host's one sample source (host_sim/sample_source.hpp) up to the sensor voltages: the
+// simulated board puts its own converter (the chip model, with its data-ready line and fault
+// injection) behind them, so the source runs without one.
 class ScenarioStream final : public SensorStream {
  public:
-  explicit ScenarioStream(const sim::Scenario& s)
-      : traj_(sim::make_trajectory(s.trajectory)),
-        model_(nav::table1_geometry<double>(s.rho_m), errors(s), sim::gravity_model(s), s.rate_hz,
-               s.seed),
-        rate_hz_(s.rate_hz) {}
+  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj)
+      : traj_(std::move(traj)),
+        source_(*traj_,
+                sim::SensorArrayModel(nav::table1_geometry<double>(s.rho_m), errors(s),
+                                      sim::gravity_model(s), s.rate_hz, s.seed),
+                nullptr, s.rate_hz) {
+    if (s.noise_uniform) source_.set_uniform_noise_mps2(s.noise_mps2, s.seed);
+  }
 
-  std::array<double, 6> volts(std::uint32_t seq) override {
-    const sim::TruthState x = traj_->at(static_cast<double>(seq) / rate_hz_);
-    const sim::SensorArrayModel::Volts v = model_.volts(x);
+  std::array<double, 6> volts(std::uint32_t /*seq*/) override {
+    // Index-driven: conversion k is the source's k-th sample (the caller asks in order).
+    const Result<sim::SourceSample> x = source_.next();
+    const sim::SensorArrayModel::Volts& v = x.value().volts;
     return {v(0), v(1), v(2), v(3), v(4), v(5)};
   }
 
+  /// The scenario's sensors as the host's scenario runner builds them: through a converter they
+  /// have the QA-1100's scale factor (1.33 V/g into 1 kΩ), plus the scenario's errors.
   static sim::ArrayErrors errors(const sim::Scenario& s) {
     sim::ArrayErrors e;
     e.misalignment = s.misalignment;
     e.temperature_c = s.temperature_c;
+    const double qa1100_sf = sim::AccelErrors::qa1100_typical().scale_v_per_g;
     for (std::size_t j = 0; j < 6; ++j) {
       sim::AccelErrors& a = e.sensors[j];
       if (s.qa1100) a = sim::AccelErrors::qa1100_typical();
+      a.scale_v_per_g = qa1100_sf;
       a.bias_g += s.bias_mps2[j] / nav::kStandardGravity;
-      if (s.noise_mps2 > 0 || !s.qa1100) a.noise_g = s.noise_mps2 / nav::kStandardGravity;
+      if (s.noise_mps2 > 0 || !s.qa1100) {
+        a.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / nav::kStandardGravity;
+      }
     }
     return e;
   }
 
  private:
   std::unique_ptr<sim::Trajectory> traj_;
-  sim::SensorArrayModel model_;
-  double rate_hz_;
+  sim::SampleSource source_;
 };
 
 std::string device_id_for(const std::string& name) {
@@ -217,7 +230,9 @@ std::string device_id_for(const std::string& name) {
 }  // namespace
 
 std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s) {
-  return std::make_unique<ScenarioStream>(s);
+  auto traj = sim::make_trajectory(s.trajectory);
+  if (!traj.is_ok()) return nullptr;
+  return std::make_unique<ScenarioStream>(s, std::move(traj).value());
 }
 
 // ---- The chip -----------------------------------------------------------------------------

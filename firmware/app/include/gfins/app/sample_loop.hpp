@@ -139,6 +139,7 @@ class SampleLoop {
   Epoch epoch_{};
   LatencyHistogram latency_{};
   std::array<std::int32_t, kAdcChannels> last_counts_{};
+  RawSample last_good_{};  // the last sample the core could integrate (warm restarts)
   std::uint32_t last_seq_ = 0;
   bool have_seq_ = false;
   std::uint8_t reload_token_ = 0;

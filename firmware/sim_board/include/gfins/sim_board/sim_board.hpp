@@ -173,7 +173,8 @@ class MemoryCanBus final : public hal::CanBus {
   hal::CanCounters counters_{};
 };
 
-/// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample.
+/// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
+/// null when the scenario's trajectory cannot be built.
 std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
 
 
