@@ -83,7 +83,8 @@ TEST(CanOutput, DecodedFramesEqualTheNavStateWithinQuantisation) {
     const std::uint64_t p = can::payload_of(f);
     std::int64_t counter = -1;
     for (const auto& s : m->signals) {
-      if (s.field == can::Field::kCounter) counter = static_cast<std::int64_t>(can::extract_bits(p, s));
+      if (s.field == can::Field::kCounter)
+        counter = static_cast<std::int64_t>(can::extract_bits(p, s));
     }
     if (m->id == can::MessageId::kEpoch) {
       // The epoch frame opens an epoch: find it by its 16-bit sample count, in order.
@@ -272,7 +273,11 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
   EXPECT_EQ(part(r, 1)->cal_id, calibration_id(d));
   EXPECT_EQ(rig_->loop->cal_id(), calibration_id(d));
   // When the file is then corrupted (truncated) and reloaded
-  { std::FILE* f = std::fopen(path_.c_str(), "w"); std::fputs("[calibration\n", f); std::fclose(f); }
+  {
+    std::FILE* f = std::fopen(path_.c_str(), "w");
+    std::fputs("[calibration\n", f);
+    std::fclose(f);
+  }
   r = send(cmd(can::Opcode::kReloadCalibration, 18), 1);
   for (int i = 0; i < 200 && part(r, 0) == nullptr; ++i) {
     rig_->bus->clear_sent();

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "gfins/app/config.hpp"
 #include "gfins/app/can_adapters.hpp"
+#include "gfins/app/config.hpp"
 #include "gfins/app/epoch_sinks.hpp"
 #include "gfins/app/logger.hpp"
 #include "gfins/app/sample_loop.hpp"
@@ -52,9 +52,8 @@ struct SimRig {
     stream = sim_board::make_scenario_stream(s);
     adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
     if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
-    source = std::make_unique<sim_board::SimSampleSource>(*stream, *adc, clock, &clock,
-                                                          sim_board::Pacing::kFast, s.rate_hz,
-                                                          samples);
+    source = std::make_unique<sim_board::SimSampleSource>(
+        *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
     source->set_faults(faults);
     tap = std::make_unique<TapSource>(*source, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);

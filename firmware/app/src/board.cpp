@@ -255,8 +255,8 @@ BoardResult make_linux_board(const FwConfig& c) {
     return out;
   }
   const double lsb = fe.value().volts_per_count(0);
-  auto source = std::make_unique<AdcSource>(std::move(spi).value(), std::move(drdy).value(),
-                                            adc_cfg, lsb);
+  auto source =
+      std::make_unique<AdcSource>(std::move(spi).value(), std::move(drdy).value(), adc_cfg, lsb);
   if (const Status st = source->start(); !st.is_ok()) {
     out.error = lnx::describe("ADS131M06 on " + c.spi_device, st);
     return out;

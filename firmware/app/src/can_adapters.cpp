@@ -34,8 +34,9 @@ static_assert(static_cast<int>(CommandKind::kRealign) == can::kOpRealign &&
                   static_cast<int>(CommandKind::kReloadCalibration) == can::kOpReloadCalibration,
               "command kinds are the CAN opcodes");
 static_assert(static_cast<int>(CommandResult::kNotReady) ==
-                  static_cast<int>(can::ResultCode::kNotReady) &&
-                  static_cast<int>(CommandResult::kBusy) == static_cast<int>(can::ResultCode::kBusy),
+                      static_cast<int>(can::ResultCode::kNotReady) &&
+                  static_cast<int>(CommandResult::kBusy) ==
+                      static_cast<int>(can::ResultCode::kBusy),
               "command results are the CAN result codes");
 static_assert(kMaxPose == can::kMaxCapturePose, "one pose range");
 static_assert(kMaxNodeId == can::kMaxNodeId, "one node id range");
@@ -119,7 +120,8 @@ DecodedFrame CanCommandCodec::decode(const hal::CanFrame& f) const {
   return out;
 }
 
-std::size_t CanCommandCodec::encode(const Response& r, std::array<hal::CanFrame, 24>& frames) const {
+std::size_t CanCommandCodec::encode(const Response& r,
+                                    std::array<hal::CanFrame, 24>& frames) const {
   std::size_t n = 0;
   if (r.has_capture) {
     can::CaptureResult c;
@@ -140,8 +142,8 @@ std::size_t CanCommandCodec::encode(const Response& r, std::array<hal::CanFrame,
   const can::Response rsp{r.raw_opcode, r.token, static_cast<can::ResultCode>(r.result),
                           r.value & 0xFFFFFFu};
   frames[n++] = can::encode_response(rsp, node_id_);
-  if (r.result == CommandResult::kOk && (r.kind == CommandKind::kReportCalibration ||
-                                         r.kind == CommandKind::kReloadCalibration)) {
+  if (r.result == CommandResult::kOk &&
+      (r.kind == CommandKind::kReportCalibration || r.kind == CommandKind::kReloadCalibration)) {
     frames[n++] = can::encode_calibration_id_response(r.token, r.cal_id, node_id_);
   }
   return n;

@@ -269,7 +269,9 @@ app::AdcCounters ChipAdc::counters() const {
   return c;
 }
 void ChipAdc::corrupt_next_frame() { impl_->adc.chip().corrupt_output_crc(1); }
-void ChipAdc::stick_channel(int ch, std::int32_t code) { impl_->adc.chip().stick_channel(ch, code); }
+void ChipAdc::stick_channel(int ch, std::int32_t code) {
+  impl_->adc.chip().stick_channel(ch, code);
+}
 void ChipAdc::saturate_channel(int ch) { impl_->adc.chip().saturate_channel(ch, true); }
 void ChipAdc::clear_channel_faults() { impl_->adc.chip().clear_channel_faults(); }
 void ChipAdc::power_on_reset() { impl_->adc.chip().power_on_reset(); }

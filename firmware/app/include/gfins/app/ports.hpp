@@ -89,10 +89,10 @@ struct Command {
   std::uint8_t token = 0;  // echoed in the response so the host matches it
   float heading_rad = 0;   // kRealign
   nav::CompensatorKind compensator = nav::CompensatorKind::kNone;  // kSetCompensator
-  std::uint8_t message = 0;                                         // kSetDivider
-  std::uint16_t divider = 0;                                        // kSetDivider
-  std::uint8_t pose = 0;                                            // kCaptureCalibration
-  std::uint16_t samples = 0;                                        // kCaptureCalibration
+  std::uint8_t message = 0;                                        // kSetDivider
+  std::uint16_t divider = 0;                                       // kSetDivider
+  std::uint8_t pose = 0;                                           // kCaptureCalibration
+  std::uint16_t samples = 0;                                       // kCaptureCalibration
 };
 
 /// Result of a command; the values are the CAN response's Result codes (docs/can-interface.md).
@@ -101,11 +101,11 @@ enum class CommandResult : std::uint8_t {
   kUnknownOpcode = 1,
   kBadLength = 2,
   kBadCrc = 3,
-  kOutOfRange = 4,   // a parameter outside its domain
-  kMalformed = 5,    // frame could not be decoded
-  kBusy = 6,         // a capture or reload is already running
-  kFailed = 7,       // executed but failed (reload: bad file; the previous calibration stays)
-  kNotReady = 8,     // not possible in the current mode
+  kOutOfRange = 4,  // a parameter outside its domain
+  kMalformed = 5,   // frame could not be decoded
+  kBusy = 6,        // a capture or reload is already running
+  kFailed = 7,      // executed but failed (reload: bad file; the previous calibration stays)
+  kNotReady = 8,    // not possible in the current mode
 };
 
 /// Calibration capture statistics of one channel, in ADC codes.
@@ -139,7 +139,7 @@ struct Response {
   bool calibrated = false;   // kReportCalibration
   bool deferred = false;     // no response now: it follows when the work is done (reload)
   bool has_capture = false;
-  CaptureResult capture{};   // kCaptureCalibration, final response
+  CaptureResult capture{};  // kCaptureCalibration, final response
 };
 
 /// Command frames in, response frames out (the CAN protocol's codec behind it).

@@ -48,6 +48,8 @@ class LatencyHistogram {
   std::int64_t max_ns() const { return max_ns_; }
   /// Upper edge of the bin holding quantile q (0..1), µs.
   double quantile_us(double q) const;
+  /// Count of bin b ([b, b+1) µs; the last bin holds everything beyond).
+  std::uint32_t bin(std::size_t b) const { return bins_[b]; }
 
  private:
   std::array<std::uint32_t, kBins> bins_{};

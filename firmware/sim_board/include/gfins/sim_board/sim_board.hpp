@@ -77,13 +77,13 @@ class ChipAdc {
   double volts_per_count() const;
   app::AdcCounters counters() const;
 
-  void corrupt_next_frame();               // output CRC error on the next frame
+  void corrupt_next_frame();  // output CRC error on the next frame
   void stick_channel(int ch, std::int32_t code);
   void saturate_channel(int ch);
   void clear_channel_faults();
-  void power_on_reset();                   // the chip resets before the next conversion
-  void drop_edge();                        // the next conversion's data-ready edge is lost
-  void extra_edge();                       // a spurious edge before the next conversion
+  void power_on_reset();  // the chip resets before the next conversion
+  void drop_edge();       // the next conversion's data-ready edge is lost
+  void extra_edge();      // a spurious edge before the next conversion
 
  private:
   struct Impl;
@@ -92,18 +92,18 @@ class ChipAdc {
 
 /// Faults injected per conversion index (seq) or on the data-ready line.
 struct FaultPlan {
-  std::vector<std::uint32_t> crc_error_at;   // frame of this seq arrives with a bad CRC
-  std::vector<std::uint32_t> missing_edges;  // the edge of this seq is lost (conversion unseen)
+  std::vector<std::uint32_t> crc_error_at;      // frame of this seq arrives with a bad CRC
+  std::vector<std::uint32_t> missing_edges;     // the edge of this seq is lost (conversion unseen)
   std::vector<std::uint32_t> extra_edge_after;  // a spurious edge after this seq's edge
   std::uint32_t reset_at = 0;                   // the chip resets before this seq (0 = never)
   std::uint32_t silent_from = 0;                // no edges from this seq on ... (0 = never)
   std::uint32_t silent_edges = 0;               // ... for this many periods
   int stuck_channel = -1;                       // this channel's code freezes from stuck_from
   std::uint32_t stuck_from = 0;
-  std::uint32_t stuck_until = 0;                // 0 = for ever
-  int saturated_channel = -1;                   // this channel sits at full scale ...
+  std::uint32_t stuck_until = 0;  // 0 = for ever
+  int saturated_channel = -1;     // this channel sits at full scale ...
   std::uint32_t saturated_from = 0;
-  std::uint32_t saturated_until = 0;            // ... until here (0 = for ever)
+  std::uint32_t saturated_until = 0;  // ... until here (0 = for ever)
 };
 
 enum class Pacing : std::uint8_t { kFast, kRealTime };
@@ -176,7 +176,6 @@ class MemoryCanBus final : public hal::CanBus {
 /// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
 /// null when the scenario's trajectory cannot be built.
 std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
-
 
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.
