@@ -1,3 +1,4 @@
+# shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets gpiochip, pull, rate
 # Stage "backend" of the in-VM test (sourced by vm-test.sh): the Linux backends' own real-kernel
 # test program (tests/drivers_linux/vm_check.cpp) against vcan0 and the gpio-sim line.
 # needs: build:tests/drivers_linux/drivers_linux_vm_check

@@ -1,3 +1,4 @@
+# shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets gpiochip, pull, rate
 # Stage "faults" of the in-VM test (sourced by vm-test.sh, after stage fw): faults made through
 # the kernel while gfins-fw runs from gfins-fw-vboard.toml; after each the firmware must still
 # run and frames must flow again on vcan0.

@@ -1,3 +1,4 @@
+# shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets gpiochip, pull, rate
 # Stage "fw" of the in-VM test (sourced by vm-test.sh): gfins-fw from its configuration file
 # (gfins-fw-vboard.toml: ADC chip model on SPI, data-ready from the gpio-sim line through
 # libgpiod, output on vcan0 through SocketCAN), read by candump and gfins-can on vcan0.
