@@ -57,6 +57,9 @@ done
 step "Debian packages (amd64, arm64, armhf) and lintian"
 ./scripts/package.sh deb-amd64 aarch64-linux armhf-linux
 
+# infra (Debian's tools on vcan0 and the gpio-sim line) and service (systemd's notify and
+# watchdog in a debootstrap root) pass today; backend, fw and faults need programs that do not
+# pass or exist yet (docs/deploy.md, "What the VM test checks") and are added here as they do.
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,service}"
 
