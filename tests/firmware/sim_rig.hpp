@@ -63,17 +63,16 @@ struct SimRig {
   /// `scenario`: a name in host_sim/scenarios; `seconds`: run length (samples = seconds·rate+1).
   SimRig(const std::string& scenario, double seconds, const sim_board::FaultPlan& faults = {},
          std::size_t can_capacity = 1u << 16) {
-    const sim::ParsedScenario p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
-    if (!p.ok()) throw std::runtime_error(p.error);
-    s = *p.scenario;
+    auto p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
+    if (!p.is_ok()) throw std::runtime_error(p.error().message);
+    s = std::move(p).value();
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
     stream = sim_board::make_scenario_stream(s);
     adc = sim_board::make_adc_chain(s);
-    source = std::make_unique<sim_board::SimSampleSource>(*stream, *adc, clock, &clock,
-                                                          sim_board::Pacing::kFast, s.rate_hz,
-                                                          samples);
+    source = std::make_unique<sim_board::SimSampleSource>(
+        *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
     source->set_faults(faults);
     tap = std::make_unique<TapSource>(*source, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);

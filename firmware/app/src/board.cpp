@@ -31,12 +31,12 @@ struct SimParts {
 
 BoardResult make_sim_board(const FwConfig& c) {
   BoardResult out;
-  const sim::ParsedScenario parsed = sim::load_scenario(c.sim_scenario, scenario_dir(c));
-  if (!parsed.ok()) {
-    out.error = parsed.error;
+  auto parsed = sim::load_scenario(c.sim_scenario, scenario_dir(c));
+  if (!parsed.is_ok()) {
+    out.error = parsed.error().message;
     return out;
   }
-  sim::Scenario s = *parsed.scenario;
+  sim::Scenario s = std::move(parsed).value();
   if (s.rate_hz != c.sample_rate_hz) {
     out.error = "scenario " + s.name + " runs at " + std::to_string(s.rate_hz) +
                 " Hz but adc.sample_rate_hz is " + std::to_string(c.sample_rate_hz);

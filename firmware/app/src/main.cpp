@@ -33,8 +33,8 @@ int run(const gfins::app::FwConfig& cfg) {
   }
   Board& board = *made.board;
 
-  const StartupCalibration cal = load_calibration(
-      cfg, board.defaults, board.factory ? &*board.factory : nullptr);
+  const StartupCalibration cal =
+      load_calibration(cfg, board.defaults, board.factory ? &*board.factory : nullptr);
   if (cal.from_file) {
     spdlog::info("{}", cal.message);
   } else {
@@ -71,15 +71,17 @@ int run(const gfins::app::FwConfig& cfg) {
   spdlog::info("stopped after {} samples; mode {}, calibration id {:08x}{}", h.samples,
                static_cast<int>(loop->mode()), loop->cal_id(),
                loop->calibrated() ? "" : " (UNCALIBRATED)");
-  spdlog::info("health: missed edges {}, extra edges {}, data-ready timeouts {}, CRC errors {}, "
-               "ADC resets {}, saturated {}, stuck events {} (mask {:#x}), CAN dropped {}, "
-               "bus-off {}, overruns {}, log dropped {}",
-               h.missed_edges, h.extra_edges, h.drdy_timeouts, h.crc_errors, h.adc_resets,
-               h.saturated_samples, h.stuck_events, h.stuck_mask, h.can_tx_dropped,
-               h.bus_off_events, h.loop_overruns, h.log_dropped);
-  spdlog::info("final state t {:.3f} s: v_n [{:.4f} {:.4f} {:.4f}] m/s, r_n [{:.4f} {:.4f} {:.4f}] m",
-               static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),
-               st.r_n.y(), st.r_n.z());
+  spdlog::info(
+      "health: missed edges {}, extra edges {}, data-ready timeouts {}, CRC errors {}, "
+      "ADC resets {}, saturated {}, stuck events {} (mask {:#x}), CAN dropped {}, "
+      "bus-off {}, overruns {}, log dropped {}",
+      h.missed_edges, h.extra_edges, h.drdy_timeouts, h.crc_errors, h.adc_resets,
+      h.saturated_samples, h.stuck_events, h.stuck_mask, h.can_tx_dropped, h.bus_off_events,
+      h.loop_overruns, h.log_dropped);
+  spdlog::info(
+      "final state t {:.3f} s: v_n [{:.4f} {:.4f} {:.4f}] m/s, r_n [{:.4f} {:.4f} {:.4f}] m",
+      static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),
+      st.r_n.y(), st.r_n.z());
   if (loop->latency().count() > 0) {
     spdlog::info("latency edge → CAN: p50 {} µs, p99 {} µs, max {:.1f} µs over {} epochs",
                  loop->latency().quantile_us(0.5), loop->latency().quantile_us(0.99),

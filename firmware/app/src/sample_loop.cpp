@@ -97,7 +97,8 @@ SampleLoop::Cycle SampleLoop::step() {
     events_.set(status_bits::kLoopOverrun, sample_index_);
     if (sample_index_ - last_log_ >= kLogEverySamples || health_.loop_overruns == 1) {
       last_log_ = sample_index_;
-      log(LogLevel::kWarn, t_edge, "loop overrun: cycle took {} ns of a {} ns period (overruns: {})",
+      log(LogLevel::kWarn, t_edge,
+          "loop overrun: cycle took {} ns of a {} ns period (overruns: {})",
           clock_.now_ns() - t_edge, period_ns_, health_.loop_overruns);
     }
   }
@@ -122,7 +123,8 @@ void SampleLoop::update_adc_counters(std::uint32_t sample) {
   if (c.chip_resets != adc_seen_.chip_resets) {
     health_.adc_resets += c.chip_resets - adc_seen_.chip_resets;
     events_.set(status_bits::kAdcRecovered, sample);
-    log(LogLevel::kError, 0, "ADC reset detected and reconfigured (resets: {})", health_.adc_resets);
+    log(LogLevel::kError, 0, "ADC reset detected and reconfigured (resets: {})",
+        health_.adc_resets);
   }
   if (c.extra_edges != adc_seen_.extra_edges) {
     health_.extra_edges += c.extra_edges - adc_seen_.extra_edges;
@@ -169,8 +171,8 @@ void SampleLoop::on_sample(const RawSample& s) {
     const std::uint32_t lost = s.seq - last_seq_ - 1u;
     health_.missed_edges += lost;
     events_.set(status_bits::kSampleGap, k);
-    log(LogLevel::kWarn, s.t_ns, "{} data-ready edge(s) missed before sample {} (missed: {})",
-        lost, s.seq, health_.missed_edges);
+    log(LogLevel::kWarn, s.t_ns, "{} data-ready edge(s) missed before sample {} (missed: {})", lost,
+        s.seq, health_.missed_edges);
   }
   last_seq_ = s.seq;
   have_seq_ = true;
@@ -212,7 +214,7 @@ void SampleLoop::on_sample(const RawSample& s) {
 
   // A CRC error means the counts are not a measurement: the pipeline skips the sample and
   // integrates across the hole with the next good one; it rejects saturated samples itself.
-  pipeline_.process(s.counts, s.t_ns, s.seq, crc_ok);
+  pipeline_.process(s);
   if (capture_.active && crc_ok) capture_add(s);
   build_epoch(s);
 }
@@ -241,9 +243,8 @@ void SampleLoop::build_epoch(const RawSample& s) {
   if (capture_.active) bits |= status_bits::kCaptureActive;
   // Degraded: the solution integrates inputs known to be wrong (a stuck or saturated channel) or
   // the ADC stopped delivering; a CRC error or a missed edge alone costs one step across a gap.
-  const bool degraded =
-      (bits & (status_bits::kStuckChannel | status_bits::kSaturated |
-               status_bits::kDataReadyLost)) != 0;
+  const bool degraded = (bits & (status_bits::kStuckChannel | status_bits::kSaturated |
+                                 status_bits::kDataReadyLost)) != 0;
   if (degraded) bits |= status_bits::kDegraded;
   mode_ = !aligned ? Mode::kAligning : (degraded ? Mode::kDegraded : Mode::kNavigating);
   epoch_.mode = mode_;
@@ -270,8 +271,8 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
       r.result = c.status().code() == ErrorCode::kOutOfRange ? CommandResult::kOutOfRange
                                                              : CommandResult::kMalformed;
       ++health_.command_errors;
-      log(LogLevel::kWarn, t_ns, "command frame id {:#x} rejected: error code {}",
-          f.value().id, static_cast<std::int64_t>(c.status().code()));
+      log(LogLevel::kWarn, t_ns, "command frame id {:#x} rejected: error code {}", f.value().id,
+          static_cast<std::int64_t>(c.status().code()));
     } else {
       execute(c.value(), r);
       log(LogLevel::kInfo, t_ns, "command {} token {} -> result {}",
@@ -295,7 +296,13 @@ Status SampleLoop::reconfigure_keep_navigation(const nav::PipelineConfig<float>&
   if (const Status s = pipeline_.configure(cfg); !s.is_ok()) return s;
   // configure() restarts alignment; a running navigation continues from its current state
   // with the new compensation instead.
-  if (navigating) pipeline_.start_at(state, last_counts_);
+  if (navigating) {
+    RawSample last;
+    last.seq = state.seq;
+    last.t_ns = state.t_ns;
+    last.counts = last_counts_;
+    pipeline_.start_at(state, last);
+  }
   return Status::ok();
 }
 
@@ -340,7 +347,8 @@ void SampleLoop::execute(const Command& c, Response& r) {
       if (c.message >= kNumMessages || c.divider > kMaxDivider) {
         return reject(CommandResult::kOutOfRange);
       }
-      if (!out_.set_divider(c.message, c.divider).is_ok()) return reject(CommandResult::kOutOfRange);
+      if (!out_.set_divider(c.message, c.divider).is_ok())
+        return reject(CommandResult::kOutOfRange);
       break;
     case CommandKind::kReportCalibration:
       break;
@@ -406,8 +414,8 @@ void SampleLoop::capture_finish() {
   }
   capture_.active = false;
   last_capture_ = r.capture;
-  log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}",
-      r.capture.pose, r.capture.channels[0].count, r.capture.motion ? 1 : 0);
+  log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}", r.capture.pose,
+      r.capture.channels[0].count, r.capture.motion ? 1 : 0);
   send_response(r);
 }
 

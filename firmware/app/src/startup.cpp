@@ -38,9 +38,9 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
   p.alignment_samples =
       static_cast<std::uint32_t>(std::llround(std::max(1.0, c.alignment_s * c.sample_rate_hz)));
   p.heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
-  p.r0_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
-                            static_cast<float>(c.position_m[1]),
-                            static_cast<float>(c.position_m[2]));
+  p.r0_n =
+      nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
+                       static_cast<float>(c.position_m[2]));
   return p;
 }
 
@@ -48,9 +48,9 @@ LoopOptions loop_options(const FwConfig& c) {
   LoopOptions o;
   o.sample_rate_hz = c.sample_rate_hz;
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
-  o.initial_position_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
-                                          static_cast<float>(c.position_m[1]),
-                                          static_cast<float>(c.position_m[2]));
+  o.initial_position_n =
+      nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
+                       static_cast<float>(c.position_m[2]));
   return o;
 }
 
@@ -69,8 +69,7 @@ calib_file::CalibrationData nominal_calibration(double volts_per_count) {
   return d;
 }
 
-StartupCalibration load_calibration(const FwConfig& c,
-                                    const calib_file::CalibrationData& defaults,
+StartupCalibration load_calibration(const FwConfig& c, const calib_file::CalibrationData& defaults,
                                     const calib_file::CalibrationData* factory) {
   StartupCalibration out;
   std::string why;

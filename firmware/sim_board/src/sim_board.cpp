@@ -59,7 +59,8 @@ Result<RawSample> SimSampleSource::do_read_sample(std::int64_t timeout_ns) {
     silent_left_ = faults_.silent_edges;
   }
   if (silent_left_ > 0) {
-    const auto periods = static_cast<std::uint32_t>(std::max<std::int64_t>(1, timeout_ns / period_ns_));
+    const auto periods =
+        static_cast<std::uint32_t>(std::max<std::int64_t>(1, timeout_ns / period_ns_));
     const std::uint32_t n = std::min({periods, silent_left_, remaining_});
     for (std::uint32_t i = 0; i < n; ++i) (void)stream_.volts(next_seq_++);
     silent_left_ -= n;
@@ -191,7 +192,8 @@ namespace {
 class ScenarioStream final : public SensorStream {
  public:
   explicit ScenarioStream(const sim::Scenario& s)
-      : traj_(sim::make_trajectory(s.trajectory)),
+      : traj_(std::move(sim::make_trajectory(s.trajectory))
+                  .value()),  // kind checked by load_scenario
         model_(nav::table1_geometry<double>(s.rho_m), errors(s), sim::gravity_model(s), s.rate_hz,
                s.seed),
         rate_hz_(s.rate_hz) {}

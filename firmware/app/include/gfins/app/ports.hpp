@@ -88,19 +88,19 @@ struct Command {
   std::uint8_t token = 0;  // echoed in the response so the host matches it
   float heading_rad = 0;   // kRealign
   nav::CompensatorKind compensator = nav::CompensatorKind::kNone;  // kSetCompensator
-  std::uint8_t message = 0;                                         // kSetDivider
-  std::uint16_t divider = 0;                                        // kSetDivider
-  std::uint8_t pose = 0;                                            // kCaptureCalibration
-  std::uint16_t samples = 0;                                        // kCaptureCalibration
+  std::uint8_t message = 0;                                        // kSetDivider
+  std::uint16_t divider = 0;                                       // kSetDivider
+  std::uint8_t pose = 0;                                           // kCaptureCalibration
+  std::uint16_t samples = 0;                                       // kCaptureCalibration
 };
 
 enum class CommandResult : std::uint8_t {
   kOk = 0,
-  kMalformed = 1,    // frame could not be decoded
-  kOutOfRange = 2,   // a parameter outside its domain
-  kBusy = 3,         // a capture or reload is already running
-  kFailed = 4,       // executed but failed (reload: bad file; the previous calibration stays)
-  kAccepted = 5,     // started; a second response follows (capture, reload)
+  kMalformed = 1,   // frame could not be decoded
+  kOutOfRange = 2,  // a parameter outside its domain
+  kBusy = 3,        // a capture or reload is already running
+  kFailed = 4,      // executed but failed (reload: bad file; the previous calibration stays)
+  kAccepted = 5,    // started; a second response follows (capture, reload)
 };
 
 /// Calibration capture statistics of one channel, in volts at the sensor.
@@ -124,7 +124,7 @@ struct Response {
   std::uint32_t cal_id = 0;  // kReportCalibration / kReloadCalibration
   bool calibrated = false;   // kReportCalibration
   bool has_capture = false;
-  CaptureResult capture{};   // kCaptureCalibration, final response
+  CaptureResult capture{};  // kCaptureCalibration, final response
 };
 
 /// Command frames in, response frames out (the CAN protocol's codec behind it).

@@ -72,18 +72,18 @@ class AdcChain {
 
 /// Faults injected per conversion index (seq) or on the data-ready line.
 struct FaultPlan {
-  std::vector<std::uint32_t> crc_error_at;   // frame of this seq arrives with a bad CRC
-  std::vector<std::uint32_t> missing_edges;  // the edge of this seq is lost (conversion unseen)
+  std::vector<std::uint32_t> crc_error_at;      // frame of this seq arrives with a bad CRC
+  std::vector<std::uint32_t> missing_edges;     // the edge of this seq is lost (conversion unseen)
   std::vector<std::uint32_t> extra_edge_after;  // a spurious edge after this seq's edge
   std::uint32_t reset_at = 0;                   // chip resets before this seq (0 = never)
   std::uint32_t silent_from = 0;                // no edges from this seq on ... (0 = never)
   std::uint32_t silent_edges = 0;               // ... for this many periods
   int stuck_channel = -1;                       // this channel's code freezes from stuck_from
   std::uint32_t stuck_from = 0;
-  std::uint32_t stuck_until = 0;                // 0 = for ever
-  int saturated_channel = -1;                   // this channel sits at full scale ...
+  std::uint32_t stuck_until = 0;  // 0 = for ever
+  int saturated_channel = -1;     // this channel sits at full scale ...
   std::uint32_t saturated_from = 0;
-  std::uint32_t saturated_until = 0;            // ... until here (0 = for ever)
+  std::uint32_t saturated_until = 0;  // ... until here (0 = for ever)
 };
 
 enum class Pacing : std::uint8_t { kFast, kRealTime };
