@@ -128,7 +128,7 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version = kForm
 /// checksum(data) folded to 32 bits (h ^ h >> 32, the rule gfins-fw uses), with 0 (reserved
 /// for "nominal parameters, no file") mapped to 1. Two files with the same values have the same
 /// identity.
-std::uint32_t calibration_id(const CalibrationData& data);
+std::uint32_t cal_id_of(const CalibrationData& data);
 /// FNV-1a 64-bit of arbitrary bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
 std::uint64_t fnv1a64(const std::string& bytes);
 
