@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build git pkg-config
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libgpiod-dev gpiod can-utils
+  libgpiod-dev gpiod can-utils libsystemd-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev
   python3 python3-matplotlib python3-numpy
   clang-format clang-tidy valgrind

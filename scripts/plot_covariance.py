@@ -12,10 +12,15 @@ import math
 import os
 import sys
 
-import matplotlib
+try:
+    import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: E402
+except ImportError as e:
+    # A clear message and a non-zero exit (gfins-sim then exits 3), not a traceback.
+    sys.exit(f"{sys.argv[0]}: cannot plot: {e} (Debian: apt install python3-matplotlib; "
+             f"this interpreter is {sys.executable})")
 
 BLOCKS = [
     ("attitude error phi (n frame)", "phi_n", "deg", 180.0 / math.pi),

@@ -53,18 +53,19 @@ nav::PipelineConfig<float> make_config() {
   return c;
 }
 
-nav::NavPipeline<float>::Counts read_adc() {
-  nav::NavPipeline<float>::Counts counts;
-  for (std::size_t j = 0; j < counts.size(); ++j) counts[j] = g_adc_counts[j];
-  return counts;
+gfins::RawSample read_adc() {
+  gfins::RawSample s;
+  for (std::size_t j = 0; j < s.counts.size(); ++j) s.counts[j] = g_adc_counts[j];
+  s.t_ns = g_adc_t_ns;
+  s.seq = g_adc_seq;
+  return s;
 }
 
 }  // namespace
 
 // The per-sample step of the firmware's sample loop: read a frame, run the pipeline, publish.
 extern "C" [[gnu::noinline]] void gfins_nav_step() {
-  const auto counts = read_adc();
-  g_pipeline.process(counts, g_adc_t_ns, g_adc_seq);
+  g_pipeline.process(read_adc());
   const nav::NavState<float>& s = g_pipeline.state();
   g_out[0] = s.q_nb.w();
   g_out[1] = s.q_nb.x();

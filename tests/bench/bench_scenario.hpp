@@ -71,7 +71,7 @@ inline Motion motion_at(double t_s) {
   return m;
 }
 
-using Counts = std::array<std::int32_t, 6>;
+using Counts = RawSample;
 
 /// kSamples frames of counts for the array of make_config(kExact) (the misalignment is the
 /// physical one whatever compensator reads the counts).
@@ -91,7 +91,7 @@ inline std::vector<Counts> make_counts() {
     const Eigen::Vector3d f_b = q_nb.conjugate() * (m.a_n - g_n);
     const auto s = truth->predict(m.wdot_b, f_b, m.w_b);
     for (int j = 0; j < 6; ++j) {
-      out[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)] =
+      out[static_cast<std::size_t>(k)].counts[static_cast<std::size_t>(j)] =
           static_cast<std::int32_t>(std::lround(fe->counts_for(j, s(j))));
     }
     // Attitude to the next sample: rotation vector of ω at the midpoint.
@@ -149,7 +149,10 @@ class Replay {
       init.t_ns = t_ns_;
       pipe_.start_at(init, buf_[0]);
     } else {
-      pipe_.process(buf_[i_], t_ns_, seq_);
+      RawSample s = buf_[i_];
+      s.t_ns = t_ns_;
+      s.seq = seq_;
+      pipe_.process(s);
     }
     i_ = (i_ + 1 == buf_.size()) ? 0 : i_ + 1;
   }

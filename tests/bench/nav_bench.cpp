@@ -46,7 +46,7 @@ void BM_SolverAlone(benchmark::State& state) {
   std::vector<nav::Vec6<T>> outputs(buf.size());
   std::vector<nav::Vec3<T>> rates(buf.size());
   for (std::size_t k = 0; k < buf.size(); ++k) {
-    fe->convert(buf[k], outputs[k]);
+    fe->convert(buf[k].counts, outputs[k]);
     rates[k] = motion_at(static_cast<double>(k) / kRateHz).w_b.cast<T>();
   }
   std::size_t i = 0;

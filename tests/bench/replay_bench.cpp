@@ -5,7 +5,7 @@
 // The recording is made once, before timing: 10 s at 1 kHz of the manoeuvre trajectory
 // (make_maneuver, preceded by 0.5 s at rest for alignment) through SensorArrayModel with Table 6
 // errors and QA-1100 class noise and AdcModel, encoded to the file format in memory. Timed:
-//   BM_Replay<T>           decoded samples → Replayer → NavPipeline<T> (exact compensator),
+//   BM_Replay<T>           decoded samples → NavLoop → NavPipeline<T> (exact compensator),
 //                          including the per-sample FNV-1a hash of the output;
 //   BM_DecodeAndReplay<T>  the same, starting from the file bytes (CRC checks and decoding);
 //   BM_Decode              file bytes → samples only.
@@ -97,7 +97,7 @@ void BM_Replay(benchmark::State& state) {
   for (auto _ : state) {
     nav::NavPipeline<T> p;
     if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
-    const ReplayReport r = replay(p, std::span<const RawSample>(d.samples));
+    const NavReport r = replay(p, std::span<const RawSample>(d.samples));
     navigating = r.navigating;
     benchmark::DoNotOptimize(r.output_hash);
   }
@@ -114,7 +114,7 @@ void BM_DecodeAndReplay(benchmark::State& state) {
     if (!rec.is_ok()) state.SkipWithError("decode failed");
     nav::NavPipeline<T> p;
     if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
-    const ReplayReport r = replay(p, std::span<const RawSample>(rec.value().samples));
+    const NavReport r = replay(p, std::span<const RawSample>(rec.value().samples));
     navigating = r.navigating;
     benchmark::DoNotOptimize(r.output_hash);
   }

@@ -5,7 +5,9 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <numbers>
 #include <random>
 #include <string>
@@ -17,6 +19,7 @@ namespace gfins::calib_file {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::read_text;
 using testing::TempDir;
 using testing::write_text;
@@ -54,8 +57,9 @@ TEST(CalibrateCli, PaperTablesGiveAFileCarryingTable6) {
   const TempDir dir;
   const auto out = dir.path() / "cal.toml";
   // When calibrated with the paper's procedure
-  const RunResult r = run_cli(dir, "--means " + kGolden + " --device-id paper-2007 --adc-lsb " +
-                                       kAdcLsb + " --compensator paper -o " + out.string());
+  const RunResult r =
+      run_cli(dir, "--means " + kGolden + " --latitude 24.8 --device-id paper-2007 --adc-lsb " +
+                       kAdcLsb + " --compensator paper -o " + out.string());
   // Then it succeeds with a good verdict and a report
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("verdict: good"));
@@ -109,14 +113,14 @@ TEST(CalibrateCli, AnyPosesThroughAPosesFileGiveThePaperResult) {
   write_text(dir.path() / "poses.csv", poses);
   // When calibrated with the general solver from the poses file, and with the paper procedure
   const auto out = dir.path() / "general.toml";
-  const RunResult r =
-      run_cli(dir, "--means " + (dir.path() / "means.csv").string() + " --poses " +
-                       (dir.path() / "poses.csv").string() + " --device-id g --adc-lsb " + kAdcLsb +
-                       " -o " + out.string());
+  const RunResult r = run_cli(dir, "--means " + (dir.path() / "means.csv").string() + " --poses " +
+                                       (dir.path() / "poses.csv").string() +
+                                       " --latitude 24.8 --device-id g --adc-lsb " + kAdcLsb +
+                                       " -o " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto paper_out = dir.path() / "paper.toml";
-  ASSERT_EQ(run_cli(dir, "--means " + kGolden + " --device-id p --adc-lsb " + kAdcLsb + " -o " +
-                             paper_out.string())
+  ASSERT_EQ(run_cli(dir, "--means " + kGolden + " --latitude 24.8 --device-id p --adc-lsb " +
+                             kAdcLsb + " -o " + paper_out.string())
                 .exit_code,
             0);
   // Then both files carry the same calibration
@@ -144,8 +148,9 @@ TEST(CalibrateCli, ANonNumericMeanNamesFileLineAndColumnAndWritesNothing) {
   const auto out = dir.path() / "cal.toml";
   write_text(out, "previous");
   // When calibrated
-  const RunResult r = run_cli(dir, "--means " + bad.string() + " --device-id b --adc-lsb " +
-                                       kAdcLsb + " -o " + out.string());
+  const RunResult r =
+      run_cli(dir, "--means " + bad.string() + " --latitude 24.8 --device-id b --adc-lsb " +
+                       kAdcLsb + " -o " + out.string());
   // Then the exit status is 1, the message points at the field, and the old file is untouched
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.output, HasSubstr("error: " + bad.string() + ":" + std::to_string(line) +
@@ -160,8 +165,8 @@ TEST(CalibrateCli, AMissingMeanIsNamed) {
   csv.erase(csv.find("6,6,-2.491551"));
   const auto bad = dir.path() / "short.csv";
   write_text(bad, csv);
-  const RunResult r =
-      run_cli(dir, "--means " + bad.string() + " --device-id b --adc-lsb 1e-7 --dry-run");
+  const RunResult r = run_cli(
+      dir, "--means " + bad.string() + " --latitude 24.8 --device-id b --adc-lsb 1e-7 --dry-run");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.output, HasSubstr("no mean for sensor 6 in attitude 6"));
 }
@@ -170,10 +175,104 @@ TEST(CalibrateCli, AWrongHeaderIsNamed) {
   const TempDir dir;
   const auto bad = dir.path() / "header.csv";
   write_text(bad, "sensor,pose,volts\n1,1,0.5\n");
-  const RunResult r =
-      run_cli(dir, "--means " + bad.string() + " --device-id b --adc-lsb 1e-7 --dry-run");
+  const RunResult r = run_cli(
+      dir, "--means " + bad.string() + " --latitude 24.8 --device-id b --adc-lsb 1e-7 --dry-run");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.output, HasSubstr("the header must name the columns sensor, attitude, mean_v"));
+  EXPECT_THAT(r.output, HasSubstr("header column 'pose' is not a known column; accepted columns: "
+                                  "sensor, attitude, mean_v (required), std_v, count (optional)"));
+}
+
+TEST(CalibrateCli, AHeaderDifferingInOneNameSaysWhichNamesAreAccepted) {
+  const TempDir dir;
+  const auto bad = dir.path() / "header.csv";
+  write_text(bad, "sensor,attitude,mean\n1,1,0.5\n");  // "mean" for "mean_v"
+  const RunResult r = run_cli(dir, "--means " + bad.string() + " --dry-run");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("header column 'mean' is not a known column; accepted "
+                                  "columns: sensor, attitude, mean_v (required)"));
+  EXPECT_THAT(r.output, HasSubstr("found: sensor, attitude, mean"));
+}
+
+TEST(CalibrateCli, BothRoutesUseAndNameTheStatedSigma) {
+  // Given Tables 4/5 with a std_v of 2 mV over 1000 samples stated for every mean
+  const TempDir dir;
+  std::string csv = read_text(kGolden);
+  std::string with_sigma;
+  std::size_t line_start = 0;
+  bool header = true;
+  while (line_start < csv.size()) {
+    const std::size_t end = csv.find('\n', line_start);
+    std::string line = csv.substr(line_start, end - line_start);
+    line_start = end == std::string::npos ? csv.size() : end + 1;
+    if (line.empty() || line[0] == '#') continue;
+    with_sigma += line + (header ? ",std_v,count\n" : ",0.002,1000\n");
+    header = false;
+  }
+  const auto means = dir.path() / "sigma.csv";
+  write_text(means, with_sigma);
+  for (const char* method : {"paper", "general"}) {
+    // When calibrated by either route
+    const RunResult r =
+        run_cli(dir, "--means " + means.string() + " --method " + method + " --dry-run");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // Then the report says the σ are the stated ones, for every sensor
+    EXPECT_THAT(r.output, HasSubstr("from the stated σ of every mean (std_v/√count")) << method;
+    EXPECT_THAT(r.output, Not(HasSubstr("residuals of the fit"))) << method;
+  }
+  // And without std_v/count it says the σ come from 2 residual dof
+  const RunResult r = run_cli(dir, "--means " + kGolden + " --dry-run");
+  EXPECT_THAT(r.output, HasSubstr("no σ stated with the means, so from the fit residuals"));
+}
+
+TEST(CalibrateCli, ADryRunNeedsNeitherAdcLsbNorDeviceIdNorGravity) {
+  const TempDir dir;
+  const RunResult r = run_cli(dir, "--means " + kGolden + " --dry-run");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("dry run: nothing written"));
+}
+
+TEST(CalibrateCli, SettingsAreCheckedBeforeSolvingWithReadableBounds) {
+  const TempDir dir;
+  const std::string out = " -o " + (dir.path() / "c.toml").string();
+  const std::string base = "--means " + kGolden + " --latitude 24.8" + out;
+  RunResult r = run_cli(dir, base + " --device-id 'a b' --adc-lsb 1e-7");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--device-id (device_id): \"a b\" is not 1 to 64 characters"));
+  EXPECT_THAT(r.output, Not(HasSubstr("verdict")));  // nothing was solved
+  r = run_cli(dir, base + " --device-id b --adc-lsb 2");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--adc-lsb 2: the ADC LSB must be a positive number of volts "
+                                  "per count, at most 1"));
+  r = run_cli(dir, base + " --device-id b --adc-lsb 1e-7 --rho -1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--rho -1: the cube half-size must be between 0.001 and 10 m"));
+  r = run_cli(dir, "--means " + kGolden + out + " --device-id b --adc-lsb 1e-7 --gravity 1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--gravity 1: the local gravity must be between 9.7 and 9.9"));
+  r = run_cli(dir, "--means " + kGolden + out + " --device-id b --adc-lsb 1e-7");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("the local gravity of the calibration site is required"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "c.toml"));
+}
+
+TEST(CalibrateCli, TheLatitudeGivesWgs84NormalGravityInTheFile) {
+  // Given a calibration at 24.8° latitude, 100 m: Somigliana's formula (WGS-84, written here)
+  // minus the free-air gradient 3.086e-6 m/s² per m.
+  const double phi = 24.8 * std::numbers::pi / 180.0;
+  const double s2 = std::sin(phi) * std::sin(phi);
+  const double gamma =
+      9.7803253359 * (1 + 0.00193185265241 * s2) / std::sqrt(1 - 0.00669437999013 * s2);
+  const double expected = gamma - 3.086e-6 * 100.0;
+  constexpr double kFreeAirModelTol = 2e-6;  // the gradient varies by 0.1 % with latitude
+  const TempDir dir;
+  const auto out = dir.path() / "c.toml";
+  const RunResult r = run_cli(dir, "--means " + kGolden + " --latitude 24.8 --height 100 " +
+                                       "--device-id b --adc-lsb 1e-7 -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto d = load_calibration_file(out);
+  ASSERT_TRUE(d.is_ok()) << d.status().message();
+  EXPECT_NEAR(d.value().gravity_mps2, expected, kFreeAirModelTol);
+  EXPECT_THAT(d.value().gravity_source, HasSubstr("latitude 24.8 deg, height 100 m"));
 }
 
 TEST(CalibrateCli, CoplanarPosesAreASolverFailure) {
@@ -193,9 +292,9 @@ TEST(CalibrateCli, CoplanarPosesAreASolverFailure) {
   }
   write_text(dir.path() / "p.csv", poses);
   write_text(dir.path() / "m.csv", means);
-  const RunResult r =
-      run_cli(dir, "--means " + (dir.path() / "m.csv").string() + " --poses " +
-                       (dir.path() / "p.csv").string() + " --device-id b --adc-lsb 1e-7 --dry-run");
+  const RunResult r = run_cli(dir, "--means " + (dir.path() / "m.csv").string() + " --poses " +
+                                       (dir.path() / "p.csv").string() +
+                                       " --latitude 24.8 --device-id b --adc-lsb 1e-7 --dry-run");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("calibration failed"));
 }
@@ -272,7 +371,7 @@ TEST(CalibrateCli, ARawRecordingIsCutIntoStaticPosesAndCalibrated) {
   const auto out = dir.path() / "rec.toml";
   const RunResult r = run_cli(dir, "--recording " + rec.string() +
                                        " --rate 100 --nominal-sf 0.5 0.33 0.5 2.5 0.34 2.5 "
-                                       "--device-id rec --adc-lsb 1e-7 -o " +
+                                       "--latitude 24.8 --device-id rec --adc-lsb 1e-7 -o " +
                                        out.string());
   // Then twelve intervals are found, matched to the twelve poses, and Table 6 comes back
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -297,7 +396,7 @@ TEST(CalibrateCli, ARecordingWithoutARateIsRefused) {
   const RunResult r = run_cli(dir, "--recording " + (dir.path() / "r.csv").string() +
                                        " --nominal-sf 1 --device-id b --adc-lsb 1e-7 --dry-run");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.output, HasSubstr("--rate (Hz) is required with --recording"));
+  EXPECT_THAT(r.output, HasSubstr("--rate (Hz) is required with a CSV --recording"));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -120,16 +121,71 @@ TEST_F(LoadErrors, BrokenSyntaxNamesTheLineAndColumn) {
 }
 
 TEST_F(LoadErrors, AnotherFormatVersionIsRefusedNamingBothVersions) {
-  const int line = line_of(good_, "format_version = 1");
-  const FileStatus s = load_text(replace_once(good_, "format_version = 1", "format_version = 2"));
+  const int line = line_of(good_, "format_version = 2");
+  const FileStatus s = load_text(replace_once(good_, "format_version = 2", "format_version = 3"));
   EXPECT_EQ(s.code(), ErrorCode::kUnimplemented);
   EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) +
-                                     ": format version 2 is "
-                                     "not supported (this build reads version 1)"));
+                                     ": format version 3 is "
+                                     "not supported (this build reads versions 1 to 2)"));
+}
+
+// A version-1 file as the previous build wrote it: no [gravity] table, "format_version = 1",
+// and the checksum over the version-1 key list (written here from docs/calibration-file.md:
+// the canonical text without the two gravity lines).
+std::string version1_text(const CalibrationData& d) {
+  std::string text = to_toml_text(d);
+  const auto g0 = text.find("[gravity]\n");
+  const auto g1 = text.find("\n\n", g0);
+  text.erase(g0, g1 + 2 - g0);
+  text = replace_once(text, "format_version = 2", "format_version = 1");
+  std::string canon = canonical_serialisation(d);
+  canon = replace_once(canon, "format_version=2\n", "format_version=1\n");
+  const auto c0 = canon.find("gravity.local_mps2=");
+  const auto c1 = canon.find("sensor.1.", c0);
+  canon.erase(c0, c1 - c0);
+  char old_sum[40];
+  char v1_sum[40];
+  std::snprintf(old_sum, sizeof old_sum, "fnv1a64:%016llx",
+                static_cast<unsigned long long>(checksum(d)));
+  std::snprintf(v1_sum, sizeof v1_sum, "fnv1a64:%016llx",
+                static_cast<unsigned long long>(fnv1a64(canon)));
+  return replace_once(text, old_sum, v1_sum);
+}
+
+TEST(FormatVersion1, LoadsWithStandardGravityAndSaysSo) {
+  // Given a version-1 file (the format before the calibration site's gravity was stored)
+  const CalibrationData d = table6_data();
+  // When it is loaded
+  const auto r = parse_calibration_text(version1_text(d), "v1.toml");
+  // Then every value reads back, and the gravity is the standard one the version-1 front end
+  // converted with, labelled as an assumption
+  ASSERT_TRUE(r.is_ok()) << r.status().message();
+  CalibrationData expected = d;
+  expected.gravity_mps2 = nav::kStandardGravity;
+  expected.gravity_source = kVersion1GravitySource;
+  EXPECT_EQ(r.value(), expected);
+  // And re-saved it becomes a version-2 file that loads with the same values
+  const auto again = parse_calibration_text(to_toml_text(r.value()), "v2.toml");
+  ASSERT_TRUE(again.is_ok()) << again.status().message();
+  EXPECT_EQ(again.value(), expected);
+}
+
+TEST(FormatVersion1, AGravityTableInAVersion1FileIsAnUnknownKey) {
+  std::string text = version1_text(table6_data());
+  text = replace_once(text, "[integrity]", "[gravity]\nlocal_mps2 = 9.8\n\n[integrity]");
+  const auto r = parse_calibration_text(text, "v1.toml");
+  ASSERT_FALSE(r.is_ok());
+  EXPECT_THAT(r.status().message(), HasSubstr("unknown key 'gravity.local_mps2'"));
+}
+
+TEST_F(LoadErrors, AVersion2FileWithoutGravityIsRefused) {
+  const FileStatus s = load_text(replace_once(good_, "local_mps2 = 9.7894\n", ""));
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("missing key 'gravity.local_mps2'"));
 }
 
 TEST_F(LoadErrors, MissingVersionIsRefused) {
-  const FileStatus s = load_text(replace_once(good_, "format_version = 1", ""));
+  const FileStatus s = load_text(replace_once(good_, "format_version = 2", ""));
   EXPECT_THAT(s.message(), HasSubstr("missing key 'format_version'"));
 }
 
@@ -225,6 +281,12 @@ TEST_F(OutOfRange, LocationErrorBeyondHalfTheArray) {
   CalibrationData d = table6_data();
   d.sensors[5].location_error_m[1] = 0.06;  // ρ = 0.1 m
   expect_refused(d, "sensor.6.location_error_m", "[1] = 0.06: a location error");
+}
+
+TEST_F(OutOfRange, GravityInGInsteadOfMetresPerSecondSquared) {
+  CalibrationData d = table6_data();
+  d.gravity_mps2 = 1.0;
+  expect_refused(d, "gravity.local_mps2", "= 1: must be a local gravity in [9.7, 9.9] m/s²");
 }
 
 TEST_F(OutOfRange, BadDeviceIdAndTimestamp) {

@@ -47,7 +47,8 @@ TEST(RoundTrip, TheFileIsReadableTomlWithUnitsAndTable6Digits) {
   EXPECT_NE(text.find("xy_deg = 1.117319\n"), std::string::npos);
   EXPECT_NE(text.find("angle = 'deg'"), std::string::npos);
   EXPECT_NE(text.find("scale_factor = 'V/g'"), std::string::npos);
-  EXPECT_NE(text.find("format_version = 1\n"), std::string::npos);
+  EXPECT_NE(text.find("format_version = 2\n"), std::string::npos);
+  EXPECT_NE(text.find("[gravity]\nlocal_mps2 = 9.7894\n"), std::string::npos) << text;
   EXPECT_NE(text.find("compensator = 'exact'"), std::string::npos);
   EXPECT_TRUE(text.ends_with(std::string(kEndMarker) + "\n"));
 }
@@ -60,6 +61,7 @@ CalibrationData random_data(std::mt19937_64& rng) {
   const auto pos = [&](double scale) { return scale * (0.5 + 0.5 * std::fabs(unit(rng))); };
   CalibrationData d = table6_data();
   d.geometry.rho_m = pos(1.0);
+  d.gravity_mps2 = 9.8 + any(0.1);  // the whole accepted range [9.7, 9.9]
   for (auto& s : d.sensors) {
     s.adc_lsb_v_per_count = pos(1e-6);
     s.scale_v_per_g = pos(5.0);
@@ -139,7 +141,7 @@ TEST(Checksum, CanonicalSerialisationIsKeyEqualsBitPatternLines) {
   const std::string c = canonical_serialisation(d);
   // Then it starts with the version and identity, doubles are their 16-hex-digit bit patterns,
   // and the file's checksum is FNV-1a 64 of exactly this text
-  EXPECT_TRUE(c.starts_with("format_version=1\ndevice_id=gfins-test-01\n")) << c;
+  EXPECT_TRUE(c.starts_with("format_version=2\ndevice_id=gfins-test-01\n")) << c;
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(std::bit_cast<std::uint64_t>(0.332572)));

@@ -32,9 +32,8 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 // relative) divided by a design row of about |ω|²/√2 ≥ 3 s⁻²: 1e-14 m; 1e-10 m leaves margin for
 // the eigen-decomposition but would still catch any model error (Δρ are of order 1e-3 m).
 constexpr double kNoiseFreeTolM = 1e-10;
-// The demonstration's bounds, from the issue: 0.05 mm and 3σ of the solver's own covariance.
+// The demonstration's resolution, from the issue: 0.05 mm.
 constexpr double kDemoTolM = 0.05e-3;
-constexpr double kSigmaBound = 3.0;
 
 // Table 6 orientation errors as printed (degrees), in the order xy, xz, yx, yz, zx, zy.
 nav::OrientationErrors<double> table6_orientation() {
@@ -70,16 +69,15 @@ struct Mount {
 };
 
 // Runs of one mounting at each rate: the table axis is vertical with u_b pointing up, so gravity
-// in body axes is −g u_b. Outputs come from ArraySolver::predict on the true (misaligned)
-// geometry, an implementation independent of the solver's equations; the centre o_b moves on a
-// circle about the axis point p_b, so its specific force is −g_b + ω×(ω×(−p_b)).
+// in body axes is −g u_b. Outputs come from the forward physics of each sensor, written here
+// (eq. (20) with ω×(ω×ρ) for the misprinted ω×ω×ρ): the centre o_b moves on a circle about the
+// axis point p_b, so sensor j at ρ*_j senses θ*_j·(−g_b + ω×(ω×(ρ*_j − p_b))). The mean of N
+// samples with white noise σ is drawn directly: its noise is N(0, σ/√N).
 std::vector<LocationRun<double>> make_runs(const std::vector<Mount>& mounts,
                                            const std::vector<double>& rates_rad_s,
                                            const ArrayGeometry<double, 6>& truth,
                                            std::mt19937_64* noise_rng) {
-  const auto solver = nav::ArraySolver<double>::create(truth);
-  EXPECT_TRUE(solver.is_ok()) << solver.status().message();
-  std::normal_distribution<double> noise(0.0, kNoiseSigma);
+  std::normal_distribution<double> mean_noise(0.0, kNoiseSigma / std::sqrt(kSamplesPerRate));
   std::vector<LocationRun<double>> runs;
   for (std::size_t m = 0; m < mounts.size(); ++m) {
     for (const double rate : rates_rad_s) {
@@ -87,14 +85,11 @@ std::vector<LocationRun<double>> make_runs(const std::vector<Mount>& mounts,
       r.w_b = rate * mounts[m].u_b.normalized();
       r.g_b = -kG * mounts[m].u_b.normalized();
       r.mounting = static_cast<int>(m);
-      const Vec3d f_b = -r.g_b + r.w_b.cross(r.w_b.cross(-mounts[m].p_b));
-      r.s_mean = solver->predict(Vec3d::Zero(), f_b, r.w_b);
-      if (noise_rng != nullptr) {
-        for (int j = 0; j < kNumSensors; ++j) {
-          double sum = 0.0;
-          for (std::uint32_t k = 0; k < kSamplesPerRate; ++k) sum += noise(*noise_rng);
-          r.s_mean(j) += sum / kSamplesPerRate;
-        }
+      for (int j = 0; j < kNumSensors; ++j) {
+        const auto js = static_cast<std::size_t>(j);
+        const Vec3d arm = truth.rho_b[js] - mounts[m].p_b;
+        r.s_mean(j) = truth.theta_b[js].dot(-r.g_b + r.w_b.cross(r.w_b.cross(arm)));
+        if (noise_rng != nullptr) r.s_mean(j) += mean_noise(*noise_rng);
       }
       r.sigma = Vec6<double>::Constant(kNoiseSigma);
       r.count = kSamplesPerRate;
@@ -246,49 +241,77 @@ TEST(LocationObservabilityTest, TwoFaceDiagonalMountingsMakeEverythingObservable
 // ---------------------------------------------------------------------------------------------
 // Noise
 
-TEST(LocationNoiseTest, RecoversEveryOffsetWithinFiftyMicronsAndThreeSigma) {
+// Statistical criteria over kNoiseSeeds independent calibrations × 18 components (issue 11):
+//   coverage  fraction of |z| = |error|/σ ≤ 3 at least 99 %; mean z² in [0.8, 1.25];
+//   χ²/dof of the fit residuals, pooled over the seeds (120 dof each), within 1 ± 0.05.
+// False-failure probabilities when the solver is right. The three components of one sensor
+// are correlated (one 3×3 covariance), sensors and seeds are independent (no axis offsets are
+// estimated): conservatively 6·kNoiseSeeds = 1200 independent clusters.
+//   coverage: P(Bin(1200, 0.0027) > 12) = 3.4e-5;
+//   mean z²: χ²₁₂₀₀/1200 < 0.8: 7.4e-8, > 1.25: 6.3e-9;
+//   pooled χ²/dof: χ²₂₄₀₀₀ is 1 ± 0.0091 (1σ); ±0.05 is 5.5σ: 4e-8.
+// In total below 1e-4. (Requiring all 90 components of five seeds within 3σ, as before, fails
+// a correct estimator 1 − 0.9973⁹⁰ = 22 % of the time.)
+constexpr int kNoiseSeeds = 200;
+constexpr double kMinCoverage = 0.99;
+constexpr double kMinMeanZ2 = 0.8;
+constexpr double kMaxMeanZ2 = 1.25;
+constexpr double kChi2PerDofTol = 0.05;
+
+TEST(LocationNoiseTest, CovarianceCoversTheErrorsAndResolvesFiftyMicrons) {
   // Given the Table 6 calibrated axes, random Δρ_j of up to 3 mm per component, the full set of
   // mountings at 2..10 rad/s and 1 milli-g white noise on 1000 samples per rate,
   const auto cal = calibrated_geometry(true);
-  double sum_norm_sq = 0.0;
-  int n_components = 0;
+  double sum_z2 = 0.0;
+  long inside = 0;
+  long n_components = 0;
+  double sum_chi2 = 0.0;
+  long sum_dof = 0;
   double worst_err_m = 0.0;
   double worst_sigma_m = 0.0;
-  for (const std::uint64_t seed : {101u, 202u, 303u, 404u, 505u}) {
-    std::mt19937_64 rng(seed);
+  for (int seed = 0; seed < kNoiseSeeds; ++seed) {
+    std::mt19937_64 rng(1000 + static_cast<std::uint64_t>(seed));
     const auto drho = random_drho(rng, 3e-3);
     const auto runs = make_runs(kFullMounts, kRates, with_drho(cal, drho), &rng);
     // when the location is calibrated,
     const auto r = calibrate_location<double>(cal, runs);
     ASSERT_TRUE(r.is_ok()) << r.status().message();
     ASSERT_TRUE(r->fully_observable());
-    // then every component is within 0.05 mm and within 3σ of the solver's covariance.
     for (int j = 0; j < kNumSensors; ++j) {
       const auto js = static_cast<std::size_t>(j);
       for (int k = 0; k < 3; ++k) {
         const double err = r->drho_b[js](k) - drho[js](k);
         const double sigma = std::sqrt(r->drho_cov_m2[js](k, k));
-        EXPECT_LT(std::abs(err), kDemoTolM) << "seed " << seed << " sensor " << j + 1;
-        EXPECT_LT(std::abs(err), kSigmaBound * sigma) << "seed " << seed << " sensor " << j + 1;
-        sum_norm_sq += (err / sigma) * (err / sigma);
+        const double z = err / sigma;
+        inside += std::abs(z) <= 3.0 ? 1 : 0;
+        sum_z2 += z * z;
         ++n_components;
         worst_err_m = std::max(worst_err_m, std::abs(err));
         worst_sigma_m = std::max(worst_sigma_m, sigma);
       }
     }
-    // The residuals agree with the stated noise: chi2/dof of 120 dof is 1 ± 0.13 (1σ).
-    EXPECT_NEAR(r->chi2 / r->dof, 1.0, 0.5) << "seed " << seed;
+    sum_chi2 += r->chi2;
+    sum_dof += r->dof;
   }
-  // The covariance is neither too small nor too large: over 90 normalized errors the mean square
-  // is 1 ± 0.15 (1σ of χ²_90/90); 0.5..1.5 is a 3σ band.
-  const double mean_sq = sum_norm_sq / n_components;
-  EXPECT_GT(mean_sq, 0.5);
-  EXPECT_LT(mean_sq, 1.5);
+  // then the errors are covered by the solver's covariance,
+  const double coverage = static_cast<double>(inside) / static_cast<double>(n_components);
+  const double mean_z2 = sum_z2 / static_cast<double>(n_components);
+  const double chi2_per_dof = sum_chi2 / static_cast<double>(sum_dof);
+  EXPECT_GE(coverage, kMinCoverage);
+  EXPECT_GE(mean_z2, kMinMeanZ2);
+  EXPECT_LE(mean_z2, kMaxMeanZ2);
+  // the residuals agree with the stated noise,
+  EXPECT_NEAR(chi2_per_dof, 1.0, kChi2PerDofTol);
+  // and the design resolves every component to 50 µm at 5σ (a property of the mountings, rates
+  // and noise, not of the draw: it cannot fail by luck).
+  EXPECT_LT(5.0 * worst_sigma_m, kDemoTolM);
   std::printf(
-      "location calibration, 1 milli-g: worst |error| %.2f um, largest sigma %.2f um, "
-      "mean squared normalized error %.2f over %d components\n",
-      worst_err_m * 1e6, worst_sigma_m * 1e6, mean_sq, n_components);
-  ::testing::Test::RecordProperty("worst_error_um", std::to_string(worst_err_m * 1e6));
+      "location calibration, 1 milli-g, %d seeds: %.2f %% of %ld components within 3 sigma, "
+      "mean z^2 %.3f, pooled chi2/dof %.3f; worst |error| %.2f um, largest sigma %.2f um\n",
+      kNoiseSeeds, 100.0 * coverage, n_components, mean_z2, chi2_per_dof, worst_err_m * 1e6,
+      worst_sigma_m * 1e6);
+  ::testing::Test::RecordProperty("coverage", std::to_string(coverage));
+  ::testing::Test::RecordProperty("mean_z2", std::to_string(mean_z2));
   ::testing::Test::RecordProperty("largest_sigma_um", std::to_string(worst_sigma_m * 1e6));
 }
 

@@ -14,9 +14,9 @@ namespace {
 const std::string kBuiltinDir = std::string(GFINS_TEST_DATA_DIR) + "/../../host_sim/scenarios";
 
 Scenario builtin(const std::string& name) {
-  const ParsedScenario p = load_scenario(name, kBuiltinDir);
-  EXPECT_TRUE(p.ok()) << p.error;
-  return *p.scenario;
+  const HostResult<Scenario> p = load_scenario(name, kBuiltinDir);
+  EXPECT_TRUE(p.is_ok()) << p.error().message;
+  return p.value();
 }
 
 constexpr std::size_t kRate = static_cast<std::size_t>(McQuantity::kRate);
@@ -39,7 +39,7 @@ TEST(MonteCarlo, CalibrationResidualGrowsRateAsTAndAttitudeAsTSquared) {
   // 1 mg per pose mean, 1 mg sensor noise) and kRuns seeds,
   constexpr std::size_t kRuns = 8;
   const Scenario s = builtin("rest-calibrated");
-  const MonteCarloResult r = run_montecarlo(s, kRuns, 1);
+  const MonteCarloResult r = run_montecarlo(s, kRuns, 1).value();
   // when the RMS error norms are fitted over the last decade of the run,
   const double t_end = r.t_s.back();
   const double w_slope = loglog_slope(r.t_s, r.rms_norm[kRate], 0.1 * t_end, t_end);
@@ -64,7 +64,7 @@ TEST(MonteCarlo, NoiseOnlyEnvelopeMatchesTheRandomWalkOfTheTrapezoidRule) {
   s.duration_s = 1.0;
   s.rate_hz = 100.0;
   constexpr std::size_t kRuns = 32;
-  const MonteCarloResult r = run_montecarlo(s, kRuns, 11);
+  const MonteCarloResult r = run_montecarlo(s, kRuns, 11).value();
   // the ω error is a random walk: ω_k = h [½ n_0 + n_1 + … + n_{k−1} + ½ n_k] with n the ω̇
   // noise of σ/(√2 ρ) per axis (notes §1), so σ_ω(k) = h σ/(√2 ρ) √(k − ½).
   const std::size_t k = r.t_s.size() - 1;

@@ -38,9 +38,9 @@ constexpr std::array<const char*, 8> kNames = {
     "after linear lo",  "after linear hi",  "after angular lo",  "after angular hi"};
 
 Scenario builtin(const std::string& name) {
-  const ParsedScenario p = load_scenario(name, kBuiltinDir);
-  EXPECT_TRUE(p.ok()) << p.error;
-  return *p.scenario;
+  const HostResult<Scenario> p = load_scenario(name, kBuiltinDir);
+  EXPECT_TRUE(p.is_ok()) << p.error().message;
+  return p.value();
 }
 
 Eight bounds_of(const ScenarioOutcome& o) {
@@ -59,7 +59,7 @@ TEST(Paper63, MatchingConfigurationReproducesAllEightQuotedBounds) {
   std::array<std::vector<double>, 8> runs;
   for (int k = 0; k < kSeeds; ++k) {
     s.seed = static_cast<std::uint64_t>(k + 1);
-    const Eight b = bounds_of(run_scenario(s));
+    const Eight b = bounds_of(run_scenario(s).value());
     for (std::size_t i = 0; i < 8; ++i) runs[i].push_back(b.v[i]);
   }
   // then the median of each bound is within kTolerance of the span of the paper's pair.
@@ -81,7 +81,7 @@ TEST(Paper63, BeforeCompensationTheBoundsDoNotDependOnTheNoiseSeed) {
   Scenario s = builtin("paper-6.3");
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     s.seed = seed;
-    const Eight b = bounds_of(run_scenario(s));
+    const Eight b = bounds_of(run_scenario(s).value());
     for (std::size_t i = 0; i < 4; ++i) {
       EXPECT_LE(std::abs(b.v[i] - kPaper.v[i]) / span(i), kTolerance) << kNames[i] << " " << b.v[i];
     }
@@ -93,7 +93,7 @@ TEST(Paper63, StatedOneMilliGNoiseCannotGiveThePapersBoundsAfterCompensation) {
   // σ(ω̇) = σ/(√2 ρ) = 9.81e-3/(√2·0.35) = 0.020 rad/s² per axis (notes §1), whose extremes over
   // 600 values are about ±3σ = ±0.06 rad/s², twenty times the paper's ±0.003.
   const Scenario s = builtin("paper-6.3-1mg");
-  const Eight b = bounds_of(run_scenario(s));
+  const Eight b = bounds_of(run_scenario(s).value());
   const double sigma_wdot = s.noise_mps2 / (std::sqrt(2.0) * s.rho_m);
   // At least 2σ (the extremes of 600 Gaussian draws exceed 2σ with probability 1 − 1e-5).
   constexpr double kMinExtremeSigmas = 2.0;
@@ -108,7 +108,7 @@ TEST(Paper63, CalibratedCompensatorLeavesTheCalibrationErrorInTheLoop) {
   // §4: about 0.39 m/s² after 2 s), yet still well below the uncompensated one.
   Scenario s = builtin("paper-6.3");
   s.misalignment_source = MisalignmentSource::kCalibrated;
-  const ScenarioOutcome o = run_scenario(s);
+  const ScenarioOutcome o = run_scenario(s).value();
   ASSERT_TRUE(o.calibration.ran);
   const double deg = M_PI / 180.0;
   EXPECT_GT(o.calibration.rms_angle_error_rad, 0.01 * deg);  // the calibration is not perfect

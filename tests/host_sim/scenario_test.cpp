@@ -43,19 +43,19 @@ std::string replace(std::string text, const std::string& from, const std::string
 }
 
 void expect_error(const std::string& text, std::initializer_list<const char*> fragments) {
-  const ParsedScenario p = parse_scenario(text, "bad.toml");
-  ASSERT_FALSE(p.ok()) << "accepted:\n" << text;
+  const HostResult<Scenario> p = parse_scenario(text, "bad.toml");
+  ASSERT_FALSE(p.is_ok()) << "accepted:\n" << text;
   for (const char* f : fragments) {
-    EXPECT_NE(p.error.find(f), std::string::npos)
-        << "message '" << p.error << "' lacks '" << f << "'";
+    EXPECT_NE(p.error().message.find(f), std::string::npos)
+        << "message '" << p.error().message << "' lacks '" << f << "'";
   }
 }
 
 TEST(ScenarioParse, GoodFileGivesEveryValue) {
   // Given a complete file, when it is parsed, then every field has the value written.
-  const ParsedScenario p = parse_scenario(kGood, "good.toml");
-  ASSERT_TRUE(p.ok()) << p.error;
-  const Scenario& s = *p.scenario;
+  const HostResult<Scenario> p = parse_scenario(kGood, "good.toml");
+  ASSERT_TRUE(p.is_ok()) << p.error().message;
+  const Scenario& s = p.value();
   EXPECT_EQ(s.name, "good");
   EXPECT_DOUBLE_EQ(s.duration_s, 2.0);
   EXPECT_DOUBLE_EQ(s.rate_hz, 100.0);
@@ -67,8 +67,8 @@ TEST(ScenarioParse, GoodFileGivesEveryValue) {
   EXPECT_DOUBLE_EQ(s.noise_mps2, 5e-4);
   EXPECT_EQ(s.compensator, nav::CompensatorKind::kExact);
   EXPECT_EQ(s.misalignment_source, MisalignmentSource::kCalibrated);
-  // Table 6's Δβ_xy = 1.117153° (notes §2), stored in radians.
-  EXPECT_NEAR(s.misalignment.orientation.beta[0], 1.117153 * M_PI / 180.0, 1e-12);
+  // Table 6's Δβ_xy = 1.117319° as the paper prints it, stored in radians.
+  EXPECT_NEAR(s.misalignment.orientation.beta[0], 1.117319 * M_PI / 180.0, 1e-12);
   // The gravity model "up" points along −z.
   EXPECT_LT(gravity_model(s).g_n(Vec3d::Zero()).z(), 0.0);
 }
@@ -77,11 +77,12 @@ TEST(ScenarioParse, EveryBuiltinScenarioParsesAndBuildsItsTrajectory) {
   const auto names = builtin_scenarios(kBuiltinDir);
   ASSERT_GE(names.size(), 9u) << kBuiltinDir;
   for (const auto& n : names) {
-    const ParsedScenario p = load_scenario(n, kBuiltinDir);
-    ASSERT_TRUE(p.ok()) << p.error;
-    EXPECT_FALSE(p.scenario->description.empty()) << n;
-    const auto traj = make_trajectory(p.scenario->trajectory);
-    const TruthState x = traj->at(0.5);
+    const HostResult<Scenario> p = load_scenario(n, kBuiltinDir);
+    ASSERT_TRUE(p.is_ok()) << p.error().message;
+    EXPECT_FALSE(p.value().description.empty()) << n;
+    const auto traj = make_trajectory(p.value().trajectory);
+    ASSERT_TRUE(traj.is_ok()) << n << ": " << traj.error().message;
+    const TruthState x = traj.value()->at(0.5);
     EXPECT_TRUE(x.q_nb.coeffs().allFinite()) << n;
   }
 }
@@ -141,9 +142,9 @@ TEST(ScenarioParse, UnknownKeyAndSyntaxErrorAreReported) {
 }
 
 TEST(ScenarioParse, MissingFileOrNameIsReported) {
-  const ParsedScenario p = load_scenario("no-such-scenario", kBuiltinDir);
-  ASSERT_FALSE(p.ok());
-  EXPECT_NE(p.error.find("no-such-scenario"), std::string::npos) << p.error;
+  const HostResult<Scenario> p = load_scenario("no-such-scenario", kBuiltinDir);
+  ASSERT_FALSE(p.is_ok());
+  EXPECT_NE(p.error().message.find("no-such-scenario"), std::string::npos) << p.error().message;
 }
 
 }  // namespace

@@ -25,10 +25,13 @@ long allocations_for_full_run(CompensatorKind kind) {
   config.alignment_samples = 10;
   NoAllocWindow window;
   if (!pipeline.configure(config).is_ok()) return -1;
-  std::array<std::int32_t, 6> counts = {10, -20, 30000, -400000, 5000, 600000};
+  RawSample s;
+  s.counts = {10, -20, 30000, -400000, 5000, 600000};
   for (std::uint32_t k = 0; k < 200; ++k) {
-    counts[k % 6] += static_cast<std::int32_t>(k);
-    pipeline.process(counts, static_cast<std::int64_t>(k) * 1000000, k);
+    s.counts[k % 6] += static_cast<std::int32_t>(k);
+    s.t_ns = static_cast<std::int64_t>(k) * 1000000;
+    s.seq = k;
+    pipeline.process(s);
   }
   if (pipeline.phase() != PipelinePhase::kNavigating) return -2;
   return window.allocations();

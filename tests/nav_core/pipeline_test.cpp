@@ -20,16 +20,27 @@ class PipelineTest : public ::testing::Test {
   }
 
   // ADC counts of an ideal array held still with attitude q_nb (NED, standard gravity).
-  NavPipeline<double>::Counts counts_at_rest(const Quat<double>& q_nb) const {
+  std::array<std::int32_t, 6> counts_at_rest(const Quat<double>& q_nb) const {
     const Vec3<double> f_b = -(q_nb.conjugate() * Vec3<double>(0, 0, kStandardGravity));
     const Vec6<double> s =
         pipeline_.solver().predict(Vec3<double>::Zero(), f_b, Vec3<double>::Zero());
-    NavPipeline<double>::Counts c{};
+    std::array<std::int32_t, 6> c{};
     for (int j = 0; j < 6; ++j) {
       c[static_cast<std::size_t>(j)] =
           static_cast<std::int32_t>(std::lround(pipeline_.front_end().counts_for(j, s(j))));
     }
     return c;
+  }
+
+  // One frame as the ADC driver hands it over.
+  static RawSample frame(const std::array<std::int32_t, 6>& counts, std::int64_t t_ns,
+                         std::uint32_t seq, std::uint32_t flags = 0) {
+    RawSample s;
+    s.counts = counts;
+    s.t_ns = t_ns;
+    s.seq = seq;
+    s.flags = flags;
+    return s;
   }
 
   PipelineConfig<double> config_;
@@ -43,11 +54,11 @@ TEST_F(PipelineTest, AlignsThenNavigatesAndStaysAtRest) {
   const auto counts = counts_at_rest(q);
   std::uint32_t seq = 0;
   for (; seq < config_.alignment_samples - 1; ++seq) {
-    EXPECT_EQ(pipeline_.process(counts, seq * 1'000'000LL, seq), PipelinePhase::kAligning);
+    EXPECT_EQ(pipeline_.process(frame(counts, seq * 1'000'000LL, seq)), PipelinePhase::kAligning);
   }
-  EXPECT_EQ(pipeline_.process(counts, seq * 1'000'000LL, seq), PipelinePhase::kNavigating);
+  EXPECT_EQ(pipeline_.process(frame(counts, seq * 1'000'000LL, seq)), PipelinePhase::kNavigating);
   const std::uint32_t first_nav_seq = seq;
-  for (++seq; seq < 2200; ++seq) pipeline_.process(counts, seq * 1'000'000LL, seq);
+  for (++seq; seq < 2200; ++seq) pipeline_.process(frame(counts, seq * 1'000'000LL, seq));
   const auto& st = pipeline_.state();
   const double t = (seq - 1 - first_nav_seq) * 1e-3;
 
@@ -85,13 +96,13 @@ TEST_F(PipelineTest, AlignsThenNavigatesAndStaysAtRest) {
 TEST_F(PipelineTest, CountsSampleGapsAndIntegratesAcrossThem) {
   const auto counts = counts_at_rest(Quat<double>::Identity());
   std::uint32_t seq = 0;
-  for (; seq < config_.alignment_samples; ++seq) pipeline_.process(counts, 0, seq);
+  for (; seq < config_.alignment_samples; ++seq) pipeline_.process(frame(counts, 0, seq));
   ASSERT_EQ(pipeline_.phase(), PipelinePhase::kNavigating);
-  pipeline_.process(counts, 0, seq + 3);  // three samples lost
+  pipeline_.process(frame(counts, 0, seq + 3));  // three samples lost
   EXPECT_EQ(pipeline_.counters().gaps, 1u);
   EXPECT_EQ(pipeline_.counters().missed_samples, 3u);
   EXPECT_TRUE(pipeline_.state().status & nav_status::kSampleGap);
-  pipeline_.process(counts, 0, seq + 4);
+  pipeline_.process(frame(counts, 0, seq + 4));
   EXPECT_FALSE(pipeline_.state().status & nav_status::kSampleGap);
   EXPECT_EQ(pipeline_.counters().gaps, 1u);
 }
@@ -99,10 +110,48 @@ TEST_F(PipelineTest, CountsSampleGapsAndIntegratesAcrossThem) {
 TEST_F(PipelineTest, RejectsSaturatedSamplesAndCountsThem) {
   auto counts = counts_at_rest(Quat<double>::Identity());
   counts[3] = kAdcCodeMax;
-  pipeline_.process(counts, 0, 0);
+  pipeline_.process(frame(counts, 0, 0));
   EXPECT_EQ(pipeline_.counters().saturated, 1u);
   EXPECT_EQ(pipeline_.counters().rejected, 1u);
   EXPECT_EQ(pipeline_.counters().samples, 1u);
+}
+
+TEST_F(PipelineTest, CrcErrorFramesAreRejectedAndAreNotGaps) {
+  // Given a navigating pipeline,
+  const auto counts = counts_at_rest(Quat<double>::Identity());
+  std::uint32_t seq = 0;
+  for (; seq < config_.alignment_samples; ++seq) pipeline_.process(frame(counts, 0, seq));
+  ASSERT_EQ(pipeline_.phase(), PipelinePhase::kNavigating);
+  const NavState<double> before = pipeline_.state();
+  // when a frame arrives with a CRC error (its counts could be anything),
+  auto garbage = counts;
+  garbage[0] = 1234567;
+  pipeline_.process(frame(garbage, 0, seq, sample_flags::kCrcError));
+  // then it is counted as rejected, leaves the state untouched, and is not a counter jump;
+  EXPECT_EQ(pipeline_.counters().rejected, 1u);
+  EXPECT_EQ(pipeline_.counters().saturated, 0u);
+  EXPECT_EQ(pipeline_.counters().gaps, 0u);
+  EXPECT_EQ(pipeline_.state().seq, before.seq);
+  EXPECT_EQ(pipeline_.state().v_n, before.v_n);
+  // and the next good frame integrates across the hole (two periods) and says so.
+  pipeline_.process(frame(counts, 0, seq + 1));
+  EXPECT_EQ(pipeline_.counters().gaps, 0u);
+  EXPECT_EQ(pipeline_.state().seq, seq + 1);
+  EXPECT_TRUE(pipeline_.state().status & nav_status::kSampleGap);
+}
+
+TEST_F(PipelineTest, GapsAreCountedOnceWhileAligningToo) {
+  // A jump of the counter is a gap whatever the phase, counted once per jump, with its size.
+  const auto counts = counts_at_rest(Quat<double>::Identity());
+  pipeline_.process(frame(counts, 0, 0xFFFFFFFDu));
+  pipeline_.process(frame(counts, 0, 0xFFFFFFFEu));
+  pipeline_.process(frame(counts, 0, 0));  // 0xFFFFFFFF lost, across the wrap of the counter
+  pipeline_.process(frame(counts, 0, 1));
+  pipeline_.process(frame(counts, 0, 5));  // 2..4 lost
+  EXPECT_EQ(pipeline_.phase(), PipelinePhase::kAligning);
+  EXPECT_EQ(pipeline_.counters().gaps, 2u);
+  EXPECT_EQ(pipeline_.counters().missed_samples, 4u);
+  EXPECT_EQ(pipeline_.counters().samples, 5u);
 }
 
 TEST_F(PipelineTest, BadConfigurationKeepsTheLastGoodOne) {

@@ -11,6 +11,8 @@
 #include "fields.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 
+#include "gfins/checksum/fnv1a.hpp"
+
 namespace gfins::calib_file {
 namespace {
 
@@ -133,6 +135,10 @@ class Validator {
         return x > 0.0 && x <= kMaxRhoM ? "" : "must be in (0, 10] m";
       case Domain::kPosition:
         return std::fabs(x) <= kMaxPositionM ? "" : "must be within ±10 m";
+      case Domain::kGravity:
+        return x >= kMinGravityMps2 && x <= kMaxGravityMps2
+                   ? ""
+                   : "must be a local gravity in [9.7, 9.9] m/s² (not g, not Gal)";
       default:
         return "";
     }
@@ -191,24 +197,17 @@ Problem validate(const CalibrationData& data) {
   return v.problem();
 }
 
-std::string canonical_serialisation(const CalibrationData& data) {
+std::string canonical_serialisation(const CalibrationData& data, std::int64_t version) {
   Canonical c;
-  c.out = "format_version=" + std::to_string(kFormatVersion) + "\n";
-  detail::visit_fields(data, c);
+  c.out = "format_version=" + std::to_string(version) + "\n";
+  detail::visit_fields(data, c, version);
   return c.out;
 }
 
-std::uint64_t fnv1a64(const std::string& bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (const char c : bytes) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
+std::uint64_t fnv1a64(const std::string& bytes) { return gfins::fnv1a64(bytes); }
 
-std::uint64_t checksum(const CalibrationData& data) {
-  return fnv1a64(canonical_serialisation(data));
+std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
+  return fnv1a64(canonical_serialisation(data, version));
 }
 
 std::string utc_now_iso8601() {

@@ -27,6 +27,7 @@ enum class Domain : std::uint8_t {
   kDeviceId,  // [A-Za-z0-9._-]{1,64}
   kUtc,       // YYYY-MM-DDTHH:MM:SSZ
   kSource,    // printable ASCII, ≤ kMaxSourceLength
+  kGravity,   // finite, kMinGravityMps2 ≤ x ≤ kMaxGravityMps2
 };
 
 /// Order of the angle keys: nav::AngleIndex (xy, xz, yx, yz, zx, zy).
@@ -52,8 +53,9 @@ inline const char* to_string_compensator(nav::CompensatorKind k) { return nav::t
 ///   geometry_kind(key, GeometryKind&), compensator(key, nav::CompensatorKind&),
 ///   number(key, double&, Domain), vec3(key, std::array<double, 3>&, Domain).
 /// Geometry's kind is visited before the keys that depend on it, so a reader sees it in time.
+/// `version` is the file's format version: the keys it defines (version 1 has no [gravity]).
 template <typename D, typename V>
-void visit_fields(D& d, V& v) {
+void visit_fields(D& d, V& v, std::int64_t version = kFormatVersion) {
   v.text("device_id", d.device_id, Domain::kDeviceId);
   v.text("created_utc", d.created_utc, Domain::kUtc);
   v.text("source", d.source, Domain::kSource);
@@ -66,6 +68,10 @@ void visit_fields(D& d, V& v) {
       v.vec3(p + "position_m", d.geometry.positions_m[j], Domain::kPosition);
       v.vec3(p + "axis", d.geometry.axes[j], Domain::kAxis);
     }
+  }
+  if (version >= 2) {
+    v.number("gravity.local_mps2", d.gravity_mps2, Domain::kGravity);
+    v.text("gravity.source", d.gravity_source, Domain::kSource);
   }
   for (std::size_t j = 0; j < kNumSensors; ++j) {
     const std::string p = "sensor." + std::to_string(j + 1) + ".";

@@ -24,6 +24,9 @@ constexpr std::string_view kHeader =
     "# gfins calibration file (docs/calibration-file.md), written by gfins-calibrate.\n"
     "# Units (also in [units]): lengths m, scale factors V/g, biases g, orientation errors\n"
     "# degrees, ADC LSB V/count; every *_sigma_* key is the 1-sigma uncertainty of its value.\n"
+    "# g in V/g and in the biases is the local gravity of the calibration site, "
+    "gravity.local_mps2\n"
+    "# (m/s^2); the firmware converts to m/s^2 with that value.\n"
     "# Sensors are numbered as in Table 1 of Hung, Fang & Lee (2007); orientation sets:\n"
     "# beta = sensors {2, 3, 5}, alpha = sensors {1, 4, 6} (eqs. (14)/(15), Table 6).\n"
     "# Any edit invalidates integrity.checksum: re-save with gfins-calibrate, do not hand-edit.\n"
@@ -230,16 +233,24 @@ FileResult<CalibrationData> parse_table(const toml::table& root, const std::stri
   if (version_int == nullptr) {
     return fail(ErrorCode::kInvalidArgument, version_line + "format_version must be an integer");
   }
-  if (version_int->get() != kFormatVersion) {
+  const std::int64_t file_version = version_int->get();
+  if (file_version < kOldestFormatVersion || file_version > kFormatVersion) {
     return fail(ErrorCode::kUnimplemented, version_line + "format version " +
-                                               std::to_string(version_int->get()) +
-                                               " is not supported (this build reads version " +
+                                               std::to_string(file_version) +
+                                               " is not supported (this build reads versions " +
+                                               std::to_string(kOldestFormatVersion) + " to " +
                                                std::to_string(kFormatVersion) + ")");
   }
-  // 2. Every value present with the right type and unit; nothing unknown.
+  // 2. Every value of that version present with the right type and unit; nothing unknown.
   CalibrationData d;
+  if (file_version == 1) {
+    // Version 1 had no calibration site; its front end converted with standard gravity, which
+    // is what these values keep doing (docs/calibration-file.md, versioning).
+    d.gravity_mps2 = nav::kStandardGravity;
+    d.gravity_source = kVersion1GravitySource;
+  }
   Reader reader(root);
-  detail::visit_fields(d, reader);
+  detail::visit_fields(d, reader, file_version);
   if (!reader.ok()) return FileStatus(reader.status().code(), prefix + reader.status().message());
   std::set<std::string> known = reader.consumed();
   known.insert("format_version");
@@ -257,7 +268,7 @@ FileResult<CalibrationData> parse_table(const toml::table& root, const std::stri
                 "hex digits>\"): the file's integrity cannot be checked");
   }
   const std::string stored = sum.value<std::string>().value_or("");
-  const std::string computed = checksum_text(checksum(d));
+  const std::string computed = checksum_text(checksum(d, file_version));
   if (stored != computed) {
     return fail(ErrorCode::kDataLoss, "line " + std::to_string(sum.node()->source().begin.line) +
                                           ": checksum mismatch: integrity.checksum is \"" + stored +

@@ -171,9 +171,9 @@ ErrorBudget error_budget(const CovarianceSpec& spec, const std::vector<double>& 
   return b;
 }
 
-void write_covariance_csv(const CovarianceResult& r, const std::string& path) {
+HostStatus write_covariance_csv(const CovarianceResult& r, const std::string& path) {
   std::ofstream out(path);
-  if (!out) throw std::runtime_error("covariance: cannot open " + path);
+  if (!out) return HostError{ErrorCode::kIoError, "covariance: cannot open " + path};
   out << "t_s";
   for (const char* n : kErrorStateNames) out << ",sigma_" << n;
   out << '\n';
@@ -183,12 +183,14 @@ void write_covariance_csv(const CovarianceResult& r, const std::string& path) {
     for (std::size_t i = 0; i < 12; ++i) out << ',' << r.sigma[i][k];
     out << '\n';
   }
-  if (!out) throw std::runtime_error("covariance: write failed: " + path);
+  out.close();
+  if (!out) return HostError{ErrorCode::kIoError, "covariance: write failed: " + path};
+  return Done{};
 }
 
-void write_budget_csv(const ErrorBudget& b, const std::string& path) {
+HostStatus write_budget_csv(const ErrorBudget& b, const std::string& path) {
   std::ofstream out(path);
-  if (!out) throw std::runtime_error("covariance: cannot open " + path);
+  if (!out) return HostError{ErrorCode::kIoError, "covariance: cannot open " + path};
   out << "source,t_s";
   for (const char* n : kErrorStateNames) out << ",sigma_" << n;
   out << '\n';
@@ -201,7 +203,9 @@ void write_budget_csv(const ErrorBudget& b, const std::string& path) {
       out << '\n';
     }
   }
-  if (!out) throw std::runtime_error("covariance: write failed: " + path);
+  out.close();
+  if (!out) return HostError{ErrorCode::kIoError, "covariance: write failed: " + path};
+  return Done{};
 }
 
 }  // namespace gfins::sim

@@ -4,13 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <stdexcept>
 
 namespace gfins::sim {
 
-MonteCarloResult run_montecarlo(const Scenario& base, std::size_t runs, std::uint64_t seed0,
-                                const ProgressFn& progress) {
-  if (runs < 2) throw std::invalid_argument("montecarlo: at least two runs are needed");
+HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
+                                            std::uint64_t seed0, const ProgressFn& progress) {
+  if (runs < 2) {
+    return HostError{ErrorCode::kInvalidArgument, "montecarlo: at least two runs are needed"};
+  }
   MonteCarloResult r;
   r.runs = runs;
   // Running sums per [quantity][axis][sample] (Welford would be overkill: errors are small and
@@ -23,7 +24,7 @@ MonteCarloResult run_montecarlo(const Scenario& base, std::size_t runs, std::uin
     Scenario s = base;
     s.seed = seed0 + k;
     s.calibration.seed = seed0 + 100003 * k;
-    const ScenarioOutcome o = run_scenario(s, {}, /*with_uncompensated=*/false);
+    GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false));
     cal2 += o.calibration.rms_angle_error_rad * o.calibration.rms_angle_error_rad;
     const auto& smp = o.compensated.samples;
     const std::size_t n = smp.size();
@@ -90,9 +91,9 @@ double loglog_slope(const std::vector<double>& t, const std::vector<double>& y, 
   return (mm * sxy - sx * sy) / (mm * sxx - sx * sx);
 }
 
-void write_montecarlo_csv(const MonteCarloResult& r, const std::string& path) {
+HostStatus write_montecarlo_csv(const MonteCarloResult& r, const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) throw std::runtime_error("cannot write " + path);
+  if (f == nullptr) return HostError{ErrorCode::kIoError, "cannot write " + path};
   std::fprintf(f, "t_s");
   const char* axes = "xyz";
   for (std::size_t q = 0; q < kMcQuantities; ++q) {
@@ -116,7 +117,10 @@ void write_montecarlo_csv(const MonteCarloResult& r, const std::string& path) {
   // The fprintf results above are not checked one by one: a failed write sets the error flag,
   // and fclose alone reports only the last flush (glibc returns 0 after an earlier ENOSPC).
   const bool write_failed = std::ferror(f) != 0;
-  if (std::fclose(f) != 0 || write_failed) throw std::runtime_error("error writing " + path);
+  if (std::fclose(f) != 0 || write_failed) {
+    return HostError{ErrorCode::kIoError, "error writing " + path};
+  }
+  return Done{};
 }
 
 }  // namespace gfins::sim

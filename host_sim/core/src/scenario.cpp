@@ -12,13 +12,14 @@
 #include <stdexcept>
 
 #include "gfins/nav_core/math.hpp"
+#include "gfins/nav_core/paper_table6.hpp"
 
 namespace gfins::sim {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-/// Thrown inside the parser only; parse_scenario turns it into ParsedScenario::error.
+/// Thrown inside the parser only; parse_scenario turns it into a HostError.
 struct ScenarioParseError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -113,6 +114,15 @@ class Reader {
       fail(n, full, "unknown value '" + v + "' (expected one of: " + list + ")");
     }
     return v;
+  }
+
+  bool boolean(const toml::table& t, const std::string& prefix, const char* key,
+               bool fallback) const {
+    const toml::node* n = t.get(key);
+    if (n == nullptr) return fallback;
+    const auto* b = n->as_boolean();
+    if (b == nullptr) fail(n, prefix + key, "expected true or false, got " + type_name(*n));
+    return b->get();
   }
 
   /// An array of exactly `size` numbers, each within [lo, hi].
@@ -251,10 +261,12 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     const std::string q = "sensors.";
     rd.only(*se, q,
             {"orientation", "beta_deg", "alpha_deg", "location_error_mm", "bias_mps2", "noise_mps2",
-             "noise_mg", "noise_distribution", "model", "temperature_c"});
+             "noise_mg", "noise_distribution", "model", "temperature_c", "adc"});
     const std::string orient =
         rd.string(*se, q, "orientation", std::string("none"), {"none", "paper_table6", "custom"});
-    if (orient == "paper_table6") s.misalignment.orientation = paper_table6_orientation();
+    if (orient == "paper_table6") {
+      s.misalignment.orientation = nav::paper_table6::misalignment<double>().orientation;
+    }
     if (orient == "custom") {
       // Bounded by the compensator's small-angle limit (0.2 rad = 11.5°).
       const auto b = rd.numbers(*se, q, "beta_deg", 6, -11.0, 11.0, true);
@@ -287,6 +299,11 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     s.temperature_c = rd.number(*se, q, "temperature_c", 25.0, -55.0, 125.0);
     s.noise_uniform = rd.string(*se, q, "noise_distribution", std::string("gaussian"),
                                 {"gaussian", "uniform"}) == "uniform";
+    s.adc = rd.boolean(*se, q, "adc", true);
+    if (!s.adc && s.qa1100) {
+      rd.fail(se->get("adc"), q + "adc",
+              "false (the paper's §6.3 m/s² setting) needs model = \"paper\", not \"qa1100\"");
+    }
   }
 
   // [compensator]
@@ -346,53 +363,34 @@ class DriveTrajectory final : public JetTrajectory {
 
 }  // namespace
 
-nav::OrientationErrors<double> paper_table6_orientation() {
-  // Degrees, notes §2 (re-computed from Tables 4/5; Table 6 prints them truncated).
-  const std::array<double, 6> beta = {1.117153,  -0.175898, -0.581243,
-                                      -0.738730, 2.454474,  2.482132};
-  const std::array<double, 6> alpha = {-2.655023, 2.596927, -0.838685,
-                                       -0.737413, 0.119500, -1.451068};
-  nav::OrientationErrors<double> o;
-  for (std::size_t i = 0; i < 6; ++i) {
-    o.beta[i] = beta[i] * kDegToRad;
-    o.alpha[i] = alpha[i] * kDegToRad;
-  }
-  return o;
-}
-
-ParsedScenario parse_scenario(std::string_view toml_text, const std::string& source) {
-  ParsedScenario out;
+HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source) {
   try {
     const toml::table root = toml::parse(toml_text, source);
-    out.scenario = parse_root(root, Reader(source), source);
+    return parse_root(root, Reader(source), source);
   } catch (const toml::parse_error& e) {
     std::ostringstream os;
     os << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
-    out.error = os.str();
+    return HostError{ErrorCode::kInvalidArgument, os.str()};
   } catch (const ScenarioParseError& e) {
-    out.error = e.what();
+    return HostError{ErrorCode::kInvalidArgument, e.what()};
   }
-  return out;
 }
 
-ParsedScenario load_scenario(const std::string& file_or_name, const std::string& builtin_dir) {
+HostResult<Scenario> load_scenario(const std::string& file_or_name,
+                                   const std::string& builtin_dir) {
   std::filesystem::path path(file_or_name);
-  if (!std::filesystem::exists(path)) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
     const auto builtin = std::filesystem::path(builtin_dir) / (file_or_name + ".toml");
-    if (!std::filesystem::exists(builtin)) {
-      ParsedScenario out;
-      out.error =
-          file_or_name + ": no such file, and no built-in scenario of that name in " + builtin_dir;
-      return out;
+    if (!std::filesystem::exists(builtin, ec)) {
+      return HostError{
+          ErrorCode::kInvalidArgument,
+          file_or_name + ": no such file, and no built-in scenario of that name in " + builtin_dir};
     }
     path = builtin;
   }
   std::ifstream in(path);
-  if (!in) {
-    ParsedScenario out;
-    out.error = path.string() + ": cannot read the file";
-    return out;
-  }
+  if (!in) return HostError{ErrorCode::kIoError, path.string() + ": cannot read the file"};
   std::ostringstream text;
   text << in.rdbuf();
   return parse_scenario(text.str(), path.string());
@@ -412,7 +410,7 @@ std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, dou
   return std::make_unique<DriveTrajectory>(speed_mps, amplitude_m, period_s);
 }
 
-std::unique_ptr<Trajectory> make_trajectory(const TrajectorySpec& t) {
+HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& t) {
   const Quatd q0 = nav::quat_from_euler(t.euler0_rad.x(), t.euler0_rad.y(), t.euler0_rad.z());
   if (t.kind == "rest" || t.kind == "calibration_poses") return make_rest(q0);
   if (t.kind == "constant_acceleration") return make_constant_acceleration(t.accel_n_mps2, q0);
@@ -420,20 +418,7 @@ std::unique_ptr<Trajectory> make_trajectory(const TrajectorySpec& t) {
   if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);
   if (t.kind == "maneuver") return make_maneuver(t.scale);
   if (t.kind == "drive") return make_drive(t.speed_mps, t.turn_amplitude_m, t.turn_period_s);
-  throw std::invalid_argument("unknown trajectory kind '" + t.kind + "'");
-}
-
-nav::GravityModel<double> gravity_model(const Scenario& s) {
-  switch (s.gravity) {
-    case GravityChoice::kDown:
-      return nav::GravityModel<double>::constant(s.gravity_mps2);
-    case GravityChoice::kUp:
-      // The paper's §6.3 frame has gravity along −z; the core's model is a signed constant.
-      return nav::GravityModel<double>::constant(-s.gravity_mps2);
-    case GravityChoice::kNormal:
-      return nav::GravityModel<double>::normal(s.latitude_rad, s.height_m);
-  }
-  return nav::GravityModel<double>::constant(s.gravity_mps2);
+  return HostError{ErrorCode::kInvalidArgument, "unknown trajectory kind '" + t.kind + "'"};
 }
 
 }  // namespace gfins::sim

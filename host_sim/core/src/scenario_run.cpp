@@ -1,12 +1,16 @@
-// Running a scenario through nav::NavPipeline<double>: the sensor outputs of the true (misaligned)
-// array plus noise, once without compensation and once with the scenario's compensator, and the
-// simulated multi-attitude calibration that gives the compensator its parameters on request.
+// Running a scenario: the one sample source (trajectory → sensor model → ADC → RawSample,
+// sample_source.hpp) makes the stream once, and the one navigation loop (nav_loop.hpp) runs it
+// through nav::NavPipeline<T>, once without compensation and once with the scenario's
+// compensator; the simulated multi-attitude calibration gives the compensator its parameters on
+// request.
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
-#include <stdexcept>
 
-#include "gfins/host_sim/array_model.hpp"
+#include "gfins/host_sim/adc_model.hpp"
+#include "gfins/host_sim/nav_loop.hpp"
+#include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/nav_core/pipeline.hpp"
@@ -14,126 +18,155 @@
 namespace gfins::sim {
 namespace {
 
-/// Draws the per-sensor noise of one sample: Gaussian, or uniform of the same σ (±√3 σ).
-class Noise {
- public:
-  Noise(double sigma, bool uniform, std::uint64_t seed)
-      : sigma_(sigma), uniform_(uniform), rng_(seed) {}
-  Vec6d draw() {
-    Vec6d n = Vec6d::Zero();
-    if (sigma_ <= 0) return n;
-    for (int j = 0; j < 6; ++j) {
-      n(j) = uniform_ ? std::sqrt(3.0) * sigma_ * (2.0 * u01_(rng_) - 1.0) : sigma_ * n01_(rng_);
-    }
-    return n;
-  }
-
- private:
-  double sigma_;
-  bool uniform_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> n01_{0.0, 1.0};
-  std::uniform_real_distribution<double> u01_{0.0, 1.0};
-};
-
-/// The sensor outputs (m/s²) of every sample, computed once so both runs see the same noise.
+/// The samples of one scenario, computed once so both runs see the same noise.
 struct Stream {
   std::vector<TruthState> truth;
-  std::vector<Vec6d> outputs;
+  std::vector<RawSample> raw;       // what the ADC delivered (scenario.adc)
+  std::vector<Vec6d> outputs_mps2;  // the paper's §6.3 only (!scenario.adc): m/s², no converter
+  double volts_per_count = 0.0;     // of the converter, V at the sensor
+  std::array<double, 6> scale_v_per_g{};  // nominal SF of each sensor, what the front end is told
 };
 
-Stream make_stream(const Scenario& s, const Trajectory& traj) {
-  // The array's outputs come from the project's sensor model (sensor_model.hpp), in volts; the
-  // front end's division by the (known) scale factor brings them back to m/s². Gaussian white
-  // noise is the model's own; uniform noise (not in the model) is added here instead.
+ArrayErrors array_errors(const Scenario& s) {
   ArrayErrors errors;
   errors.misalignment = s.misalignment;
   errors.temperature_c = s.temperature_c;
   const double g = nav::kStandardGravity;
+  const double qa1100_sf = AccelErrors::qa1100_typical().scale_v_per_g;
   for (std::size_t j = 0; j < 6; ++j) {
     AccelErrors& e = errors.sensors[j];
     if (s.qa1100) e = AccelErrors::qa1100_typical();
+    // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
+    // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
+    // out).
+    if (s.adc) e.scale_v_per_g = qa1100_sf;
     e.bias_g += s.bias_mps2[j] / g;
+    // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
     if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
   }
+  return errors;
+}
+
+HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
+  const ArrayErrors errors = array_errors(s);
   SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
                          s.seed);
-  Noise uniform(s.noise_uniform ? s.noise_mps2 : 0.0, true, s.seed);
+  AdcConfig adc_config;
+  adc_config.sample_rate_hz = s.rate_hz;
+  SampleSource source(traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
+                      s.rate_hz);
+  if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   const auto steps = static_cast<std::size_t>(std::llround(s.duration_s * s.rate_hz));
   Stream st;
+  st.volts_per_count = source.volts_per_count();
+  for (std::size_t j = 0; j < 6; ++j) st.scale_v_per_g[j] = errors.sensors[j].scale_v_per_g;
   st.truth.reserve(steps + 1);
-  st.outputs.reserve(steps + 1);
+  (s.adc ? st.raw.reserve(steps + 1) : st.outputs_mps2.reserve(steps + 1));
   for (std::size_t k = 0; k <= steps; ++k) {
-    const TruthState x = traj.at(static_cast<double>(k) / s.rate_hz);
-    const SensorArrayModel::Volts v = model.volts(x);
-    Vec6d out = uniform.draw();
-    for (int j = 0; j < 6; ++j) {
-      out(j) += v(j) / errors.sensors[static_cast<std::size_t>(j)].scale_v_per_g * g;
+    const Result<SourceSample> x = source.next();
+    if (!x.is_ok()) return host_error(x.status(), "scenario " + s.name + ": converter: ");
+    st.truth.push_back(x->truth);
+    if (s.adc) {
+      st.raw.push_back(x->raw);
+    } else {
+      Vec6d out;
+      for (int j = 0; j < 6; ++j) {
+        out(j) =
+            x->volts(j) / st.scale_v_per_g[static_cast<std::size_t>(j)] * nav::kStandardGravity;
+      }
+      st.outputs_mps2.push_back(out);
     }
-    st.truth.push_back(x);
-    st.outputs.push_back(out);
   }
   return st;
 }
 
-RunSeries navigate(const Scenario& s, const Stream& st, nav::CompensatorKind kind,
-                   const nav::Misalignment<double>& m, const std::array<double, 6>& bias_mps2,
-                   const std::string& label, const ProgressFn& progress, double progress_base) {
+template <typename T>
+nav::Misalignment<T> cast_misalignment(const nav::Misalignment<double>& m) {
+  nav::Misalignment<T> o;
+  for (std::size_t i = 0; i < 6; ++i) {
+    o.orientation.beta[i] = static_cast<T>(m.orientation.beta[i]);
+    o.orientation.alpha[i] = static_cast<T>(m.orientation.alpha[i]);
+    o.drho_b[i] = m.drho_b[i].template cast<T>();
+  }
+  return o;
+}
+
+SampleRecord record_of(const TruthState& truth, const nav::NavState<double>& e) {
+  SampleRecord rec;
+  rec.t_s = truth.t_s;
+  rec.truth = truth;
+  rec.q_nb_est = e.q_nb;
+  rec.w_b_est = e.w_b;
+  rec.wdot_b_est = e.wdot_b;
+  rec.a_n_est = e.a_n;
+  rec.v_n_est = e.v_n;
+  rec.r_n_est = e.r_n;
+  return rec;
+}
+
+template <typename T>
+HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::CompensatorKind kind,
+                               const nav::Misalignment<double>& m,
+                               const std::array<double, 6>& bias_mps2, const std::string& label,
+                               const ProgressFn& progress, double progress_base) {
   nav::PipelineConfig<double> cfg;
   cfg.nominal = nav::table1_geometry<double>(s.rho_m);
-  cfg.front_end.volts_per_count.fill(1.0);
-  cfg.front_end.scale_v_per_g.fill(1.0);
-  cfg.misalignment = m;
-  cfg.compensator = kind;
-  cfg.gravity = gravity_model(s);
-  cfg.sample_rate_hz = s.rate_hz;
-  // Heap-allocated: the pipeline is a large object (on the board it lives in static storage).
-  auto pipeline = std::make_unique<nav::NavPipeline<double>>();
-  if (const auto status = pipeline->configure(cfg); !status.is_ok()) {
-    throw std::runtime_error(std::string("navigation core rejected the configuration: ") +
-                             status.message());
+  // The real front end: the converter's LSB, the sensors' scale factors, the biases the
+  // compensator is told (true or calibrated). Unused by the §6.3 m/s² entry.
+  for (std::size_t j = 0; j < 6; ++j) {
+    cfg.front_end.volts_per_count[j] = s.adc ? st.volts_per_count : 1.0;
+    cfg.front_end.scale_v_per_g[j] = st.scale_v_per_g[j];
+    cfg.front_end.bias_g[j] = bias_mps2[j] / nav::kStandardGravity;
   }
-  const auto corrected = [&](std::size_t k) {
-    Vec6d out = st.outputs[k];
-    for (int j = 0; j < 6; ++j) out(j) -= bias_mps2[static_cast<std::size_t>(j)];
-    return out;
-  };
+  cfg.sample_rate_hz = s.rate_hz;
+  nav::PipelineConfig<T> cfg_t;
+  cfg_t.nominal = cfg.nominal.template cast<T>();
+  cfg_t.front_end = cfg.front_end.template cast<T>();
+  cfg_t.misalignment = cast_misalignment<T>(m);
+  cfg_t.compensator = kind;
+  cfg_t.gravity = gravity_model<T>(s);
+  cfg_t.sample_rate_hz = cfg.sample_rate_hz;
+  // Heap-allocated: the pipeline is a large object (on the board it lives in static storage).
+  auto pipeline = std::make_unique<nav::NavPipeline<T>>();
+  if (const auto status = pipeline->configure(cfg_t); !status.is_ok()) {
+    return host_error(status,
+                      "scenario " + s.name + ": navigation core rejected the configuration: ");
+  }
   RunSeries r;
   r.label = label;
   r.samples.reserve(st.truth.size());
   // The truth is given at the first sample (no alignment): the experiment measures what the
   // array errors do to navigation, not the alignment.
-  nav::NavState<double> init;
-  const TruthState& x0 = st.truth.front();
-  init.q_nb = x0.q_nb;
-  init.w_b = x0.w_b;
-  init.wdot_b = x0.wdot_b;
-  init.v_n = x0.v_n;
-  init.r_n = x0.r_n;
-  pipeline->start_at_outputs(init, corrected(0));
+  const nav::NavState<T> init = to_nav_state<T>(st.truth.front(), 0);
+  if (s.adc) {
+    pipeline->start_at(init, st.raw.front());
+  } else {
+    Vec6d first = st.outputs_mps2.front();
+    for (int j = 0; j < 6; ++j) first(j) -= bias_mps2[static_cast<std::size_t>(j)];
+    pipeline->start_at_specific_force(init, first.template cast<T>());
+  }
+  r.samples.push_back(record_of(st.truth.front(), pipeline->state().template cast<double>()));
   const std::size_t n = st.truth.size();
   const std::size_t every = std::max<std::size_t>(n / 100, 1);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (k > 0) {
-      pipeline->process_outputs(corrected(k),
-                                static_cast<std::int64_t>(std::llround(st.truth[k].t_s * 1e9)),
-                                static_cast<std::uint32_t>(k));
+  NavLoop<T> loop(*pipeline, [&](std::uint64_t, const nav::NavState<T>& e) {
+    r.samples.push_back(record_of(st.truth[e.seq], e.template cast<double>()));
+  });
+  for (std::size_t k = 1; k < n; ++k) {
+    if (s.adc) {
+      loop.step(st.raw[k]);
+    } else {
+      // The paper's §6.3: m/s² after the front end, bias removed here (NavPipeline says why).
+      Vec6d out = st.outputs_mps2[k];
+      for (int j = 0; j < 6; ++j) out(j) -= bias_mps2[static_cast<std::size_t>(j)];
+      loop.step_specific_force(out.template cast<T>(),
+                               static_cast<std::int64_t>(std::llround(st.truth[k].t_s * 1e9)),
+                               static_cast<std::uint32_t>(k));
     }
-    const nav::NavState<double>& e = pipeline->state();
-    SampleRecord rec;
-    rec.t_s = st.truth[k].t_s;
-    rec.truth = st.truth[k];
-    rec.q_nb_est = e.q_nb;
-    rec.w_b_est = e.w_b;
-    rec.wdot_b_est = e.wdot_b;
-    rec.a_n_est = e.a_n;
-    rec.v_n_est = e.v_n;
-    rec.r_n_est = e.r_n;
-    r.samples.push_back(rec);
     if (progress && k % every == 0) {
       progress(progress_base + 0.5 * static_cast<double>(k) / static_cast<double>(n));
     }
   }
+  r.report = loop.report();
   return r;
 }
 
@@ -149,7 +182,7 @@ Vec3d SampleRecord::att_err_b() const {
   return 2.0 * dq.vec();
 }
 
-CalibrationOutcome simulate_calibration(const Scenario& s) {
+HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s) {
   // The array's true axes θ*_i (eqs. (14)/(15)); positions do not matter at rest.
   const auto truth = nav::misaligned_geometry(nav::table1_geometry<double>(1.0), s.misalignment);
   const auto t2 = calib::table2_attitudes<double>();
@@ -176,8 +209,7 @@ CalibrationOutcome simulate_calibration(const Scenario& s) {
   }
   const auto res = calib::calibrate_multi_attitude<double>(std::span(obs.data(), obs.size()));
   if (!res.is_ok()) {
-    throw std::runtime_error(std::string("simulated calibration failed: ") +
-                             res.status().message());
+    return host_error(res.status(), "scenario " + s.name + ": simulated calibration failed: ");
   }
   const auto& r = res.value();
   CalibrationOutcome c;
@@ -195,12 +227,12 @@ CalibrationOutcome simulate_calibration(const Scenario& s) {
   return c;
 }
 
-ScenarioOutcome run_scenario(const Scenario& s, const ProgressFn& progress,
-                             bool with_uncompensated) {
+HostResult<ScenarioOutcome> run_scenario(const Scenario& s, const ProgressFn& progress,
+                                         bool with_uncompensated, NavScalar scalar) {
   ScenarioOutcome out;
   const bool calibrated = s.misalignment_source == MisalignmentSource::kCalibrated;
   if (calibrated || s.trajectory.kind == "calibration_poses") {
-    out.calibration = simulate_calibration(s);
+    GFINS_TRY(out.calibration, simulate_calibration(s));
   }
   if (s.trajectory.kind == "calibration_poses") return out;
 
@@ -214,16 +246,22 @@ ScenarioOutcome run_scenario(const Scenario& s, const ProgressFn& progress,
       bias_comp[j] = out.calibration.bias_est_g[j] * nav::kStandardGravity;
     }
   }
-  const auto traj = make_trajectory(s.trajectory);
-  const Stream st = make_stream(s, *traj);
+  GFINS_TRY(const auto traj, make_trajectory(s.trajectory));
+  GFINS_TRY(const Stream st, make_stream(s, *traj));
+  const auto run = [&](nav::CompensatorKind kind, const nav::Misalignment<double>& m,
+                       const std::array<double, 6>& bias, const std::string& label, double base) {
+    return scalar == NavScalar::kFloat
+               ? navigate<float>(s, st, kind, m, bias, label, progress, base)
+               : navigate<double>(s, st, kind, m, bias, label, progress, base);
+  };
   if (with_uncompensated) {
-    out.uncompensated = navigate(s, st, nav::CompensatorKind::kNone, nav::Misalignment<double>{},
-                                 std::array<double, 6>{}, "uncompensated", progress, 0.0);
+    GFINS_TRY(out.uncompensated, run(nav::CompensatorKind::kNone, nav::Misalignment<double>{},
+                                     std::array<double, 6>{}, "uncompensated", 0.0));
   }
-  out.compensated = navigate(s, st, s.compensator, out.compensator_misalignment, bias_comp,
-                             std::string("compensated (") + nav::to_string(s.compensator) + ", " +
-                                 source_name(s.misalignment_source) + ")",
-                             progress, 0.5);
+  GFINS_TRY(out.compensated, run(s.compensator, out.compensator_misalignment, bias_comp,
+                                 std::string("compensated (") + nav::to_string(s.compensator) +
+                                     ", " + source_name(s.misalignment_source) + ")",
+                                 0.5));
   if (progress) progress(1.0);
   return out;
 }
@@ -249,9 +287,9 @@ Bounds angular_accel_bounds(const RunSeries& r) {
   return bounds_of(r, [](const SampleRecord& x) { return x.wdot_err_b(); });
 }
 
-void write_series_csv(const RunSeries& r, const std::string& path) {
+HostStatus write_series_csv(const RunSeries& r, const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) throw std::runtime_error("cannot write " + path);
+  if (f == nullptr) return HostError{ErrorCode::kIoError, "cannot write " + path};
   std::fprintf(f,
                "t_s,"
                "true_qw,true_qx,true_qy,true_qz,true_wx,true_wy,true_wz,"
@@ -287,7 +325,10 @@ void write_series_csv(const RunSeries& r, const std::string& path) {
   // The fprintf results above are not checked one by one: a failed write sets the error flag,
   // and fclose alone reports only the last flush (glibc returns 0 after an earlier ENOSPC).
   const bool write_failed = std::ferror(f) != 0;
-  if (std::fclose(f) != 0 || write_failed) throw std::runtime_error("error writing " + path);
+  if (std::fclose(f) != 0 || write_failed) {
+    return HostError{ErrorCode::kIoError, "error writing " + path};
+  }
+  return Done{};
 }
 
 }  // namespace gfins::sim

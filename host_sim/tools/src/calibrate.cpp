@@ -1,5 +1,6 @@
 #include "calibrate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -49,6 +50,10 @@ FileResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
                    std::to_string(j + 1) + " (Tables 4/5 need all 36)");
       }
       p.mean_v[i][j] = at[i][j]->mean_v;
+      // σ of the mean from std_v and count where given: both routes use it (issue 11).
+      if (at[i][j]->count > 0) {
+        p.sigma_v[i][j] = at[i][j]->std_v / std::sqrt(static_cast<double>(at[i][j]->count));
+      }
     }
   }
   CalibrationRun run;
@@ -133,12 +138,72 @@ std::string fmt(const char* format, double x) {
   return buf;
 }
 
+// Which σ the ± figures below are: the report says it once, in words, for all sensors.
+std::string sigma_statement(const calib::MultiAttitudeResult<double>& r) {
+  int stated = 0;
+  int residual = 0;
+  for (const auto src : r.covariance_source) {
+    stated += src == calib::CovarianceSource::kStatedSigma ? 1 : 0;
+    residual += src == calib::CovarianceSource::kResiduals ? 1 : 0;
+  }
+  if (stated == 6) {
+    return "uncertainties (± 1σ): from the stated σ of every mean (std_v/√count of the input), "
+           "propagated through the fit";
+  }
+  if (residual == 6) {
+    return "uncertainties (± 1σ): no σ stated with the means, so from the fit residuals (n − 4 "
+           "degrees of freedom per sensor: with 6 poses a Student-t with 2 dof, only ~90 % of "
+           "true values within 3σ); give std_v and count for honest uncertainties";
+  }
+  return "uncertainties (± 1σ): per sensor as the last column says (stated σ where every mean "
+         "of the sensor has one, else residuals)";
+}
+
+}  // namespace
+
+namespace {
+
+std::string channel_list(std::uint8_t mask) {
+  std::string out;
+  for (int j = 0; j < 6; ++j) {
+    if ((mask >> j) & 1u) out += (out.empty() ? "" : ", ") + std::to_string(j + 1);
+  }
+  return out;
+}
+
+std::string span_text(std::uint64_t start, std::uint64_t end, double rate_hz) {
+  return fmt("%.2f", static_cast<double>(start) / rate_hz) + "-" +
+         fmt("%.2f", static_cast<double>(end) / rate_hz) + " s";
+}
+
+// Why a pose the detector rejected cannot be used, in the user's terms.
+std::string rejection_text(const calib::RejectedPose<double>& r, const RecordingOptions& o) {
+  if (r.reason == calib::PoseRejection::kTooNoisy) {
+    double worst = 0.0;
+    for (std::size_t c = 0; c < 6; ++c) {
+      if ((r.noisy_channels >> c) & 1u) worst = std::max(worst, r.std_v[c]);
+    }
+    return "the board moved (or vibrated) during it: channel(s) " + channel_list(r.noisy_channels) +
+           " have a standard deviation up to " + fmt("%.3g", worst * 1e3) +
+           " mV, above the still limit " + fmt("%.3g", o.still_std_v * 1e3) + " mV (--still-std-v)";
+  }
+  return "held still for only " + fmt("%.2f", static_cast<double>(r.count) / o.rate_hz) +
+         " s, less than the " + fmt("%.3g", o.min_still_s) + " s a pose needs";
+}
+
 }  // namespace
 
 FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
                                                      const std::optional<std::vector<Pose>>& poses,
-                                                     const RecordingOptions& options,
+                                                     const RecordingOptions& options_in,
                                                      const std::string& recording_file) {
+  RecordingOptions options = options_in;
+  if (!(options.rate_hz > 0.0)) options.rate_hz = rec.rate_hz;
+  if (!(options.rate_hz > 0.0)) {
+    return bad(recording_file +
+               ": the sample rate is unknown: give --rate (Hz) for a CSV "
+               "recording");
+  }
   calib::StaticDetectorConfig<double> cfg;
   cfg.sample_rate_hz = options.rate_hz;
   cfg.window_s = options.window_s;
@@ -149,21 +214,62 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   calib::StaticDetector<double>& detector = created.value();
   for (const auto& sample : rec.samples_v) (void)detector.push(sample);
   (void)detector.finish();
-
-  CalibrationRun run;
-  const auto intervals = detector.intervals();
-  run.notes.push_back(recording_file + ": " + std::to_string(rec.samples_v.size()) +
-                      " samples at " + fmt("%g", options.rate_hz) + " Hz, " +
-                      std::to_string(intervals.size()) + " static intervals, " +
-                      std::to_string(detector.rejected().size()) + " poses rejected");
-  for (const auto& r : detector.rejected()) {
-    run.notes.push_back("rejected pose at " +
-                        fmt("%.2f", static_cast<double>(r.start_index) / options.rate_hz) +
-                        " s: " + calib::to_string(r.reason));
-  }
   if (detector.dropped() > 0) {
     return bad(recording_file + ": more static intervals than the detector holds (" +
                std::to_string(calib::kMaxAttitudes) + ")");
+  }
+
+  // Every pose the detector found or rejected, with the reason a pose cannot be used: it moved
+  // or was too short (the detector), or a channel saturated / a frame failed its CRC inside it
+  // (the recording's flags). A refused pose is left out; the others are used.
+  CalibrationRun run;
+  std::vector<std::string> refused;
+  for (const auto& r : detector.rejected()) {
+    refused.push_back("pose at " + span_text(r.start_index, r.end_index, options.rate_hz) +
+                      " refused: " + rejection_text(r, options));
+  }
+  std::vector<calib::StaticInterval<double>> usable;
+  const auto intervals = detector.intervals();
+  for (const auto& it : intervals) {
+    std::uint8_t sat = 0;
+    std::uint64_t n_sat = 0;
+    std::uint64_t n_crc = 0;
+    for (std::uint64_t k = it.start_index; k < it.end_index && k < rec.saturated_mask.size(); ++k) {
+      sat = static_cast<std::uint8_t>(sat | rec.saturated_mask[k]);
+      n_sat += rec.saturated_mask[k] != 0 ? 1 : 0;
+      n_crc += rec.crc_error[k];
+    }
+    const std::string where = "pose at " + span_text(it.start_index, it.end_index, options.rate_hz);
+    if (sat != 0) {
+      refused.push_back(where + " refused: channel(s) " + channel_list(sat) +
+                        " saturated (ADC code at full scale) in " + std::to_string(n_sat) +
+                        " samples: the output is clipped, its mean is not the sensor's");
+    } else if (n_crc > 0) {
+      refused.push_back(where + " refused: " + std::to_string(n_crc) +
+                        " ADC frames with a CRC error inside it: its samples are not all valid");
+    } else {
+      usable.push_back(it);
+    }
+  }
+  run.notes.push_back(recording_file + ": " + std::to_string(rec.samples_v.size()) +
+                      " samples at " + fmt("%g", options.rate_hz) + " Hz, " +
+                      std::to_string(intervals.size()) + " still intervals, " +
+                      std::to_string(usable.size()) + " usable, " + std::to_string(refused.size()) +
+                      " poses refused");
+  for (const auto& r : refused) run.notes.push_back(r);
+  if (usable.size() < calib::kMinAttitudes) {
+    std::string what = recording_file + ": " + std::to_string(usable.size()) +
+                       " usable still intervals, at least " + std::to_string(calib::kMinAttitudes) +
+                       " non-coplanar poses are needed.";
+    what += "\n  still intervals found:";
+    if (intervals.empty()) what += " none";
+    for (const auto& it : intervals) {
+      what += "\n    " + span_text(it.start_index, it.end_index, options.rate_hz);
+    }
+    what += "\n  poses refused:";
+    if (refused.empty()) what += " none";
+    for (const auto& r : refused) what += "\n    " + r;
+    return bad(what);
   }
 
   std::vector<std::array<double, 3>> expected;
@@ -187,20 +293,20 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   }
   calib::PoseAssignmentConfig<double> assign;
   assign.nominal_scale_v_per_g = options.nominal_scale_v_per_g;
-  std::vector<calib::AttitudeObservation<double>> obs(intervals.size());
-  std::vector<int> attitude_of(intervals.size(), -1);
+  std::vector<calib::AttitudeObservation<double>> obs(usable.size());
+  std::vector<int> attitude_of(usable.size(), -1);
   const auto n = calib::intervals_to_observations<double>(
-      intervals, std::span<const std::array<double, 3>>(expected.data(), expected.size()), assign,
+      std::span<const calib::StaticInterval<double>>(usable.data(), usable.size()),
+      std::span<const std::array<double, 3>>(expected.data(), expected.size()), assign,
       std::span<calib::AttitudeObservation<double>>(obs.data(), obs.size()),
       std::span<int>(attitude_of.data(), attitude_of.size()));
   if (!n.is_ok()) return bad(recording_file + ": " + n.status().message());
   obs.resize(n.value());
-  for (std::size_t k = 0; k < intervals.size(); ++k) {
-    const auto& it = intervals[k];
+  for (std::size_t k = 0; k < usable.size(); ++k) {
+    const auto& it = usable[k];
     const int a = attitude_of[k];
     run.notes.push_back("interval " + std::to_string(k + 1) + ": " +
-                        fmt("%.2f", static_cast<double>(it.start_index) / options.rate_hz) + "-" +
-                        fmt("%.2f", static_cast<double>(it.end_index) / options.rate_hz) + " s, " +
+                        span_text(it.start_index, it.end_index, options.rate_hz) + ", " +
                         (a >= 0 ? "pose " + labels[static_cast<std::size_t>(a)]
                                 : std::string("no expected pose within 20 degrees: skipped")));
     if (a >= 0) {
@@ -242,6 +348,8 @@ calib_file::CalibrationData make_calibration_data(const CalibrationRun& run,
     s.location_error_m = settings.location[j].location_error_m;
     s.location_error_sigma_m = settings.location[j].location_error_sigma_m;
   }
+  d.gravity_mps2 = settings.gravity_mps2;
+  d.gravity_source = settings.gravity_source;
   for (std::size_t i = 0; i < 6; ++i) {
     d.beta.angle_deg[i] = r.orientation.beta[i] * kDegPerRad;
     d.alpha.angle_deg[i] = r.orientation.alpha[i] * kDegPerRad;
@@ -285,6 +393,7 @@ void print_report(std::ostream& out, const CalibrationRun& run) {
       << "poses: " << r.num_attitudes
       << ", largest condition number of a sensor's design: " << fmt("%.3g", r.max_condition_number)
       << "\n\n";
+  out << sigma_statement(r) << "\n\n";
   out << "sensor set   SF (V/g)              bias (g)                RMS resid (mg)  cond   "
          "uncertainty from\n";
   for (std::size_t j = 0; j < 6; ++j) {
@@ -322,6 +431,105 @@ void print_report(std::ostream& out, const CalibrationRun& run) {
   }
   out << "\nverdict: " << calib::to_string(r.verdict) << "\n";
   for (const std::string& w : verdict_warnings(r)) out << "  warning: " << w << "\n";
+}
+
+FileStatus check_settings(const FileSettings& settings) {
+  // A trial file with these settings and neutral calibrated values: the file's own validation
+  // (docs/calibration-file.md, ranges) names the first setting it would refuse.
+  calib_file::CalibrationData d;
+  d.device_id = settings.device_id;
+  d.created_utc = "2000-01-01T00:00:00Z";
+  d.geometry = settings.geometry;
+  d.gravity_mps2 = settings.gravity_mps2;
+  d.gravity_source = settings.gravity_source;
+  for (std::size_t j = 0; j < 6; ++j) {
+    d.sensors[j].adc_lsb_v_per_count = settings.adc_lsb_v_per_count[j];
+    d.sensors[j].scale_v_per_g = 1.0;
+    d.sensors[j].location_error_m = settings.location[j].location_error_m;
+    d.sensors[j].location_error_sigma_m = settings.location[j].location_error_sigma_m;
+  }
+  const calib_file::Problem p = calib_file::validate(d);
+  if (!p.found()) return FileStatus::ok();
+  std::string option = p.key;
+  if (p.key == "device_id") option = "--device-id";
+  if (p.key.find("adc_lsb") != std::string::npos) option = "--adc-lsb";
+  if (p.key == "geometry.rho_m") option = "--rho";
+  if (p.key.rfind("gravity.", 0) == 0) option = "--gravity / --latitude";
+  return FileStatus(ErrorCode::kInvalidArgument, option + " (" + p.key + "): " + p.problem);
+}
+
+FileResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& rows,
+                                                    const calib_file::CalibrationData& cal,
+                                                    double prior_sigma_m,
+                                                    const std::string& runs_file) {
+  // θ*_j from the orientation calibration (eqs. (14)/(15)), ρ_j nominal: what §4.2 assumes known.
+  nav::Misalignment<double> orientation = calib_file::misalignment<double>(cal);
+  for (auto& d : orientation.drho_b) d.setZero();
+  const auto calibrated =
+      nav::misaligned_geometry(calib_file::nominal_geometry<double>(cal), orientation);
+  const double g = cal.gravity_mps2;  // the g of V/g: outputs → m/s² as the front end does
+  std::vector<calib::LocationRun<double>> runs;
+  for (const LocationRunRow& row : rows) {
+    calib::LocationRun<double> r;
+    const nav::Vec3<double> up =
+        nav::Vec3<double>(row.axis_up_b[0], row.axis_up_b[1], row.axis_up_b[2]).normalized();
+    r.w_b = row.rate_rad_s * up;
+    r.g_b = -g * up;  // table axis vertical, pointing up: gravity is down along it
+    r.mounting = row.mounting;
+    for (int j = 0; j < 6; ++j) {
+      const auto& sj = cal.sensors[static_cast<std::size_t>(j)];
+      // eq. (21): s*_j = (P/SF − b)·g, and its per-sample σ.
+      r.s_mean(j) = (row.mean_v[static_cast<std::size_t>(j)] / sj.scale_v_per_g - sj.bias_g) * g;
+      r.sigma(j) = row.std_v[static_cast<std::size_t>(j)] / sj.scale_v_per_g * g;
+    }
+    r.count = row.count;
+    runs.push_back(r);
+  }
+  const auto solved = calib::calibrate_location<double>(
+      calibrated, std::span<const calib::LocationRun<double>>(runs.data(), runs.size()));
+  if (!solved.is_ok()) {
+    return FileStatus(solved.status().code(), runs_file + ": location calibration failed (" +
+                                                  to_string(solved.status().code()) +
+                                                  "): " + solved.status().message());
+  }
+  LocationReport rep;
+  rep.solution = solved.value();
+  const auto& sol = rep.solution;
+  rep.lines.push_back("location errors (paper §4.2) from " + std::to_string(rows.size()) +
+                      " rate-table runs in " + std::to_string(sol.num_mountings) +
+                      " mounting(s); chi2/dof " +
+                      fmt("%.3g", sol.dof > 0 ? sol.chi2 / sol.dof : 0.0) + " (" +
+                      std::to_string(sol.dof) + " dof)");
+  rep.lines.push_back(
+      "sensor  drho_x (mm)          drho_y (mm)          drho_z (mm)          "
+      "not observable");
+  for (std::size_t j = 0; j < 6; ++j) {
+    // Unobservable directions are held at 0; their σ is the mechanical prior, not the data's.
+    nav::Mat3<double> cov = sol.drho_cov_m2[j];
+    const nav::Vec3<double> dir = sol.unobservable_dir_b[j];
+    if (sol.unobservable_dims[j] > 0) cov += prior_sigma_m * prior_sigma_m * dir * dir.transpose();
+    std::string line = "a" + std::to_string(j + 1) + "     ";
+    for (int k = 0; k < 3; ++k) {
+      rep.drho_m[j][static_cast<std::size_t>(k)] = sol.drho_b[j](k);
+      rep.sigma_m[j][static_cast<std::size_t>(k)] = std::sqrt(std::max(0.0, cov(k, k)));
+      line += fmt(" %8.4f", sol.drho_b[j](k) * 1e3) + " ± " +
+              fmt("%-8.2g", rep.sigma_m[j][static_cast<std::size_t>(k)] * 1e3);
+    }
+    if (sol.unobservable_dims[j] > 0) {
+      line += "  " + std::to_string(sol.unobservable_dims[j]) + " direction(s), e.g. [" +
+              fmt("%.2f", dir.x()) + " " + fmt("%.2f", dir.y()) + " " + fmt("%.2f", dir.z()) +
+              "]: held at 0, sigma = prior " + fmt("%.3g", prior_sigma_m * 1e3) + " mm";
+    } else {
+      line += "  none";
+    }
+    rep.lines.push_back(line);
+  }
+  if (!sol.fully_observable()) {
+    rep.lines.push_back(
+        "  note: runs about body x, y, z alone never see the radial component of a sensor's "
+        "offset; add the two face-diagonal mountings (docs/calibration.md, location runs)");
+  }
+  return rep;
 }
 
 }  // namespace gfins::tools

@@ -10,6 +10,7 @@
 
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/nav_core/calibration/location.hpp"
 #include "gfins/nav_core/calibration/multi_attitude.hpp"
 #include "gfins/nav_core/calibration/static_detector.hpp"
 
@@ -45,7 +46,7 @@ FileResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
 /// pose is matched to the nearest expected attitude (the poses file, or the twelve of Tables 2
 /// and 3) using nominal scale factors, and the general solver runs on the interval means.
 struct RecordingOptions {
-  double rate_hz = 0.0;
+  double rate_hz = 0.0;       // 0: take it from the recording (.gfr header)
   double still_std_v = 2e-3;  // largest std of a still channel, V (2-3× the noise)
   double window_s = 0.1;
   double min_still_s = 2.0;
@@ -64,7 +65,28 @@ struct FileSettings {
   std::array<double, 6> adc_lsb_v_per_count{};
   std::array<calib_file::SensorCalibration, 6> location{};  // only Δρ and its σ are used
   nav::CompensatorKind compensator = nav::CompensatorKind::kExact;
+  double gravity_mps2 = 0.0;   // local gravity of the calibration site (m/s²)
+  std::string gravity_source;  // how it was obtained, for the file and the report
 };
+
+/// The first setting outside the calibration file's domain (device id, ADC LSB, ρ, gravity),
+/// found before anything is solved; message names the option.
+FileStatus check_settings(const FileSettings& settings);
+
+/// Location calibration (paper §4.2) from rate-table runs, given the orientation calibration
+/// (SF, bias, angles, nominal geometry and local gravity of `cal`): Δρ_j and its 1σ per body
+/// component, and which components the runs did not determine (held at 0; their σ is the
+/// mechanical prior `prior_sigma_m`).
+struct LocationReport {
+  calib::LocationCalibration<double> solution;
+  std::array<std::array<double, 3>, 6> drho_m{};
+  std::array<std::array<double, 3>, 6> sigma_m{};
+  std::vector<std::string> lines;  // the report
+};
+FileResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& runs,
+                                                    const calib_file::CalibrationData& cal,
+                                                    double prior_sigma_m,
+                                                    const std::string& runs_file);
 
 /// The calibration file's content: SF, bias, angles (rad → deg) and their 1σ from the run.
 calib_file::CalibrationData make_calibration_data(const CalibrationRun& run,

@@ -2,9 +2,12 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <utility>
+
+#include "gfins/host_sim/recording.hpp"
 
 namespace gfins::tools {
 namespace {
@@ -28,6 +31,39 @@ std::vector<std::string> split(const std::string& line) {
 }
 
 FileStatus bad(const std::string& what) { return FileStatus(ErrorCode::kInvalidArgument, what); }
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+// Every column of the header must be one of `required` or `optional`, and every required one
+// must be there; the message names the offending column and lists the accepted names, so a
+// header that differs in one name ("mean" for "mean_v") says what it should be.
+FileStatus check_header(const CsvTable& t, const std::vector<std::string>& required,
+                        const std::vector<std::string>& optional) {
+  std::vector<std::string> accepted = required;
+  accepted.insert(accepted.end(), optional.begin(), optional.end());
+  const std::string names =
+      "accepted columns: " + join(required) +
+      (optional.empty() ? "" : " (required), " + join(optional) + " (optional)");
+  for (const std::string& h : t.header) {
+    bool known = false;
+    for (const std::string& a : accepted) known = known || a == h;
+    if (!known) {
+      return bad(t.file + ": header column '" + h + "' is not a known column; " + names +
+                 "; found: " + join(t.header));
+    }
+  }
+  for (const std::string& r : required) {
+    if (t.column(r) < 0) {
+      return bad(t.file + ": the header has no column '" + r + "'; " + names +
+                 "; found: " + join(t.header));
+    }
+  }
+  return FileStatus::ok();
+}
 
 }  // namespace
 
@@ -99,14 +135,15 @@ FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
   auto table = read_csv(path);
   if (!table.is_ok()) return table.status();
   const CsvTable& t = table.value();
+  if (const FileStatus h = check_header(t, {"sensor", "attitude", "mean_v"}, {"std_v", "count"});
+      !h.is_ok()) {
+    return h;
+  }
   const int c_sensor = t.column("sensor");
   const int c_attitude = t.column("attitude");
   const int c_mean = t.column("mean_v");
   const int c_std = t.column("std_v");
   const int c_count = t.column("count");
-  if (c_sensor < 0 || c_attitude < 0 || c_mean < 0) {
-    return bad(t.file + ": the header must name the columns sensor, attitude, mean_v");
-  }
   if ((c_std < 0) != (c_count < 0)) {
     return bad(t.file + ": columns std_v and count go together (σ of a mean = std_v/√count)");
   }
@@ -146,11 +183,11 @@ FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
   auto table = read_csv(path);
   if (!table.is_ok()) return table.status();
   const CsvTable& t = table.value();
+  if (const FileStatus h = check_header(t, {"attitude", "fx_g", "fy_g", "fz_g"}, {}); !h.is_ok()) {
+    return h;
+  }
   const int c_att = t.column("attitude");
   const std::array<int, 3> c_f = {t.column("fx_g"), t.column("fy_g"), t.column("fz_g")};
-  if (c_att < 0 || c_f[0] < 0 || c_f[1] < 0 || c_f[2] < 0) {
-    return bad(t.file + ": the header must name the columns attitude, fx_g, fy_g, fz_g");
-  }
   std::vector<Pose> poses;
   std::set<int> seen;
   for (const CsvRow& r : t.rows) {
@@ -178,14 +215,61 @@ FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
   return poses;
 }
 
+namespace {
+
+bool has_gfr_magic(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<char, 8> magic{};
+  in.read(magic.data(), static_cast<std::streamsize>(magic.size()));
+  return in.gcount() == static_cast<std::streamsize>(magic.size()) && magic == sim::kRecordingMagic;
+}
+
+FileResult<Recording> read_gfr(const std::filesystem::path& path) {
+  auto file = sim::read_recording(path.string());
+  if (!file.is_ok()) {
+    return FileStatus(file.error().code, path.string() + ": " + file.error().message);
+  }
+  const sim::Recording& r = file.value();
+  Recording rec;
+  rec.from_gfr = true;
+  rec.rate_hz = r.header.sample_rate_hz;
+  rec.volts_per_count = r.header.volts_per_count;
+  rec.samples_v.reserve(r.samples.size());
+  rec.saturated_mask.reserve(r.samples.size());
+  rec.crc_error.reserve(r.samples.size());
+  for (const RawSample& smp : r.samples) {
+    std::array<double, 6> v{};
+    std::uint8_t sat = (smp.flags & sample_flags::kSaturated) != 0 ? 0x3F : 0;
+    for (std::size_t j = 0; j < 6; ++j) {
+      v[j] = static_cast<double>(smp.counts[j]) * rec.volts_per_count[j];
+      if (smp.counts[j] >= kAdcCodeMax || smp.counts[j] <= kAdcCodeMin) {
+        sat = static_cast<std::uint8_t>(sat | (1u << j));
+      }
+    }
+    rec.samples_v.push_back(v);
+    rec.saturated_mask.push_back(sat);
+    rec.crc_error.push_back((smp.flags & sample_flags::kCrcError) != 0 ? 1 : 0);
+  }
+  if (rec.samples_v.empty()) return bad(path.string() + ": the recording holds no samples");
+  return rec;
+}
+
+}  // namespace
+
 FileResult<Recording> read_recording(const std::filesystem::path& path) {
+  if (has_gfr_magic(path)) return read_gfr(path);
   auto table = read_csv(path);
   if (!table.is_ok()) return table.status();
   const CsvTable& t = table.value();
   std::array<int, 6> c{};
   for (std::size_t j = 0; j < 6; ++j) {
     c[j] = t.column("v" + std::to_string(j + 1));
-    if (c[j] < 0) return bad(t.file + ": the header must name the columns v1 … v6 (volts)");
+    if (c[j] < 0) {
+      return bad(t.file + ": the header has no column 'v" + std::to_string(j + 1) +
+                 "'; a CSV recording needs the columns v1, v2, v3, v4, v5, v6 (volts; other "
+                 "columns such as a time stamp are ignored); found: " +
+                 join(t.header));
+    }
   }
   Recording rec;
   rec.samples_v.reserve(t.rows.size());
@@ -199,6 +283,59 @@ FileResult<Recording> read_recording(const std::filesystem::path& path) {
     rec.samples_v.push_back(s);
   }
   return rec;
+}
+
+}  // namespace gfins::tools
+
+namespace gfins::tools {
+
+FileResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path) {
+  auto table = read_csv(path);
+  if (!table.is_ok()) return table.status();
+  const CsvTable& t = table.value();
+  std::vector<std::string> required = {"mounting", "axis_x", "axis_y", "axis_z", "rate_rad_s"};
+  for (int j = 1; j <= 6; ++j) required.push_back("mean_v" + std::to_string(j));
+  for (int j = 1; j <= 6; ++j) required.push_back("std_v" + std::to_string(j));
+  required.push_back("count");
+  if (const FileStatus h = check_header(t, required, {}); !h.is_ok()) return h;
+  std::vector<LocationRunRow> rows;
+  for (const CsvRow& r : t.rows) {
+    LocationRunRow run;
+    run.line = r.line;
+    const auto m = t.integer(r, t.column("mounting"), 0, 7);
+    if (!m.is_ok()) return m.status();
+    run.mounting = static_cast<int>(m.value());
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto a = t.number(r, t.column(std::string("axis_") + "xyz"[k]));
+      if (!a.is_ok()) return a.status();
+      run.axis_up_b[k] = a.value();
+    }
+    const double norm = std::hypot(run.axis_up_b[0], run.axis_up_b[1], run.axis_up_b[2]);
+    if (!(norm > 0.5)) {
+      return bad(t.where(r) + "the table axis (axis_x, axis_y, axis_z) has length " +
+                 std::to_string(norm) + ": give the upward unit axis in body axes");
+    }
+    const auto rate = t.number(r, t.column("rate_rad_s"));
+    if (!rate.is_ok()) return rate.status();
+    run.rate_rad_s = rate.value();
+    for (std::size_t j = 0; j < 6; ++j) {
+      const auto mean = t.number(r, t.column("mean_v" + std::to_string(j + 1)));
+      if (!mean.is_ok()) return mean.status();
+      const auto sd = t.number(r, t.column("std_v" + std::to_string(j + 1)));
+      if (!sd.is_ok()) return sd.status();
+      if (!(sd.value() > 0.0)) {
+        return bad(t.where(r) + "std_v" + std::to_string(j + 1) +
+                   " must be positive (the noise of the samples, V)");
+      }
+      run.mean_v[j] = mean.value();
+      run.std_v[j] = sd.value();
+    }
+    const auto count = t.integer(r, t.column("count"), 1, 1'000'000'000);
+    if (!count.is_ok()) return count.status();
+    run.count = static_cast<std::uint32_t>(count.value());
+    rows.push_back(run);
+  }
+  return rows;
 }
 
 }  // namespace gfins::tools

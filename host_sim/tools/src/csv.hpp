@@ -60,11 +60,38 @@ struct Pose {
 };
 FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path);
 
-/// A raw recording: six columns v1..v6 (volts, sensors in Table 1 order), other columns (e.g. a
-/// time stamp) ignored; the sample rate is given separately.
+/// A raw recording, either
+///   - a .gfr file (docs/recording-format.md, recognised by its magic): counts × the header's ADC
+///     LSB per channel, the header's sample rate, and which samples were not measurements; or
+///   - a CSV with six columns v1..v6 (volts, sensors in Table 1 order), other columns (e.g. a
+///     time stamp) ignored; the sample rate is given separately.
 struct Recording {
   std::vector<std::array<double, 6>> samples_v;
+  /// Per sample (.gfr only, else empty): bit j set when channel j sat at the converter's full
+  /// scale (code at kAdcCodeMax/kAdcCodeMin, or the sample's kSaturated flag: all channels).
+  std::vector<std::uint8_t> saturated_mask;
+  /// Per sample (.gfr only, else empty): 1 when the frame's CRC failed (counts not valid).
+  std::vector<std::uint8_t> crc_error;
+  bool from_gfr = false;
+  double rate_hz = 0.0;                     // .gfr header; 0 for CSV
+  std::array<double, 6> volts_per_count{};  // .gfr header; zeros for CSV
 };
 FileResult<Recording> read_recording(const std::filesystem::path& path);
+
+/// One constant-rate rate-table run (location calibration, paper §4.2): the fixture pose
+/// ("mounting"), the table axis in body axes pointing UP (the table axis is vertical, so gravity
+/// in body axes is −g·axis), the rate and the mean output of each sensor over whole revolutions.
+/// CSV columns: mounting, axis_x, axis_y, axis_z, rate_rad_s, mean_v1..mean_v6, std_v1..std_v6,
+/// count.
+struct LocationRunRow {
+  int mounting = 0;  // 0..7, runs of one fixture pose share it
+  std::array<double, 3> axis_up_b{};
+  double rate_rad_s = 0.0;
+  std::array<double, 6> mean_v{};
+  std::array<double, 6> std_v{};
+  std::uint32_t count = 0;
+  int line = 0;
+};
+FileResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path);
 
 }  // namespace gfins::tools

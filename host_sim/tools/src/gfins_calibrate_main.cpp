@@ -6,8 +6,11 @@
 // be written.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +18,7 @@
 #include "calibrate.hpp"
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/nav_core/gravity.hpp"
 
 namespace {
 
@@ -35,6 +39,7 @@ int fail(int code, const std::string& message) {
 struct Options {
   std::string means;
   std::string recording;
+  std::string location_runs;
   double rate_hz = 0.0;
   double still_std_v = 2e-3;
   std::vector<double> nominal_sf;
@@ -46,12 +51,88 @@ struct Options {
   std::string compensator;
   double rho_m = 0.1;
   double adc_lsb = 0.0;
+  double gravity_mps2 = 0.0;
+  double latitude_deg = std::numeric_limits<double>::quiet_NaN();
+  double height_m = 0.0;
+  double location_prior_m = 1e-3;
   bool force = false;
   bool dry_run = false;
 };
 
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+// Numeric options checked before anything is read or solved, with their bounds as plain numbers.
+int check_numbers(const Options& o) {
+  const auto outside = [](double x, double lo, double hi) {
+    return !std::isfinite(x) || x < lo || x > hi;
+  };
+  if (outside(o.rho_m, 1e-3, calib_file::kMaxRhoM)) {
+    return fail(kExitInput, "--rho " + num(o.rho_m) + ": the cube half-size must be between " +
+                                "0.001 and " + num(calib_file::kMaxRhoM) + " m");
+  }
+  if (o.adc_lsb != 0.0 && outside(o.adc_lsb, 1e-12, calib_file::kMaxAdcLsbV)) {
+    return fail(kExitInput, "--adc-lsb " + num(o.adc_lsb) +
+                                ": the ADC LSB must be a positive number of volts per count, at "
+                                "most 1 (a 24-bit ADC with a 2.5 V reference: 2.98e-07)");
+  }
+  if (o.gravity_mps2 != 0.0 &&
+      outside(o.gravity_mps2, calib_file::kMinGravityMps2, calib_file::kMaxGravityMps2)) {
+    return fail(kExitInput, "--gravity " + num(o.gravity_mps2) +
+                                ": the local gravity must be between 9.7 and 9.9 m/s² (give "
+                                "m/s², not g or Gal)");
+  }
+  if (!std::isnan(o.latitude_deg) && outside(o.latitude_deg, -90.0, 90.0)) {
+    return fail(kExitInput, "--latitude " + num(o.latitude_deg) +
+                                ": the geodetic latitude must be between -90 and 90 degrees");
+  }
+  if (outside(o.height_m, -500.0, 9000.0)) {
+    return fail(kExitInput, "--height " + num(o.height_m) +
+                                ": the ellipsoidal height of the site must be between -500 and "
+                                "9000 m");
+  }
+  if (o.rate_hz != 0.0 && outside(o.rate_hz, 1.0, 1e6)) {
+    return fail(kExitInput, "--rate " + num(o.rate_hz) + ": must be between 1 and 1000000 Hz");
+  }
+  if (outside(o.still_std_v, 1e-9, 10.0)) {
+    return fail(kExitInput, "--still-std-v " + num(o.still_std_v) +
+                                ": must be between 1e-09 and 10 V (2-3x the sensor noise)");
+  }
+  if (outside(o.location_prior_m, 0.0, 0.05)) {
+    return fail(kExitInput,
+                "--location-prior " + num(o.location_prior_m) + ": must be between 0 and 0.05 m");
+  }
+  if (o.gravity_mps2 != 0.0 && !std::isnan(o.latitude_deg)) {
+    return fail(kExitInput, "give the local gravity once: --gravity or --latitude, not both");
+  }
+  return kExitOk;
+}
+
+// Local gravity of the calibration site from the options (--gravity, or --latitude/--height
+// through the WGS-84 normal gravity model of nav_core/gravity.hpp); false when neither is given.
+bool gravity_from_options(const Options& o, FileSettings& s) {
+  if (o.gravity_mps2 != 0.0) {
+    s.gravity_mps2 = o.gravity_mps2;
+    s.gravity_source = "given (--gravity)";
+    return true;
+  }
+  if (!std::isnan(o.latitude_deg)) {
+    s.gravity_mps2 = static_cast<double>(
+        nav::GravityModel<double>::normal(o.latitude_deg * std::numbers::pi / 180.0, o.height_m)
+            .magnitude_at_origin());
+    s.gravity_source = "WGS-84 normal gravity at latitude " + num(o.latitude_deg) +
+                       " deg, height " + num(o.height_m) + " m";
+    return true;
+  }
+  return false;
+}
+
 // The parts of the file the calibration does not determine: from --base, then the options.
-int settings_from(const Options& o, FileSettings& s) {
+// A dry run writes nothing, so it needs none of them.
+int settings_from(const Options& o, const Recording* rec, FileSettings& s) {
   if (!o.base.empty()) {
     const auto base = calib_file::load_calibration_file(o.base);
     if (!base.is_ok()) return fail(kExitInput, base.status().message());
@@ -59,51 +140,70 @@ int settings_from(const Options& o, FileSettings& s) {
     s.device_id = b.device_id;
     s.geometry = b.geometry;
     s.compensator = b.compensator;
+    s.gravity_mps2 = b.gravity_mps2;
+    s.gravity_source = b.gravity_source;
     for (std::size_t j = 0; j < 6; ++j) {
       s.adc_lsb_v_per_count[j] = b.sensors[j].adc_lsb_v_per_count;
       s.location[j] = b.sensors[j];
     }
   } else {
-    if (o.adc_lsb <= 0.0) {
-      return fail(kExitInput,
-                  "--adc-lsb (V/count, Vref/(gain·2^23) for a 24-bit ADC) is required without "
-                  "--base");
-    }
     s.geometry.kind = calib_file::GeometryKind::kTable1;
     s.geometry.rho_m = o.rho_m;
-    s.adc_lsb_v_per_count.fill(o.adc_lsb);
+    if (rec != nullptr && rec->from_gfr) s.adc_lsb_v_per_count = rec->volts_per_count;
   }
   if (!o.device_id.empty()) s.device_id = o.device_id;
-  if (s.device_id.empty()) return fail(kExitInput, "--device-id is required without --base");
   if (o.adc_lsb > 0.0) s.adc_lsb_v_per_count.fill(o.adc_lsb);
+  const bool have_gravity = gravity_from_options(o, s) || !o.base.empty();
   if (o.compensator == "none") s.compensator = nav::CompensatorKind::kNone;
   if (o.compensator == "paper") s.compensator = nav::CompensatorKind::kPaper;
   if (o.compensator == "exact") s.compensator = nav::CompensatorKind::kExact;
+  if (o.dry_run) {
+    // Placeholders so the report can be made; nothing is written.
+    if (!have_gravity) {
+      s.gravity_mps2 = nav::kStandardGravity;
+      s.gravity_source = "dry run: not given";
+    }
+    return kExitOk;
+  }
+  if (s.adc_lsb_v_per_count[0] <= 0.0) {
+    return fail(kExitInput,
+                "--adc-lsb (V/count, Vref/(gain·2^23) for a 24-bit ADC) is required without "
+                "--base (a .gfr recording carries it)");
+  }
+  if (s.device_id.empty()) return fail(kExitInput, "--device-id is required without --base");
+  if (!have_gravity) {
+    return fail(kExitInput,
+                "the local gravity of the calibration site is required without --base: "
+                "--gravity M/S2, or --latitude DEG [--height M] (WGS-84 normal gravity); the "
+                "poses sense 1 local g, which is the g of every V/g in the file");
+  }
+  if (const FileStatus st = check_settings(s); !st.is_ok()) return fail(kExitInput, st.message());
   return kExitOk;
 }
 
 // Runs the solver on the chosen input; kExitOk or the exit status of the failure.
-int calibrate(const Options& o, CalibrationInputs& in, FileResult<CalibrationRun>& out) {
+int calibrate(const Options& o, const std::optional<Recording>& rec, CalibrationInputs& in,
+              FileResult<CalibrationRun>& out) {
   if (!o.poses.empty()) {
     const auto poses = read_poses(o.poses);
     if (!poses.is_ok()) return fail(kExitInput, poses.status().message());
     in.poses = poses.value();
   }
-  if (!o.recording.empty()) {
+  if (rec) {
     RecordingOptions ro;
     ro.rate_hz = o.rate_hz;
     ro.still_std_v = o.still_std_v;
-    if (o.rate_hz <= 0.0) return fail(kExitInput, "--rate (Hz) is required with --recording");
+    if (o.rate_hz <= 0.0 && !rec->from_gfr) {
+      return fail(kExitInput, "--rate (Hz) is required with a CSV --recording");
+    }
     if (o.nominal_sf.size() == 1)
       ro.nominal_scale_v_per_g.fill(o.nominal_sf[0]);
     else if (o.nominal_sf.size() == 6)
       std::copy_n(o.nominal_sf.begin(), 6, ro.nominal_scale_v_per_g.begin());
     else
       return fail(kExitInput, "--nominal-sf takes 1 or 6 values (V/g) with --recording");
-    const auto rec = read_recording(o.recording);
-    if (!rec.is_ok()) return fail(kExitInput, rec.status().message());
     in.method = Method::kGeneral;
-    out = run_recording_calibration(rec.value(), in.poses, ro, o.recording);
+    out = run_recording_calibration(*rec, in.poses, ro, o.recording);
     return kExitOk;
   }
   const auto means = read_means(o.means);
@@ -117,37 +217,89 @@ int calibrate(const Options& o, CalibrationInputs& in, FileResult<CalibrationRun
 }
 
 int run(const Options& o) {
-  FileSettings settings;
-  if (const int rc = settings_from(o, settings); rc != kExitOk) return rc;
-  CalibrationInputs in;
-  FileResult<CalibrationRun> calibrated(FileStatus(ErrorCode::kUnimplemented, "not run"));
-  if (const int rc = calibrate(o, in, calibrated); rc != kExitOk) return rc;
-  const std::string input = o.recording.empty() ? o.means : o.recording;
-  settings.source = "gfins-calibrate " +
-                    std::string(in.method == Method::kPaper ? "paper" : "general") + " from " +
-                    std::filesystem::path(input).filename().string();
-  if (!calibrated.is_ok()) {
-    const auto& st = calibrated.status();
-    return fail(st.code() == ErrorCode::kInvalidArgument &&
-                        st.message().find("calibration failed") == std::string::npos
-                    ? kExitInput
-                    : kExitSolver,
-                st.message());
+  std::optional<Recording> rec;
+  if (!o.recording.empty()) {
+    auto r = read_recording(o.recording);
+    if (!r.is_ok()) return fail(kExitInput, r.status().message());
+    rec = std::move(r).value();
   }
-  const CalibrationRun& cal = calibrated.value();
-  print_report(std::cout, cal);
-  if (settings.location[0].location_error_m == std::array<double, 3>{} && o.base.empty()) {
-    std::cout << "  note: location errors are not part of this calibration: Δρ = 0 written "
-                 "(use --base to keep a previous location calibration)\n";
+  FileSettings settings;
+  if (const int rc = settings_from(o, rec ? &*rec : nullptr, settings); rc != kExitOk) return rc;
+  std::optional<std::vector<LocationRunRow>> location_rows;
+  if (!o.location_runs.empty()) {
+    auto rows = read_location_runs(o.location_runs);
+    if (!rows.is_ok()) return fail(kExitInput, rows.status().message());
+    location_rows = std::move(rows).value();
   }
 
-  const calib_file::CalibrationData data = make_calibration_data(cal, settings);
+  calib_file::CalibrationData data;
+  bool verdict_good = true;
+  std::string verdict_text;
+  const bool orientation = !o.means.empty() || rec.has_value();
+  if (orientation) {
+    CalibrationInputs in;
+    FileResult<CalibrationRun> calibrated(FileStatus(ErrorCode::kUnimplemented, "not run"));
+    if (const int rc = calibrate(o, rec, in, calibrated); rc != kExitOk) return rc;
+    const std::string input = o.recording.empty() ? o.means : o.recording;
+    settings.source = "gfins-calibrate " +
+                      std::string(in.method == Method::kPaper ? "paper" : "general") + " from " +
+                      std::filesystem::path(input).filename().string();
+    if (!calibrated.is_ok()) {
+      const auto& st = calibrated.status();
+      return fail(st.code() == ErrorCode::kInvalidArgument &&
+                          st.message().find("calibration failed") == std::string::npos
+                      ? kExitInput
+                      : kExitSolver,
+                  st.message());
+    }
+    const CalibrationRun& cal = calibrated.value();
+    print_report(std::cout, cal);
+    std::cout << "local gravity of the calibration site: " << num(settings.gravity_mps2)
+              << " m/s² (" << settings.gravity_source << "): the g of every V/g and bias\n";
+    data = make_calibration_data(cal, settings);
+    verdict_good = cal.result.verdict == calib::Verdict::kGood;
+    verdict_text = calib::to_string(cal.result.verdict);
+  } else {
+    // Location only: the orientation calibration (and its gravity) comes from --base.
+    const auto base = calib_file::load_calibration_file(o.base);
+    if (!base.is_ok()) return fail(kExitInput, base.status().message());
+    data = base.value();
+    data.device_id = settings.device_id;
+    data.compensator = settings.compensator;
+    data.created_utc = calib_file::utc_now_iso8601();
+    data.source = "gfins-calibrate location from " +
+                  std::filesystem::path(o.location_runs).filename().string() + " on " +
+                  std::filesystem::path(o.base).filename().string();
+    if (o.gravity_mps2 != 0.0 || !std::isnan(o.latitude_deg)) {
+      std::cout << "note: --gravity/--latitude ignored: the scale factors of --base are in units "
+                   "of its own local gravity, "
+                << num(data.gravity_mps2) << " m/s²\n";
+    }
+  }
+  if (location_rows) {
+    const auto loc =
+        run_location_calibration(*location_rows, data, o.location_prior_m, o.location_runs);
+    if (!loc.is_ok()) {
+      return fail(loc.status().code() == ErrorCode::kInvalidArgument ? kExitInput : kExitSolver,
+                  loc.status().message());
+    }
+    std::cout << "\n";
+    for (const auto& line : loc.value().lines) std::cout << line << "\n";
+    for (std::size_t j = 0; j < 6; ++j) {
+      data.sensors[j].location_error_m = loc.value().drho_m[j];
+      data.sensors[j].location_error_sigma_m = loc.value().sigma_m[j];
+    }
+  } else if (o.base.empty()) {
+    std::cout << "  note: location errors are not part of this calibration: Δρ = 0 written "
+                 "(give --location-runs, or --base to keep a previous location calibration)\n";
+  }
+
   if (o.dry_run) {
     std::cout << "\ndry run: nothing written\n";
     return kExitOk;
   }
-  if (cal.result.verdict != calib::Verdict::kGood && !o.force) {
-    return fail(kExitVerdict, std::string("verdict \"") + calib::to_string(cal.result.verdict) +
+  if (!verdict_good && !o.force) {
+    return fail(kExitVerdict, std::string("verdict \"") + verdict_text +
                                   "\": no file written (--force writes it anyway)");
   }
   const auto saved = calib_file::save_calibration_file(o.output, data);
@@ -163,9 +315,10 @@ int run(const Options& o) {
 // writing) into a message and kExitInput.
 int calibrate_main(int argc, char** argv) {
   CLI::App app{
-      "Multi-attitude calibration of the six-accelerometer array (Hung, Fang & Lee 2007, §4.1).\n"
-      "Reads mean outputs per sensor and pose, solves scale factors, biases and orientation\n"
-      "errors, prints a report and writes the calibration file (docs/calibration-file.md).",
+      "Calibration of the six-accelerometer array (Hung, Fang & Lee 2007, §4).\n"
+      "Orientation poses (--means or --recording): scale factors, biases and orientation errors;\n"
+      "rate-table runs (--location-runs): location errors. Prints a report and writes the\n"
+      "calibration file (docs/calibration.md, docs/calibration-file.md).",
       "gfins-calibrate"};
   Options o;
   auto* means = app.add_option("--means", o.means,
@@ -174,17 +327,23 @@ int calibrate_main(int argc, char** argv) {
                     ->check(CLI::ExistingFile);
   auto* recording =
       app.add_option("--recording", o.recording,
-                     "CSV of raw samples with columns v1..v6 (V); static poses found by the "
-                     "static detector, matched to --poses or to the 12 poses of Tables 2/3")
+                     "raw recording: a .gfr file (docs/recording-format.md) or a CSV with "
+                     "columns v1..v6 (V); still poses found by the static detector, matched to "
+                     "--poses or to the 12 poses of Tables 2/3")
           ->check(CLI::ExistingFile)
           ->excludes(means);
   means->excludes(recording);
-  app.add_option("--rate", o.rate_hz, "sample rate of --recording (Hz)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--location-runs", o.location_runs,
+                 "CSV of rate-table runs: mounting,axis_x,axis_y,axis_z,rate_rad_s,"
+                 "mean_v1..mean_v6,std_v1..std_v6,count (location errors, paper §4.2)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--location-prior", o.location_prior_m,
+                 "1-sigma (m) written for location components the runs cannot observe "
+                 "(default 0.001, the mechanical tolerance)");
+  app.add_option("--rate", o.rate_hz, "sample rate of a CSV --recording (Hz)");
   app.add_option("--still-std-v", o.still_std_v,
                  "largest standard deviation of a still channel (V), 2-3x the noise "
-                 "(--recording; default 2e-3)")
-      ->check(CLI::PositiveNumber);
+                 "(--recording; default 0.002)");
   app.add_option("--nominal-sf", o.nominal_sf,
                  "nominal scale factor(s) in V/g, 1 or 6 values, to recognise the poses of a "
                  "--recording");
@@ -195,16 +354,20 @@ int calibrate_main(int argc, char** argv) {
                  "paper (eqs. 17/18 + LS, Table 2/3 poses) or general (any >= 4 poses); "
                  "default: paper without --poses, general with")
       ->check(CLI::IsMember({"auto", "paper", "general"}));
+  app.add_option("--gravity", o.gravity_mps2,
+                 "local gravity of the calibration site, m/s² (e.g. 9.7894)");
+  app.add_option("--latitude", o.latitude_deg,
+                 "geodetic latitude of the calibration site, degrees: local gravity from the "
+                 "WGS-84 normal gravity model");
+  app.add_option("--height", o.height_m, "ellipsoidal height of the site, m (with --latitude)");
   app.add_option("-o,--output", o.output, "calibration file to write (atomically)");
   app.add_option("--base", o.base,
-                 "previous calibration file: keeps its device id, geometry, ADC LSB, location "
-                 "errors and compensator unless given here")
+                 "previous calibration file: keeps its device id, geometry, ADC LSB, local "
+                 "gravity, location errors and compensator unless given here")
       ->check(CLI::ExistingFile);
   app.add_option("--device-id", o.device_id, "board identifier [A-Za-z0-9._-]");
-  app.add_option("--rho", o.rho_m, "cube half-size rho (m), Table 1 geometry")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--adc-lsb", o.adc_lsb, "ADC LSB (V/count) of every channel")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--rho", o.rho_m, "cube half-size rho (m), Table 1 geometry (default 0.1)");
+  app.add_option("--adc-lsb", o.adc_lsb, "ADC LSB (V/count) of every channel");
   app.add_option("--compensator", o.compensator, "none | paper | exact (default exact)")
       ->check(CLI::IsMember({"none", "paper", "exact"}));
   app.add_flag("--force", o.force, "write the file even when the verdict is not good");
@@ -214,12 +377,23 @@ int calibrate_main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitInput;
   }
-  if (o.means.empty() == o.recording.empty()) {
-    return fail(kExitInput, "give one input: --means FILE or --recording FILE");
+  if (!o.means.empty() && !o.recording.empty()) {
+    return fail(kExitInput, "give one orientation input: --means FILE or --recording FILE");
+  }
+  if (o.means.empty() && o.recording.empty() && o.location_runs.empty()) {
+    return fail(kExitInput,
+                "give an input: --means FILE or --recording FILE (orientation), and/or "
+                "--location-runs FILE (location)");
+  }
+  if (o.means.empty() && o.recording.empty() && o.base.empty()) {
+    return fail(kExitInput,
+                "--location-runs alone needs --base: the location solution uses the scale "
+                "factors, biases and orientation errors of a previous calibration");
   }
   if (o.output.empty() && !o.dry_run) {
     return fail(kExitInput, "--output is required (or --dry-run)");
   }
+  if (const int rc = check_numbers(o); rc != kExitOk) return rc;
   return run(o);
 }
 

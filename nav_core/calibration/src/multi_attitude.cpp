@@ -164,8 +164,11 @@ Status solve_sensor(int i, std::span<const AttitudeObservation<T>> obs,
     w(r) = sigma_stated
                ? std::sqrt(static_cast<T>(o.sample_count)) / o.sample_std_v[si]  // 1/σ(mean)
                : T(1);
-    a.row(r) = w(r) * a0.row(r);
-    y(r) = w(r) * o.mean_v[si];
+    // The fit is weighted by 1/σ unless the configuration asks for the unweighted estimator
+    // (the paper's procedure); w keeps 1/σ for the χ² and the covariance either way.
+    const T fit_w = cfg.weighted ? w(r) : T(1);
+    a.row(r) = fit_w * a0.row(r);
+    y(r) = fit_w * o.mean_v[si];
     p_min = std::min(p_min, o.mean_v[si]);
     p_max = std::max(p_max, o.mean_v[si]);
   }
@@ -181,7 +184,18 @@ Status solve_sensor(int i, std::span<const AttitudeObservation<T>> obs,
   const Vec4<T> x = qr.solve(y);
   const Mat4<T> r = qr.matrixQR().template topRows<4>().template triangularView<Eigen::Upper>();
   const Mat4<T> r_inv = r.template triangularView<Eigen::Upper>().solve(Mat4<T>::Identity());
-  Mat4<T> cov_x = r_inv * r_inv.transpose();  // (AᵀWA)⁻¹
+  Mat4<T> cov_x = r_inv * r_inv.transpose();  // (AᵀWA)⁻¹, or (AᵀA)⁻¹ unweighted
+  if (sigma_stated && !cfg.weighted) {
+    // Unweighted estimate x = (AᵀA)⁻¹Aᵀy with the stated Σ = diag(σ²) of y: its covariance is
+    // the sandwich (AᵀA)⁻¹ AᵀΣA (AᵀA)⁻¹ (equal to (AᵀΣ⁻¹A)⁻¹ only when all σ are equal).
+    Mat4<T> meat = Mat4<T>::Zero();
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto rk = static_cast<Eigen::Index>(k);
+      const Vec4<T> row = a0.row(rk).transpose();
+      meat += (row * row.transpose()) / (w(rk) * w(rk));
+    }
+    cov_x = cov_x * meat * cov_x;
+  }
 
   // Residuals (V, unweighted) and the weighted sum of squares.
   T ss_v = T(0);
@@ -195,6 +209,9 @@ Status solve_sensor(int i, std::span<const AttitudeObservation<T>> obs,
   }
   const std::size_t dof = n - kMinAttitudes;
   CovarianceSource source = CovarianceSource::kStatedSigma;
+  if (!sigma_stated && !cfg.weighted) {
+    ss_w = ss_v;  // w = 1: the residual variance in V², as the weighted branch with w = 1
+  }
   if (!sigma_stated) {
     if (dof > 0) {
       source = CovarianceSource::kResiduals;
@@ -381,8 +398,10 @@ std::array<AttitudeObservation<T>, 12> paper_observations(const PaperTableOutput
       AttitudeObservation<T>& o = obs[offset + j];
       o.f_b_g = att[j];
       o.used_mask = 0;
+      o.sample_count = 1;  // sigma_v is already the σ of the mean
       for (const int s : set) {
         o.mean_v[static_cast<std::size_t>(s)] = p.mean_v[static_cast<std::size_t>(s)][j];
+        o.sample_std_v[static_cast<std::size_t>(s)] = p.sigma_v[static_cast<std::size_t>(s)][j];
         o.used_mask = static_cast<std::uint8_t>(o.used_mask | (1u << s));
       }
     }
@@ -396,8 +415,12 @@ template <typename T>
 Result<MultiAttitudeResult<T>> calibrate_paper_procedure(const PaperTableOutputs<T>& p,
                                                          const MultiAttitudeConfig<T>& config) {
   const auto obs = paper_observations(p);
+  // The paper's procedure is the unweighted estimator: its covariance with stated σ is the
+  // sandwich, which the general solver gives with weighted = false.
+  MultiAttitudeConfig<T> unweighted = config;
+  unweighted.weighted = false;
   Result<MultiAttitudeResult<T>> general =
-      calibrate_multi_attitude<T>(std::span<const AttitudeObservation<T>>(obs), config);
+      calibrate_multi_attitude<T>(std::span<const AttitudeObservation<T>>(obs), unweighted);
   if (!general.is_ok()) return general;
   MultiAttitudeResult<T> out = general.value();
 

@@ -19,14 +19,20 @@ struct CanFrame {
   static constexpr std::uint32_t kMaxExtendedId = 0x1FFFFFFF;
   static constexpr std::uint8_t kMaxLen = 8;
 
-  std::uint32_t id = 0;     // 11-bit (standard) or 29-bit (extended) identifier, no flag bits
-  bool extended = false;    // 29-bit identifier
-  std::uint8_t len = 0;     // data length, 0..8
+  std::uint32_t id = 0;   // 11-bit (standard) or 29-bit (extended) identifier, no flag bits
+  bool extended = false;  // 29-bit identifier
+  std::uint8_t len = 0;   // data length, 0..8
   std::array<std::uint8_t, kMaxLen> data{};
 };
 
 /// ISO 11898-1 fault confinement states, plus "down" for an interface that is not up.
-enum class CanBusState : std::uint8_t { kErrorActive, kErrorWarning, kErrorPassive, kBusOff, kDown };
+enum class CanBusState : std::uint8_t {
+  kErrorActive,
+  kErrorWarning,
+  kErrorPassive,
+  kBusOff,
+  kDown
+};
 
 constexpr const char* to_string(CanBusState s) {
   switch (s) {
@@ -46,15 +52,15 @@ constexpr const char* to_string(CanBusState s) {
 
 /// Counters only grow (they wrap at 2^32).
 struct CanCounters {
-  std::uint32_t tx_frames = 0;         // frames handed to the controller / sink
-  std::uint32_t tx_dropped = 0;        // frames dropped: queue full, bus-off, interface down
-  std::uint32_t tx_queued = 0;         // frames that had to wait in the backend's queue
-  std::uint32_t rx_frames = 0;         // data frames received
-  std::uint32_t rx_dropped = 0;        // frames the kernel or backend reported lost on receive
-  std::uint32_t error_frames = 0;      // error frames seen (SocketCAN CAN_ERR_FLAG)
-  std::uint32_t bus_off_events = 0;    // transitions into bus-off
+  std::uint32_t tx_frames = 0;       // frames handed to the controller / sink
+  std::uint32_t tx_dropped = 0;      // frames dropped: queue full, bus-off, interface down
+  std::uint32_t tx_queued = 0;       // frames that had to wait in the backend's queue
+  std::uint32_t rx_frames = 0;       // data frames received
+  std::uint32_t rx_dropped = 0;      // frames the kernel or backend reported lost on receive
+  std::uint32_t error_frames = 0;    // error frames seen (SocketCAN CAN_ERR_FLAG)
+  std::uint32_t bus_off_events = 0;  // transitions into bus-off
   std::uint32_t error_passive_events = 0;
-  std::uint32_t restarts = 0;          // recoveries from bus-off / interface down
+  std::uint32_t restarts = 0;  // recoveries from bus-off / interface down
 };
 
 class CanBus {

@@ -26,7 +26,8 @@ class SpiDevice {
   /// kMaxTransferBytes; otherwise what the backend reports (kIoError with errno, kUnavailable).
   [[nodiscard]] Status transfer(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
     if (tx.size() != rx.size() || tx.empty()) {
-      return Status(ErrorCode::kInvalidArgument, "spi: tx and rx must have the same, non-zero size");
+      return Status(ErrorCode::kInvalidArgument,
+                    "spi: tx and rx must have the same, non-zero size");
     }
     if (tx.size() > kMaxTransferBytes) {
       return Status(ErrorCode::kInvalidArgument, "spi: transfer longer than kMaxTransferBytes");

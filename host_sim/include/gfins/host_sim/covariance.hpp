@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "gfins/host_sim/error.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/error_model.hpp"
 #include "gfins/nav_core/geometry.hpp"
@@ -71,8 +72,8 @@ struct ErrorBudget {
 /// Propagates each source group alone and all together; σ at the samples nearest `times_s`.
 ErrorBudget error_budget(const CovarianceSpec& spec, const std::vector<double>& times_s);
 
-/// CSV writers; throw std::runtime_error on I/O errors.
-void write_covariance_csv(const CovarianceResult& r, const std::string& path);
-void write_budget_csv(const ErrorBudget& b, const std::string& path);
+/// CSV writers.
+HostStatus write_covariance_csv(const CovarianceResult& r, const std::string& path);
+HostStatus write_budget_csv(const ErrorBudget& b, const std::string& path);
 
 }  // namespace gfins::sim

@@ -37,8 +37,8 @@ struct MonteCarloResult {
 
 /// Runs the scenario `runs` times (compensated run only): run k uses noise seed seed0 + k and
 /// calibration seed seed0 + 100003 k. `progress` gets the fraction of runs done.
-MonteCarloResult run_montecarlo(const Scenario& base, std::size_t runs, std::uint64_t seed0,
-                                const ProgressFn& progress = {});
+HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
+                                            std::uint64_t seed0, const ProgressFn& progress = {});
 
 /// Least-squares slope of log y against log t over the samples with t in [t_lo, t_hi] and y > 0.
 /// Returns NaN with fewer than two such samples.
@@ -47,6 +47,6 @@ double loglog_slope(const std::vector<double>& t, const std::vector<double>& y, 
 
 /// Writes t, mean and σ of every quantity and axis, and the RMS norms, as CSV. Throws
 /// std::runtime_error on I/O errors.
-void write_montecarlo_csv(const MonteCarloResult& r, const std::string& path);
+HostStatus write_montecarlo_csv(const MonteCarloResult& r, const std::string& path);
 
 }  // namespace gfins::sim

@@ -1,15 +1,15 @@
-// Raw-sample recordings: a compact little-endian binary file of RawSample values with the
-// context needed to replay them (sample rate, ADC LSB, array geometry). The byte layout is
-// specified in docs/recording-format.md; this header is its implementation.
+// Raw-sample recordings, the host's file layer: a compact little-endian binary file of RawSample
+// values with the context needed to replay them (sample rate, ADC LSB, array geometry). The byte
+// layout is specified in docs/recording-format.md; this header is its implementation.
 //
 //   header (384 bytes, CRC-32 at byte 380)
 //   block 0: records_per_block × 32-byte records, then the CRC-32 of those record bytes
 //   block 1: ...
 //   last block: 1..records_per_block records, then its CRC-32
 //
-// Errors are values (RecordingResult) that name the byte offset where the file breaks: a short
-// header, a record cut in the middle, a block whose CRC does not match, wrong magic or version.
-// Nothing here throws (allocation failure aside).
+// Errors are values (HostResult, error.hpp) that name the byte offset where the file breaks: a
+// short header, a record cut in the middle, a block whose CRC does not match, wrong magic or
+// version. Nothing here throws (allocation failure aside).
 #pragma once
 
 #include <array>
@@ -22,91 +22,50 @@
 #include <utility>
 #include <vector>
 
+#include "gfins/host_sim/error.hpp"
 #include "gfins/nav_core/geometry.hpp"
+#include "gfins/recording/codec.hpp"
 #include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::sim {
 
-inline constexpr std::array<char, 8> kRecordingMagic = {'G', 'F', 'I', 'N', 'S', 'R', 'A', 'W'};
-inline constexpr std::uint16_t kRecordingVersion = 1;
-inline constexpr std::size_t kRecordingHeaderBytes = 384;
-inline constexpr std::size_t kRecordingRecordBytes = 32;
-inline constexpr std::size_t kRecordingCrcBytes = 4;
-inline constexpr std::uint32_t kDefaultRecordsPerBlock = 256;
-/// record_count of a file whose writer never closed it: the reader takes every complete block.
-inline constexpr std::uint64_t kRecordCountUnknown = ~std::uint64_t{0};
+// The format itself (constants, header, records, CRC) is the codec of nav_core/recording,
+// shared with the board; this file is the host's layer on top: whole images and files.
+inline constexpr auto kRecordingMagic = recording::kMagic;
+inline constexpr std::uint16_t kRecordingVersion = recording::kVersion;
+inline constexpr std::size_t kRecordingHeaderBytes = recording::kHeaderBytes;
+inline constexpr std::size_t kRecordingRecordBytes = recording::kRecordBytes;
+inline constexpr std::size_t kRecordingCrcBytes = recording::kCrcBytes;
+inline constexpr std::uint32_t kDefaultRecordsPerBlock = recording::kDefaultRecordsPerBlock;
+inline constexpr std::uint64_t kRecordCountUnknown = recording::kRecordCountUnknown;
 
-/// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
-/// of zlib and PNG. crc32("123456789") = 0xCBF43926. `crc` continues a previous call.
-std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0);
+using RecordingHeader = recording::Header;
+using recording::crc32;
+using recording::decode_record;
+using recording::encode_header;
 
-/// What a recording says about how its samples were made.
-struct RecordingHeader {
-  std::uint16_t version = kRecordingVersion;
-  double sample_rate_hz = 1000.0;
-  std::uint16_t channel_count = kAdcChannels;
-  std::uint32_t records_per_block = kDefaultRecordsPerBlock;
-  std::uint64_t record_count = kRecordCountUnknown;  // filled in by the writer's close()
-  std::array<double, 6> volts_per_count{};           // ADC LSB per channel, V at the sensor
-  nav::ArrayGeometry<double, 6> geometry{};          // ρ_j (m) and θ_j, body frame
-};
-
-/// Why a recording could not be read or written, and where.
-struct RecordingError {
-  ErrorCode code = ErrorCode::kDataLoss;
-  std::uint64_t byte_offset = 0;  // offset in the file where the problem starts
-  std::string message;            // says what is wrong, with the offset
-};
-
-/// A value or the RecordingError explaining why there is none (host-side Result with a dynamic
-/// message, since the message carries offsets).
-template <typename T>
-class [[nodiscard]] RecordingResult {
- public:
-  RecordingResult(T value) : value_(std::move(value)) {}               // NOLINT: implicit
-  RecordingResult(RecordingError error) : error_(std::move(error)) {}  // NOLINT: implicit
-
-  bool is_ok() const { return value_.has_value(); }
-  const T& value() const& { return *value_; }
-  T& value() & { return *value_; }
-  T&& value() && { return std::move(*value_); }
-  const RecordingError& error() const { return error_; }
-
- private:
-  std::optional<T> value_;
-  RecordingError error_{};
-};
-
-/// Success without a value.
-struct Done {};
+/// decode_header of the codec with a message naming what is wrong and where.
+HostResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes);
+/// encode_record of the codec with a message naming the sample.
+HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
 
 struct Recording {
   RecordingHeader header;
   std::vector<RawSample> samples;
 };
 
-/// The header's 384 bytes (CRC included).
-std::array<std::uint8_t, kRecordingHeaderBytes> encode_header(const RecordingHeader& h);
-/// Checks magic, version, sizes and the header CRC.
-RecordingResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes);
-
-/// One 32-byte record. Fails (kOutOfRange) when a count is outside 24-bit two's complement or
-/// flags has bits above 15: the record could not hold them exactly.
-RecordingResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
-RawSample decode_record(std::span<const std::uint8_t, kRecordingRecordBytes> bytes);
-
 /// The whole file in memory (header with record_count set, every block and its CRC).
-RecordingResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
-                                                            std::span<const RawSample> samples);
+HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
+                                                       std::span<const RawSample> samples);
 /// Parses a whole file image; errors name the byte offset (docs/recording-format.md).
-RecordingResult<Recording> decode_recording(std::span<const std::uint8_t> bytes);
+HostResult<Recording> decode_recording(std::span<const std::uint8_t> bytes);
 
 /// Reads and decodes a file (kIoError when it cannot be opened or read).
-RecordingResult<Recording> read_recording(const std::string& path);
+HostResult<Recording> read_recording(const std::string& path);
 /// Writes a whole recording at once (through RecordingWriter).
-RecordingResult<Done> write_recording(const std::string& path, const RecordingHeader& header,
-                                      std::span<const RawSample> samples);
+HostStatus write_recording(const std::string& path, const RecordingHeader& header,
+                           std::span<const RawSample> samples);
 
 /// Streaming reader: the header at open, then one block at a time, with the same checks and
 /// error offsets as decode_recording (which is built on it). Memory use is one block, so a
@@ -114,8 +73,8 @@ RecordingResult<Done> write_recording(const std::string& path, const RecordingHe
 /// (which must outlive the reader).
 class RecordingReader {
  public:
-  static RecordingResult<RecordingReader> open(const std::string& path);
-  static RecordingResult<RecordingReader> from_bytes(std::span<const std::uint8_t> bytes);
+  static HostResult<RecordingReader> open(const std::string& path);
+  static HostResult<RecordingReader> from_bytes(std::span<const std::uint8_t> bytes);
   RecordingReader(RecordingReader&& other) noexcept;
   RecordingReader& operator=(RecordingReader&& other) noexcept;
   RecordingReader(const RecordingReader&) = delete;
@@ -126,15 +85,15 @@ class RecordingReader {
 
   /// Replaces `out` with the samples of the next block. Returns false (and an empty `out`) at the
   /// clean end of the recording, an error when the file is truncated or corrupt there.
-  RecordingResult<bool> next_block(std::vector<RawSample>& out);
+  HostResult<bool> next_block(std::vector<RawSample>& out);
 
   /// Records returned so far.
   std::uint64_t records_read() const { return index_; }
 
  private:
   RecordingReader() = default;
-  RecordingResult<Done> read_at(std::uint64_t offset, std::size_t n, std::uint8_t* dst);
-  RecordingResult<bool> check_end();
+  HostStatus read_at(std::uint64_t offset, std::size_t n, std::uint8_t* dst);
+  HostResult<bool> check_end();
 
   std::FILE* file_ = nullptr;
   std::string path_;
@@ -153,8 +112,7 @@ class RecordingReader {
 /// readable up to its last complete block.
 class RecordingWriter {
  public:
-  static RecordingResult<RecordingWriter> open(const std::string& path,
-                                               const RecordingHeader& header);
+  static HostResult<RecordingWriter> open(const std::string& path, const RecordingHeader& header);
   RecordingWriter(RecordingWriter&& other) noexcept;
   // Both close an open writer (as close() does) without reporting errors: call close() to see
   // them.
@@ -163,14 +121,14 @@ class RecordingWriter {
   RecordingWriter& operator=(const RecordingWriter&) = delete;
   ~RecordingWriter();
 
-  RecordingResult<Done> append(const RawSample& s);
-  RecordingResult<Done> close();
+  HostStatus append(const RawSample& s);
+  HostStatus close();
   std::uint64_t records_written() const { return records_; }
 
  private:
   RecordingWriter(std::FILE* file, const RecordingHeader& header);
-  RecordingResult<Done> flush_block();
-  RecordingError io_error(const char* what) const;
+  HostStatus flush_block();
+  HostError io_error(const char* what) const;
 
   std::FILE* file_ = nullptr;
   RecordingHeader header_;

@@ -3,7 +3,8 @@
 // through the navigation core the firmware uses (nav::NavPipeline), without and with compensation.
 //
 // Host code: the standard library and exceptions are allowed here, but nothing escapes this
-// interface: parse errors come back as values whose message names the file, the key and the line.
+// interface: errors come back as HostError values (error.hpp) whose message names the file, the
+// key and the line.
 #pragma once
 
 #include <array>
@@ -15,6 +16,8 @@
 #include <string_view>
 #include <vector>
 
+#include "gfins/host_sim/error.hpp"
+#include "gfins/host_sim/nav_loop.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/calibration/multi_attitude.hpp"
 #include "gfins/nav_core/compensator.hpp"
@@ -95,38 +98,50 @@ struct Scenario {
   // given) on top of them. The front end divides by the true scale factor in both cases.
   bool qa1100 = false;
   double temperature_c = 25.0;  // array temperature (reference 25 °C)
+
+  // The converter. true (every scenario but the paper's §6.3): volts → ADC (sample_source.hpp)
+  // → RawSample counts → the pipeline's front end with the real LSB and the QA-1100's nominal
+  // scale factor (1.33 V/g for the "paper" model too). false ([sensors] adc = false, the
+  // paper-6.3 files only): the paper's §6.3 experiment, whose sensor outputs are m/s² with a
+  // noise stated in m/s² and no converter, enter the pipeline after its front end
+  // (nav::NavPipeline::process_specific_force), unit-gain sensors.
+  bool adc = true;
 };
 
-/// Result of parsing: a scenario, or an error naming the file, the key and the line.
-struct ParsedScenario {
-  std::optional<Scenario> scenario;
-  std::string error;
-  bool ok() const { return scenario.has_value(); }
-};
+/// Parses TOML text; `source` names it in messages. Errors name the file, the key and the line.
+HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source);
 
-/// Parses TOML text; `source` names it in messages.
-ParsedScenario parse_scenario(std::string_view toml_text, const std::string& source);
-
-/// Loads a file, or a built-in scenario by name from `builtin_dir` (NAME.toml).
-ParsedScenario load_scenario(const std::string& file_or_name, const std::string& builtin_dir);
+/// Loads a file, or a built-in scenario by name from `builtin_dir` (NAME.toml): the one
+/// scenario registry of the host is that folder (host_sim/scenarios).
+HostResult<Scenario> load_scenario(const std::string& file_or_name, const std::string& builtin_dir);
 
 /// Names of the built-in scenarios in a folder (file stems of *.toml), sorted.
 std::vector<std::string> builtin_scenarios(const std::string& builtin_dir);
 
-/// The paper's Table 6 orientation errors (rad), as computed from Tables 4/5 (notes §2).
-nav::OrientationErrors<double> paper_table6_orientation();
-
-/// The trajectory of a scenario. Throws std::invalid_argument for a kind it does not know
-/// (parse_scenario rejects those first).
-std::unique_ptr<Trajectory> make_trajectory(const TrajectorySpec& spec);
+/// The trajectory of a scenario; kInvalidArgument for a kind it does not know (parse_scenario
+/// rejects those first).
+HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& spec);
 
 /// A vehicle drive with turns: forward at speed v along north, weaving east
 /// y(t) = A (1 − cos Ωt), Ω = 2π/period, heading along the velocity ψ = atan(ẏ/v), with a bank
 /// angle φ = atan(v ψ̇ / g) as a coordinated turn.
 std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, double period_s);
 
-/// The gravity model of a scenario.
-nav::GravityModel<double> gravity_model(const Scenario& s);
+/// The gravity model of a scenario, in the scalar T of its user (the sensor model: double; the
+/// navigation core: float or double).
+template <typename T = double>
+nav::GravityModel<T> gravity_model(const Scenario& s) {
+  switch (s.gravity) {
+    case GravityChoice::kDown:
+      return nav::GravityModel<T>::constant(static_cast<T>(s.gravity_mps2));
+    case GravityChoice::kUp:
+      // The paper's §6.3 frame has gravity along −z; the core's model is a signed constant.
+      return nav::GravityModel<T>::constant(static_cast<T>(-s.gravity_mps2));
+    case GravityChoice::kNormal:
+      break;
+  }
+  return nav::GravityModel<T>::normal(s.latitude_rad, s.height_m);
+}
 
 // ---- Running a scenario ---------------------------------------------------------------------
 
@@ -151,8 +166,9 @@ struct SampleRecord {
 };
 
 struct RunSeries {
-  std::string label;  // "uncompensated" or "compensated (paper, true)" ...
-  std::vector<SampleRecord> samples;
+  std::string label;                  // "uncompensated" or "compensated (paper, true)" ...
+  std::vector<SampleRecord> samples;  // the start (t = 0) and every sample that navigated
+  NavReport report;                   // the navigation loop's counters (gaps, rejected, ...)
 };
 
 /// Summary of a simulated multi-attitude calibration.
@@ -176,15 +192,20 @@ struct ScenarioOutcome {
 using ProgressFn = std::function<void(double)>;
 
 /// Simulates a multi-attitude calibration of the array of `s` (true misalignment and biases),
-/// with its CalibrationSpec and seed. Throws std::runtime_error when the solver fails.
-CalibrationOutcome simulate_calibration(const Scenario& s);
+/// with its CalibrationSpec and seed. Fails when the solver fails.
+HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s);
 
-/// Runs a navigation scenario twice with the same noise realisation: without compensation and
-/// with the scenario's compensator. For a calibration_poses scenario only `calibration` is filled.
-/// Throws std::runtime_error when the core rejects the configuration.
+/// Scalar of the navigation core a run uses: float is the board's, double the host reference.
+enum class NavScalar : std::uint8_t { kFloat, kDouble };
+
+/// Runs a navigation scenario twice with the same samples (one SampleSource stream, computed
+/// once): without compensation and with the scenario's compensator, both through the one
+/// navigation loop (NavLoop). For a calibration_poses scenario only `calibration` is filled.
+/// Fails when the core rejects the configuration or the converter fails.
 /// With `with_uncompensated` false only the compensated run is made (Monte-Carlo).
-ScenarioOutcome run_scenario(const Scenario& s, const ProgressFn& progress = {},
-                             bool with_uncompensated = true);
+HostResult<ScenarioOutcome> run_scenario(const Scenario& s, const ProgressFn& progress = {},
+                                         bool with_uncompensated = true,
+                                         NavScalar scalar = NavScalar::kDouble);
 
 /// Smallest and largest component over all samples (t > 0) of a vector series.
 struct Bounds {
@@ -194,7 +215,7 @@ struct Bounds {
 Bounds linear_accel_bounds(const RunSeries& r);   // a_err_n, m/s²
 Bounds angular_accel_bounds(const RunSeries& r);  // wdot_err_b, rad/s²
 
-/// Writes a run as CSV: t, truth, estimate and errors. Throws std::runtime_error on I/O errors.
-void write_series_csv(const RunSeries& r, const std::string& path);
+/// Writes a run as CSV: t, truth, estimate and errors.
+HostStatus write_series_csv(const RunSeries& r, const std::string& path);
 
 }  // namespace gfins::sim

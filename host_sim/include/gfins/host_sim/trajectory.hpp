@@ -21,10 +21,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 
 #include "gfins/host_sim/jet.hpp"
+#include "gfins/nav_core/nav_state.hpp"
 
 namespace gfins::sim {
 
@@ -43,6 +46,24 @@ struct TruthState {
   Vec3d v_n = Vec3d::Zero();       // m/s
   Vec3d a_n = Vec3d::Zero();       // kinematic acceleration of o_b, m/s²
 };
+
+/// The one TruthState → NavState conversion (start_at with the truth, error against the truth):
+/// attitude, rate, angular acceleration, acceleration, velocity and position, t_ns = t_s in ns
+/// (rounded), seq as given. f_b stays zero: it depends on the gravity model, which the truth
+/// does not carry, and nothing that starts from the truth reads it.
+template <typename T>
+nav::NavState<T> to_nav_state(const TruthState& x, std::uint32_t seq = 0) {
+  nav::NavState<double> s;
+  s.t_ns = static_cast<std::int64_t>(std::llround(x.t_s * 1e9));
+  s.seq = seq;
+  s.q_nb = x.q_nb;
+  s.w_b = x.w_b;
+  s.wdot_b = x.wdot_b;
+  s.a_n = x.a_n;
+  s.v_n = x.v_n;
+  s.r_n = x.r_n;
+  return s.template cast<T>();
+}
 
 class Trajectory {
  public:

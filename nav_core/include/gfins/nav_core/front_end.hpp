@@ -1,9 +1,13 @@
 // Front end: ADC counts → volts → specific force along each sensitive axis, per sensor.
 //
 // The QA-1100 output current through its load resistor gives a voltage P = SF (f·θ + b) with SF
-// in V/g and b in g (paper eq. (21)); so f·θ = P/SF − b. The result is in m/s² with g the
-// standard gravity, the unit the scale factors are expressed in. Scale factor and bias are the
-// calibrated ones; orientation and location errors are the compensator's job.
+// in V/g and b in g (paper eq. (21)); so f·θ = P/SF − b. The multi-attitude calibration (§4.1)
+// takes |f| = 1 g in every pose, so "g" in V/g and in the bias is the LOCAL gravity of the
+// calibration site (9.7894 m/s² at 24.8° latitude, 9.8322 at the poles), not the standard
+// 9.80665: the result is converted to m/s² with that g (FrontEndParams::gravity_mps2, stored in
+// the calibration file). Converting with standard gravity instead would scale every specific
+// force by 9.80665/g_cal (+0.18 % for a board calibrated at 24.8°). Scale factor and bias are
+// the calibrated ones; orientation and location errors are the compensator's job.
 #pragma once
 
 #include <algorithm>
@@ -21,6 +25,8 @@ struct FrontEndParams {
   std::array<T, N> volts_per_count{};  // ADC LSB per channel, V (Vref / (gain · 2^23))
   std::array<T, N> scale_v_per_g{};    // SF_aj, V/g (paper Table 6)
   std::array<T, N> bias_g{};           // b_aj, g (paper Table 6)
+  /// The g of the two lines above, m/s²: local gravity magnitude of the calibration site.
+  T gravity_mps2 = static_cast<T>(kStandardGravity);
 
   template <typename U>
   FrontEndParams<U, N> cast() const {
@@ -30,6 +36,7 @@ struct FrontEndParams {
       o.scale_v_per_g[j] = static_cast<U>(scale_v_per_g[j]);
       o.bias_g[j] = static_cast<U>(bias_g[j]);
     }
+    o.gravity_mps2 = static_cast<U>(gravity_mps2);
     return o;
   }
 };
@@ -41,10 +48,15 @@ class FrontEnd {
 
   FrontEnd() = default;
 
-  /// Fails with kInvalidArgument when a scale factor or LSB is zero, negative or not finite.
+  /// Fails with kInvalidArgument when a scale factor, LSB or the calibration gravity is zero,
+  /// negative or not finite.
   static Result<FrontEnd> create(const FrontEndParams<T, N>& p) {
     FrontEnd fe;
-    const T g = static_cast<T>(kStandardGravity);
+    const T g = p.gravity_mps2;  // local gravity of the calibration site: the g of V/g
+    if (!(g > T(0)) || !std::isfinite(g)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "front end: the calibration gravity is not a positive finite number");
+    }
     for (int j = 0; j < N; ++j) {
       const auto i = static_cast<std::size_t>(j);
       const T sf = p.scale_v_per_g[i];
@@ -61,7 +73,7 @@ class FrontEnd {
     return fe;
   }
 
-  /// s**_j = (counts_j · LSB_j / SF_j − b_j) · g (m/s²). Returns a mask of the channels whose
+  /// s**_j = (counts_j · LSB_j / SF_j − b_j) · g_cal (m/s²). Returns a mask of the channels whose
   /// code sits at the converter's full scale (saturated: the value is not a measurement).
   std::uint32_t convert(const std::array<std::int32_t, N>& counts, Outputs& s) const {
     // Conversion and the range of the codes in one branch-free loop (the compiler vectorises

@@ -25,8 +25,11 @@
 
 namespace gfins::calib_file {
 
-/// The format version this build reads and writes (docs/calibration-file.md, versioning).
-inline constexpr std::int64_t kFormatVersion = 1;
+/// The format version this build writes (docs/calibration-file.md, versioning). Version 2 added
+/// the local gravity of the calibration site ([gravity]).
+inline constexpr std::int64_t kFormatVersion = 2;
+/// The oldest version this build still reads (converted on load: see kVersion1GravitySource).
+inline constexpr std::int64_t kOldestFormatVersion = 1;
 inline constexpr std::size_t kNumSensors = 6;
 
 /// Acceptance bounds of the values (validate()); the doc lists the same numbers.
@@ -39,7 +42,15 @@ inline constexpr double kAxisUnitTolerance = 1e-6;     // nominal axes are unit 
 inline constexpr double kMaxAdcLsbV = 1.0;             // V/count; a 24-bit ADC is ~1e-7
 inline constexpr std::size_t kMaxDeviceIdLength = 64;
 inline constexpr std::size_t kMaxSourceLength = 256;
-
+/// Accepted local gravity, m/s². Normal gravity on the WGS-84 ellipsoid spans 9.7803 (equator) to
+/// 9.8322 (poles) and falls by 3.1e-6 m/s² per metre of height (9.755 at 8 km); the bounds admit
+/// every real site and refuse a value in another unit (1 "g", 980 Gal).
+inline constexpr double kMinGravityMps2 = 9.7;
+inline constexpr double kMaxGravityMps2 = 9.9;
+/// gravity.source given to a version-1 file on load: version 1 had no notion of the site, and
+/// its front end converted V/g with standard gravity, which the conversion keeps.
+inline constexpr const char* kVersion1GravitySource =
+    "format version 1 file: standard gravity assumed (calibration site unknown)";
 enum class GeometryKind : std::uint8_t {
   kTable1 = 0,  // the paper's Table 1 (Chen's cube) with half-size rho_m
   kCustom = 1,  // positions and axes given explicitly
@@ -86,6 +97,12 @@ struct CalibrationData {
   SetOrientation beta{};   // set {2, 3, 5}: Δβ (nav::kSetBeta)
   SetOrientation alpha{};  // set {1, 4, 6}: Δα (nav::kSetAlpha)
   nav::CompensatorKind compensator = nav::CompensatorKind::kExact;
+  /// Local gravity magnitude of the calibration site, m/s²: the multi-attitude calibration takes
+  /// |f| = 1 g in every pose, so this is the g of every V/g and bias above (format version 2).
+  double gravity_mps2 = nav::kStandardGravity;
+  /// How gravity_mps2 was obtained (free text, printable ASCII, ≤ 256): "given", or "WGS-84
+  /// normal gravity at latitude 24.8 deg, height 50 m".
+  std::string gravity_source;
 
   bool operator==(const CalibrationData&) const = default;
 };
@@ -102,9 +119,11 @@ Problem validate(const CalibrationData& data);
 /// The canonical serialisation the checksum covers (docs/calibration-file.md): one line
 /// "key=value\n" per value in a fixed order, doubles as the 16 hex digits of their IEEE-754
 /// binary64 bit pattern, so it is the same on every machine and for every text formatting.
-std::string canonical_serialisation(const CalibrationData& data);
-/// FNV-1a 64-bit over canonical_serialisation(data).
-std::uint64_t checksum(const CalibrationData& data);
+/// `version` selects the key list of that format version (1 has no [gravity]).
+std::string canonical_serialisation(const CalibrationData& data,
+                                    std::int64_t version = kFormatVersion);
+/// FNV-1a 64-bit over canonical_serialisation(data, version).
+std::uint64_t checksum(const CalibrationData& data, std::int64_t version = kFormatVersion);
 /// FNV-1a 64-bit of arbitrary bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
 std::uint64_t fnv1a64(const std::string& bytes);
 
@@ -140,6 +159,7 @@ nav::FrontEndParams<T, 6> front_end_params(const CalibrationData& d) {
     p.scale_v_per_g[j] = static_cast<T>(d.sensors[j].scale_v_per_g);
     p.bias_g[j] = static_cast<T>(d.sensors[j].bias_g);
   }
+  p.gravity_mps2 = static_cast<T>(d.gravity_mps2);  // the g of V/g: calibration site
   return p;
 }
 

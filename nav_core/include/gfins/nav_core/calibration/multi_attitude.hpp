@@ -80,6 +80,10 @@ struct MultiAttitudeConfig {
   T max_rms_residual_g = T(2e-3);  // RMS residual per sensor / SF (g); Tables 4/5: ≤ 0.5 mg
   T max_chi2_per_dof = T(9);       // weighted residuals vs the stated σ
   T max_angle_rad = T(0.0873);     // 5°: beyond, the small-angle model (14)/(15) is poor
+  /// Weighted least squares by 1/σ(mean) when σ is stated (the best linear unbiased estimate);
+  /// false: unweighted least squares, the paper's procedure, whose covariance with stated σ is
+  /// then the sandwich (AᵀA)⁻¹AᵀΣA(AᵀA)⁻¹. Without stated σ both are the same estimator.
+  bool weighted = true;
 };
 
 /// Where a sensor's parameter covariance comes from.
@@ -169,17 +173,22 @@ std::array<std::array<T, 3>, 6> table3_attitudes();
 template <typename T>
 struct PaperTableOutputs {
   std::array<std::array<T, 6>, 6> mean_v{};
+  /// σ of each mean (V), same layout; all zero when not stated. When every mean of a sensor has
+  /// σ > 0 its covariance comes from them (stated σ), else from the residuals (2 dof per sensor
+  /// on Tables 2/3: a Student-t with 2 dof covers only 90 % within 3σ).
+  std::array<std::array<T, 6>, 6> sigma_v{};
 };
 
 /// The twelve observations (Table 2 poses recording set β, then Table 3 poses recording set α)
-/// that feed the general solver with the paper's data.
+/// that feed the general solver with the paper's data, with p.sigma_v as σ(mean) (count 1).
 template <typename T>
 std::array<AttitudeObservation<T>, 12> paper_observations(const PaperTableOutputs<T>& p);
 
 /// The paper's own procedure: SF from the closed forms (17a-c)/(18a-c), then least squares for
 /// the bias and the two angles of each sensor with SF fixed (the 18 output equations of each
-/// set decouple per sensor). Residuals, covariance, condition number and verdict are those of
-/// the general solver on the same data, which gives the same estimates (docs/calibration.md).
+/// set decouple per sensor). The estimates equal the unweighted general solver's
+/// (docs/calibration.md); residuals, covariance (stated σ where p.sigma_v gives it: the
+/// sandwich of the unweighted estimator), condition number and verdict are that solver's.
 template <typename T>
 Result<MultiAttitudeResult<T>> calibrate_paper_procedure(
     const PaperTableOutputs<T>& p, const MultiAttitudeConfig<T>& config = MultiAttitudeConfig<T>{});

@@ -1,0 +1,152 @@
+# Installation and Debian packages (docs/deploy.md).
+#
+# `cmake --install <build> [--prefix P]` puts the programs in P/bin, the scenarios in
+# P/share/gfins/scenarios, the plot scripts in P/share/gfins/scripts and the documentation in
+# P/share/doc/gfins. Built with CMAKE_INSTALL_PREFIX=/usr (the `deb` presets) the board files
+# go to their Debian places instead: /etc/gfins/gfins-fw.toml, /var/lib/gfins,
+# /lib/systemd/system/gfins-fw.service, /lib/udev/rules.d/60-gfins-fw.rules.
+#
+# `cpack --config <build>/CPackConfig.cmake` then makes one .deb per component:
+#   gfins-fw     (component board): the firmware, its configuration, unit and udev rule
+#   gfins-tools  (component tools): gfins-can and the other host programs, scenarios, scripts
+# for the architecture of the build (amd64, arm64 or armhf).
+include(GNUInstallDirs)
+
+set(GFINS_PKG_DIR ${PROJECT_SOURCE_DIR}/packaging)
+if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  # Debian layout (FHS): configuration and state outside /usr, units and rules in /lib.
+  set(gfins_conf_dest /etc/gfins)
+  set(gfins_state_dest /var/lib/gfins)
+  set(gfins_unit_dest /lib/systemd/system)
+  set(gfins_udev_dest /lib/udev/rules.d)
+else()
+  set(gfins_conf_dest ${CMAKE_INSTALL_SYSCONFDIR}/gfins)
+  set(gfins_state_dest ${CMAKE_INSTALL_LOCALSTATEDIR}/lib/gfins)
+  set(gfins_unit_dest ${CMAKE_INSTALL_LIBDIR}/systemd/system)
+  set(gfins_udev_dest ${CMAKE_INSTALL_LIBDIR}/udev/rules.d)
+endif()
+set(GFINS_FULL_BINDIR ${CMAKE_INSTALL_FULL_BINDIR})
+if(IS_ABSOLUTE "${gfins_conf_dest}")
+  set(GFINS_FULL_CONFDIR ${gfins_conf_dest})
+else()
+  set(GFINS_FULL_CONFDIR ${CMAKE_INSTALL_PREFIX}/${gfins_conf_dest})
+endif()
+set(GFINS_DOC_DIR ${CMAKE_INSTALL_FULL_DATADIR}/doc/gfins-fw)
+
+# --- board: the firmware ---------------------------------------------------------------------
+set(gfins_components "")
+if(TARGET gfins-fw)
+  list(APPEND gfins_components board)
+  install(TARGETS gfins-fw RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT board)
+  set(gfins_default_config ${PROJECT_SOURCE_DIR}/firmware/app/gfins-fw.toml)
+  if(NOT EXISTS ${gfins_default_config})
+    message(FATAL_ERROR "gfins-fw is built but ${gfins_default_config} (its default "
+                        "configuration, installed as ${GFINS_FULL_CONFDIR}/gfins-fw.toml) is missing")
+  endif()
+  install(FILES ${gfins_default_config} DESTINATION ${gfins_conf_dest} COMPONENT board)
+  install(DIRECTORY DESTINATION ${gfins_state_dest} COMPONENT board)
+  configure_file(${GFINS_PKG_DIR}/gfins-fw.service.in ${PROJECT_BINARY_DIR}/gfins-fw.service @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/gfins-fw.service DESTINATION ${gfins_unit_dest}
+          COMPONENT board)
+  install(FILES ${GFINS_PKG_DIR}/60-gfins-fw.rules DESTINATION ${gfins_udev_dest} COMPONENT board)
+  install(FILES docs/deploy.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-fw COMPONENT board)
+endif()
+
+# --- tools: host programs, scenarios, plot scripts, documentation ----------------------------
+set(gfins_tool_targets "")
+foreach(t IN ITEMS gfins-can gfins-sim gfins-calibrate gfins-replay)
+  if(TARGET ${t})
+    list(APPEND gfins_tool_targets ${t})
+  endif()
+endforeach()
+if(gfins_tool_targets)
+  list(APPEND gfins_components tools)
+  install(TARGETS ${gfins_tool_targets} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+          COMPONENT tools)
+  install(DIRECTORY host_sim/scenarios/ DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scenarios
+          COMPONENT tools FILES_MATCHING PATTERN "*.toml")
+  file(GLOB gfins_plot_scripts CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/scripts/*.py)
+  install(PROGRAMS ${gfins_plot_scripts} DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scripts
+          COMPONENT tools)
+  install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-tools COMPONENT tools
+          FILES_MATCHING PATTERN "*.md" PATTERN "*.png")
+  install(FILES README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-tools COMPONENT tools)
+endif()
+
+# --- Debian packages (CPack DEB) ---------------------------------------------------------------
+if(NOT gfins_components)
+  return()
+endif()
+# Debian's name for the target architecture (cross builds set CMAKE_SYSTEM_PROCESSOR).
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64)$")
+  set(gfins_deb_arch arm64)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^arm")
+  set(gfins_deb_arch armhf)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  set(gfins_deb_arch amd64)
+else()
+  set(gfins_deb_arch ${CMAKE_SYSTEM_PROCESSOR})
+endif()
+
+# Per-package copyright and a compressed changelog, as Debian policy §12.5 and §12.7 ask.
+foreach(c IN LISTS gfins_components)
+  if(c STREQUAL board)
+    set(pkg gfins-fw)
+  else()
+    set(pkg gfins-tools)
+  endif()
+  install(FILES ${GFINS_PKG_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${pkg}
+          COMPONENT ${c})
+  set(gz ${PROJECT_BINARY_DIR}/packaging/${pkg}/changelog.gz)
+  add_custom_command(OUTPUT ${gz}
+                     COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/packaging/${pkg}
+                     COMMAND gzip -9n -c ${GFINS_PKG_DIR}/changelog > ${gz}
+                     DEPENDS ${GFINS_PKG_DIR}/changelog VERBATIM)
+  add_custom_target(gfins_changelog_${c} ALL DEPENDS ${gz})
+  install(FILES ${gz} DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${pkg} COMPONENT ${c})
+endforeach()
+
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME gfins)
+# Empty: each package's first description line is its summary (CPackDeb would otherwise put
+# the project's description in front of every component's).
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "")
+set(CPACK_PACKAGE_VENDOR "gfins")
+set(CPACK_PACKAGE_CONTACT "gfins maintainers <maintainers@users.noreply.h-seed-37f600bd.example>")
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
+set(CPACK_COMPONENTS_ALL ${gfins_components})
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${gfins_deb_arch})
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
+set(CPACK_STRIP_FILES ON)
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS OFF)
+# dpkg-shlibdeps derives the library dependencies; for a cross build it needs the target's
+# objdump and the multiarch packages' shlibs (scripts/install-cross-deps.sh installs them).
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+
+set(CPACK_DEBIAN_BOARD_PACKAGE_NAME gfins-fw)
+set(CPACK_DEBIAN_BOARD_DESCRIPTION
+    "gyro-free inertial navigation firmware for a Linux board
+Reads six accelerometers through an ADS131M06 ADC (spidev and a GPIO
+data-ready line), computes attitude, velocity and position without a
+gyroscope and publishes them on SocketCAN. Runs as the systemd service
+gfins-fw (Type=notify, watchdog, restart on failure) under its own user;
+configuration in /etc/gfins, calibration in /var/lib/gfins.")
+set(CPACK_DEBIAN_BOARD_PACKAGE_DEPENDS "adduser, init-system-helpers (>= 1.52)")
+set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_EXTRA
+    "${GFINS_PKG_DIR}/deb/postinst;${GFINS_PKG_DIR}/deb/prerm;${GFINS_PKG_DIR}/deb/postrm")
+set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+
+set(CPACK_DEBIAN_TOOLS_PACKAGE_NAME gfins-tools)
+set(CPACK_DEBIAN_TOOLS_DESCRIPTION
+    "host tools of the gfins gyro-free inertial navigation system
+gfins-can decodes the firmware's CAN frames (live SocketCAN or candump
+logs); gfins-sim simulates trajectories through the sensor model and the
+navigation core; gfins-calibrate computes a calibration file. Includes the
+scenario files and the plot scripts.")
+set(CPACK_DEBIAN_TOOLS_PACKAGE_RECOMMENDS "python3, python3-matplotlib, python3-numpy, can-utils")
+
+include(CPack)

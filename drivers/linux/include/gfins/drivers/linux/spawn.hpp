@@ -1,0 +1,45 @@
+// Starting a helper program without a shell (DESIGN.md: process I/O is a Linux backend; the
+// project brief: never pass user text through a shell, no system()/popen()).
+//
+// The program and every argument go to posix_spawn(3) as separate argv strings, so an argument
+// is never parsed: quotes, `;`, `$()`, spaces, newlines and a leading `-` reach the child as the
+// bytes they are. The child inherits the environment and the standard streams; the caller waits
+// for it and gets its exit status.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "gfins/status/status.hpp"
+
+namespace gfins::drivers::lnx {
+
+/// How a child ended.
+struct ProcessExit {
+  bool exited = false;  // true: it returned from main / called exit(); false: killed by a signal
+  int code = 0;         // exit code when exited
+  int signal = 0;       // signal number when killed
+  bool ok() const { return exited && code == 0; }
+};
+
+struct SpawnOptions {
+  /// Working directory of the child; empty: the caller's.
+  std::string cwd;
+  /// Look `argv[0]` up in PATH when it holds no '/' (execvp rules); otherwise it is a path.
+  bool search_path = true;
+  /// Files (created or truncated) that receive the child's stdout / stderr; empty: inherited.
+  std::string stdout_path;
+  std::string stderr_path;
+};
+
+/// Runs argv[0] with arguments argv[1..] and waits for it. Fails (kInvalidArgument) on an empty
+/// argv or an argument holding a NUL byte, (kUnavailable, os_error = errno) when the program
+/// cannot be started (not found, not executable), (kIoError, os_error) when waiting fails. A
+/// child that runs and fails is not an error of this call: look at ProcessExit.
+Result<ProcessExit> run_program(std::span<const std::string> argv,
+                                const SpawnOptions& options = {});
+
+/// "exit status 3" / "killed by signal 9 (Killed)": for messages.
+std::string describe(const ProcessExit& e);
+
+}  // namespace gfins::drivers::lnx

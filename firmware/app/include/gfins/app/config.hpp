@@ -1,0 +1,141 @@
+// gfins-fw configuration: a TOML file (docs/firmware.md, "Configuration") overridden by the
+// command line. Host/Linux side of the firmware: std::string, exceptions inside (tomlplusplus and
+// CLI11 throw) and caught at this interface; every problem comes back as a message naming the
+// file (or "command line"), the key and what is allowed.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gfins/nav_core/compensator.hpp"
+
+namespace gfins::app {
+
+enum class BoardKind : std::uint8_t { kLinux, kSim };
+enum class Pacing : std::uint8_t { kFast, kRealTime };  // simulated board only
+enum class GravityChoice : std::uint8_t { kStandard, kConstant, kNormal };
+enum class WatchdogKind : std::uint8_t { kNone, kSystemd, kDevice };
+/// "calibration" = the compensator the calibration file names.
+enum class CompensatorChoice : std::uint8_t { kCalibration, kNone, kPaper, kExact };
+
+/// Output messages whose rate is configurable: the divider of the sample rate per message
+/// (0 = off), in the CAN message table's order (docs/can-interface.md; MessageId 0..13). The
+/// names are the keys of [output] (and of --divider NAME=N).
+inline constexpr std::array<std::string_view, 14> kMessageNames = {
+    "epoch",    "status",   "quaternion",  "euler",      "rate",          "angular_accel",
+    "accel",    "velocity", "position_ne", "position_d", "health_adc",    "health_system",
+    "sensors_a", "sensors_b"};
+inline constexpr std::size_t kNumMessages = kMessageNames.size();
+/// Defaults of the CAN message table: 100 Hz navigation at 1 kHz (50 Hz Euler angles and angular
+/// acceleration), 1 Hz health, raw sensor outputs off; the bus budget is in
+/// docs/can-interface.md.
+inline constexpr std::array<std::uint16_t, kNumMessages> kDefaultDividers = {
+    10, 10, 10, 20, 10, 20, 10, 10, 10, 10, 1000, 1000, 0, 0};
+inline constexpr std::uint16_t kMaxDivider = 10000;
+
+/// ADS131M06 output data rates reachable with its 8.192 MHz clock (datasheet §8.4.2.2, OSR
+/// 1024..8192 → f_MOD / OSR with f_MOD = 4.096 MHz).
+inline constexpr std::array<double, 4> kSampleRatesHz = {500.0, 1000.0, 2000.0, 4000.0};
+inline constexpr int kMaxNodeId = 15;  // 4 bits of the identifier (docs/can-interface.md)
+inline constexpr int kMaxRtPriority = 99;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
+
+struct FwConfig {
+  BoardKind board = BoardKind::kLinux;
+
+  // [adc]
+  std::string spi_device = "/dev/spidev0.0";
+  std::string gpio_chip = "gpiochip0";
+  std::string drdy_line = "25";  // line offset (digits only) or line name
+  double sample_rate_hz = 1000.0;
+
+  // [can]
+  std::string can_interface = "can0";
+  std::string can_log;  // non-empty: write a candump log file instead of using an interface
+  int node_id = 1;
+
+  // [output]
+  std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;
+
+  // [navigation]
+  CompensatorChoice compensator = CompensatorChoice::kCalibration;
+  GravityChoice gravity = GravityChoice::kStandard;
+  double gravity_mps2 = 9.80665;  // kConstant
+  double latitude_deg = 0.0;      // kNormal
+  double height_m = 0.0;          // kNormal
+  double heading_deg = 0.0;       // initial heading (nothing on board senses it)
+  std::array<double, 3> position_m{};  // initial position, NED from the alignment point
+  double alignment_s = 1.0;            // time at rest averaged by the static alignment
+
+  // [calibration]
+  std::string calibration_file = "/var/lib/gfins/calibration.toml";
+
+  // [realtime]
+  int rt_priority = 80;
+  bool lock_memory = true;
+
+  // [watchdog]
+  WatchdogKind watchdog = WatchdogKind::kSystemd;
+  std::string watchdog_device = "/dev/watchdog";
+
+  // [log]
+  std::string log_level = "info";  // trace debug info warn error off
+
+  // [sim]
+  std::string sim_scenario = "rest";
+  std::string sim_scenario_dir;  // empty: the installed scenarios next to the binary
+  Pacing pacing = Pacing::kFast;
+  double sim_duration_s = 0.0;  // 0 = the scenario's duration
+};
+
+/// Outcome of loading: the configuration, or the first problem.
+struct ConfigResult {
+  std::optional<FwConfig> config;
+  std::string error;  // "gfins-fw.toml: can.node_id = 40: must be an integer 0..15"
+  bool ok() const { return config.has_value(); }
+};
+
+/// Parses TOML text; `source` names it in messages. Keys absent from the text keep their
+/// defaults; unknown keys are errors.
+ConfigResult parse_config(std::string_view toml_text, const std::string& source,
+                          FwConfig base = {});
+
+/// Reads and parses a file.
+ConfigResult load_config(const std::string& path, FwConfig base = {});
+
+/// Checks every field (ranges, enumerations, consistency); `origin` names where the values came
+/// from. Returns "" when all are valid.
+std::string validate(const FwConfig& c, const std::string& origin);
+
+/// The commented default configuration (what firmware/app/gfins-fw.toml ships).
+std::string default_config_text();
+
+const char* to_string(BoardKind b);
+const char* to_string(Pacing p);
+const char* to_string(GravityChoice g);
+const char* to_string(CompensatorChoice c);
+const char* to_string(WatchdogKind w);
+
+/// Index of a message name in kMessageNames, or -1.
+int message_index(std::string_view name);
+
+/// The compensator to run given the configuration's choice and the calibration file's.
+nav::CompensatorKind resolve_compensator(CompensatorChoice choice, nav::CompensatorKind from_file);
+
+/// Outcome of the command line: a configuration to run with, or an exit (help, error, printed
+/// default configuration) with its code.
+struct CliResult {
+  std::optional<FwConfig> config;
+  std::string config_source;  // the file the configuration came from ("" = built-in defaults)
+  bool check_only = false;    // --check-config: validate and exit
+  int exit_code = 0;          // when !config
+  std::string message;        // printed when !config (stdout for exit 0, stderr otherwise)
+};
+
+/// Parses argv: --config FILE (default: none = built-in defaults) then every override.
+CliResult parse_command_line(int argc, const char* const* argv);
+
+}  // namespace gfins::app

@@ -1,0 +1,127 @@
+// Health of the board: counters (they only grow, wrap at 2^32), the stuck-channel detector and
+// the status bits published with every epoch (docs/faults.md maps each fault to all of these).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gfins/sample/raw_sample.hpp"
+
+namespace gfins::app {
+
+struct HealthCounters {
+  std::uint32_t samples = 0;            // frames read from the ADC
+  std::uint32_t missed_edges = 0;       // data-ready edges lost (sequence jumps)
+  std::uint32_t extra_edges = 0;        // data-ready edges without a new conversion
+  std::uint32_t drdy_timeouts = 0;      // no data-ready edge within the timeout
+  std::uint32_t crc_errors = 0;         // ADC frames with a CRC mismatch
+  std::uint32_t adc_resets = 0;         // ADC resets seen and recovered from
+  std::uint32_t adc_read_errors = 0;    // read_sample failures other than timeouts
+  std::uint32_t saturated_samples = 0;  // samples with a channel at full scale
+  std::uint32_t stuck_events = 0;       // channels that became stuck
+  std::uint32_t rejected_samples = 0;   // samples not integrated (CRC, saturation)
+  std::uint32_t can_tx_dropped = 0;     // frames the CAN backend dropped or refused
+  std::uint32_t bus_off_events = 0;     // transitions into bus-off
+  std::uint32_t loop_overruns = 0;      // a cycle finished after the next edge was due
+  std::uint32_t log_dropped = 0;        // log records lost to a full queue
+  std::uint32_t commands = 0;           // commands executed
+  std::uint32_t command_errors = 0;     // commands rejected (malformed, out of range, busy)
+  std::uint8_t stuck_mask = 0;          // channels stuck now (bit j = channel j)
+  std::uint8_t saturated_mask = 0;      // channels saturated in the last sample
+};
+
+/// Bits of Epoch::status_bits: the positions of the CAN status frame's StatusFlags
+/// (docs/can-interface.md). Bits 0..3 mirror nav::nav_status; 4 and 5 are set by the publisher
+/// (a value clipped / not available); 14..17 are the firmware's additions (docs/faults.md).
+/// Event bits (marked *) stay set for kEventHoldSamples after the event so a status frame sent at
+/// a lower rate still shows it; the counters are exact.
+namespace status_bits {
+inline constexpr std::uint32_t kAligned = 1u << 0;        // static alignment done
+inline constexpr std::uint32_t kSampleGap = 1u << 1;     // * samples missing (edges lost)
+inline constexpr std::uint32_t kInputInvalid = 1u << 2;   // this sample was rejected
+inline constexpr std::uint32_t kCompensated = 1u << 3;    // misalignment compensation active
+inline constexpr std::uint32_t kCrcError = 1u << 6;       // * ADC CRC error
+inline constexpr std::uint32_t kSaturated = 1u << 7;      // * a channel at full scale
+inline constexpr std::uint32_t kStuckChannel = 1u << 8;   // a channel stuck now
+inline constexpr std::uint32_t kUncalibrated = 1u << 9;   // nominal defaults in use
+inline constexpr std::uint32_t kLoopOverrun = 1u << 10;   // * a cycle overran its period
+inline constexpr std::uint32_t kCanTxDrop = 1u << 11;     // * CAN frames dropped
+inline constexpr std::uint32_t kCaptureActive = 1u << 12; // calibration capture running
+inline constexpr std::uint32_t kDegraded = 1u << 13;      // navigation output not trustworthy
+inline constexpr std::uint32_t kAdcRecovered = 1u << 14;  // * the ADC was reset/reconfigured
+inline constexpr std::uint32_t kDataReadyLost = 1u << 15; // * no data-ready edge in time
+inline constexpr std::uint32_t kBusOff = 1u << 16;        // * CAN controller went bus-off
+inline constexpr std::uint32_t kExtraEdge = 1u << 17;     // * data-ready without a conversion
+}  // namespace status_bits
+
+/// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).
+inline constexpr std::uint32_t kEventHoldSamples = 1000;
+
+/// Holds event bits set for kEventHoldSamples samples after their last occurrence.
+class LatchedBits {
+ public:
+  void set(std::uint32_t bits, std::uint32_t sample) {
+    for (unsigned b = 0; b < 32; ++b) {
+      if ((bits >> b) & 1u) last_[b] = sample, active_ |= 1u << b;
+    }
+  }
+  std::uint32_t get(std::uint32_t sample) {
+    for (unsigned b = 0; b < 32; ++b) {
+      if (((active_ >> b) & 1u) != 0 && sample - last_[b] >= kEventHoldSamples) {
+        active_ &= ~(1u << b);
+      }
+    }
+    return active_;
+  }
+
+ private:
+  std::array<std::uint32_t, 32> last_{};
+  std::uint32_t active_ = 0;
+};
+
+/// A channel is stuck when its code has not changed for kStuckSamples consecutive valid samples
+/// while at least one other channel changed in that window (so a noiseless simulation or a
+/// genuinely constant input on every channel is not called stuck). Codes at either rail are the
+/// saturation detector's business and do not count here.
+///
+/// K = 50 samples (50 ms at 1 kHz): a live QA-1100 channel at rest shows tens of counts of noise
+/// (70 µg rms · 1.33 V/g ≈ 93 µV ≈ 78 counts of 1.19 µV; docs/sensor-model.md), and even a channel
+/// with only 2 counts rms repeats its code with probability < 0.15 per sample, so 49 repeats in a
+/// row happen with probability < 0.15^49 ≈ 4e-41: no false alarms; 50 ms is short against the
+/// seconds over which a wrong channel spoils the navigation solution.
+inline constexpr std::uint32_t kStuckSamples = 50;
+
+class StuckDetector {
+ public:
+  /// Feeds one valid sample; returns the mask of channels stuck now.
+  std::uint8_t update(const std::array<std::int32_t, kAdcChannels>& counts) {
+    for (std::size_t j = 0; j < kAdcChannels; ++j) {
+      const bool rail = counts[j] >= kAdcCodeMax || counts[j] <= kAdcCodeMin;
+      if (primed_ && counts[j] == last_[j] && !rail) {
+        if (run_[j] < kStuckSamples) ++run_[j];
+      } else {
+        run_[j] = 0;
+      }
+      last_[j] = counts[j];
+    }
+    primed_ = true;
+    std::uint8_t mask = 0;
+    for (std::size_t j = 0; j < kAdcChannels; ++j) {
+      if (run_[j] < kStuckSamples) continue;
+      bool others_move = false;
+      for (std::size_t k = 0; k < kAdcChannels; ++k) {
+        if (k != j && run_[k] < kStuckSamples) others_move = true;
+      }
+      if (others_move) mask = static_cast<std::uint8_t>(mask | (1u << j));
+    }
+    return mask;
+  }
+  void reset() { primed_ = false, run_.fill(0); }
+
+ private:
+  std::array<std::int32_t, kAdcChannels> last_{};
+  std::array<std::uint32_t, kAdcChannels> run_{};
+  bool primed_ = false;
+};
+
+}  // namespace gfins::app

@@ -1,0 +1,56 @@
+// Re-reading the calibration file is file I/O and parsing (allocation, blocking): it runs on a
+// worker thread. The loop posts a request and polls for the outcome once per cycle; nothing on
+// the loop's side blocks or allocates.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "gfins/nav_core/pipeline.hpp"
+
+namespace gfins::app {
+
+/// The calibration parts the loop applies, and how it identifies them.
+struct CalibrationSet {
+  nav::PipelineConfig<float> config{};  // full pipeline configuration built from the calibration
+  std::uint32_t cal_id = 0;             // 0 = uncalibrated defaults
+  bool calibrated = false;
+};
+
+class ReloadWorker {
+ public:
+  /// `load` runs on the worker thread: a new set, or nullopt when the file is missing or bad
+  /// (it logs why). It is given the loop's current configuration to start from.
+  using LoadFn = std::function<std::optional<CalibrationSet>(const nav::PipelineConfig<float>&)>;
+
+  explicit ReloadWorker(LoadFn load);
+  ~ReloadWorker();
+  ReloadWorker(const ReloadWorker&) = delete;
+  ReloadWorker& operator=(const ReloadWorker&) = delete;
+
+  /// Loop side: starts a reload from `current`; false when one is already running.
+  bool request(const nav::PipelineConfig<float>& current);
+
+  enum class Poll : std::uint8_t { kNothing, kReady, kFailed };
+  /// Loop side, non-blocking: kReady copies the new set into `out`.
+  Poll poll(CalibrationSet& out);
+
+ private:
+  void run();
+
+  LoadFn load_;
+  std::mutex mutex_;  // guards the hand-over slots; the loop only ever try_locks it
+  std::condition_variable wake_;
+  nav::PipelineConfig<float> request_config_{};
+  CalibrationSet result_{};
+  std::atomic<int> state_{0};  // 0 idle, 1 requested, 2 running, 3 ready, 4 failed
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+}  // namespace gfins::app

@@ -1,0 +1,151 @@
+// The real-time sample loop (docs/firmware.md, "The sample loop"): one cycle per data-ready edge
+//
+//   read frame → NavPipeline::process → health → Publisher (dividers) → CAN service →
+//   commands (receive with timeout 0, at most kMaxCommandsPerCycle) → watchdog kick
+//
+// After configure() nothing here allocates, blocks (except the data-ready wait inside
+// read_sample) or formats text: events go to the log queue as fixed-size records.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gfins/app/health.hpp"
+#include "gfins/app/log_queue.hpp"
+#include "gfins/app/ports.hpp"
+#include "gfins/app/reload_worker.hpp"
+#include "gfins/hal/can_bus.hpp"
+#include "gfins/hal/clock.hpp"
+#include "gfins/hal/watchdog.hpp"
+#include "gfins/nav_core/pipeline.hpp"
+
+namespace gfins::app {
+
+/// Commands handled per cycle: a burst of commands cannot stretch one cycle past its period
+/// (each is a few µs; two keep the worst case far below 1 ms).
+inline constexpr int kMaxCommandsPerCycle = 2;
+/// read_sample waits this many sample periods before reporting a lost data-ready line.
+inline constexpr std::int64_t kReadTimeoutPeriods = 3;
+/// A calibration capture averages at most this many samples (65 s at 1 kHz).
+inline constexpr std::uint32_t kMaxCaptureSamples = 65535;
+inline constexpr std::uint8_t kMaxPose = 63;
+/// Capture motion threshold: a channel whose standard deviation exceeds 2 mg of its scale factor
+/// was not static (QA-1100 noise is 70 µg rms per sample, docs/sensor-model.md: ~30x that).
+inline constexpr double kCaptureMotionStdG = 2e-3;
+
+/// Latency of the loop: data-ready edge → the cycle's frames handed to the CAN backend. A fixed
+/// histogram of 1 µs bins (no allocation); values beyond the last bin land in it.
+class LatencyHistogram {
+ public:
+  static constexpr std::size_t kBins = 20000;  // 0..20 ms
+  void add(std::int64_t ns) {
+    const std::int64_t us = ns < 0 ? 0 : ns / 1000;
+    ++bins_[static_cast<std::size_t>(us < static_cast<std::int64_t>(kBins) ? us : kBins - 1)];
+    ++count_;
+    if (ns > max_ns_) max_ns_ = ns;
+  }
+  std::uint64_t count() const { return count_; }
+  std::int64_t max_ns() const { return max_ns_; }
+  /// Upper edge of the bin holding quantile q (0..1), µs.
+  double quantile_us(double q) const;
+
+ private:
+  std::array<std::uint32_t, kBins> bins_{};
+  std::uint64_t count_ = 0;
+  std::int64_t max_ns_ = 0;
+};
+
+struct LoopOptions {
+  double sample_rate_hz = 1000.0;
+  float initial_heading_rad = 0;
+  nav::Vec3<float> initial_position_n = nav::Vec3<float>::Zero();
+};
+
+class SampleLoop {
+ public:
+  SampleLoop(SampleSource& adc, hal::CanBus& bus, EpochSink& out, hal::Clock& clock,
+             FwLogQueue& log);
+
+  /// Optional collaborators (set before configure): command codec, watchdog, reload worker.
+  void set_command_codec(const CommandCodec* codec) { codec_ = codec; }
+  void set_watchdog(hal::Watchdog* wd) { watchdog_ = wd; }
+  void set_reload_worker(ReloadWorker* w) { reload_ = w; }
+
+  /// Start-up: configures the pipeline (alignment starts with the first sample).
+  [[nodiscard]] Status configure(const CalibrationSet& cal, const LoopOptions& options);
+
+  enum class Cycle : std::uint8_t { kSample, kTimeout, kReadError };
+  /// One cycle: waits for the next edge, processes it.
+  Cycle step();
+
+  const HealthCounters& health() const { return health_; }
+  const LatencyHistogram& latency() const { return latency_; }
+  const nav::NavPipeline<float>& pipeline() const { return pipeline_; }
+  Mode mode() const { return mode_; }
+  std::uint32_t cal_id() const { return cal_.cal_id; }
+  bool calibrated() const { return cal_.calibrated; }
+  bool capture_active() const { return capture_.active; }
+  /// The result of the last finished calibration capture (also sent as response frames).
+  const CaptureResult& last_capture() const { return last_capture_; }
+
+  /// Executes one decoded command (the CAN path calls it; tests may too). Fills `r` with the
+  /// immediate response; nothing changes when the command is rejected.
+  void execute(const Command& c, Response& r);
+
+ private:
+  struct Capture {
+    bool active = false;
+    Command command{};
+    std::uint32_t target = 0;
+    std::array<double, kAdcChannels> mean{}, m2{};
+    std::array<std::uint32_t, kAdcChannels> n{};
+    std::array<bool, kAdcChannels> saturated{};
+  };
+
+  void on_sample(const RawSample& s);
+  void update_adc_counters(std::uint32_t sample);
+  void update_can_counters(std::uint32_t sample, std::int64_t t_ns);
+  void capture_add(const RawSample& s);
+  void capture_finish();
+  void handle_commands(std::int64_t t_ns);
+  void poll_reload(std::int64_t t_ns);
+  void send_response(const Response& r);
+  void build_epoch(const RawSample& s);
+  Status reconfigure_keep_navigation(const nav::PipelineConfig<float>& cfg);
+  void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
+           std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0);
+
+  SampleSource& adc_;
+  hal::CanBus& bus_;
+  EpochSink& out_;
+  hal::Clock& clock_;
+  FwLogQueue& log_;
+  const CommandCodec* codec_ = nullptr;
+  hal::Watchdog* watchdog_ = nullptr;
+  ReloadWorker* reload_ = nullptr;
+
+  nav::NavPipeline<float> pipeline_{};
+  CalibrationSet cal_{};
+  LoopOptions options_{};
+  std::int64_t period_ns_ = 1000000;
+  HealthCounters health_{};
+  AdcCounters adc_seen_{};
+  hal::CanCounters can_seen_{};
+  hal::CanBusState can_state_ = hal::CanBusState::kErrorActive;
+  StuckDetector stuck_{};
+  LatchedBits events_{};
+  Capture capture_{};
+  CaptureResult last_capture_{};
+  Epoch epoch_{};
+  LatencyHistogram latency_{};
+  std::array<std::int32_t, kAdcChannels> last_counts_{};
+  std::uint32_t last_seq_ = 0;
+  bool have_seq_ = false;
+  std::uint8_t reload_token_ = 0;
+  bool reload_pending_ = false;
+  Mode mode_ = Mode::kStartup;
+  std::uint32_t sample_index_ = 0;
+  std::uint32_t last_log_ = 0;
+};
+
+}  // namespace gfins::app

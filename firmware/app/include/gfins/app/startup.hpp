@@ -1,0 +1,50 @@
+// Start-up steps that turn the configuration and the calibration file into what the sample loop
+// runs with (docs/firmware.md, "Start-up"). Host/Linux side: allocation and file I/O are fine
+// here, before the loop starts.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "gfins/app/config.hpp"
+#include "gfins/app/reload_worker.hpp"
+#include "gfins/app/sample_loop.hpp"
+#include "gfins/calib_file/calibration_data.hpp"
+
+namespace gfins::app {
+
+/// 32-bit calibration identity published on CAN: the file's FNV-1a 64 checksum folded to 32
+/// bits (high XOR low). 0 is reserved for "uncalibrated defaults" (a file folding to 0 is
+/// published as 1).
+std::uint32_t calibration_id(const calib_file::CalibrationData& d);
+
+/// Pipeline configuration from the firmware configuration and a calibration.
+nav::PipelineConfig<float> pipeline_config(const FwConfig& c, const calib_file::CalibrationData& d);
+
+/// Loop options (rates, initial heading and position) from the configuration.
+LoopOptions loop_options(const FwConfig& c);
+
+struct StartupCalibration {
+  CalibrationSet set;
+  bool from_file = false;
+  std::string message;  // what happened (a loud warning when !from_file)
+};
+
+/// Reads `c.calibration_file`. Missing or invalid → `defaults` flagged uncalibrated (cal_id 0),
+/// and `message` says why; the file is never modified. With no file configured and a `factory`
+/// calibration (the simulated board's: its scenario's true parameters), that one is used as a
+/// calibration.
+StartupCalibration load_calibration(const FwConfig& c,
+                                    const calib_file::CalibrationData& defaults,
+                                    const calib_file::CalibrationData* factory = nullptr);
+
+/// Nominal calibration of a board whose chain has `volts_per_count` at the sensor: Table 1
+/// geometry with ρ = 0.1 m, QA-1100 nominal scale factor 1.33 V/g (1.33 mA/g into 1 kΩ), zero
+/// bias and misalignment, no compensation.
+calib_file::CalibrationData nominal_calibration(double volts_per_count);
+
+/// The ReloadWorker's loader for the configured file: a new set on success; logs and nullopt on
+/// failure (the calibration in use stays).
+ReloadWorker::LoadFn calibration_reloader(const FwConfig& c);
+
+}  // namespace gfins::app

@@ -1,0 +1,186 @@
+// gfins-fw command line (CLI11): a configuration file, then overrides of its keys. The help text
+// names the configuration key each option overrides.
+#include <CLI/CLI.hpp>
+
+#include <sstream>
+
+#include "gfins/app/config.hpp"
+
+namespace gfins::app {
+namespace {
+
+template <typename E, std::size_t N>
+E pick(const std::string& s, const std::array<const char*, N>& names,
+       const std::array<E, N>& values) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (s == names[i]) return values[i];
+  }
+  return values[0];  // unreachable: CLI::IsMember checked the text
+}
+
+}  // namespace
+
+CliResult parse_command_line(int argc, const char* const* argv) {
+  CliResult out;
+  CLI::App app{
+      "gfins-fw: the gyro-free INS firmware. Reads the ADC on every data-ready edge, navigates and "
+      "publishes on CAN; --sim runs the same program on the simulated board.",
+      "gfins-fw"};
+  std::string config_file, board, spi, chip, line, can_if, can_log, compensator, calib, gravity,
+      watchdog, wd_device, level, scenario, scenario_dir, pacing;
+  double rate = 0, g = 0, lat = 0, height = 0, heading = 0, align = 0, duration = 0;
+  std::vector<double> position;
+  std::vector<std::string> dividers;
+  int node = 0, prio = 0;
+  bool no_mlock = false, print_default = false;
+
+  app.add_option("-c,--config", config_file, "configuration file (TOML); default: built-in")
+      ->check(CLI::ExistingFile);
+  auto* o_sim = app.add_option("--sim", scenario,
+                               "run on the simulated board with this scenario (name or .toml; "
+                               "sets board.kind = \"sim\" and sim.scenario)");
+  auto* o_board = app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim"}));
+  auto* o_spi = app.add_option("--spi-device", spi, "adc.spi_device");
+  auto* o_chip = app.add_option("--gpio-chip", chip, "adc.gpio_chip");
+  auto* o_line = app.add_option("--drdy-line", line, "adc.drdy_line (offset or name)");
+  auto* o_rate = app.add_option("--sample-rate", rate, "adc.sample_rate_hz");
+  auto* o_can = app.add_option("--can", can_if, "can.interface");
+  auto* o_log = app.add_option("--can-log", can_log, "can.log_file (candump log instead of an interface)");
+  auto* o_node = app.add_option("--node-id", node, "can.node_id");
+  auto* o_div = app.add_option("--divider", dividers,
+                               "output.NAME = N (repeatable), NAME a message of [output]: epoch "
+                               "status quaternion euler rate angular_accel accel velocity "
+                               "position_ne position_d health_adc health_system sensors_a "
+                               "sensors_b");
+  auto* o_comp = app.add_option("--compensator", compensator, "navigation.compensator")
+                     ->check(CLI::IsMember({"calibration", "none", "paper", "exact"}));
+  auto* o_cal = app.add_option("--calibration", calib, "calibration.file");
+  auto* o_grav = app.add_option("--gravity", gravity, "navigation.gravity")
+                     ->check(CLI::IsMember({"standard", "constant", "normal"}));
+  auto* o_g = app.add_option("--gravity-mps2", g, "navigation.gravity_mps2");
+  auto* o_lat = app.add_option("--latitude-deg", lat, "navigation.latitude_deg");
+  auto* o_h = app.add_option("--height-m", height, "navigation.height_m");
+  auto* o_head = app.add_option("--heading-deg", heading, "navigation.heading_deg");
+  auto* o_pos = app.add_option("--position-m", position, "navigation.position_m (3 numbers, NED)")
+                    ->expected(3)
+                    ->delimiter(',');
+  auto* o_align = app.add_option("--alignment-s", align, "navigation.alignment_s");
+  auto* o_prio = app.add_option("--rt-priority", prio, "realtime.priority (0 = no SCHED_FIFO)");
+  app.add_flag("--no-mlock", no_mlock, "realtime.lock_memory = false");
+  auto* o_wd = app.add_option("--watchdog", watchdog, "watchdog.kind")
+                   ->check(CLI::IsMember({"none", "systemd", "device"}));
+  auto* o_wdd = app.add_option("--watchdog-device", wd_device, "watchdog.device");
+  auto* o_level = app.add_option("--log-level", level, "log.level");
+  auto* o_pacing = app.add_option("--pacing", pacing, "sim.pacing")
+                       ->check(CLI::IsMember({"fast", "realtime"}));
+  auto* o_dur = app.add_option("--duration", duration, "sim.duration_s (0 = the scenario's)");
+  auto* o_sdir = app.add_option("--scenario-dir", scenario_dir, "sim.scenario_dir");
+  app.add_flag("--check-config", out.check_only, "validate the configuration and exit");
+  app.add_flag("--print-default-config", print_default, "print the commented default and exit");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::ostringstream o, err;
+    out.exit_code = app.exit(e, o, err);
+    out.message = o.str() + err.str();
+    return out;
+  }
+  if (print_default) {
+    out.message = default_config_text();
+    return out;
+  }
+
+  FwConfig c;
+  if (!config_file.empty()) {
+    ConfigResult r = load_config(config_file);
+    if (!r.ok()) {
+      out.exit_code = 2;
+      out.message = "gfins-fw: " + r.error + "\n";
+      return out;
+    }
+    c = *r.config;
+    out.config_source = config_file;
+  }
+
+  if (o_board->count()) c.board = board == "sim" ? BoardKind::kSim : BoardKind::kLinux;
+  if (o_sim->count()) {
+    c.board = BoardKind::kSim;
+    c.sim_scenario = scenario;
+  }
+  if (o_spi->count()) c.spi_device = spi;
+  if (o_chip->count()) c.gpio_chip = chip;
+  if (o_line->count()) c.drdy_line = line;
+  if (o_rate->count()) c.sample_rate_hz = rate;
+  if (o_can->count()) c.can_interface = can_if;
+  if (o_log->count()) c.can_log = can_log;
+  if (o_node->count()) c.node_id = node;
+  for (const std::string& d : dividers) {
+    const auto eq = d.find('=');
+    const int m = eq == std::string::npos ? -1 : message_index(d.substr(0, eq));
+    long n = -1;
+    if (m >= 0) {
+      try {
+        std::size_t used = 0;
+        n = std::stol(d.substr(eq + 1), &used);
+        if (used != d.size() - eq - 1) n = -1;
+      } catch (const std::exception&) {
+        n = -1;
+      }
+    }
+    if (m < 0 || n < 0 || n > kMaxDivider) {
+      out.exit_code = 2;
+      out.message = "gfins-fw: command line: --divider " + d +
+                    ": expected NAME=N with NAME a message of [output] and N 0.." +
+                    std::to_string(kMaxDivider) + "\n";
+      return out;
+    }
+    c.dividers[static_cast<std::size_t>(m)] = static_cast<std::uint16_t>(n);
+  }
+  (void)o_div;
+  if (o_comp->count()) {
+    c.compensator = pick(compensator, std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
+                         std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration,
+                                                          CompensatorChoice::kNone,
+                                                          CompensatorChoice::kPaper,
+                                                          CompensatorChoice::kExact});
+  }
+  if (o_cal->count()) c.calibration_file = calib;
+  if (o_grav->count()) {
+    c.gravity = pick(gravity, std::array<const char*, 3>{"standard", "constant", "normal"},
+                     std::array<GravityChoice, 3>{GravityChoice::kStandard,
+                                                  GravityChoice::kConstant,
+                                                  GravityChoice::kNormal});
+  }
+  if (o_g->count()) c.gravity_mps2 = g;
+  if (o_lat->count()) c.latitude_deg = lat;
+  if (o_h->count()) c.height_m = height;
+  if (o_head->count()) c.heading_deg = heading;
+  if (o_pos->count()) c.position_m = {position[0], position[1], position[2]};
+  if (o_align->count()) c.alignment_s = align;
+  if (o_prio->count()) c.rt_priority = prio;
+  if (no_mlock) c.lock_memory = false;
+  if (o_wd->count()) {
+    c.watchdog = pick(watchdog, std::array<const char*, 3>{"none", "systemd", "device"},
+                      std::array<WatchdogKind, 3>{WatchdogKind::kNone, WatchdogKind::kSystemd,
+                                                  WatchdogKind::kDevice});
+  }
+  if (o_wdd->count()) c.watchdog_device = wd_device;
+  if (o_level->count()) c.log_level = level;
+  if (o_pacing->count()) c.pacing = pacing == "realtime" ? Pacing::kRealTime : Pacing::kFast;
+  if (o_dur->count()) c.sim_duration_s = duration;
+  if (o_sdir->count()) c.sim_scenario_dir = scenario_dir;
+
+  // The file was valid on its own, so a problem now comes from an option.
+  const std::string origin =
+      config_file.empty() ? "command line" : "command line (over " + config_file + ")";
+  if (std::string problem = validate(c, origin); !problem.empty()) {
+    out.exit_code = 2;
+    out.message = "gfins-fw: " + problem + "\n";
+    return out;
+  }
+  out.config = std::move(c);
+  return out;
+}
+
+}  // namespace gfins::app

@@ -1,0 +1,444 @@
+// TOML → FwConfig with every key checked (gfins/app/config.hpp). tomlplusplus is used header-only
+// here as in firmware/calib_file (same reasons); every toml:: call that can throw is inside the
+// try block of parse_config().
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "gfins/app/config.hpp"
+
+namespace gfins::app {
+namespace {
+
+struct ConfigError {
+  std::string message;
+};
+
+// Reads typed values out of the parsed table; every problem throws ConfigError with the file,
+// line and key; remembers the keys it knows so the rest can be reported as unknown.
+class Reader {
+ public:
+  Reader(const toml::table& root, const std::string& source) : root_(root), source_(source) {}
+
+  const toml::node* find(const std::string& key) {
+    known_.insert(key);
+    const toml::node_view<const toml::node> n = root_.at_path(key);
+    return n ? n.node() : nullptr;
+  }
+
+  [[noreturn]] void fail(const std::string& key, const toml::node* n, const std::string& what) {
+    std::ostringstream m;
+    m << source_;
+    if (n != nullptr && n->source().begin.line > 0) m << ":" << n->source().begin.line;
+    m << ": " << key;
+    if (n != nullptr) m << " = " << value_text(*n);
+    m << ": " << what;
+    throw ConfigError{m.str()};
+  }
+
+  void text(const std::string& key, std::string& s) {
+    if (const toml::node* n = find(key)) {
+      if (!n->is_string()) fail(key, n, "must be a string");
+      s = n->value<std::string>().value_or("");
+    }
+  }
+  void integer(const std::string& key, int& v, int lo, int hi) {
+    if (const toml::node* n = find(key)) {
+      const auto* i = n->as_integer();
+      if (i == nullptr || i->get() < lo || i->get() > hi) {
+        fail(key, n, "must be an integer " + std::to_string(lo) + ".." + std::to_string(hi));
+      }
+      v = static_cast<int>(i->get());
+    }
+  }
+  void number(const std::string& key, double& x) {
+    if (const toml::node* n = find(key)) {
+      if (const auto* f = n->as_floating_point()) {
+        x = f->get();
+      } else if (const auto* i = n->as_integer()) {
+        x = static_cast<double>(i->get());
+      } else {
+        fail(key, n, "must be a number");
+      }
+    }
+  }
+  void boolean(const std::string& key, bool& b) {
+    if (const toml::node* n = find(key)) {
+      if (!n->is_boolean()) fail(key, n, "must be true or false");
+      b = n->value<bool>().value_or(false);
+    }
+  }
+  void vec3(const std::string& key, std::array<double, 3>& v) {
+    if (const toml::node* n = find(key)) {
+      const toml::array* a = n->as_array();
+      if (a == nullptr || a->size() != 3) fail(key, n, "must be an array of 3 numbers");
+      for (std::size_t k = 0; k < 3; ++k) {
+        const toml::node* e = a->get(k);
+        if (const auto* f = e->as_floating_point()) {
+          v[k] = f->get();
+        } else if (const auto* i = e->as_integer()) {
+          v[k] = static_cast<double>(i->get());
+        } else {
+          fail(key, n, "must be an array of 3 numbers");
+        }
+      }
+    }
+  }
+  // One of `names`; sets `out` to the matching enumerator of `values`.
+  template <typename E, std::size_t N>
+  void choice(const std::string& key, E& out, const std::array<const char*, N>& names,
+              const std::array<E, N>& values) {
+    if (const toml::node* n = find(key)) {
+      std::string allowed;
+      for (std::size_t i = 0; i < N; ++i) {
+        allowed += (i == 0 ? "\"" : (i + 1 == N ? " or \"" : ", \"")) + std::string(names[i]) + "\"";
+      }
+      if (!n->is_string()) fail(key, n, "must be " + allowed);
+      const std::string s = n->value<std::string>().value_or("");
+      for (std::size_t i = 0; i < N; ++i) {
+        if (s == names[i]) {
+          out = values[i];
+          return;
+        }
+      }
+      fail(key, n, "must be " + allowed);
+    }
+  }
+  // The data-ready line: an offset (integer, or a string of digits) or a line name.
+  void line(const std::string& key, std::string& s) {
+    if (const toml::node* n = find(key)) {
+      if (const auto* i = n->as_integer()) {
+        if (i->get() < 0 || i->get() > 1023) fail(key, n, "line offset must be 0..1023");
+        s = std::to_string(i->get());
+      } else if (n->is_string()) {
+        s = n->value<std::string>().value_or("");
+      } else {
+        fail(key, n, "must be a line offset (integer) or a line name (string)");
+      }
+    }
+  }
+
+  // The first key present in the file that no reader asked for.
+  void reject_unknown(const toml::table& t, const std::string& prefix) {
+    for (const auto& [k, node] : t) {
+      const std::string p = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (const toml::table* sub = node.as_table(); sub != nullptr && known_tables_.count(p) != 0) {
+        reject_unknown(*sub, p);
+      } else if (known_.count(p) == 0) {
+        std::ostringstream m;
+        m << source_;
+        if (node.source().begin.line > 0) m << ":" << node.source().begin.line;
+        m << ": unknown key '" << p << "'";
+        throw ConfigError{m.str()};
+      }
+    }
+  }
+  void table(const std::string& name) { known_tables_.insert(name); }
+
+ private:
+  static std::string value_text(const toml::node& n) {
+    std::ostringstream o;
+    if (n.is_table()) return "{...}";
+    if (n.is_array()) return "[...]";
+    if (const auto* v = n.as_string()) o << '"' << v->get() << '"';
+    if (const auto* v = n.as_integer()) o << v->get();
+    if (const auto* v = n.as_floating_point()) o << v->get();
+    if (const auto* v = n.as_boolean()) o << (v->get() ? "true" : "false");
+    std::string s = o.str();
+    if (s.size() > 60) s = s.substr(0, 57) + "...";
+    return s;
+  }
+
+  const toml::table& root_;
+  const std::string& source_;
+  std::set<std::string> known_;
+  std::set<std::string> known_tables_;
+};
+
+void read_all(Reader& r, FwConfig& c) {
+  for (const char* t : {"board", "adc", "can", "output", "navigation", "calibration", "realtime",
+                        "watchdog", "log", "sim"}) {
+    r.table(t);
+  }
+  r.choice("board.kind", c.board, std::array<const char*, 2>{"linux", "sim"},
+           std::array<BoardKind, 2>{BoardKind::kLinux, BoardKind::kSim});
+  r.text("adc.spi_device", c.spi_device);
+  r.text("adc.gpio_chip", c.gpio_chip);
+  r.line("adc.drdy_line", c.drdy_line);
+  r.number("adc.sample_rate_hz", c.sample_rate_hz);
+  r.text("can.interface", c.can_interface);
+  r.text("can.log_file", c.can_log);
+  r.integer("can.node_id", c.node_id, 0, kMaxNodeId);
+  for (std::size_t m = 0; m < kNumMessages; ++m) {
+    int d = c.dividers[m];
+    r.integer("output." + std::string(kMessageNames[m]), d, 0, kMaxDivider);
+    c.dividers[m] = static_cast<std::uint16_t>(d);
+  }
+  r.choice("navigation.compensator", c.compensator,
+           std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
+           std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration,
+                                            CompensatorChoice::kNone, CompensatorChoice::kPaper,
+                                            CompensatorChoice::kExact});
+  r.choice("navigation.gravity", c.gravity,
+           std::array<const char*, 3>{"standard", "constant", "normal"},
+           std::array<GravityChoice, 3>{GravityChoice::kStandard, GravityChoice::kConstant,
+                                        GravityChoice::kNormal});
+  r.number("navigation.gravity_mps2", c.gravity_mps2);
+  r.number("navigation.latitude_deg", c.latitude_deg);
+  r.number("navigation.height_m", c.height_m);
+  r.number("navigation.heading_deg", c.heading_deg);
+  r.vec3("navigation.position_m", c.position_m);
+  r.number("navigation.alignment_s", c.alignment_s);
+  r.text("calibration.file", c.calibration_file);
+  r.integer("realtime.priority", c.rt_priority, 0, kMaxRtPriority);
+  r.boolean("realtime.lock_memory", c.lock_memory);
+  r.choice("watchdog.kind", c.watchdog, std::array<const char*, 3>{"none", "systemd", "device"},
+           std::array<WatchdogKind, 3>{WatchdogKind::kNone, WatchdogKind::kSystemd,
+                                       WatchdogKind::kDevice});
+  r.text("watchdog.device", c.watchdog_device);
+  r.text("log.level", c.log_level);
+  r.text("sim.scenario", c.sim_scenario);
+  r.text("sim.scenario_dir", c.sim_scenario_dir);
+  r.choice("sim.pacing", c.pacing, std::array<const char*, 2>{"fast", "realtime"},
+           std::array<Pacing, 2>{Pacing::kFast, Pacing::kRealTime});
+  r.number("sim.duration_s", c.sim_duration_s);
+}
+
+bool printable_path(const std::string& s) {
+  return !s.empty() && s.size() < 4096 &&
+         std::all_of(s.begin(), s.end(), [](char ch) { return ch >= 0x20 && ch != 0x7F; });
+}
+
+// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the NUL), no '/', no whitespace.
+bool valid_ifname(const std::string& s) {
+  return !s.empty() && s.size() <= 15 && std::all_of(s.begin(), s.end(), [](char ch) {
+    return ch > 0x20 && ch < 0x7F && ch != '/' && ch != ':';
+  });
+}
+
+}  // namespace
+
+std::string validate(const FwConfig& c, const std::string& origin) {
+  const auto bad = [&](const char* key, const std::string& value, const std::string& allowed) {
+    return origin + ": " + key + " = " + value + ": " + allowed;
+  };
+  const auto num = [](double x) {
+    std::ostringstream o;
+    o << x;
+    return o.str();
+  };
+  if (std::find(kSampleRatesHz.begin(), kSampleRatesHz.end(), c.sample_rate_hz) ==
+      kSampleRatesHz.end()) {
+    return bad("adc.sample_rate_hz", num(c.sample_rate_hz),
+               "must be 500, 1000, 2000 or 4000 (ADS131M06 data rates at 8.192 MHz)");
+  }
+  if (!printable_path(c.spi_device)) {
+    return bad("adc.spi_device", "\"" + c.spi_device + "\"", "must be a device path");
+  }
+  if (!printable_path(c.gpio_chip)) {
+    return bad("adc.gpio_chip", "\"" + c.gpio_chip + "\"", "must be a chip name or path");
+  }
+  if (c.drdy_line.empty() || c.drdy_line.size() > 31 ||
+      !std::all_of(c.drdy_line.begin(), c.drdy_line.end(),
+                   [](char ch) { return ch > 0x20 && ch < 0x7F; })) {
+    return bad("adc.drdy_line", "\"" + c.drdy_line + "\"",
+               "must be a line offset or a line name of 1..31 printable characters");
+  }
+  if (c.can_log.empty() && !valid_ifname(c.can_interface)) {
+    return bad("can.interface", "\"" + c.can_interface + "\"",
+               "must be an interface name of 1..15 characters without '/', ':' or spaces");
+  }
+  if (!c.can_log.empty() && !printable_path(c.can_log)) {
+    return bad("can.log_file", "\"" + c.can_log + "\"", "must be a printable file path");
+  }
+  if (c.node_id < 0 || c.node_id > kMaxNodeId) {
+    return bad("can.node_id", std::to_string(c.node_id),
+               "must be an integer 0.." + std::to_string(kMaxNodeId));
+  }
+  for (std::size_t m = 0; m < kNumMessages; ++m) {
+    if (c.dividers[m] > kMaxDivider) {
+      return bad(("output." + std::string(kMessageNames[m])).c_str(),
+                 std::to_string(c.dividers[m]),
+                 "must be 0 (off) .. " + std::to_string(kMaxDivider));
+    }
+  }
+  // The CAN message table's rule: epoch and status open every epoch, so they share a divider
+  // (not 0), and every other enabled message is a multiple of it (its frames follow an epoch).
+  const std::uint16_t epoch_div = c.dividers[0];
+  if (epoch_div == 0) return bad("output.epoch", "0", "must be 1.." + std::to_string(kMaxDivider));
+  if (c.dividers[1] != epoch_div) {
+    return bad("output.status", std::to_string(c.dividers[1]),
+               "must equal output.epoch (" + std::to_string(epoch_div) + ")");
+  }
+  for (std::size_t m = 2; m < kNumMessages; ++m) {
+    if (c.dividers[m] % epoch_div != 0) {
+      return bad(("output." + std::string(kMessageNames[m])).c_str(),
+                 std::to_string(c.dividers[m]),
+                 "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) +
+                     ")");
+    }
+  }
+  if (!(c.gravity_mps2 >= 9.7 && c.gravity_mps2 <= 9.9)) {
+    return bad("navigation.gravity_mps2", num(c.gravity_mps2),
+               "must be 9.7..9.9 m/s² (the Earth's surface range is 9.76..9.84)");
+  }
+  if (!(std::abs(c.latitude_deg) <= 90.0)) {
+    return bad("navigation.latitude_deg", num(c.latitude_deg), "must be -90..90 degrees");
+  }
+  if (!(c.height_m >= -500.0 && c.height_m <= 20000.0)) {
+    return bad("navigation.height_m", num(c.height_m),
+               "must be -500..20000 m (the normal gravity's free-air term is first order)");
+  }
+  if (!(c.heading_deg >= -360.0 && c.heading_deg <= 360.0)) {
+    return bad("navigation.heading_deg", num(c.heading_deg), "must be -360..360 degrees");
+  }
+  for (double p : c.position_m) {
+    if (!std::isfinite(p) || std::abs(p) > 1e7) {
+      return bad("navigation.position_m", num(p), "components must be finite, |x| <= 1e7 m");
+    }
+  }
+  if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
+    return bad("navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s");
+  }
+  if (!c.calibration_file.empty() && !printable_path(c.calibration_file)) {
+    return bad("calibration.file", "\"" + c.calibration_file + "\"",
+               "must be a printable file path (or empty for none)");
+  }
+  if (c.rt_priority < 0 || c.rt_priority > kMaxRtPriority) {
+    return bad("realtime.priority", std::to_string(c.rt_priority),
+               "must be 0 (no SCHED_FIFO) .. 99");
+  }
+  if (c.watchdog == WatchdogKind::kDevice && !printable_path(c.watchdog_device)) {
+    return bad("watchdog.device", "\"" + c.watchdog_device + "\"", "must be a device path");
+  }
+  static constexpr std::array<const char*, 6> kLevels = {"trace", "debug", "info",
+                                                         "warn",  "error", "off"};
+  if (std::find_if(kLevels.begin(), kLevels.end(),
+                   [&](const char* l) { return c.log_level == l; }) == kLevels.end()) {
+    return bad("log.level", "\"" + c.log_level + "\"",
+               "must be \"trace\", \"debug\", \"info\", \"warn\", \"error\" or \"off\"");
+  }
+  if (c.board == BoardKind::kSim) {
+    if (c.sim_scenario.empty() || c.sim_scenario.size() > 4096 ||
+        c.sim_scenario.find('\0') != std::string::npos) {
+      return bad("sim.scenario", "\"" + c.sim_scenario + "\"",
+                 "must be a scenario name or a .toml file");
+    }
+    if (!(c.sim_duration_s >= 0.0 && c.sim_duration_s <= 86400.0)) {
+      return bad("sim.duration_s", num(c.sim_duration_s),
+                 "must be 0 (the scenario's) .. 86400 s");
+    }
+  }
+  return "";
+}
+
+ConfigResult parse_config(std::string_view toml_text, const std::string& source, FwConfig base) {
+  ConfigResult out;
+  try {
+    const toml::table root = toml::parse(toml_text, source);
+    Reader r(root, source);
+    read_all(r, base);
+    r.reject_unknown(root, "");
+  } catch (const toml::parse_error& e) {
+    std::ostringstream m;
+    m << source << ":" << e.source().begin.line << ": TOML syntax: " << e.description();
+    out.error = m.str();
+    return out;
+  } catch (const ConfigError& e) {
+    out.error = e.message;
+    return out;
+  } catch (const std::exception& e) {
+    out.error = source + ": " + e.what();
+    return out;
+  }
+  if (std::string problem = validate(base, source); !problem.empty()) {
+    out.error = std::move(problem);
+    return out;
+  }
+  out.config = std::move(base);
+  return out;
+}
+
+ConfigResult load_config(const std::string& path, FwConfig base) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    ConfigResult r;
+    r.error = path + ": cannot open the configuration file";
+    return r;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    ConfigResult r;
+    r.error = path + ": read error";
+    return r;
+  }
+  return parse_config(text.str(), path, std::move(base));
+}
+
+const char* to_string(BoardKind b) { return b == BoardKind::kSim ? "sim" : "linux"; }
+const char* to_string(Pacing p) { return p == Pacing::kRealTime ? "realtime" : "fast"; }
+const char* to_string(GravityChoice g) {
+  switch (g) {
+    case GravityChoice::kStandard:
+      return "standard";
+    case GravityChoice::kConstant:
+      return "constant";
+    case GravityChoice::kNormal:
+      return "normal";
+  }
+  return "?";
+}
+const char* to_string(CompensatorChoice c) {
+  switch (c) {
+    case CompensatorChoice::kCalibration:
+      return "calibration";
+    case CompensatorChoice::kNone:
+      return "none";
+    case CompensatorChoice::kPaper:
+      return "paper";
+    case CompensatorChoice::kExact:
+      return "exact";
+  }
+  return "?";
+}
+const char* to_string(WatchdogKind w) {
+  switch (w) {
+    case WatchdogKind::kNone:
+      return "none";
+    case WatchdogKind::kSystemd:
+      return "systemd";
+    case WatchdogKind::kDevice:
+      return "device";
+  }
+  return "?";
+}
+
+int message_index(std::string_view name) {
+  for (std::size_t m = 0; m < kNumMessages; ++m) {
+    if (kMessageNames[m] == name) return static_cast<int>(m);
+  }
+  return -1;
+}
+
+nav::CompensatorKind resolve_compensator(CompensatorChoice choice,
+                                         nav::CompensatorKind from_file) {
+  switch (choice) {
+    case CompensatorChoice::kCalibration:
+      return from_file;
+    case CompensatorChoice::kNone:
+      return nav::CompensatorKind::kNone;
+    case CompensatorChoice::kPaper:
+      return nav::CompensatorKind::kPaper;
+    case CompensatorChoice::kExact:
+      return nav::CompensatorKind::kExact;
+  }
+  return from_file;
+}
+
+}  // namespace gfins::app

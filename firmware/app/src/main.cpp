@@ -1,0 +1,111 @@
+// gfins-fw: configuration → calibration → ADC start → static alignment → navigation, on the
+// Linux board or on the simulated board (docs/firmware.md).
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <memory>
+
+#include "board.hpp"
+#include "gfins/app/config.hpp"
+#include "gfins/app/logger.hpp"
+#include "gfins/app/sample_loop.hpp"
+#include "gfins/app/startup.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop.store(true); }
+
+int run(const gfins::app::FwConfig& cfg) {
+  using namespace gfins::app;
+  gfins::app::init_spdlog(cfg.log_level);
+  spdlog::info("gfins-fw: board {}, {} Hz, node {}, compensator {}", to_string(cfg.board),
+               cfg.sample_rate_hz, cfg.node_id, to_string(cfg.compensator));
+
+  BoardResult made = make_board(cfg);
+  if (!made.board) {
+    spdlog::critical("board set-up failed: {}", made.error);
+    return 1;
+  }
+  Board& board = *made.board;
+
+  const StartupCalibration cal = load_calibration(
+      cfg, board.defaults, board.factory ? &*board.factory : nullptr);
+  if (cal.from_file) {
+    spdlog::info("{}", cal.message);
+  } else {
+    spdlog::warn("**************************************************************************");
+    spdlog::warn("{}", cal.message);
+    spdlog::warn("**************************************************************************");
+  }
+
+  auto log_queue = std::make_unique<FwLogQueue>();
+  LogDrain drain(*log_queue);
+  drain.start();
+  ReloadWorker reload(calibration_reloader(cfg));
+
+  auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
+                                           *log_queue);
+  loop->set_command_codec(board.codec.get());
+  loop->set_watchdog(board.watchdog.get());
+  loop->set_reload_worker(&reload);
+  if (const gfins::Status s = loop->configure(cal.set, loop_options(cfg)); !s.is_ok()) {
+    spdlog::critical("navigation core rejected the configuration: {}", s.message());
+    return 1;
+  }
+  if (const std::string warn = board.enter_realtime(cfg); !warn.empty()) spdlog::warn("{}", warn);
+  if (board.watchdog) (void)board.watchdog->notify_ready();
+  spdlog::info("sample loop running (alignment: keep the board still for {} s)", cfg.alignment_s);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  while (!g_stop.load(std::memory_order_relaxed) && !board.finished()) loop->step();
+
+  drain.stop();
+  const HealthCounters& h = loop->health();
+  const auto& st = loop->pipeline().state();
+  spdlog::info("stopped after {} samples; mode {}, calibration id {:08x}{}", h.samples,
+               static_cast<int>(loop->mode()), loop->cal_id(),
+               loop->calibrated() ? "" : " (UNCALIBRATED)");
+  spdlog::info("health: missed edges {}, extra edges {}, data-ready timeouts {}, CRC errors {}, "
+               "ADC resets {}, saturated {}, stuck events {} (mask {:#x}), CAN dropped {}, "
+               "bus-off {}, overruns {}, log dropped {}",
+               h.missed_edges, h.extra_edges, h.drdy_timeouts, h.crc_errors, h.adc_resets,
+               h.saturated_samples, h.stuck_events, h.stuck_mask, h.can_tx_dropped,
+               h.bus_off_events, h.loop_overruns, h.log_dropped);
+  spdlog::info("final state t {:.3f} s: v_n [{:.4f} {:.4f} {:.4f}] m/s, r_n [{:.4f} {:.4f} {:.4f}] m",
+               static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),
+               st.r_n.y(), st.r_n.z());
+  if (loop->latency().count() > 0) {
+    spdlog::info("latency edge → CAN: p50 {} µs, p99 {} µs, max {:.1f} µs over {} epochs",
+                 loop->latency().quantile_us(0.5), loop->latency().quantile_us(0.99),
+                 static_cast<double>(loop->latency().max_ns()) * 1e-3, loop->latency().count());
+  }
+  board.close();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const gfins::app::CliResult cli = gfins::app::parse_command_line(argc, argv);
+    if (!cli.config) {
+      std::fputs(cli.message.c_str(), cli.exit_code == 0 ? stdout : stderr);
+      return cli.exit_code;
+    }
+    if (cli.check_only) {
+      std::printf("gfins-fw: configuration %s is valid\n",
+                  cli.config_source.empty() ? "(defaults)" : cli.config_source.c_str());
+      return 0;
+    }
+    return run(*cli.config);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gfins-fw: %s\n", e.what());
+    return 1;
+  }
+}

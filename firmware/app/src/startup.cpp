@@ -1,0 +1,130 @@
+#include "gfins/app/startup.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "gfins/calib_file/calibration_file.hpp"
+
+namespace gfins::app {
+namespace {
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+}
+
+std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
+  const std::uint64_t h = calib_file::checksum(d);
+  const auto id = static_cast<std::uint32_t>(h ^ (h >> 32));
+  return id == 0 ? 1u : id;
+}
+
+nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
+                                           const calib_file::CalibrationData& d) {
+  nav::PipelineConfig<float> p;
+  calib_file::apply_to(d, p);
+  p.compensator = resolve_compensator(c.compensator, d.compensator);
+  switch (c.gravity) {
+    case GravityChoice::kStandard:
+      p.gravity = nav::GravityModel<float>::constant(static_cast<float>(nav::kStandardGravity));
+      break;
+    case GravityChoice::kConstant:
+      p.gravity = nav::GravityModel<float>::constant(static_cast<float>(c.gravity_mps2));
+      break;
+    case GravityChoice::kNormal:
+      p.gravity = nav::GravityModel<float>::normal(c.latitude_deg * kRadPerDeg, c.height_m);
+      break;
+  }
+  p.sample_rate_hz = c.sample_rate_hz;
+  p.alignment_samples =
+      static_cast<std::uint32_t>(std::llround(std::max(1.0, c.alignment_s * c.sample_rate_hz)));
+  p.heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
+  p.r0_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
+                            static_cast<float>(c.position_m[1]),
+                            static_cast<float>(c.position_m[2]));
+  return p;
+}
+
+LoopOptions loop_options(const FwConfig& c) {
+  LoopOptions o;
+  o.sample_rate_hz = c.sample_rate_hz;
+  o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
+  o.initial_position_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
+                                          static_cast<float>(c.position_m[1]),
+                                          static_cast<float>(c.position_m[2]));
+  return o;
+}
+
+calib_file::CalibrationData nominal_calibration(double volts_per_count) {
+  calib_file::CalibrationData d;
+  d.device_id = "nominal";
+  d.created_utc = "1970-01-01T00:00:00Z";
+  d.source = "gfins-fw nominal defaults (no calibration file)";
+  d.geometry.kind = calib_file::GeometryKind::kTable1;
+  d.geometry.rho_m = 0.1;
+  for (auto& s : d.sensors) {
+    s.adc_lsb_v_per_count = volts_per_count;
+    s.scale_v_per_g = 1.33;  // QA-1100: 1.33 mA/g nominal into a 1 kΩ load resistor
+  }
+  d.compensator = nav::CompensatorKind::kNone;
+  return d;
+}
+
+StartupCalibration load_calibration(const FwConfig& c,
+                                    const calib_file::CalibrationData& defaults,
+                                    const calib_file::CalibrationData* factory) {
+  StartupCalibration out;
+  std::string why;
+  if (c.calibration_file.empty() && factory != nullptr) {
+    out.set.config = pipeline_config(c, *factory);
+    out.set.cal_id = calibration_id(*factory);
+    out.set.calibrated = true;
+    out.from_file = true;  // a real calibration, not the flagged defaults
+    out.message = "factory calibration of the board (" + factory->source + ")";
+    return out;
+  }
+  if (c.calibration_file.empty()) {
+    why = "no calibration file configured (calibration.file is empty)";
+  } else {
+    auto loaded = calib_file::load_calibration_file(c.calibration_file);
+    if (loaded.is_ok()) {
+      out.set.config = pipeline_config(c, loaded.value());
+      out.set.cal_id = calibration_id(loaded.value());
+      out.set.calibrated = true;
+      out.from_file = true;
+      char id[16];
+      std::snprintf(id, sizeof id, "%08x", out.set.cal_id);
+      out.message = "calibration " + c.calibration_file + " (device " + loaded.value().device_id +
+                    ", id " + id + ")";
+      return out;
+    }
+    why = loaded.status().message();
+  }
+  out.set.config = pipeline_config(c, defaults);
+  out.set.cal_id = 0;
+  out.set.calibrated = false;
+  out.message = "UNCALIBRATED: " + why +
+                "; navigating with nominal defaults, the CAN status says uncalibrated";
+  return out;
+}
+
+ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
+  return [c](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> {
+    if (c.calibration_file.empty()) {
+      spdlog::error("calibration reload: no calibration file configured");
+      return std::nullopt;
+    }
+    auto loaded = calib_file::load_calibration_file(c.calibration_file);
+    if (!loaded.is_ok()) {
+      spdlog::error("calibration reload failed, the calibration in use stays: {}",
+                    loaded.status().message());
+      return std::nullopt;
+    }
+    CalibrationSet s;
+    s.config = pipeline_config(c, loaded.value());
+    s.cal_id = calibration_id(loaded.value());
+    s.calibrated = true;
+    return s;
+  };
+}
+
+}  // namespace gfins::app

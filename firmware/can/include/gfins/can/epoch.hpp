@@ -1,0 +1,73 @@
+// What the firmware hands the CAN publisher once per sample: the navigation state, the six
+// compensated accelerometer outputs, the mode, the validity/health bits, the calibration identity
+// and the health counters (docs/can-interface.md describes how each reaches the bus).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gfins/nav_core/nav_state.hpp"
+
+namespace gfins::can {
+
+/// Operating mode carried by GfinsEpoch.Mode (4 bits on the bus; VAL_ table in the DBC).
+enum class Mode : std::uint8_t {
+  kStartup = 0,      // configuring the ADC, loading calibration
+  kAligning = 1,     // static leveling in progress: attitude not yet valid
+  kNavigating = 2,   // navigation outputs valid
+  kCalibrating = 3,  // a calibration capture is running (navigation continues)
+  kFault = 4,        // a fault stopped navigation; health frames say which
+  kReplay = 5,       // fed from a recorded or synthetic stream (hardware-in-the-loop)
+};
+
+/// Bits of Epoch::status_bits and of GfinsStatus.StatusFlags (20 bits on the bus). Bits 0..3 are
+/// the navigation core's nav_status bits, at the same positions (checked below).
+namespace status_bits {
+inline constexpr std::uint32_t kAligned = 1u << 0;       // initial attitude set
+inline constexpr std::uint32_t kSampleGap = 1u << 1;     // sample counter jumped before this step
+inline constexpr std::uint32_t kInputInvalid = 1u << 2;  // a sample was rejected (flags, NaN)
+inline constexpr std::uint32_t kCompensated = 1u << 3;   // misalignment compensation active
+inline constexpr std::uint32_t kCanSaturated = 1u << 4;  // a value of this epoch was clipped to
+                                                         // its signal's documented limit
+inline constexpr std::uint32_t kCanNotAvailable = 1u << 5;  // a value was NaN/inf: sent as N/A
+inline constexpr std::uint32_t kAdcCrcError = 1u << 6;      // ADC frame CRC error since last epoch
+inline constexpr std::uint32_t kAdcSaturated = 1u << 7;     // an ADC channel at full scale
+inline constexpr std::uint32_t kAdcChannelStuck = 1u << 8;  // a channel judged stuck
+inline constexpr std::uint32_t kNominalCalibration = 1u << 9;  // no calibration file: nominal
+inline constexpr std::uint32_t kLoopOverrun = 1u << 10;        // the sample loop missed a deadline
+inline constexpr std::uint32_t kCanTxDropped = 1u << 11;       // CAN frames were dropped
+inline constexpr std::uint32_t kCaptureActive = 1u << 12;      // calibration capture running
+inline constexpr std::uint32_t kHealthDegraded = 1u << 13;     // any health counter grew recently
+inline constexpr std::uint32_t kAllBits = (1u << 20) - 1;      // width of the bus field
+static_assert(kAligned == nav::nav_status::kAligned && kSampleGap == nav::nav_status::kSampleGap &&
+                  kInputInvalid == nav::nav_status::kInputInvalid &&
+                  kCompensated == nav::nav_status::kCompensated,
+              "bits 0..3 mirror nav_status so the publisher can OR NavState::status in");
+inline constexpr std::uint32_t kNavStatusMask = 0xFu;
+}  // namespace status_bits
+
+/// Counters carried by GfinsHealthAdc / GfinsHealthSystem. Each only grows; on the bus it is
+/// sent modulo 2^(signal length) (a rolling count: receivers look at differences).
+struct Health {
+  std::uint32_t missed_drdy_edges = 0;  // data-ready edges the loop did not service
+  std::uint32_t adc_crc_errors = 0;     // ADC frames with a CRC mismatch
+  std::uint32_t adc_resets = 0;         // chip resets detected / recoveries
+  std::uint32_t saturated_samples = 0;  // samples with a channel at full scale
+  std::uint8_t stuck_channel_mask = 0;  // bit c = channel c judged stuck (6 bits)
+  std::uint32_t can_tx_dropped = 0;     // frames the CAN backend dropped
+  std::uint32_t bus_off_events = 0;     // transitions into bus-off
+  std::uint32_t loop_overruns = 0;      // sample-loop deadline misses
+};
+
+/// One sample's worth of what may be published. Every value refers to nav.t_ns, the sampling
+/// instant (data-ready edge) of sample nav.seq.
+struct Epoch {
+  nav::NavState<float> nav;           // q_nb, ω_b, ω̇_b, f_b, v_n, r_n (frames: b FRD, n NED)
+  std::array<float, 6> accel_mps2{};  // compensated outputs of the six sensors, m/s²
+  std::uint8_t mode = 0;              // Mode
+  std::uint32_t status_bits = 0;      // status_bits (nav.status bits 0..3 are ORed in)
+  std::uint32_t cal_id = 0;           // identity of the calibration in use (0 = nominal)
+  Health health;
+};
+
+}  // namespace gfins::can

@@ -1,0 +1,640 @@
+// The one message table of the gfins CAN interface. The firmware encoder (Publisher, responses),
+// the host decoder (gfins-can), the command codec and the DBC generator all read it; nothing about
+// the bus layout is written anywhere else (docs/can-interface.md is generated from the same facts
+// and checked against it).
+//
+// Conventions (docs/can-interface.md): classic CAN 2.0, 11-bit identifiers = base + node id
+// (node id 0..15), 8 data bytes, signals little-endian (Intel, DBC "@1"), bit 0 = LSB of byte 0.
+// Data frames: payload bits 0..51, rolling epoch counter bits 52..55, CRC-8/SAE-J1850 bits 56..63
+// over the two identifier bytes (little-endian) and data bytes 0..6.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace gfins::can {
+
+inline constexpr std::uint8_t kMaxNodeId = 15;
+inline constexpr std::uint32_t kNodeIdSpan = 16;  // base IDs are 16 apart
+inline constexpr std::uint32_t kDefaultBitRate = 500000;
+inline constexpr double kDefaultSampleRateHz = 1000.0;  // the dividers' defaults assume 1 kHz
+inline constexpr std::uint8_t kFrameLength = 8;
+inline constexpr std::uint8_t kCounterStartBit = 52;
+inline constexpr std::uint8_t kCounterLength = 4;
+inline constexpr std::uint8_t kCrcStartBit = 56;
+inline constexpr std::uint8_t kCrcByte = 7;
+
+/// What a signal carries, so the encoder knows where to read it and the decoder where to put it.
+enum class Field : std::uint8_t {
+  kNone,
+  kCounter,
+  kCrc,
+  // GfinsEpoch / GfinsStatus
+  kTimeUs,
+  kSampleCount,
+  kMode,
+  kStatusFlags,
+  kCalId,
+  // navigation (index = axis or component)
+  kQuaternion,  // index 0 = w, 1..3 = x, y, z
+  kEuler,       // 0 roll, 1 pitch, 2 yaw
+  kRate,
+  kAngularAccel,
+  kAccel,
+  kVelocity,
+  kPosition,
+  kSensorAccel,  // index = sensor 0..5
+  // health
+  kMissedEdges,
+  kAdcCrcErrors,
+  kAdcResets,
+  kStuckMask,
+  kSaturatedSamples,
+  kCanTxDropped,
+  kBusOffEvents,
+  kLoopOverruns,
+  // command
+  kCmdOpcode,
+  kCmdToken,
+  kCmdHeading,
+  kCmdCompensator,
+  kCmdMessage,
+  kCmdDivider,
+  kCmdPose,
+  kCmdSamples,
+  // response
+  kRspOpcode,
+  kRspToken,
+  kRspPart,
+  kRspResult,
+  kRspValue,
+  kRspCalId,
+  kRspMean,  // index = channel
+  kRspStd,
+  kRspCount,
+  kRspSaturated,
+  kRspMotion,
+  kRspPose,
+  kRspSamples,
+};
+
+/// What happens to a value beyond the signal's range: navigation values are clipped to the
+/// documented limit (and the epoch flagged), counters and times wrap modulo 2^length.
+enum class Overflow : std::uint8_t { kSaturate, kWrap };
+
+inline constexpr std::int16_t kNotMultiplexed = -1;
+inline constexpr std::int16_t kMultiplexor = -2;
+
+struct ValueName {
+  std::int64_t raw;
+  std::string_view name{};
+};
+
+struct SignalDef {
+  std::string_view name{};
+  Field field = Field::kNone;
+  std::uint8_t index = 0;  // axis / component / channel for array fields
+  std::uint8_t start_bit = 0;
+  std::uint8_t length = 0;
+  bool is_signed = false;
+  double factor = 1.0;
+  double offset = 0.0;
+  std::string_view unit{};
+  double min = 0.0;  // physical limits: encoder saturates here, DBC [min|max]
+  double max = 0.0;
+  bool has_na = false;      // a raw value reserved for "not available"
+  std::int64_t na_raw = 0;  // that raw value (most negative for signed, all ones for unsigned)
+  Overflow overflow = Overflow::kSaturate;
+  std::int16_t mux = kNotMultiplexed;   // kMultiplexor, or the selector value this signal needs
+  std::span<const ValueName> values{};  // enumeration (DBC VAL_)
+  std::string_view instant{};           // which instant the value refers to
+  std::string_view comment{};
+};
+
+enum class MessageId : std::uint8_t {
+  kEpoch,
+  kStatus,
+  kQuaternion,
+  kEuler,
+  kRate,
+  kAngularAccel,
+  kAccel,
+  kVelocity,
+  kPositionNE,
+  kPositionD,
+  kHealthAdc,
+  kHealthSystem,
+  kSensorsA,
+  kSensorsB,
+  kCommand,
+  kResponse,
+};
+inline constexpr std::size_t kMessageCount = 16;
+
+enum class MessageKind : std::uint8_t { kData, kCommand, kResponse };
+
+struct MessageDef {
+  std::string_view name{};
+  MessageId id;
+  std::uint16_t base_id;  // CAN identifier of node 0
+  MessageKind kind;
+  std::uint16_t default_divider;  // of the sample rate; 0 = off (commands/responses: unused)
+  std::span<const SignalDef> signals;
+  std::string_view sender;  // DBC node
+  std::string_view comment{};
+};
+
+// ---------------------------------------------------------------------------------------------
+// Enumerations
+
+inline constexpr std::array<ValueName, 6> kModeValues{{{0, "Startup"},
+                                                       {1, "Aligning"},
+                                                       {2, "Navigating"},
+                                                       {3, "Calibrating"},
+                                                       {4, "Fault"},
+                                                       {5, "Replay"}}};
+
+inline constexpr std::array<ValueName, 7> kOpcodeValues{{{1, "Realign"},
+                                                         {2, "ResetNavigation"},
+                                                         {3, "SetCompensator"},
+                                                         {4, "SetDivider"},
+                                                         {5, "ReportCalibrationId"},
+                                                         {6, "StartCapture"},
+                                                         {7, "ReloadCalibration"}}};
+
+inline constexpr std::array<ValueName, 3> kCompensatorValues{
+    {{0, "None"}, {1, "Paper"}, {2, "Exact"}}};
+
+inline constexpr std::array<ValueName, 9> kResultValues{{{0, "Ok"},
+                                                         {1, "UnknownOpcode"},
+                                                         {2, "BadLength"},
+                                                         {3, "BadCrc"},
+                                                         {4, "OutOfRange"},
+                                                         {5, "Malformed"},
+                                                         {6, "Busy"},
+                                                         {7, "Failed"},
+                                                         {8, "NotReady"}}};
+
+inline constexpr std::array<ValueName, 16> kMessageIdValues{{{0, "Epoch"},
+                                                             {1, "Status"},
+                                                             {2, "Quaternion"},
+                                                             {3, "Euler"},
+                                                             {4, "AngularRate"},
+                                                             {5, "AngularAccel"},
+                                                             {6, "Accel"},
+                                                             {7, "Velocity"},
+                                                             {8, "PositionNE"},
+                                                             {9, "PositionD"},
+                                                             {10, "HealthAdc"},
+                                                             {11, "HealthSystem"},
+                                                             {12, "SensorsA"},
+                                                             {13, "SensorsB"},
+                                                             {14, "Command"},
+                                                             {15, "Response"}}};
+
+// ---------------------------------------------------------------------------------------------
+// Signal builders (keep the table one row per signal)
+
+inline constexpr std::string_view kAtSample =
+    "sampling instant of the epoch's sample (data-ready edge, GfinsEpoch.TimeUs)";
+inline constexpr std::string_view kCumulative =
+    "cumulative count up to and including the epoch's sample";
+inline constexpr std::string_view kAtCommand = "when the frame is received";
+inline constexpr std::string_view kAtResponse = "when the response is sent";
+inline constexpr std::string_view kOverCapture = "over the capture's N samples";
+
+/// A signed physical value with the most negative raw value reserved for "not available".
+constexpr SignalDef physical(std::string_view name, Field field, std::uint8_t index,
+                             std::uint8_t start, std::uint8_t length, double factor,
+                             std::string_view unit, double min, double max,
+                             std::string_view comment) {
+  return SignalDef{.name = name,
+                   .field = field,
+                   .index = index,
+                   .start_bit = start,
+                   .length = length,
+                   .is_signed = true,
+                   .factor = factor,
+                   .unit = unit,
+                   .min = min,
+                   .max = max,
+                   .has_na = true,
+                   .na_raw = -(std::int64_t{1} << (length - 1)),
+                   .instant = kAtSample,
+                   .comment = comment};
+}
+
+/// An unsigned integer that wraps modulo 2^length (counters, times).
+constexpr SignalDef wrapping(std::string_view name, Field field, std::uint8_t start,
+                             std::uint8_t length, std::string_view unit, std::string_view instant,
+                             std::string_view comment) {
+  return SignalDef{.name = name,
+                   .field = field,
+                   .start_bit = start,
+                   .length = length,
+                   .unit = unit,
+                   .min = 0.0,
+                   .max = static_cast<double>((std::uint64_t{1} << length) - 1),
+                   .overflow = Overflow::kWrap,
+                   .instant = instant,
+                   .comment = comment};
+}
+
+/// An unsigned integer or enumeration, saturating at `max`.
+constexpr SignalDef unsigned_int(std::string_view name, Field field, std::uint8_t index,
+                                 std::uint8_t start, std::uint8_t length, double max,
+                                 std::int16_t mux, std::span<const ValueName> values,
+                                 std::string_view instant, std::string_view comment,
+                                 double min = 0.0) {
+  return SignalDef{.name = name,
+                   .field = field,
+                   .index = index,
+                   .start_bit = start,
+                   .length = length,
+                   .min = min,
+                   .max = max,
+                   .mux = mux,
+                   .values = values,
+                   .instant = instant,
+                   .comment = comment};
+}
+
+constexpr SignalDef counter_signal() {
+  return wrapping("Counter", Field::kCounter, kCounterStartBit, kCounterLength, "",
+                  "the epoch this frame belongs to",
+                  "Rolling epoch counter (mod 16): equal to the GfinsEpoch.Counter of the epoch "
+                  "this frame belongs to; advances by one per published epoch");
+}
+
+constexpr SignalDef crc_signal() {
+  return SignalDef{.name = "Crc",
+                   .field = Field::kCrc,
+                   .start_bit = kCrcStartBit,
+                   .length = 8,
+                   .max = 255.0,
+                   .instant = "the frame",
+                   .comment =
+                       "CRC-8/SAE-J1850 (poly 0x1D, init 0xFF, xorout 0xFF) over the "
+                       "identifier (2 bytes, little-endian) and data bytes 0..6"};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Signals per message
+
+inline constexpr std::array<SignalDef, 5> kEpochSignals{{
+    wrapping("TimeUs", Field::kTimeUs, 0, 32, "us", kAtSample,
+             "Device time of the epoch's sample: data-ready edge, CLOCK_MONOTONIC, microseconds "
+             "mod 2^32 (wraps every 71.6 min)"),
+    wrapping("SampleCount", Field::kSampleCount, 32, 16, "", kAtSample,
+             "ADC sample counter of the epoch's sample, mod 2^16"),
+    unsigned_int("Mode", Field::kMode, 0, 48, 4, 15.0, kNotMultiplexed, kModeValues, kAtSample,
+                 "Operating mode"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 4> kStatusSignals{{
+    unsigned_int("StatusFlags", Field::kStatusFlags, 0, 0, 20, 1048575.0, kNotMultiplexed, {},
+                 kAtSample,
+                 "Validity and health bits: 0 aligned, 1 sample gap, 2 input invalid, 3 "
+                 "compensated, 4 a value of this epoch saturated on CAN, 5 a value was not "
+                 "available, 6 ADC CRC error, 7 ADC saturated, 8 ADC channel stuck, 9 nominal "
+                 "calibration, 10 loop overrun, 11 CAN frames dropped, 12 capture active, 13 "
+                 "health degraded"),
+    unsigned_int("CalId", Field::kCalId, 0, 20, 32, 4294967295.0, kNotMultiplexed, {}, kAtSample,
+                 "Identity of the calibration in use (0 = nominal parameters)"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr double kQuatFactor = 1.0 / 4095.0;
+inline constexpr std::array<SignalDef, 6> kQuaternionSignals{{
+    physical(
+        "Qw", Field::kQuaternion, 0, 0, 13, kQuatFactor, "", -1.0, 1.0,
+        "Attitude quaternion q_nb (body FRD to navigation NED), scalar part; sent with Qw >= 0"),
+    physical("Qx", Field::kQuaternion, 1, 13, 13, kQuatFactor, "", -1.0, 1.0,
+             "Attitude quaternion q_nb, x"),
+    physical("Qy", Field::kQuaternion, 2, 26, 13, kQuatFactor, "", -1.0, 1.0,
+             "Attitude quaternion q_nb, y"),
+    physical("Qz", Field::kQuaternion, 3, 39, 13, kQuatFactor, "", -1.0, 1.0,
+             "Attitude quaternion q_nb, z"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kEulerSignals{{
+    physical("Roll", Field::kEuler, 0, 0, 16, 1e-4, "rad", -3.1416, 3.1416,
+             "Roll, ZYX Euler angles of q_nb (NED to FRD)"),
+    physical("Pitch", Field::kEuler, 1, 16, 16, 1e-4, "rad", -1.5708, 1.5708,
+             "Pitch, ZYX Euler angles of q_nb"),
+    physical("Yaw", Field::kEuler, 2, 32, 16, 1e-4, "rad", -3.1416, 3.1416,
+             "Yaw (heading from north), ZYX Euler angles of q_nb"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kRateSignals{{
+    physical("RateX", Field::kRate, 0, 0, 16, 5e-4, "rad/s", -16.0, 16.0,
+             "Angular rate w_nb^b, body x (forward)"),
+    physical("RateY", Field::kRate, 1, 16, 16, 5e-4, "rad/s", -16.0, 16.0,
+             "Angular rate w_nb^b, body y (right)"),
+    physical("RateZ", Field::kRate, 2, 32, 16, 5e-4, "rad/s", -16.0, 16.0,
+             "Angular rate w_nb^b, body z (down)"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kAngularAccelSignals{{
+    physical("AngAccX", Field::kAngularAccel, 0, 0, 16, 5e-3, "rad/s^2", -160.0, 160.0,
+             "Angular acceleration dw/dt, body x"),
+    physical("AngAccY", Field::kAngularAccel, 1, 16, 16, 5e-3, "rad/s^2", -160.0, 160.0,
+             "Angular acceleration dw/dt, body y"),
+    physical("AngAccZ", Field::kAngularAccel, 2, 32, 16, 5e-3, "rad/s^2", -160.0, 160.0,
+             "Angular acceleration dw/dt, body z"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kAccelSignals{{
+    physical("AccelX", Field::kAccel, 0, 0, 16, 0.01, "m/s^2", -320.0, 320.0,
+             "Specific force f_b at the array centre, body x"),
+    physical("AccelY", Field::kAccel, 1, 16, 16, 0.01, "m/s^2", -320.0, 320.0,
+             "Specific force f_b at the array centre, body y"),
+    physical("AccelZ", Field::kAccel, 2, 32, 16, 0.01, "m/s^2", -320.0, 320.0,
+             "Specific force f_b at the array centre, body z"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kVelocitySignals{{
+    physical("VelN", Field::kVelocity, 0, 0, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, north"),
+    physical("VelE", Field::kVelocity, 1, 16, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, east"),
+    physical("VelD", Field::kVelocity, 2, 32, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, down"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 4> kPositionNESignals{{
+    physical("PosN", Field::kPosition, 0, 0, 26, 0.01, "m", -335000.0, 335000.0,
+             "Position r_n from the alignment point, north"),
+    physical("PosE", Field::kPosition, 1, 26, 26, 0.01, "m", -335000.0, 335000.0,
+             "Position r_n from the alignment point, east"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 3> kPositionDSignals{{
+    physical("PosD", Field::kPosition, 2, 0, 26, 0.01, "m", -335000.0, 335000.0,
+             "Position r_n from the alignment point, down"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 6> kHealthAdcSignals{{
+    wrapping("MissedEdges", Field::kMissedEdges, 0, 16, "", kCumulative,
+             "Data-ready edges the sample loop did not service, mod 2^16"),
+    wrapping("AdcCrcErrors", Field::kAdcCrcErrors, 16, 16, "", kCumulative,
+             "ADC frames with a CRC mismatch, mod 2^16"),
+    wrapping("AdcResets", Field::kAdcResets, 32, 8, "", kCumulative,
+             "ADC resets detected and recovered, mod 2^8"),
+    unsigned_int("StuckMask", Field::kStuckMask, 0, 40, 6, 63.0, kNotMultiplexed, {}, kAtSample,
+                 "Bit c set: ADC channel c+1 judged stuck"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 6> kHealthSystemSignals{{
+    wrapping("SaturatedSamples", Field::kSaturatedSamples, 0, 16, "", kCumulative,
+             "Samples with an ADC channel at full scale, mod 2^16"),
+    wrapping("CanTxDropped", Field::kCanTxDropped, 16, 16, "", kCumulative,
+             "CAN frames the bus backend dropped, mod 2^16"),
+    wrapping("BusOffEvents", Field::kBusOffEvents, 32, 8, "", kCumulative,
+             "Transitions into bus-off, mod 2^8"),
+    wrapping("LoopOverruns", Field::kLoopOverruns, 40, 12, "", kCumulative,
+             "Sample-loop deadline misses, mod 2^12"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kSensorsASignals{{
+    physical("Sensor1", Field::kSensorAccel, 0, 0, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 1 along its sensing axis"),
+    physical("Sensor2", Field::kSensorAccel, 1, 16, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 2 along its sensing axis"),
+    physical("Sensor3", Field::kSensorAccel, 2, 32, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 3 along its sensing axis"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kSensorsBSignals{{
+    physical("Sensor4", Field::kSensorAccel, 3, 0, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 4 along its sensing axis"),
+    physical("Sensor5", Field::kSensorAccel, 4, 16, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 5 along its sensing axis"),
+    physical("Sensor6", Field::kSensorAccel, 5, 32, 16, 0.02, "m/s^2", -600.0, 600.0,
+             "Compensated specific force of accelerometer 6 along its sensing axis"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+// Command (host -> board). Opcode is the multiplexor: each opcode's arguments are the signals
+// with its value in `mux`. Bits not used by the opcode must be zero.
+inline constexpr std::uint8_t kOpRealign = 1;
+inline constexpr std::uint8_t kOpResetNavigation = 2;
+inline constexpr std::uint8_t kOpSetCompensator = 3;
+inline constexpr std::uint8_t kOpSetDivider = 4;
+inline constexpr std::uint8_t kOpReportCalibrationId = 5;
+inline constexpr std::uint8_t kOpStartCapture = 6;
+inline constexpr std::uint8_t kOpReloadCalibration = 7;
+inline constexpr std::uint8_t kMaxCapturePose = 63;
+
+inline constexpr std::array<SignalDef, 9> kCommandSignals{{
+    SignalDef{.name = "Opcode",
+              .field = Field::kCmdOpcode,
+              .start_bit = 0,
+              .length = 8,
+              .min = 1.0,
+              .max = 7.0,
+              .mux = kMultiplexor,
+              .values = kOpcodeValues,
+              .instant = kAtCommand,
+              .comment = "Command"},
+    unsigned_int("Token", Field::kCmdToken, 0, 8, 8, 255.0, kNotMultiplexed, {}, kAtCommand,
+                 "Chosen by the sender, echoed in every response frame"),
+    SignalDef{.name = "Heading",
+              .field = Field::kCmdHeading,
+              .start_bit = 16,
+              .length = 16,
+              .is_signed = true,
+              .factor = 1e-4,
+              .unit = "rad",
+              .min = -3.1416,
+              .max = 3.1416,
+              .mux = kOpRealign,
+              .instant = kAtCommand,
+              .comment = "Realign: heading (yaw of q_nb) to align to; roll and pitch from "
+                         "static leveling"},
+    unsigned_int("Compensator", Field::kCmdCompensator, 0, 16, 8, 2.0, kOpSetCompensator,
+                 kCompensatorValues, kAtCommand, "SetCompensator: compensator to use"),
+    unsigned_int("DividerMessage", Field::kCmdMessage, 0, 16, 8, 13.0, kOpSetDivider,
+                 kMessageIdValues, kAtCommand, "SetDivider: the data message"),
+    unsigned_int("Divider", Field::kCmdDivider, 0, 24, 16, 65535.0, kOpSetDivider, {}, kAtCommand,
+                 "SetDivider: new divider of the sample rate (0 = off); a multiple of the "
+                 "Epoch divider"),
+    unsigned_int("CapturePose", Field::kCmdPose, 0, 16, 8, kMaxCapturePose, kOpStartCapture, {},
+                 kAtCommand, "StartCapture: pose index k"),
+    unsigned_int("CaptureSamples", Field::kCmdSamples, 0, 24, 16, 65535.0, kOpStartCapture, {},
+                 kAtCommand, "StartCapture: number of samples N", 1.0),
+    crc_signal(),
+}};
+
+// Response (board -> host). Part is the multiplexor.
+inline constexpr std::uint8_t kPartStatus = 0;
+inline constexpr std::uint8_t kPartCalibrationId = 1;
+inline constexpr std::uint8_t kPartCaptureDone = 2;
+inline constexpr std::uint8_t kPartMean = 0x10;     // + channel 0..5
+inline constexpr std::uint8_t kPartStd = 0x20;      // + channel
+inline constexpr std::uint8_t kPartCount = 0x30;    // + channel
+inline constexpr double kMeanFactor = 1.0 / 256.0;  // ADC counts
+inline constexpr double kStdFactor = 1.0 / 4096.0;  // ADC counts
+
+#define GFINS_CAN_CHANNEL_SIGNALS(N, C)                                                       \
+  SignalDef{.name = "MeanCh" #N,                                                              \
+            .field = Field::kRspMean,                                                         \
+            .index = C,                                                                       \
+            .start_bit = 24,                                                                  \
+            .length = 32,                                                                     \
+            .is_signed = true,                                                                \
+            .factor = kMeanFactor,                                                            \
+            .unit = "count",                                                                  \
+            .min = -8388608.0,                                                                \
+            .max = 8388607.0,                                                                 \
+            .mux = kPartMean + C,                                                             \
+            .instant = kOverCapture,                                                          \
+            .comment = "Capture: mean ADC code of channel " #N},                              \
+      SignalDef{.name = "StdCh" #N,                                                           \
+                .field = Field::kRspStd,                                                      \
+                .index = C,                                                                   \
+                .start_bit = 24,                                                              \
+                .length = 32,                                                                 \
+                .factor = kStdFactor,                                                         \
+                .unit = "count",                                                              \
+                .min = 0.0,                                                                   \
+                .max = 1048575.0,                                                             \
+                .mux = kPartStd + C,                                                          \
+                .instant = kOverCapture,                                                      \
+                .comment = "Capture: standard deviation of channel " #N},                     \
+      unsigned_int("CountCh" #N, Field::kRspCount, C, 24, 16, 65535.0, kPartCount + C, {},    \
+                   kOverCapture, "Capture: samples averaged on channel " #N),                 \
+      unsigned_int("SaturatedCh" #N, Field::kRspSaturated, C, 40, 1, 1.0, kPartCount + C, {}, \
+                   kOverCapture, "Capture: channel " #N " reached full scale"),               \
+      unsigned_int("MotionCh" #N, Field::kRspMotion, C, 41, 1, 1.0, kPartCount + C, {},       \
+                   kOverCapture, "Capture: channel " #N " varied more than a static pose allows")
+
+inline constexpr std::array<SignalDef, 39> kResponseSignals{{
+    unsigned_int("RspOpcode", Field::kRspOpcode, 0, 0, 8, 255.0, kNotMultiplexed, kOpcodeValues,
+                 kAtResponse, "Opcode of the command answered (echo, also when unknown)"),
+    unsigned_int("RspToken", Field::kRspToken, 0, 8, 8, 255.0, kNotMultiplexed, {}, kAtResponse,
+                 "Token of the command answered (echo)"),
+    SignalDef{.name = "Part",
+              .field = Field::kRspPart,
+              .start_bit = 16,
+              .length = 8,
+              .max = 255.0,
+              .mux = kMultiplexor,
+              .instant = kAtResponse,
+              .comment = "0 status, 1 calibration id, 2 capture done, 0x10+c mean, 0x20+c std, "
+                         "0x30+c count and flags of channel c+1"},
+    unsigned_int("Result", Field::kRspResult, 0, 24, 8, 255.0, kPartStatus, kResultValues,
+                 kAtResponse, "Outcome of the command"),
+    unsigned_int("Value", Field::kRspValue, 0, 32, 24, 16777215.0, kPartStatus, {}, kAtResponse,
+                 "Command-specific: the new divider, the accepted N, the failing message id"),
+    unsigned_int("CalId", Field::kRspCalId, 0, 24, 32, 4294967295.0, kPartCalibrationId, {},
+                 kAtResponse, "Identity of the calibration in use (0 = nominal)"),
+    unsigned_int("DonePose", Field::kRspPose, 0, 24, 8, 255.0, kPartCaptureDone, {}, kOverCapture,
+                 "Capture finished: pose index k"),
+    unsigned_int("DoneSamples", Field::kRspSamples, 0, 32, 16, 65535.0, kPartCaptureDone, {},
+                 kOverCapture, "Capture finished: samples taken"),
+    GFINS_CAN_CHANNEL_SIGNALS(1, 0),
+    GFINS_CAN_CHANNEL_SIGNALS(2, 1),
+    GFINS_CAN_CHANNEL_SIGNALS(3, 2),
+    GFINS_CAN_CHANNEL_SIGNALS(4, 3),
+    GFINS_CAN_CHANNEL_SIGNALS(5, 4),
+    GFINS_CAN_CHANNEL_SIGNALS(6, 5),
+    crc_signal(),
+}};
+#undef GFINS_CAN_CHANNEL_SIGNALS
+
+// ---------------------------------------------------------------------------------------------
+// The table. Order = MessageId order = transmission order within an epoch.
+
+inline constexpr std::array<MessageDef, kMessageCount> kMessages{{
+    {"GfinsEpoch", MessageId::kEpoch, 0x100, MessageKind::kData, 10, kEpochSignals, "GFINS",
+     "Opens each epoch: time and sample counter of the sample every following frame refers to"},
+    {"GfinsStatus", MessageId::kStatus, 0x110, MessageKind::kData, 10, kStatusSignals, "GFINS",
+     "Validity and health bits and calibration identity; sent with every GfinsEpoch"},
+    {"GfinsQuaternion", MessageId::kQuaternion, 0x120, MessageKind::kData, 10, kQuaternionSignals,
+     "GFINS", "Attitude quaternion q_nb"},
+    {"GfinsEuler", MessageId::kEuler, 0x130, MessageKind::kData, 20, kEulerSignals, "GFINS",
+     "Attitude as ZYX Euler angles"},
+    {"GfinsAngularRate", MessageId::kRate, 0x140, MessageKind::kData, 10, kRateSignals, "GFINS",
+     "Angular rate, body frame"},
+    {"GfinsAngularAccel", MessageId::kAngularAccel, 0x150, MessageKind::kData, 20,
+     kAngularAccelSignals, "GFINS", "Angular acceleration, body frame (Chen's solution)"},
+    {"GfinsAccel", MessageId::kAccel, 0x160, MessageKind::kData, 10, kAccelSignals, "GFINS",
+     "Specific force at the array centre, body frame"},
+    {"GfinsVelocity", MessageId::kVelocity, 0x170, MessageKind::kData, 10, kVelocitySignals,
+     "GFINS", "Velocity, navigation frame (NED)"},
+    {"GfinsPositionNE", MessageId::kPositionNE, 0x180, MessageKind::kData, 10, kPositionNESignals,
+     "GFINS", "Position from the alignment point, north and east"},
+    {"GfinsPositionD", MessageId::kPositionD, 0x190, MessageKind::kData, 10, kPositionDSignals,
+     "GFINS", "Position from the alignment point, down"},
+    {"GfinsHealthAdc", MessageId::kHealthAdc, 0x1A0, MessageKind::kData, 1000, kHealthAdcSignals,
+     "GFINS", "ADC health counters"},
+    {"GfinsHealthSystem", MessageId::kHealthSystem, 0x1B0, MessageKind::kData, 1000,
+     kHealthSystemSignals, "GFINS", "Loop and bus health counters"},
+    {"GfinsSensorsA", MessageId::kSensorsA, 0x1C0, MessageKind::kData, 0, kSensorsASignals, "GFINS",
+     "Compensated accelerometer outputs 1-3 (off by default)"},
+    {"GfinsSensorsB", MessageId::kSensorsB, 0x1D0, MessageKind::kData, 0, kSensorsBSignals, "GFINS",
+     "Compensated accelerometer outputs 4-6 (off by default)"},
+    {"GfinsCommand", MessageId::kCommand, 0x600, MessageKind::kCommand, 0, kCommandSignals, "HOST",
+     "Command to the board; answered by GfinsResponse with the same Opcode and Token"},
+    {"GfinsResponse", MessageId::kResponse, 0x680, MessageKind::kResponse, 0, kResponseSignals,
+     "GFINS", "Response to a GfinsCommand"},
+}};
+
+constexpr const MessageDef& message(MessageId id) {
+  return kMessages[static_cast<std::size_t>(id)];
+}
+
+/// The message a standard identifier belongs to and its node id; nullptr when unknown.
+constexpr const MessageDef* find_message(std::uint32_t can_id, std::uint8_t* node_id) {
+  for (const MessageDef& m : kMessages) {
+    if (can_id >= m.base_id && can_id < m.base_id + kNodeIdSpan) {
+      if (node_id != nullptr) *node_id = static_cast<std::uint8_t>(can_id - m.base_id);
+      return &m;
+    }
+  }
+  return nullptr;
+}
+
+constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id) {
+  return message(id).base_id + node_id;
+}
+
+/// Index of a signal by name within a message (kNoSignal when absent).
+inline constexpr std::size_t kNoSignal = static_cast<std::size_t>(-1);
+constexpr std::size_t signal_index(const MessageDef& m, std::string_view name) {
+  for (std::size_t i = 0; i < m.signals.size(); ++i) {
+    if (m.signals[i].name == name) return i;
+  }
+  return kNoSignal;
+}
+
+inline constexpr std::size_t kMaxSignalsPerMessage = 39;
+
+}  // namespace gfins::can

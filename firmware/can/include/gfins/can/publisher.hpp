@@ -1,0 +1,84 @@
+// Publisher: per-message rate dividers of the sample rate + the message table -> hal::CanBus.
+// Called once per sample from the real-time loop: no allocation, no blocking (hal::CanBus::send
+// never blocks), no exceptions.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gfins/can/epoch.hpp"
+#include "gfins/can/message_table.hpp"
+#include "gfins/hal/can_bus.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::can {
+
+/// Dividers of the sample rate per message (index = MessageId); 0 = off.
+using Dividers = std::array<std::uint16_t, kMessageCount>;
+
+constexpr Dividers default_dividers() {
+  Dividers d{};
+  for (std::size_t i = 0; i < kMessageCount; ++i) d[i] = kMessages[i].default_divider;
+  return d;
+}
+
+struct PublisherConfig {
+  std::uint8_t node_id = 0;  // 0..kMaxNodeId: added to every base identifier
+  Dividers dividers = default_dividers();
+};
+
+struct PublisherCounters {
+  std::uint32_t epochs = 0;              // epochs opened (GfinsEpoch frames built)
+  std::uint32_t frames_sent = 0;         // frames the bus accepted
+  std::uint32_t send_failures = 0;       // frames the bus refused (dropped, bus off, ...)
+  std::uint32_t saturated_values = 0;    // values clipped to their signal's limit
+  std::uint32_t unavailable_values = 0;  // NaN/inf values sent as not available
+};
+
+/// Checks a divider set: Epoch and Status equal (Status rides with every Epoch); every enabled
+/// data message a multiple of the Epoch divider (so its frames always follow an Epoch frame);
+/// command/response entries 0.
+[[nodiscard]] Status check_dividers(const Dividers& d);
+[[nodiscard]] Status check_config(const PublisherConfig& c);
+
+/// Values of one epoch as the bus carries them, before quantisation: what the encoder reads for a
+/// (field, index) of the table. Exposed so the host can compare decoded frames with the state.
+double epoch_field(const Epoch& e, Field field, std::uint8_t index);
+
+/// The frame of data message `m` for epoch `e` with epoch counter `counter`: encoded, sealed with
+/// its CRC. `saturated`/`unavailable` are incremented per clipped / not-available value.
+hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
+                                std::uint8_t counter, std::uint32_t* saturated,
+                                std::uint32_t* unavailable);
+
+class Publisher {
+ public:
+  /// An invalid configuration (see check_config) is replaced by the defaults and reported by
+  /// init_status(); call check_config() first to refuse it instead.
+  Publisher(hal::CanBus& bus, const PublisherConfig& c);
+
+  /// Once per sample. Sends the messages whose divider divides nav.seq, GfinsEpoch and
+  /// GfinsStatus first; the status frame carries kCanSaturated / kCanNotAvailable when a value of
+  /// this epoch was clipped / not available. Send failures are counted, never retried here.
+  void publish(const Epoch& e);
+
+  /// Changes one data message's divider (0 = off) under the rules of check_dividers;
+  /// kInvalidArgument (and nothing changed) otherwise.
+  [[nodiscard]] Status set_divider(MessageId m, std::uint16_t divider);
+
+  std::uint16_t divider(MessageId m) const { return dividers_[static_cast<std::size_t>(m)]; }
+  const Dividers& dividers() const { return dividers_; }
+  std::uint8_t node_id() const { return node_id_; }
+  Status init_status() const { return init_status_; }
+  const PublisherCounters& counters() const { return counters_; }
+
+ private:
+  hal::CanBus* bus_;
+  std::uint8_t node_id_ = 0;
+  Dividers dividers_{};
+  std::uint8_t counter_ = 0;  // epoch counter, mod 16
+  Status init_status_{};
+  PublisherCounters counters_{};
+};
+
+}  // namespace gfins::can

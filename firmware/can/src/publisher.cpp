@@ -1,0 +1,200 @@
+#include "gfins/can/publisher.hpp"
+
+#include <cmath>
+
+#include "gfins/can/signal_codec.hpp"
+
+namespace gfins::can {
+namespace {
+
+constexpr std::size_t idx(MessageId m) { return static_cast<std::size_t>(m); }
+
+/// ZYX Euler angles (roll, pitch, yaw) of q_nb, rad: the usual aerospace sequence for a
+/// body-to-NED rotation (yaw about z_n, then pitch, then roll). Pitch clamps the asin argument
+/// against rounding just beyond ±1.
+double euler_angle(const nav::Quat<float>& qf, std::uint8_t axis) {
+  const double w = qf.w();
+  const double x = qf.x();
+  const double y = qf.y();
+  const double z = qf.z();
+  switch (axis) {
+    case 0:
+      return std::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+    case 1:
+      return std::asin(std::clamp(2.0 * (w * y - z * x), -1.0, 1.0));
+    default:
+      return std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+  }
+}
+
+double vec(const nav::Vec3<float>& v, std::uint8_t i) { return static_cast<double>(v[i]); }
+
+}  // namespace
+
+Status check_dividers(const Dividers& d) {
+  const std::uint16_t epoch = d[idx(MessageId::kEpoch)];
+  if (d[idx(MessageId::kStatus)] != epoch) {
+    return Status(ErrorCode::kInvalidArgument, "can: the Status divider must equal the Epoch's");
+  }
+  for (const MessageDef& m : kMessages) {
+    const std::uint16_t v = d[idx(m.id)];
+    if (m.kind != MessageKind::kData) {
+      if (v != 0) return Status(ErrorCode::kInvalidArgument, "can: commands are not periodic");
+      continue;
+    }
+    if (v == 0) continue;
+    if (epoch == 0 || v % epoch != 0) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "can: a divider must be a multiple of the Epoch divider");
+    }
+  }
+  return Status::ok();
+}
+
+Status check_config(const PublisherConfig& c) {
+  if (c.node_id > kMaxNodeId) return Status(ErrorCode::kInvalidArgument, "can: node id > 15");
+  return check_dividers(c.dividers);
+}
+
+double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
+  const nav::NavState<float>& n = e.nav;
+  switch (field) {
+    case Field::kTimeUs:
+      // Floor division keeps the µs of a negative scenario time consistent with its ns.
+      return static_cast<double>(n.t_ns >= 0 ? n.t_ns / 1000 : -((-n.t_ns + 999) / 1000));
+    case Field::kSampleCount:
+      return static_cast<double>(n.seq);
+    case Field::kMode:
+      return e.mode;
+    case Field::kStatusFlags:
+      return static_cast<double>((e.status_bits | (n.status & status_bits::kNavStatusMask)) &
+                                 status_bits::kAllBits);
+    case Field::kCalId:
+      return static_cast<double>(e.cal_id);
+    case Field::kQuaternion: {
+      // q and -q are the same rotation; the bus carries the one with w >= 0.
+      const double sign = n.q_nb.w() < 0.0f ? -1.0 : 1.0;
+      const double c[4] = {n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()};
+      return sign * c[index & 3u];
+    }
+    case Field::kEuler:
+      return euler_angle(n.q_nb, index);
+    case Field::kRate:
+      return vec(n.w_b, index);
+    case Field::kAngularAccel:
+      return vec(n.wdot_b, index);
+    case Field::kAccel:
+      return vec(n.f_b, index);
+    case Field::kVelocity:
+      return vec(n.v_n, index);
+    case Field::kPosition:
+      return vec(n.r_n, index);
+    case Field::kSensorAccel:
+      return static_cast<double>(e.accel_mps2[index % 6u]);
+    case Field::kMissedEdges:
+      return e.health.missed_drdy_edges;
+    case Field::kAdcCrcErrors:
+      return e.health.adc_crc_errors;
+    case Field::kAdcResets:
+      return e.health.adc_resets;
+    case Field::kStuckMask:
+      return e.health.stuck_channel_mask & 0x3Fu;
+    case Field::kSaturatedSamples:
+      return e.health.saturated_samples;
+    case Field::kCanTxDropped:
+      return e.health.can_tx_dropped;
+    case Field::kBusOffEvents:
+      return e.health.bus_off_events;
+    case Field::kLoopOverruns:
+      return e.health.loop_overruns;
+    default:
+      return 0.0;
+  }
+}
+
+hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
+                                std::uint8_t counter, std::uint32_t* saturated,
+                                std::uint32_t* unavailable) {
+  hal::CanFrame f;
+  f.id = m.base_id + node_id;
+  f.len = kFrameLength;
+  std::uint64_t p = 0;
+  for (const SignalDef& s : m.signals) {
+    if (s.field == Field::kCrc) continue;
+    if (s.field == Field::kCounter) {
+      p = insert_bits(p, s, counter);
+      continue;
+    }
+    const EncodedSignal enc = encode_signal(s, epoch_field(e, s.field, s.index));
+    p = insert_bits(p, s, enc.bits);
+    if (enc.saturated && saturated != nullptr) ++*saturated;
+    if (enc.not_available && unavailable != nullptr) ++*unavailable;
+  }
+  set_payload(f, p);
+  seal_frame(f);
+  return f;
+}
+
+Publisher::Publisher(hal::CanBus& bus, const PublisherConfig& c) : bus_(&bus) {
+  init_status_ = check_config(c);
+  if (init_status_.is_ok()) {
+    node_id_ = c.node_id;
+    dividers_ = c.dividers;
+  } else {
+    dividers_ = default_dividers();
+  }
+}
+
+void Publisher::publish(const Epoch& e) {
+  const std::uint16_t epoch_div = dividers_[idx(MessageId::kEpoch)];
+  if (epoch_div == 0 || e.nav.seq % epoch_div != 0) return;
+
+  // Build every frame first so the status frame (sent second) can flag a value of this epoch
+  // that saturated in a later frame.
+  std::array<hal::CanFrame, kMessageCount> frames{};
+  std::size_t n = 2;  // slots 0 and 1: GfinsEpoch, GfinsStatus
+  std::uint32_t saturated = 0;
+  std::uint32_t unavailable = 0;
+  for (const MessageDef& m : kMessages) {
+    if (m.kind != MessageKind::kData || m.id == MessageId::kEpoch || m.id == MessageId::kStatus) {
+      continue;
+    }
+    const std::uint16_t d = dividers_[idx(m.id)];
+    if (d == 0 || e.nav.seq % d != 0) continue;
+    frames[n++] = encode_data_frame(m, e, node_id_, counter_, &saturated, &unavailable);
+  }
+  frames[0] = encode_data_frame(message(MessageId::kEpoch), e, node_id_, counter_, &saturated,
+                                &unavailable);
+  Epoch flagged = e;
+  if (saturated != 0) flagged.status_bits |= status_bits::kCanSaturated;
+  if (unavailable != 0) flagged.status_bits |= status_bits::kCanNotAvailable;
+  frames[1] = encode_data_frame(message(MessageId::kStatus), flagged, node_id_, counter_,
+                                &saturated, &unavailable);
+
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bus_->send(frames[i]).is_ok()) {
+      ++counters_.frames_sent;
+    } else {
+      ++counters_.send_failures;
+    }
+  }
+  counters_.saturated_values += saturated;
+  counters_.unavailable_values += unavailable;
+  ++counters_.epochs;
+  counter_ = static_cast<std::uint8_t>((counter_ + 1u) & 0x0Fu);
+}
+
+Status Publisher::set_divider(MessageId m, std::uint16_t divider) {
+  Dividers d = dividers_;
+  d[idx(m)] = divider;
+  // Changing the epoch divider moves the status frame with it.
+  if (m == MessageId::kEpoch) d[idx(MessageId::kStatus)] = divider;
+  if (m == MessageId::kStatus) {
+    return Status(ErrorCode::kInvalidArgument, "can: the Status divider follows the Epoch's");
+  }
+  const Status s = check_dividers(d);
+  if (s.is_ok()) dividers_ = d;
+  return s;
+}
+
+}  // namespace gfins::can

@@ -1,0 +1,169 @@
+// The simulated board (docs/firmware.md, "The simulated board"): the same firmware loop as on the
+// board, fed through the same seams by simulation backends:
+//
+//   scenario → trajectory → QA-1100 sensor model → volts ─┐
+//   sample clock → data-ready edge (seq, t_ns) ───────────┴→ ADC (chain) → RawSample → SampleLoop
+//   SampleLoop → Publisher → hal::CanBus (MemoryCanBus here, or SocketCAN / a candump log file)
+//
+// Pacing: kFast takes the next edge at once, stamped with its scenario time (driven by the
+// sample index, bit-exact run to run); kRealTime sleeps until each edge's time on the monotonic
+// clock and stamps it with that time (for latency figures).
+//
+// Fault injection (tests, docs/faults.md) sits at the places the faults happen: the ADC chain
+// (CRC error, stuck or saturated channel, chip reset), the data-ready line (missing, extra and
+// absent edges) and the CAN bus (MemoryCanBus: refusing frames, bus-off).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gfins/app/ports.hpp"
+#include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/hal/can_bus.hpp"
+#include "gfins/hal/clock.hpp"
+#include "gfins/host_sim/scenario.hpp"
+
+namespace gfins::sim_board {
+
+/// The monotonic clock through std::chrono::steady_clock (CLOCK_MONOTONIC on Linux).
+class SteadyClock final : public hal::Clock {
+ private:
+  std::int64_t do_now_ns() override;
+  Status do_sleep_until_ns(std::int64_t t_ns) override;
+};
+
+/// Clock of the fast pacing: reads the time of the edge being processed (no wall clock at all,
+/// so a fast run never sees overruns and is reproducible).
+class SampleClock final : public hal::Clock {
+ public:
+  void set(std::int64_t t_ns) { t_ns_ = t_ns; }
+
+ private:
+  std::int64_t do_now_ns() override { return t_ns_; }
+  Status do_sleep_until_ns(std::int64_t t_ns) override {
+    if (t_ns > t_ns_) t_ns_ = t_ns;
+    return Status::ok();
+  }
+  std::int64_t t_ns_ = 0;
+};
+
+/// Scenario → six sensor voltages per sample (the analog side of the board).
+class SensorStream {
+ public:
+  virtual ~SensorStream() = default;
+  /// Volts at the six sensor outputs for conversion `seq` (called once per conversion, in order).
+  virtual std::array<double, 6> volts(std::uint32_t seq) = 0;
+};
+
+/// The ADC between the sensor voltages and the RawSample: the ADS131M06 chip model driven
+/// through the real driver once that lands (SimulatedAdc), a behavioural model until then.
+class AdcChain {
+ public:
+  virtual ~AdcChain() = default;
+  virtual Status start() = 0;
+  virtual Result<RawSample> convert(const std::array<double, 6>& volts, std::uint32_t seq,
+                                    std::int64_t t_ns) = 0;
+  virtual double volts_per_count() const = 0;
+  virtual app::AdcCounters counters() const = 0;
+};
+
+/// Faults injected per conversion index (seq) or on the data-ready line.
+struct FaultPlan {
+  std::vector<std::uint32_t> crc_error_at;   // frame of this seq arrives with a bad CRC
+  std::vector<std::uint32_t> missing_edges;  // the edge of this seq is lost (conversion unseen)
+  std::vector<std::uint32_t> extra_edge_after;  // a spurious edge after this seq's edge
+  std::uint32_t reset_at = 0;                   // chip resets before this seq (0 = never)
+  std::uint32_t silent_from = 0;                // no edges from this seq on ... (0 = never)
+  std::uint32_t silent_edges = 0;               // ... for this many periods
+  int stuck_channel = -1;                       // this channel's code freezes from stuck_from
+  std::uint32_t stuck_from = 0;
+  std::uint32_t stuck_until = 0;                // 0 = for ever
+  int saturated_channel = -1;                   // this channel sits at full scale ...
+  std::uint32_t saturated_from = 0;
+  std::uint32_t saturated_until = 0;            // ... until here (0 = for ever)
+};
+
+enum class Pacing : std::uint8_t { kFast, kRealTime };
+
+/// The data-ready line and the ADC of the simulated board, as the loop sees them.
+class SimSampleSource final : public app::SampleSource {
+ public:
+  SimSampleSource(SensorStream& stream, AdcChain& adc, hal::Clock& clock, SampleClock* sample_clock,
+                  Pacing pacing, double sample_rate_hz, std::uint32_t samples);
+
+  void set_faults(const FaultPlan& f) { faults_ = f; }
+  /// True once every sample of the run was delivered.
+  bool finished() const { return remaining_ == 0; }
+  std::uint32_t next_seq() const { return next_seq_; }
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override;
+  app::AdcCounters do_counters() const override;
+  double do_volts_per_count() const override { return adc_.volts_per_count(); }
+  std::int64_t edge_time(std::uint32_t seq) const;
+  static bool contains(const std::vector<std::uint32_t>& v, std::uint32_t x);
+
+  SensorStream& stream_;
+  AdcChain& adc_;
+  hal::Clock& clock_;
+  SampleClock* sample_clock_;
+  Pacing pacing_;
+  std::int64_t period_ns_;
+  double period_s_;
+  std::int64_t t0_ns_ = 0;
+  std::uint32_t next_seq_ = 0;
+  std::uint32_t remaining_;
+  FaultPlan faults_{};
+  app::AdcCounters extra_{};  // counted here: faults the stand-in ADC cannot see itself
+  bool extra_pending_ = false;
+  std::uint32_t silent_left_ = 0;
+  std::array<std::int32_t, 6> frozen_{};
+};
+
+/// An in-memory CAN bus: frames sent are kept (fixed capacity, the oldest overwritten), frames
+/// queued with inject_rx() are received. Faults: refuse(true) makes every send fail as a full
+/// queue does (kResourceExhausted, counted as dropped); bus_off(true) enters bus-off (sends fail
+/// with kUnavailable, counted) until bus_off(false) (counted as a restart).
+class MemoryCanBus final : public hal::CanBus {
+ public:
+  explicit MemoryCanBus(std::size_t capacity = 1u << 16, std::size_t rx_capacity = 64);
+
+  void refuse(bool on) { refuse_ = on; }
+  void bus_off(bool on);
+  /// Host → board frame (commands); false when the receive queue is full.
+  bool inject_rx(const hal::CanFrame& f);
+  /// Frames sent, oldest first (at most `capacity`); total() counts all ever sent.
+  std::vector<hal::CanFrame> sent() const;
+  std::uint64_t total() const { return total_; }
+  void clear_sent() { head_ = 0, total_ = 0; }
+
+ private:
+  Status do_send(const hal::CanFrame& f) override;
+  Result<hal::CanFrame> do_receive(std::int64_t timeout_ns) override;
+  hal::CanBusState do_state() const override { return state_; }
+  hal::CanCounters do_counters() const override { return counters_; }
+
+  std::vector<hal::CanFrame> ring_;
+  std::size_t head_ = 0;
+  std::uint64_t total_ = 0;
+  std::vector<hal::CanFrame> rx_;
+  std::size_t rx_head_ = 0, rx_count_ = 0;
+  bool refuse_ = false;
+  hal::CanBusState state_ = hal::CanBusState::kErrorActive;
+  hal::CanCounters counters_{};
+};
+
+/// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample.
+std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
+
+/// The behavioural ADC (host_sim AdcModel) until the register-level chip model lands.
+std::unique_ptr<AdcChain> make_adc_chain(const sim::Scenario& s);
+
+/// The factory calibration of the simulated array: its true scale factors, biases and
+/// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.
+calib_file::CalibrationData scenario_calibration(const sim::Scenario& s, double volts_per_count);
+
+}  // namespace gfins::sim_board

@@ -1,0 +1,74 @@
+// gfins-sim covariance [NAME] (docs/error-model.md): predicted 1σ envelopes of the twelve
+// navigation errors along the scenario's truth, and the error budget at chosen times. The
+// scenario gives trajectory, duration, rate, ρ, gravity and white noise (QA-1100 noise and bias
+// random walk with model = "qa1100"); the constant-error σ come from the options.
+#include <algorithm>
+#include <cmath>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "gfins/host_sim/covariance.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
+
+namespace gfins::sim::app {
+
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::string out_dir,
+                   bool do_plot) {
+  namespace nav = gfins::nav;
+  auto loaded = load(name);
+  if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
+  const Scenario& s = loaded.value();
+  if (out_dir.empty()) out_dir = "sim-out/covariance-" + s.name;
+  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  auto traj = make_trajectory(s.trajectory);
+  if (!traj.is_ok()) return fail(traj.error(), kExitBadInput);
+  CovarianceSpec spec;
+  spec.trajectory = traj.value().get();
+  spec.geometry = nav::table1_geometry<double>(s.rho_m);
+  spec.gravity = gravity_model(s);
+  spec.duration_s = s.duration_s;
+  spec.dt_s = 1.0 / s.rate_hz;
+  spec.decimation = static_cast<std::size_t>(std::max(1.0, std::round(s.rate_hz / 100.0)));
+  const double g = nav::kStandardGravity;
+  const AccelErrors qa = AccelErrors::qa1100_typical();
+  const double noise = s.noise_mps2 > 0 ? s.noise_mps2 : (s.qa1100 ? qa.noise_g * g : 0.0);
+  const double rw = c.bias_rw_ug_sqrt_s > 0 ? c.bias_rw_ug_sqrt_s * 1e-6 * g
+                                            : (s.qa1100 ? qa.bias_rw_g_per_sqrt_s * g : 0.0);
+  spec.noise.white_sigma_mps2.fill(noise);
+  spec.noise.bias_rw_mps2_sqrt_s.fill(rw);
+  spec.noise.bias_sigma_mps2.fill(c.bias_ug * 1e-6 * g);
+  spec.constants.scale_factor_sigma.fill(c.scale_ppm * 1e-6);
+  spec.constants.orientation_sigma_rad.fill(c.orientation_urad * 1e-6);
+  spec.constants.location_sigma_m.fill(c.location_mm * 1e-3);
+  std::vector<double> times = c.times_s;
+  if (times.empty()) times = {0.25 * s.duration_s, 0.5 * s.duration_s, s.duration_s};
+  std::printf(
+      "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
+      describe(s).c_str(), noise, c.bias_ug, rw);
+  const CovarianceResult r = propagate_covariance(spec);
+  if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
+    return fail(w.error(), kExitError);
+  }
+  const ErrorBudget b = error_budget(spec, times);
+  if (auto w = write_budget_csv(b, out_dir + "/budget.csv"); !w.is_ok()) {
+    return fail(w.error(), kExitError);
+  }
+  const std::size_t last = r.t_s.size() - 1;
+  const auto block = [&](std::size_t off) {
+    return std::sqrt(r.sigma[off][last] * r.sigma[off][last] +
+                     r.sigma[off + 1][last] * r.sigma[off + 1][last] +
+                     r.sigma[off + 2][last] * r.sigma[off + 2][last]);
+  };
+  std::printf(
+      "predicted 1 sigma at t = %.3g s: |phi| %.4g deg, |dr| %.4g m, |dv| %.4g m/s, "
+      "|dw| %.4g rad/s\nwritten: %s/covariance.csv, %s/budget.csv\n",
+      r.t_s[last], block(0) * 180.0 / M_PI, block(3), block(6), block(9), out_dir.c_str(),
+      out_dir.c_str());
+  if (!do_plot) return kExitOk;
+  if (auto p = plot("plot_covariance.py", {out_dir}); !p.is_ok()) {
+    return fail(p.error(), kExitPlotFailed);
+  }
+  return kExitOk;
+}
+
+}  // namespace gfins::sim::app

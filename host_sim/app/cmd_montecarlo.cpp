@@ -1,0 +1,54 @@
+// gfins-sim montecarlo [NAME]: N seeds, error statistics over time and log-log growth slopes.
+#include <cmath>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "gfins/host_sim/montecarlo.hpp"
+
+namespace gfins::sim::app {
+
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
+                   std::string out_dir, bool do_plot) {
+  auto loaded = load(name);
+  if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
+  const Scenario& s = loaded.value();
+  if (out_dir.empty()) out_dir = "sim-out/montecarlo-" + s.name;
+  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  std::printf("gfins-sim montecarlo: %zu runs of %s\n", runs, describe(s).c_str());
+  const auto result = run_montecarlo(s, runs, seed0, tty_progress("montecarlo"));
+  if (!result.is_ok()) return fail(result.error(), kExitError);
+  const MonteCarloResult& r = result.value();
+  if (auto w = write_montecarlo_csv(r, out_dir + "/montecarlo.csv"); !w.is_ok()) {
+    return fail(w.error(), kExitError);
+  }
+  // Fit window: the last decade of the run, where the constant-residual terms dominate the noise
+  // random walk (montecarlo.hpp).
+  const double t_end = r.t_s.back();
+  const double w_slope = loglog_slope(
+      r.t_s, r.rms_norm[static_cast<std::size_t>(McQuantity::kRate)], 0.1 * t_end, t_end);
+  const double a_slope = loglog_slope(
+      r.t_s, r.rms_norm[static_cast<std::size_t>(McQuantity::kAttitude)], 0.1 * t_end, t_end);
+  const std::string slopes_path = out_dir + "/slopes.txt";
+  std::FILE* f = std::fopen(slopes_path.c_str(), "w");
+  if (f == nullptr) return fail({ErrorCode::kIoError, "cannot write " + slopes_path}, kExitError);
+  for (std::FILE* o : {stdout, f}) {
+    std::fprintf(o, "RMS calibration angle error over the runs: %.4f deg\n",
+                 r.rms_calibration_angle_error_rad * 180.0 / M_PI);
+    std::fprintf(o, "log-log slope of RMS |w error| over [%.3g, %.3g] s: %.3f (kinematics: 1)\n",
+                 0.1 * t_end, t_end, w_slope);
+    std::fprintf(
+        o, "log-log slope of RMS |attitude error| over [%.3g, %.3g] s: %.3f (kinematics: 2)\n",
+        0.1 * t_end, t_end, a_slope);
+    std::fprintf(o, "final RMS: |w| %.4g rad/s, |att| %.4g deg, |v| %.4g m/s, |r| %.4g m\n",
+                 r.rms_norm[0].back(), r.rms_norm[1].back() * 180.0 / M_PI, r.rms_norm[2].back(),
+                 r.rms_norm[3].back());
+  }
+  if (auto c = close_output(f, slopes_path); !c.is_ok()) return fail(c.error(), kExitError);
+  if (!do_plot) return kExitOk;
+  if (auto p = plot("plot_sim.py", {"montecarlo", out_dir}); !p.is_ok()) {
+    return fail(p.error(), kExitPlotFailed);
+  }
+  return kExitOk;
+}
+
+}  // namespace gfins::sim::app

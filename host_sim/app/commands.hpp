@@ -1,0 +1,46 @@
+// The subcommands of gfins-sim, one file each (docs/simulation.md).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gfins::sim::app {
+
+/// gfins-sim without a subcommand: a scenario's trajectory with an ideal array (no misalignment,
+/// no bias), once without and once with white noise, through the ADC and the core in `scalar`.
+struct DefaultOptions {
+  std::string scenario = "maneuver";
+  double duration_s = 10.0;
+  double rate_hz = 1000.0;
+  double rho_m = 0.1;
+  double noise_mg = 1.0;
+  unsigned seed = 1;
+  std::string scalar = "float";
+  std::string csv_path;
+};
+int cmd_default(const DefaultOptions& o);
+
+/// gfins-sim run FILE|NAME: without and with compensation, CSV, summary, PNG.
+int cmd_run(const std::string& name, std::string out_dir, bool do_plot);
+
+/// gfins-sim paper63: the paper's §6.3 in four configurations.
+int cmd_paper63(std::string out_dir, bool do_plot);
+
+/// gfins-sim montecarlo [NAME]: N seeds, envelopes and growth slopes.
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
+                   std::string out_dir, bool do_plot);
+
+/// gfins-sim covariance [NAME]: predicted 1σ envelopes and error budget (docs/error-model.md).
+struct CovarianceOptions {
+  double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;
+  std::vector<double> times_s;
+};
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::string out_dir,
+                   bool do_plot);
+
+/// gfins-sim list: the scenarios of host_sim/scenarios with their descriptions.
+int cmd_list();
+
+}  // namespace gfins::sim::app

@@ -1,0 +1,146 @@
+#include "common.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "gfins/drivers/linux/spawn.hpp"
+
+namespace gfins::sim::app {
+
+int fail(const HostError& e, int exit_code) {
+  std::fprintf(stderr, "gfins-sim: %s\n", e.message.c_str());
+  return exit_code;
+}
+
+HostResult<Scenario> load(const std::string& file_or_name) {
+  return load_scenario(file_or_name, GFINS_SCENARIO_DIR);
+}
+
+HostStatus make_dir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return HostError{ErrorCode::kIoError, "cannot create " + dir + ": " + ec.message()};
+  return Done{};
+}
+
+HostStatus close_output(std::FILE* f, const std::string& path) {
+  const bool write_failed = std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || write_failed) {
+    return HostError{ErrorCode::kIoError, "error writing " + path};
+  }
+  return Done{};
+}
+
+HostStatus plot(const std::string& script, const std::vector<std::string>& args) {
+  namespace lnx = gfins::drivers::lnx;
+  const char* env = std::getenv("GFINS_PYTHON");
+  std::error_code ec;
+  const std::string python = env != nullptr && env[0] != '\0'                  ? env
+                             : std::filesystem::exists("/usr/bin/python3", ec) ? "/usr/bin/python3"
+                                                                               : "python3";
+  const std::string path = std::string(GFINS_SCRIPTS_DIR) + "/" + script;
+  std::vector<std::string> argv = {python, path};
+  argv.insert(argv.end(), args.begin(), args.end());
+  // The summary first, then the script's own output (both go to the same terminal or log).
+  (void)std::fflush(stdout);
+  const auto r = lnx::run_program(argv);
+  if (!r.is_ok()) {
+    const int err = r.status().os_error();
+    return HostError{ErrorCode::kUnavailable,
+                     "plotting failed: cannot start " + python + " " + path + ": " +
+                         r.status().message() +
+                         (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) +
+                         "; the CSV files are written"};
+  }
+  if (!r.value().ok()) {
+    return HostError{ErrorCode::kUnavailable,
+                     "plotting failed: " + script + " ended with " + lnx::describe(r.value()) +
+                         " (its message is above; set GFINS_PYTHON to a python3 with matplotlib, "
+                         "or pass --no-plot); the CSV files are written"};
+  }
+  return Done{};
+}
+
+ProgressFn tty_progress(const std::string& what) {
+  if (isatty(fileno(stderr)) == 0) return {};
+  return [what, last = -1](double f) mutable {
+    const int pct = static_cast<int>(f * 100.0);
+    if (pct == last) return;
+    last = pct;
+    std::fprintf(stderr, "\r  %s: %3d %%%s", what.c_str(), pct, pct >= 100 ? "\n" : "");
+  };
+}
+
+NavSummary nav_summary(const RunSeries& r) {
+  NavSummary n;
+  for (const auto& x : r.samples) {
+    const double a = x.att_err_b().norm() * 180.0 / M_PI;
+    n.att_max_deg = std::max(n.att_max_deg, a);
+    n.vel_max_mps = std::max(n.vel_max_mps, x.v_err_n().norm());
+    n.pos_max_m = std::max(n.pos_max_m, x.r_err_n().norm());
+    n.att_final_deg = a;
+    n.vel_final_mps = x.v_err_n().norm();
+    n.pos_final_m = x.r_err_n().norm();
+  }
+  return n;
+}
+
+std::string describe(const Scenario& s) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%s: %s\n  %.3g s at %.0f Hz, rho %.3f m, noise %.3g m/s^2 (%s), compensator %s "
+                "with the %s misalignment, %s",
+                s.name.c_str(), s.description.c_str(), s.duration_s, s.rate_hz, s.rho_m,
+                s.noise_mps2, s.noise_uniform ? "uniform" : "gaussian",
+                gfins::nav::to_string(s.compensator),
+                s.misalignment_source == MisalignmentSource::kTrue ? "true" : "calibrated",
+                s.adc ? "counts through the ADC" : "m/s^2 without ADC (paper §6.3)");
+  return buf;
+}
+
+void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c) {
+  std::fprintf(f, "simulated calibration (Tables 2/3 poses, %.3g g per pose mean):\n",
+               s.calibration.mean_noise_g);
+  std::fprintf(f, "  %-6s %12s %12s %12s\n", "angle", "true deg", "est deg", "1sigma deg");
+  const char* names[6] = {"xy", "xz", "yx", "yz", "zx", "zy"};
+  const double k = 180.0 / M_PI;
+  for (std::size_t i = 0; i < 6; ++i) {
+    std::fprintf(f, "  b_%-4s %12.6f %12.6f %12.6f\n", names[i],
+                 s.misalignment.orientation.beta[i] * k, c.estimated.beta[i] * k,
+                 c.std_rad.beta[i] * k);
+  }
+  for (std::size_t i = 0; i < 6; ++i) {
+    std::fprintf(f, "  a_%-4s %12.6f %12.6f %12.6f\n", names[i],
+                 s.misalignment.orientation.alpha[i] * k, c.estimated.alpha[i] * k,
+                 c.std_rad.alpha[i] * k);
+  }
+  std::fprintf(f, "  RMS angle error %.4f deg\n", c.rms_angle_error_rad * k);
+}
+
+void print_run_table(std::FILE* f, const ScenarioOutcome& o) {
+  std::fprintf(f, "%-44s %11s %11s %11s %11s %11s %11s\n", "run", "lin lo", "lin hi", "ang lo",
+               "ang hi", "att deg", "pos m");
+  for (const auto* r : {&o.uncompensated, &o.compensated}) {
+    if (r->samples.empty()) continue;
+    const auto lin = linear_accel_bounds(*r);
+    const auto ang = angular_accel_bounds(*r);
+    const NavSummary n = nav_summary(*r);
+    std::fprintf(f, "%-44s %11.4g %11.4g %11.4g %11.4g %11.4g %11.4g\n", r->label.c_str(), lin.lo,
+                 lin.hi, ang.lo, ang.hi, n.att_final_deg, n.pos_final_m);
+  }
+  std::fprintf(
+      f,
+      "(lin: linear acceleration error, nav frame, m/s^2; ang: angular acceleration error, "
+      "rad/s^2;\n min/max over components and samples t > 0; att, pos: final error)\n");
+  const NavReport& rep = o.compensated.report;
+  if (rep.rejected != 0 || !rep.gaps.empty()) {
+    std::fprintf(f, "samples rejected by the pipeline (saturated or CRC error): %llu, gaps: %zu\n",
+                 static_cast<unsigned long long>(rep.rejected), rep.gaps.size());
+  }
+}
+
+}  // namespace gfins::sim::app

@@ -1,0 +1,55 @@
+// What the subcommands of gfins-sim share: exit codes, scenario loading, output files, the plot
+// scripts (started without a shell), progress and the summary tables.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "gfins/host_sim/error.hpp"
+#include "gfins/host_sim/scenario.hpp"
+
+namespace gfins::sim::app {
+
+// Exit codes of gfins-sim (also in --help and docs/simulation.md).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitError = 1;       // an output could not be written, a run failed
+inline constexpr int kExitBadInput = 2;    // command line or scenario file rejected
+inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures asked for are not
+
+/// Prints "gfins-sim: <message>" on stderr and returns `exit_code`.
+int fail(const HostError& e, int exit_code);
+
+/// A scenario file, or a built-in scenario by name (host_sim/scenarios: the one registry).
+HostResult<Scenario> load(const std::string& file_or_name);
+
+/// Creates the output folder (and its parents).
+HostStatus make_dir(const std::string& dir);
+
+/// Closes an output file. A failed write or close (disk full, I/O error) leaves the file
+/// incomplete, so it is an error. The error flag is read first because fclose alone reports
+/// only the last flush (glibc returns 0 after an earlier ENOSPC).
+HostStatus close_output(std::FILE* f, const std::string& path);
+
+/// Runs scripts/<script> with `args` through the Python interpreter ($GFINS_PYTHON, else
+/// Debian's /usr/bin/python3, which has python3-matplotlib; a python3 first on PATH often lacks
+/// it), without a shell: the arguments reach the script as they are, whatever they contain.
+/// Fails with a message naming the script and its exit status (or why it could not start).
+HostStatus plot(const std::string& script, const std::vector<std::string>& args);
+
+/// Progress on a TTY only (a log file gets no \r lines).
+ProgressFn tty_progress(const std::string& what);
+
+struct NavSummary {
+  double att_final_deg = 0, att_max_deg = 0;
+  double vel_final_mps = 0, vel_max_mps = 0;
+  double pos_final_m = 0, pos_max_m = 0;
+};
+NavSummary nav_summary(const RunSeries& r);
+
+/// One paragraph: name, description, duration, rate, ρ, noise, compensator.
+std::string describe(const Scenario& s);
+void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c);
+void print_run_table(std::FILE* f, const ScenarioOutcome& o);
+
+}  // namespace gfins::sim::app

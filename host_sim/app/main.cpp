@@ -1,0 +1,115 @@
+// gfins-sim: the host simulation (docs/simulation.md). One file per subcommand:
+//
+//   gfins-sim                      cmd_default.cpp: a scenario's trajectory with an ideal array
+//                                  and white noise (the project's main job, scripts/bootstrap.sh)
+//   gfins-sim run FILE|NAME        cmd_run.cpp: without and with compensation, CSV, summary, PNG
+//   gfins-sim paper63              cmd_paper63.cpp: the paper's §6.3 (Figs. 7-10), four configs
+//   gfins-sim montecarlo [NAME]    cmd_montecarlo.cpp: N seeds, statistics and growth slopes
+//   gfins-sim covariance [NAME]    cmd_covariance.cpp: predicted 1σ envelopes, error budget
+//   gfins-sim list                 cmd_list.cpp: the scenarios of host_sim/scenarios
+//
+// Every run goes through the one sample source and navigation loop of host_sim; scenarios come
+// from the one registry, host_sim/scenarios/*.toml.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "common.hpp"
+
+namespace {
+
+namespace app = gfins::sim::app;
+
+int sim_main(int argc, char** argv) {
+  app::DefaultOptions o;
+  o.scalar = GFINS_NAV_SCALAR_DEFAULT;
+  CLI::App cli{"gfins-sim: scenarios through the gyro-free navigation core"};
+  cli.footer(
+      "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
+      "scenario rejected; 3 CSV written but plotting failed (PNG asked for).");
+  const std::vector<std::string> names = gfins::sim::builtin_scenarios(GFINS_SCENARIO_DIR);
+  cli.add_option("-s,--scenario", o.scenario, "trajectory of a built-in scenario")
+      ->check(CLI::IsMember(names))
+      ->capture_default_str();
+  cli.add_option("-d,--duration", o.duration_s, "simulated time, s")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
+  cli.add_option("-r,--rate", o.rate_hz, "sample rate, Hz")
+      ->check(CLI::Range(1.0, 1e5))
+      ->capture_default_str();
+  cli.add_option("--rho", o.rho_m, "cube half-size rho, m (Table 1)")
+      ->check(CLI::Range(1e-3, 10.0))
+      ->capture_default_str();
+  cli.add_option("--noise-mg", o.noise_mg, "white noise per sensor for the noisy run, milli-g")
+      ->check(CLI::Range(0.0, 1e3))
+      ->capture_default_str();
+  cli.add_option("--seed", o.seed, "noise seed")->capture_default_str();
+  cli.add_option("--scalar", o.scalar, "navigation core scalar")
+      ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
+  cli.add_option("--csv", o.csv_path,
+                 "write t, attitude/velocity/position errors of the ideal run");
+
+  std::string scenario_name;
+  std::string out_dir;
+  bool no_plot = false;
+  std::size_t mc_runs = 50;
+  std::uint64_t mc_seed = 1;
+  auto* run_cmd = cli.add_subcommand("run", "run a scenario file or built-in scenario");
+  run_cmd->add_option("scenario", scenario_name, "file, or built-in name (host_sim/scenarios)")
+      ->required();
+  auto* p63 = cli.add_subcommand("paper63", "the paper's §6.3 experiment, Figs. 7-10");
+  auto* mc = cli.add_subcommand("montecarlo", "N seeds: error statistics and growth slopes");
+  mc->add_option("scenario", scenario_name, "file, or built-in name")
+      ->default_val("rest-calibrated");
+  mc->add_option("-n,--runs", mc_runs, "number of runs")
+      ->check(CLI::Range(2, 100000))
+      ->capture_default_str();
+  mc->add_option("--seed0", mc_seed, "seed of the first run")->capture_default_str();
+  app::CovarianceOptions cov_opts;
+  auto* cov = cli.add_subcommand("covariance", "predicted 1-sigma envelopes and error budget");
+  cov->add_option("scenario", scenario_name, "file, or built-in name")
+      ->default_val("rest-calibrated");
+  cov->add_option("--bias-ug", cov_opts.bias_ug, "random-constant bias 1 sigma per sensor, ug");
+  cov->add_option("--bias-rw", cov_opts.bias_rw_ug_sqrt_s, "bias random walk, ug/sqrt(s)");
+  cov->add_option("--scale-ppm", cov_opts.scale_ppm, "residual scale-factor error 1 sigma, ppm");
+  cov->add_option("--orientation-urad", cov_opts.orientation_urad,
+                  "residual axis orientation error 1 sigma per axis, urad");
+  cov->add_option("--location-mm", cov_opts.location_mm,
+                  "residual location error 1 sigma per axis, mm");
+  cov->add_option("--at", cov_opts.times_s, "budget times, s (default T/4, T/2, T)");
+  for (auto* c : {run_cmd, p63, mc, cov}) {
+    c->add_option("-o,--out", out_dir, "output folder (default sim-out/<name>)");
+    c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
+  }
+  auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
+  cli.require_subcommand(0, 1);
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = cli.exit(e);
+    return rc == 0 ? app::kExitOk : app::kExitBadInput;
+  }
+  if (*run_cmd) return app::cmd_run(scenario_name, out_dir, !no_plot);
+  if (*p63) return app::cmd_paper63(out_dir, !no_plot);
+  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
+  if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
+  if (*list_cmd) return app::cmd_list();
+  return app::cmd_default(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Library calls return HostError values; what may still throw here is allocation and the
+  // covariance propagation's argument checks. Any of them is a message and exit code 1.
+  try {
+    return sim_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gfins-sim: %s\n", e.what());
+    return app::kExitError;
+  }
+}

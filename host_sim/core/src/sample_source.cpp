@@ -1,0 +1,59 @@
+#include "gfins/host_sim/sample_source.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <utility>
+
+namespace gfins::sim {
+
+Result<RawSample> BehaviouralAdc::convert(const std::array<double, 6>& sensor_volts,
+                                          std::uint32_t seq, std::int64_t t_ns) {
+  Eigen::Matrix<double, 6, 1> v;
+  for (std::size_t j = 0; j < 6; ++j) v(static_cast<Eigen::Index>(j)) = sensor_volts[j];
+  RawSample s = model_.sample(v, seq);
+  s.t_ns = t_ns;  // the source's edge time (SimulatedAdc takes it as an input too)
+  return s;
+}
+
+std::unique_ptr<SourceAdc> make_source_adc(const AdcConfig& config) {
+  // The one place that picks the host's converter: the register-level SimulatedAdc replaces
+  // this line when host_sim/chip lands.
+  return std::make_unique<BehaviouralAdc>(config);
+}
+
+SampleSource::SampleSource(const Trajectory& trajectory, SensorArrayModel sensors,
+                           std::unique_ptr<SourceAdc> adc, double sample_rate_hz)
+    : trajectory_(trajectory),
+      sensors_(std::move(sensors)),
+      adc_(std::move(adc)),
+      rate_hz_(sample_rate_hz) {}
+
+void SampleSource::set_uniform_noise_mps2(double sigma_mps2, std::uint64_t seed) {
+  uniform_sigma_mps2_ = sigma_mps2;
+  uniform_rng_.seed(seed);
+}
+
+Result<SourceSample> SampleSource::next() {
+  const std::uint32_t k = k_++;
+  SourceSample out;
+  out.truth = trajectory_.at(static_cast<double>(k) / rate_hz_);
+  out.volts = sensors_.volts(out.truth);
+  if (uniform_sigma_mps2_ > 0.0) {
+    for (std::size_t j = 0; j < 6; ++j) {
+      const double n_mps2 = std::sqrt(3.0) * uniform_sigma_mps2_ * (2.0 * u01_(uniform_rng_) - 1.0);
+      out.volts(static_cast<Eigen::Index>(j)) +=
+          n_mps2 / nav::kStandardGravity * sensors_.errors().sensors[j].scale_v_per_g;
+    }
+  }
+  out.raw.seq = k;
+  out.raw.t_ns = std::llround(static_cast<double>(k) * 1e9 / rate_hz_);
+  if (!adc_) return out;
+  std::array<double, 6> v{};
+  for (std::size_t j = 0; j < 6; ++j) v[j] = out.volts(static_cast<Eigen::Index>(j));
+  const Result<RawSample> raw = adc_->convert(v, k, out.raw.t_ns);
+  if (!raw.is_ok()) return raw.status();
+  out.raw = raw.value();
+  return out;
+}
+
+}  // namespace gfins::sim

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Cross-build prerequisites for the Linux board presets (aarch64-linux, armhf-linux): adds the
+# Debian architectures arm64 and armhf, installs the cross compilers, the target architectures'
+# -dev packages the firmware and its tests link with (multiarch, next to the host's), and
+# qemu-user-static to run the cross-built unit tests. Idempotent; run as root on Debian 12.
+# Fails naming the package apt cannot install.
+set -euo pipefail
+
+archs=(arm64 armhf)
+target_dev=(libgpiod-dev libsystemd-dev libgtest-dev libgmock-dev libtomlplusplus-dev
+            libspdlog-dev libfmt-dev)
+packages=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static binfmt-support)
+for a in "${archs[@]}"; do
+  for p in "${target_dev[@]}"; do packages+=("$p:$a"); done
+done
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-cross-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-cross-deps: must run as root to install: ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+added=0
+for a in "${archs[@]}"; do
+  if ! dpkg --print-foreign-architectures | grep -qx "$a"; then
+    dpkg --add-architecture "$a"
+    added=1
+  fi
+done
+policy=$(apt-cache policy "libgpiod-dev:${archs[0]}" "libgpiod-dev:${archs[1]}")
+if [ $added -eq 1 ] || [ "$(grep -c 'Candidate: [0-9]' <<<"$policy")" -ne 2 ]; then
+  # A mirror in mid-sync makes one index fail: retry once, then let the install name what is
+  # missing.
+  apt-get update -qq || { sleep 5; apt-get update -qq; } ||
+    echo "install-cross-deps: apt-get update reported errors (continuing with the indexes it has)" >&2
+fi
+echo "install-cross-deps: installing ${#missing[@]} package(s): ${missing[*]}"
+# A Multi-Arch: same library must have one version on every architecture; when the mirror's
+# indexes disagree (a security update published for amd64 first), apt gives up with "Depends:
+# <lib>:<arch> ... but it is not going to be installed". Align such a library on the version
+# the foreign architectures have, then install.
+align_multiarch() {
+  local sim lib v specs
+  sim=$(apt-get install -s --no-install-recommends "${missing[@]}" 2>&1 || true)
+  for lib in $(sed -n 's/.*Depends: \([a-z0-9.+-]*\):\(arm64\|armhf\) .*not going to be installed.*/\1/p' <<<"$sim" | sort -u); do
+    v=$(apt-cache policy "$lib:${archs[0]}" | sed -n 's/^ *Candidate: //p')
+    specs=("$lib:amd64=$v")
+    for a in "${archs[@]}"; do specs+=("$lib:$a=$v"); done
+    echo "install-cross-deps: aligning $lib on $v for amd64 and ${archs[*]}"
+    apt-get install -y -qq --no-install-recommends --allow-downgrades "${specs[@]}" >/dev/null ||
+      { echo "install-cross-deps: cannot align $lib on version $v across architectures" >&2; exit 1; }
+  done
+}
+align_multiarch
+if ! apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; then
+  for p in "${missing[@]}"; do
+    apt-get install -y -qq --no-install-recommends "$p" >/dev/null ||
+      { echo "install-cross-deps: apt-get install $p failed" >&2; exit 1; }
+  done
+fi
+echo "install-cross-deps: done"

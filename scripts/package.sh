@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Debian packages per architecture (docs/deploy.md): configures and builds each preset, makes
+# its .deb files with CPack into out/deb/ and runs lintian on them; fails on any lintian error.
+#
+#   scripts/package.sh [preset...]      default: deb-amd64 aarch64-linux armhf-linux
+#
+# The cross presets need scripts/install-cross-deps.sh first. GFINS_JOBS sets the parallelism.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=${GFINS_JOBS:-$(nproc)}
+presets=("$@")
+[ ${#presets[@]} -gt 0 ] || presets=(deb-amd64 aarch64-linux armhf-linux)
+out=out/deb
+mkdir -p "$out"
+command -v lintian >/dev/null || { echo "package.sh: lintian missing: apt install lintian" >&2; exit 1; }
+command -v dpkg-shlibdeps >/dev/null ||
+  { echo "package.sh: dpkg-shlibdeps missing: apt install dpkg-dev" >&2; exit 1; }
+
+for p in "${presets[@]}"; do
+  echo "=== package: $p"
+  cmake --preset "$p" >/dev/null
+  cmake --build --preset "$p" -j "$jobs"
+  cpack --config "build/$p/CPackConfig.cmake" -B "build/$p/cpack" >/dev/null
+  for deb in "build/$p/cpack"/*.deb; do
+    cp "$deb" "$out/"
+    echo "  $(basename "$deb")"
+  done
+done
+
+debs=("$out"/*.deb)
+echo "=== lintian ${#debs[@]} package(s)"
+# --fail-on error: warnings are shown but only errors fail the build.
+lintian --fail-on error --no-tag-display-limit "${debs[@]}"
+echo "package.sh: ${#debs[@]} package(s) in $out, lintian: no errors"

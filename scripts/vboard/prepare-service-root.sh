@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The root file system of the service-manager stage: a fresh copy of the clean debootstrap
+# root (make-sysroot.sh) with the virtual board's kernel modules, its units and scripts, and -
+# when given - the gfins-fw .deb installed with dpkg inside it (a clean install: postinst
+# creates the user, enables the unit). Needs the initramfs staged by make-initramfs.sh (the
+# modules and drdy-toggle come from there).
+#
+#   prepare-service-root.sh [--deb FILE] [--fw-config FILE] [--rate HZ] -o DIR
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+source "$here/common.sh"
+
+deb=""
+fw_config=""
+rate=500
+out=""
+while [ $# -gt 0 ]; do
+  case $1 in
+    --deb) deb=$2; shift 2 ;;
+    --fw-config) fw_config=$2; shift 2 ;;
+    --rate) rate=$2; shift 2 ;;
+    -o) out=$2; shift 2 ;;
+    *) vb_die "prepare-service-root.sh: unknown argument '$1'" ;;
+  esac
+done
+[ -n "$out" ] || vb_die "prepare-service-root.sh: -o DIR missing"
+kver=$(vb_kernel_abi)
+pristine=$("$here/make-sysroot.sh")
+staged=$vboard_cache/initramfs/root
+[ -e "$staged/lib/modules/load-order" ] || vb_die "no staged initramfs: run make-initramfs.sh first"
+
+rm -rf "$out"
+cp -a "$pristine" "$out"
+mkdir -p "$out/lib/modules/$kver/extra" "$out/vboard"
+while read -r m; do cp "$staged/lib/modules/$m" "$out/lib/modules/$kver/extra/"; done \
+  <"$staged/lib/modules/load-order"
+depmod -b "$out" "$kver" || vb_die "depmod in the service root failed"
+cp "$staged/vboard/drdy-toggle" "$out/vboard/"
+cp "$here/service/"*.sh "$out/vboard/"
+chmod +x "$out/vboard/"*.sh
+echo "RATE=$rate" >"$out/vboard/rate.env"
+echo "WANT_FW=$([ -n "$deb" ] && echo 1 || echo 0)" >"$out/vboard/service.env"
+for u in "$here/service/"*.service; do
+  cp "$u" "$out/etc/systemd/system/"
+done
+for u in vboard-setup vboard-drdy vboard-check vboard-notify-probe; do
+  ln -sf "/etc/systemd/system/$u.service" "$out/etc/systemd/system/multi-user.target.wants/$u.service"
+done
+
+if [ -n "$deb" ]; then
+  [ -e "$deb" ] || vb_die "package $deb missing"
+  cp "$deb" "$out/tmp/"
+  chroot "$out" dpkg -i "/tmp/$(basename "$deb")" >"$vboard_cache/service-dpkg.log" 2>&1 ||
+    { cat "$vboard_cache/service-dpkg.log" >&2; vb_die "dpkg -i $(basename "$deb") in the clean root failed"; }
+  rm -f "$out/tmp/$(basename "$deb")"
+  [ -L "$out/etc/systemd/system/multi-user.target.wants/gfins-fw.service" ] ||
+    vb_die "the gfins-fw postinst did not enable gfins-fw.service"
+  if [ -n "$fw_config" ]; then
+    # The VM has no SPI controller: the firmware runs from a configuration for the virtual
+    # board (the ADC chip model on SPI, vcan0, the gpio-sim line) through a unit drop-in.
+    cp "$fw_config" "$out/etc/gfins/vboard.toml"
+    mkdir -p "$out/etc/systemd/system/gfins-fw.service.d"
+    printf '[Service]\nExecStart=\nExecStart=/usr/bin/gfins-fw --config /etc/gfins/vboard.toml\n' \
+      >"$out/etc/systemd/system/gfins-fw.service.d/vboard.conf"
+  fi
+fi
+vb_log "service root ready: $out"

@@ -1,0 +1,83 @@
+#!/bin/sh
+# vboard-check.service (service-manager stage): assertions under a real systemd, printed as
+# VBOARD-CHECK lines on the serial console and into /var/log/vboard-result (read by the host
+# through the shared root). Then the unit powers the VM off.
+out=/var/log/vboard-result
+: >$out
+failed=0
+checks=0
+say() { echo "$*"; echo "$*" >>$out; }
+pass() { checks=$((checks + 1)); say "VBOARD-CHECK PASS $*"; }
+fail() { checks=$((checks + 1)); failed=$((failed + 1)); say "VBOARD-CHECK FAIL $*"; }
+prop() { systemctl show -p "$2" --value "$1"; }
+wait_for() { # wait_for SECONDS COMMAND...: poll every 0.2 s until the command succeeds
+  n=$(($1 * 5))
+  shift
+  while [ $n -gt 0 ]; do
+    "$@" && return 0
+    sleep 0.2
+    n=$((n - 1))
+  done
+  return 1
+}
+. /vboard/service.env
+say "VBOARD-BOOTED uptime=$(cut -d' ' -f1 /proc/uptime) (systemd $(systemctl --version | head -n 1 | cut -d' ' -f2))"
+
+# --- Debian's systemd-notify as the service: the service manager's side ----------------------
+restarted() { [ "$(prop vboard-notify-probe NRestarts)" -ge 1 ]; }
+if wait_for 20 restarted; then
+  pass "probe-watchdog-restart: the probe stopped kicking; systemd restarted it (NRestarts=$(prop vboard-notify-probe NRestarts))"
+else
+  fail "probe-watchdog-restart: no restart within 20 s (NRestarts=$(prop vboard-notify-probe NRestarts), state $(prop vboard-notify-probe ActiveState))"
+fi
+if journalctl -u vboard-notify-probe --no-pager | grep -q 'Watchdog timeout'; then
+  pass "probe-watchdog-journal: the journal names the watchdog timeout"
+else
+  fail "probe-watchdog-journal: no 'Watchdog timeout' in the probe's journal"
+fi
+
+# --- gfins-fw from its .deb ------------------------------------------------------------------
+if [ "$WANT_FW" = 1 ]; then
+  if [ ! -x /usr/bin/gfins-fw ]; then
+    fail "fw-installed: /usr/bin/gfins-fw missing (the .deb was not installed)"
+  else
+    pass "fw-installed: $(dpkg-query -W -f='${Package} ${Version} ${Architecture}' gfins-fw)"
+    id gfins >/dev/null 2>&1 && pass "fw-user: $(id gfins)" || fail "fw-user: no user gfins"
+    active() { [ "$(prop gfins-fw ActiveState)" = active ]; }
+    if wait_for 60 active; then
+      pass "fw-active: Type=notify service reached active (READY=1); status '$(prop gfins-fw StatusText)'"
+    else
+      fail "fw-active: state $(prop gfins-fw ActiveState)/$(prop gfins-fw SubState) after 60 s"
+      journalctl -u gfins-fw --no-pager | tail -n 30 | sed 's/^/VBOARD-LOG fw: /'
+    fi
+    pid=$(prop gfins-fw MainPID)
+    user=$(ps -o user= -p "$pid" 2>/dev/null | tr -d ' ')
+    [ "$user" = gfins ] && pass "fw-runs-as-gfins: MainPID $pid runs as $user" ||
+      fail "fw-runs-as-gfins: MainPID $pid runs as '${user:-?}'"
+    policy=$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *//p' | head -n 1)
+    say "VBOARD-INFO fw scheduling: $policy"
+    frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
+    [ "$frames" -eq 20 ] && pass "fw-frames: 20 frames on vcan0 from the service" ||
+      fail "fw-frames: $frames of 20 frames on vcan0 within 5 s"
+
+    # A hung loop: stop the process; the watchdog must fire and systemd restart it.
+    before=$(prop gfins-fw NRestarts)
+    kill -STOP "$pid"
+    newpid() { p=$(prop gfins-fw MainPID); [ "$p" != "$pid" ] && [ "$p" != 0 ] && active; }
+    if wait_for 30 newpid; then
+      pass "fw-hang-restart: SIGSTOP'd loop killed on watchdog timeout, restarted as PID $(prop gfins-fw MainPID) (NRestarts $before -> $(prop gfins-fw NRestarts))"
+    else
+      fail "fw-hang-restart: no restart within 30 s (state $(prop gfins-fw ActiveState), NRestarts $(prop gfins-fw NRestarts))"
+    fi
+    journalctl -u gfins-fw --no-pager | grep -q 'Watchdog timeout' &&
+      pass "fw-watchdog-journal: the journal names the watchdog timeout" ||
+      fail "fw-watchdog-journal: no 'Watchdog timeout' in gfins-fw's journal"
+    frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
+    [ "$frames" -eq 20 ] && pass "fw-frames-after-restart: frames on vcan0 again" ||
+      fail "fw-frames-after-restart: $frames of 20 frames within 5 s"
+  fi
+fi
+
+if [ $failed -eq 0 ] && [ $checks -gt 0 ]; then result=PASS; else result=FAIL; fi
+say "VBOARD-RESULT $result checks=$checks failed=$failed"
+say "VBOARD-END status=$failed uptime=$(cut -d' ' -f1 /proc/uptime)"

@@ -1,0 +1,123 @@
+#!/bin/sh
+# The in-VM test of the virtual board (busybox sh inside QEMU; see docs/deploy.md, "The virtual
+# board"). Every assertion prints one line
+#   VBOARD-CHECK PASS|FAIL <name>: <what was measured>
+# and measurements print "VBOARD-MEASURE <name> <value>"; the last line is
+#   VBOARD-RESULT PASS|FAIL checks=N failed=F
+# Stages come from the kernel command line: vboard.stages=infra,backend,fw,faults (default all).
+# A stage whose program is missing FAILS naming it: nothing is skipped silently.
+failed=0
+checks=0
+pass() { checks=$((checks + 1)); echo "VBOARD-CHECK PASS $*"; }
+fail() { checks=$((checks + 1)); failed=$((failed + 1)); echo "VBOARD-CHECK FAIL $*"; }
+check() { # check NAME DETAIL COMMAND...: PASS when the command succeeds
+  name=$1 detail=$2
+  shift 2
+  if "$@"; then pass "$name: $detail"; else fail "$name: $detail"; fi
+}
+measure() { echo "VBOARD-MEASURE $1 $2"; }
+param() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" /proc/cmdline; }
+
+stages=$(param vboard.stages)
+[ -n "$stages" ] || stages=infra,backend,fw,faults
+rate=$(param vboard.rate)
+[ -n "$rate" ] || rate=500
+want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
+
+# --- the kernel side: vcan0 and a gpio-sim chip with the data-ready line -----------------------
+setup_vcan() {
+  ip link add dev vcan0 type vcan && ip link set up vcan0
+}
+setup_gpio_sim() {
+  d=/sys/kernel/config/gpio-sim/vboard
+  mkdir -p $d/bank0/line0 &&
+    echo 1 >$d/bank0/num_lines &&
+    echo gfins-vboard >$d/bank0/label &&
+    echo adc-drdy >$d/bank0/line0/name &&
+    echo 1 >$d/live || return 1
+  dev=$(cat $d/dev_name)
+  chip=$(cat $d/bank0/chip_name)
+  pull=/sys/devices/platform/$dev/$chip/sim_gpio0/pull
+  gpiochip=$chip
+  [ -w "$pull" ]
+}
+
+check vcan0-up "ip link add dev vcan0 type vcan; ip link set up vcan0" setup_vcan
+check gpio-sim-live "configfs chip with line 0 named adc-drdy is live" setup_gpio_sim
+echo "VBOARD-INFO gpio-sim chip=$gpiochip pull=$pull"
+
+# --- stage infra: the infrastructure checked with Debian's own tools ---------------------------
+if want infra; then
+  n=200
+  candump -L -n $n vcan0 >/tmp/infra-candump.log &
+  dump_pid=$!
+  sleep 1
+  cangen vcan0 -g 1 -n $n -I 123 -L 8 -D i -p 10
+  sleep 1
+  kill $dump_pid 2>/dev/null
+  wait $dump_pid 2>/dev/null
+  got=$(grep -c ' vcan0 123#' /tmp/infra-candump.log)
+  # cangen -D i: the first data byte counts up from 0, one per frame (mod 256).
+  bad=$(awk '{ split($3, a, "#"); b = substr(a[2], 1, 2); v = 0;
+               for (i = 1; i <= 2; ++i) v = v * 16 + index("0123456789ABCDEF", toupper(substr(b, i, 1))) - 1;
+               if (v != (NR - 1) % 256) ++bad } END { print bad + 0 }' /tmp/infra-candump.log)
+  check can-loopback "candump saw $got of $n cangen frames, $bad out of sequence" \
+    [ "$got" -eq $n -a "$bad" -eq 0 ]
+
+  check gpiodetect "gpiodetect lists $gpiochip" sh -c "gpiodetect | grep -q '^$gpiochip '"
+  check gpioinfo-name "gpioinfo names line 0 adc-drdy" sh -c "gpioinfo $gpiochip | grep -q '\"adc-drdy\"'"
+
+  # Edges at the nominal rate: gpiomon must see every one, spaced one period apart.
+  n=$((rate * 4))
+  gpiomon --rising-edge --num-events=$n --format='%s %n' $gpiochip 0 >/tmp/infra-gpiomon.log &
+  mon_pid=$!
+  sleep 1
+  drdy-toggle "$pull" "$rate" $n >/tmp/infra-toggle.log
+  sleep 1
+  kill $mon_pid 2>/dev/null
+  wait $mon_pid 2>/dev/null
+  cat /tmp/infra-toggle.log
+  got=$(wc -l </tmp/infra-gpiomon.log)
+  # Kernel timestamps: mean spacing over the run (s) and the largest gap, in periods.
+  # gpiomon's %n is not zero-padded: seconds and nanoseconds are read as two fields.
+  set -- $(awk -v p="$rate" '{ t = $1 + $2 * 1e-9 }
+                           NR > 1 { d = t - prev; s += d; if (d * p > m) { m = d * p; at = NR }
+                                    if (d * p > 1.5) ++gaps }
+                           { prev = t }
+                           END { if (NR > 1) printf "%.1f %.2f %d %d", (NR - 1) / s, m, gaps, at }' \
+    /tmp/infra-gpiomon.log)
+  measure gpiomon-rate-hz "$1"
+  measure gpiomon-max-gap-periods "$2"
+  measure gpiomon-gaps-over-1.5-periods "$3"
+  skipped=$(sed -n 's/.*skipped=\([0-9]*\).*/\1/p' /tmp/infra-toggle.log)
+  check gpiomon-edges "gpiomon saw $got of $n rising edges at $rate Hz (toggler skipped ${skipped:-?})" \
+    [ "$got" -eq $n -a "${skipped:-1}" -eq 0 ]
+
+  # The toggler alone at several rates: how often it is late (> 1/4 period) or stalls a period.
+  for r in 250 500 1000 2000 4000; do
+    measure toggle-alone-$r "$(drdy-toggle "$pull" $r $((r * 2)) | sed 's/drdy-toggle: //')"
+  done
+
+  # What the VM reaches at most (as fast as the sysfs writes go, gpiomon reading).
+  gpiomon --rising-edge --silent $gpiochip 0 &
+  mon_pid=$!
+  sleep 1
+  drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
+  kill $mon_pid 2>/dev/null
+  wait $mon_pid 2>/dev/null
+  measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
+fi
+
+for s in backend fw faults; do
+  want $s || continue
+  if [ -e /vboard/stage-$s.sh ]; then
+    . /vboard/stage-$s.sh
+  else
+    fail "stage-$s: its program is not in the image (see scripts/vboard/run.sh)"
+  fi
+done
+
+dmesg | grep -iE 'clocksource|tsc' | sed 's/^/VBOARD-INFO dmesg /'
+if [ $failed -eq 0 ] && [ $checks -gt 0 ]; then result=PASS; else result=FAIL; fi
+echo "VBOARD-RESULT $result checks=$checks failed=$failed"
+[ $result = PASS ]

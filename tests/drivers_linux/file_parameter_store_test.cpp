@@ -1,0 +1,233 @@
+// FileParameterStore on real files in a temporary folder: the atomic save survives a failure at
+// every step (the kernel's calls, failed one at a time through lnx::Os), loads report what is
+// wrong, and the real kernel's refusals (missing folder, sysfs) come through with errno.
+#include "gfins/drivers/lnx/file_parameter_store.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "gfins/drivers/lnx/error_text.hpp"
+
+namespace gfins::drivers::lnx {
+namespace {
+
+using ::testing::HasSubstr;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string t = (std::filesystem::temp_directory_path() / "gfins-store-XXXXXX").string();
+    path_ = ::mkdtemp(t.data());
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
+                                 std::filesystem::perm_options::add, ec);
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::size_t count_entries(const std::filesystem::path& dir) {
+  std::size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) n += e.exists() ? 1 : 0;
+  return n;
+}
+
+// The real kernel, except that the call making step `fail_at` fails with `err` (close still
+// closes: the descriptor must not leak even when close reports an error).
+class FailingOs : public Os {
+ public:
+  FailingOs(SaveStep fail_at, int err) : fail_at_(fail_at), err_(err) {}
+
+  int mkostemp(char* t, int flags) override {
+    if (fail_at_ == SaveStep::kCreateTemp) return fail();
+    temp_fd_ = Os::mkostemp(t, flags);
+    return temp_fd_;
+  }
+  long write(int fd, const void* b, std::size_t n) override {
+    if (fail_at_ == SaveStep::kWrite) return fail();
+    return Os::write(fd, b, n < 5 ? n : 5);  // short writes: the backend must loop
+  }
+  int fsync(int fd) override {
+    const bool dir = fd != temp_fd_;  // the temporary is closed before the folder is opened
+    if ((fail_at_ == SaveStep::kSyncFile && !dir) || (fail_at_ == SaveStep::kSyncDir && dir)) {
+      return fail();
+    }
+    return Os::fsync(fd);
+  }
+  int close(int fd) override {
+    const int r = Os::close(fd);
+    if (fd != temp_fd_) return r;
+    temp_fd_ = -1;  // the folder's descriptor may reuse the number
+    if (fail_at_ == SaveStep::kCloseFile) return fail();
+    return r;
+  }
+  int rename(const char* a, const char* b) override {
+    if (fail_at_ == SaveStep::kRename) return fail();
+    return Os::rename(a, b);
+  }
+
+ private:
+  int fail() {
+    errno = err_;
+    return -1;
+  }
+  SaveStep fail_at_;
+  int err_;
+  int temp_fd_ = -1;
+};
+
+std::span<const char> bytes(const std::string& s) { return {s.data(), s.size()}; }
+
+class AtomicSave : public ::testing::TestWithParam<SaveStep> {
+ protected:
+  void SetUp() override {
+    auto s = FileParameterStore::open(path_.string());
+    ASSERT_TRUE(s.is_ok());
+    ASSERT_TRUE(s.value()->save(bytes(old_)).is_ok());
+  }
+  const TempDir dir_;
+  const std::filesystem::path path_ = dir_.path() / "cal.toml";
+  const std::string old_ = "# the good calibration\nscale = 0.5\n";
+  const std::string new_ = "# a newer calibration, longer than the old one\nscale = 0.25\n";
+};
+
+TEST_P(AtomicSave, AFailureAtAnyStepLeavesAWholeFileAndNoTemporaryBehind) {
+  const SaveStep step = GetParam();
+  FailingOs os(step, EIO);
+  auto store = FileParameterStore::open(path_.string(), os);
+  ASSERT_TRUE(store.is_ok());
+  // When the OS fails this step with EIO
+  const Status s = store.value()->save(bytes(new_));
+  // Then the save reports the step and errno
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_EQ(s.code(), ErrorCode::kIoError);
+  EXPECT_EQ(s.os_error(), EIO);
+  EXPECT_EQ(store.value()->last_failed_step(), step);
+  EXPECT_THAT(s.message(), HasSubstr(to_string(step)));
+  // And the target holds one whole version: the old one before the commit point, the new after
+  if (step == SaveStep::kSyncDir) {
+    EXPECT_THAT(s.message(), HasSubstr("new file is in place"));
+    EXPECT_EQ(read_text(path_), new_);
+  } else {
+    EXPECT_THAT(s.message(), HasSubstr("previous file is unchanged"));
+    EXPECT_EQ(read_text(path_), old_);
+  }
+  EXPECT_EQ(count_entries(dir_.path()), 1u);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryStep, AtomicSave,
+                         ::testing::Values(SaveStep::kCreateTemp, SaveStep::kWrite,
+                                           SaveStep::kSyncFile, SaveStep::kCloseFile,
+                                           SaveStep::kRename, SaveStep::kSyncDir));
+
+TEST(FileParameterStore, SaveThenLoadRoundTripsTheBytesAndTheFileIsWorldReadable) {
+  const TempDir dir;
+  const auto path = dir.path() / "cal.toml";
+  auto store = FileParameterStore::open(path.string());
+  ASSERT_TRUE(store.is_ok());
+  const std::string blob = "a = 1\n\0b = 2\n";  // bytes, not a C string
+  ASSERT_TRUE(store.value()->save(bytes(blob)).is_ok());
+  std::array<char, 64> buf{};
+  const auto n = store.value()->load(buf);
+  ASSERT_TRUE(n.is_ok());
+  EXPECT_EQ(std::string(buf.data(), n.value()), blob);
+  const auto perms = std::filesystem::status(path).permissions();
+  EXPECT_NE(perms & std::filesystem::perms::others_read, std::filesystem::perms::none);
+}
+
+TEST(FileParameterStore, AFileThatFillsTheBufferExactlyLoadsAndOneByteMoreDoesNot) {
+  const TempDir dir;
+  auto store = FileParameterStore::open((dir.path() / "p").string());
+  ASSERT_TRUE(store.is_ok());
+  ASSERT_TRUE(store.value()->save(bytes("12345678")).is_ok());
+  std::array<char, 8> exact{};
+  EXPECT_EQ(store.value()->load(exact).value(), 8u);
+  std::array<char, 7> small{};
+  EXPECT_EQ(store.value()->load(small).status().code(), ErrorCode::kResourceExhausted);
+}
+
+TEST(FileParameterStore, NothingStoredIsUnavailableWithENOENT) {
+  const TempDir dir;
+  const auto path = (dir.path() / "absent.toml").string();
+  auto store = FileParameterStore::open(path);
+  ASSERT_TRUE(store.is_ok());
+  std::array<char, 16> buf{};
+  const auto r = store.value()->load(buf);
+  EXPECT_EQ(r.status().code(), ErrorCode::kUnavailable);
+  EXPECT_EQ(r.status().os_error(), ENOENT);
+  EXPECT_EQ(describe(path, r.status()),
+            path + ": parameter store: no file: No such file or directory (errno 2)");
+}
+
+TEST(FileParameterStore, AMissingFolderFailsTheFirstStepWithENOENT) {
+  const TempDir dir;
+  auto store = FileParameterStore::open((dir.path() / "no-such-dir" / "cal.toml").string());
+  ASSERT_TRUE(store.is_ok());
+  const Status s = store.value()->save(bytes("x"));
+  EXPECT_EQ(s.code(), ErrorCode::kIoError);
+  EXPECT_EQ(s.os_error(), ENOENT);
+  EXPECT_EQ(store.value()->last_failed_step(), SaveStep::kCreateTemp);
+}
+
+TEST(FileParameterStore, AFolderNobodyMayWriteRefusesTheSaveAndKeepsTheOldFile) {
+  const TempDir dir;
+  const auto path = dir.path() / "cal.toml";
+  auto store = FileParameterStore::open(path.string());
+  ASSERT_TRUE(store.is_ok());
+  ASSERT_TRUE(store.value()->save(bytes("old\n")).is_ok());
+  std::filesystem::permissions(dir.path(), std::filesystem::perms::owner_write,
+                               std::filesystem::perm_options::remove);
+  if (::access(dir.path().c_str(), W_OK) == 0) {
+    GTEST_SKIP() << "running as root (permissions ignored); the read-only case below uses sysfs";
+  }
+  const Status s = store.value()->save(bytes("new\n"));
+  EXPECT_EQ(s.os_error(), EACCES);
+  EXPECT_EQ(read_text(path), "old\n");
+}
+
+TEST(FileParameterStore, AReadOnlyFolderEvenForRootIsARealOsFailure) {
+  // sysfs refuses file creation to everybody, root included.
+  if (!std::filesystem::is_directory("/sys/kernel")) GTEST_SKIP() << "no sysfs mounted";
+  auto store = FileParameterStore::open("/sys/gfins-cal.toml");
+  ASSERT_TRUE(store.is_ok());
+  const Status s = store.value()->save(bytes("x"));
+  EXPECT_EQ(s.code(), ErrorCode::kIoError);
+  EXPECT_NE(s.os_error(), 0);
+  EXPECT_EQ(store.value()->last_failed_step(), SaveStep::kCreateTemp);
+  EXPECT_FALSE(std::filesystem::exists("/sys/gfins-cal.toml"));
+}
+
+TEST(FileParameterStore, PathsThatNameNoFileAreRefusedAtOpen) {
+  EXPECT_EQ(FileParameterStore::open("").status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(FileParameterStore::open("/etc/gfins/").status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(FileParameterStore::open("/etc/..").status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(FileParameterStore::open(std::string(5000, 'a')).status().code(),
+            ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(FileParameterStore::open("cal.toml").is_ok());  // relative: the current folder
+}
+
+}  // namespace
+}  // namespace gfins::drivers::lnx

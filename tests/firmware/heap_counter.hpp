@@ -1,0 +1,58 @@
+// Counts every heap allocation of the process: malloc, calloc, realloc, memalign, aligned_alloc,
+// posix_memalign are interposed (the executable's definitions win over glibc's for every caller,
+// libstdc++'s operator new included) and forwarded to glibc's __libc_* entry points. Include it
+// in exactly one translation unit of a test executable. Not with AddressSanitizer, which owns
+// malloc itself: HeapCounter::available() is false there.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+
+namespace gfins::testing {
+inline std::atomic<long> g_heap_calls{0};
+struct HeapCounter {
+  static long calls() { return g_heap_calls.load(std::memory_order_relaxed); }
+#if defined(__SANITIZE_ADDRESS__)
+  static constexpr bool available() { return false; }
+#else
+  static constexpr bool available() { return true; }
+#endif
+};
+}  // namespace gfins::testing
+
+#if !defined(__SANITIZE_ADDRESS__)
+extern "C" {
+void* __libc_malloc(std::size_t) noexcept;
+void* __libc_calloc(std::size_t, std::size_t) noexcept;
+void* __libc_realloc(void*, std::size_t) noexcept;
+void* __libc_memalign(std::size_t, std::size_t) noexcept;
+
+void* malloc(std::size_t n) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(n);
+}
+void* calloc(std::size_t n, std::size_t size) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t n) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, n);
+}
+void* memalign(std::size_t align, std::size_t n) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(align, n);
+}
+void* aligned_alloc(std::size_t align, std::size_t n) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  return __libc_memalign(align, n);
+}
+int posix_memalign(void** out, std::size_t align, std::size_t n) noexcept {
+  gfins::testing::g_heap_calls.fetch_add(1, std::memory_order_relaxed);
+  void* p = __libc_memalign(align, n);
+  if (p == nullptr) return 12;  // ENOMEM
+  *out = p;
+  return 0;
+}
+}
+#endif

@@ -1,0 +1,128 @@
+// A simulated board wired to the firmware's sample loop for tests: the same parts gfins-fw --sim
+// builds (scenario stream, ADC chain, fast pacing, in-memory CAN bus), plus taps that record the
+// samples the loop read and the epochs it handed to the publisher.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gfins/app/config.hpp"
+#include "gfins/app/epoch_sinks.hpp"
+#include "gfins/app/logger.hpp"
+#include "gfins/app/sample_loop.hpp"
+#include "gfins/app/startup.hpp"
+#include "gfins/host_sim/scenario.hpp"
+#include "gfins/sim_board/sim_board.hpp"
+
+namespace gfins::testing {
+
+/// Records every sample read through it (reserved up front: no allocation while recording).
+class TapSource final : public app::SampleSource {
+ public:
+  TapSource(app::SampleSource& inner, std::size_t reserve) : inner_(inner) {
+    samples_.reserve(reserve);
+  }
+  const std::vector<RawSample>& samples() const { return samples_; }
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override {
+    Result<RawSample> r = inner_.read_sample(timeout_ns);
+    if (r.is_ok() && samples_.size() < samples_.capacity()) samples_.push_back(r.value());
+    return r;
+  }
+  app::AdcCounters do_counters() const override { return inner_.counters(); }
+  double do_volts_per_count() const override { return inner_.volts_per_count(); }
+
+  app::SampleSource& inner_;
+  std::vector<RawSample> samples_;
+};
+
+/// Stands in for the CAN publisher until the protocol's Publisher is wired in: one 8-byte frame
+/// per epoch whose seq is a multiple of 10 (100 Hz at 1 kHz), carrying the sample counter.
+class StubPublisher final : public app::EpochSink {
+ public:
+  explicit StubPublisher(hal::CanBus& bus) : bus_(bus) {}
+  void publish(const app::Epoch& e) override {
+    if (e.nav.seq % 10 != 0) return;
+    hal::CanFrame f;
+    f.id = 0x100;
+    f.len = 8;
+    for (std::size_t i = 0; i < 4; ++i) f.data[i] = static_cast<std::uint8_t>(e.nav.seq >> (8 * i));
+    (void)bus_.send(f);
+  }
+  Status set_divider(std::size_t m, std::uint16_t) override {
+    return m < app::kNumMessages ? Status::ok() : Status(ErrorCode::kOutOfRange, "message");
+  }
+
+ private:
+  hal::CanBus& bus_;
+};
+
+struct SimRig {
+  /// `scenario`: a name in host_sim/scenarios; `seconds`: run length (samples = seconds·rate+1).
+  SimRig(const std::string& scenario, double seconds, const sim_board::FaultPlan& faults = {},
+         std::size_t can_capacity = 1u << 16) {
+    const sim::ParsedScenario p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
+    if (!p.ok()) throw std::runtime_error(p.error);
+    s = *p.scenario;
+    config.board = app::BoardKind::kSim;
+    config.calibration_file.clear();
+    samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
+    stream = sim_board::make_scenario_stream(s);
+    adc = sim_board::make_adc_chain(s);
+    source = std::make_unique<sim_board::SimSampleSource>(*stream, *adc, clock, &clock,
+                                                          sim_board::Pacing::kFast, s.rate_hz,
+                                                          samples);
+    source->set_faults(faults);
+    tap = std::make_unique<TapSource>(*source, samples);
+    bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
+    publisher = std::make_unique<StubPublisher>(*bus);
+    recording = std::make_unique<app::RecordingSink>(publisher.get(), samples);
+    log = std::make_unique<app::FwLogQueue>();
+    factory = sim_board::scenario_calibration(s, adc->volts_per_count());
+    cal = app::load_calibration(config, factory, &factory).set;
+    loop = std::make_unique<app::SampleLoop>(*tap, *bus, *recording, clock, *log);
+  }
+
+  void configure() {
+    const Status st = loop->configure(cal, app::loop_options(config));
+    if (!st.is_ok()) throw std::runtime_error(st.message());
+  }
+
+  /// Runs until the scenario's samples are all delivered.
+  void run() {
+    while (!source->finished()) loop->step();
+  }
+
+  /// Runs `n` cycles at most.
+  void run_cycles(std::uint32_t n) {
+    for (std::uint32_t i = 0; i < n && !source->finished(); ++i) loop->step();
+  }
+
+  /// Log lines the loop queued so far (formatted as the logger thread would).
+  std::vector<std::string> drain_log() {
+    std::vector<std::string> lines;
+    app::LogRecord r;
+    while (log->pop(r)) lines.push_back(app::format_record(r));
+    return lines;
+  }
+
+  sim::Scenario s;
+  app::FwConfig config;
+  std::uint32_t samples = 0;
+  std::unique_ptr<sim_board::SensorStream> stream;
+  std::unique_ptr<sim_board::AdcChain> adc;
+  sim_board::SampleClock clock;
+  std::unique_ptr<sim_board::SimSampleSource> source;
+  std::unique_ptr<TapSource> tap;
+  std::unique_ptr<sim_board::MemoryCanBus> bus;
+  std::unique_ptr<StubPublisher> publisher;
+  std::unique_ptr<app::RecordingSink> recording;
+  std::unique_ptr<app::FwLogQueue> log;
+  calib_file::CalibrationData factory;
+  app::CalibrationSet cal;
+  std::unique_ptr<app::SampleLoop> loop;
+};
+
+}  // namespace gfins::testing
