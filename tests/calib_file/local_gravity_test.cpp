@@ -147,12 +147,14 @@ double residual_at_rest(const CalibrationData& d, const Board& b, double lat_nav
   std::normal_distribution<double> unit(0.0, 1.0);
   double sum = 0.0;
   for (std::uint32_t k = 0; k < kAlignSamples + kNavSamples; ++k) {
-    std::array<std::int32_t, 6> counts{};
+    RawSample raw;
+    raw.seq = k;
+    raw.t_ns = std::int64_t(k) * 1'000'000;
     for (std::size_t j = 0; j < 6; ++j) {
       const double v = output_v(b, j, g_nav * up) + noise_v * unit(rng);
-      counts[j] = static_cast<std::int32_t>(std::lround(v / kLsb));
+      raw.counts[j] = static_cast<std::int32_t>(std::lround(v / kLsb));
     }
-    const auto phase = p.process(counts, std::int64_t(k) * 1'000'000, k);
+    const auto phase = p.process(raw);
     if (k >= kAlignSamples) {
       EXPECT_EQ(phase, nav::PipelinePhase::kNavigating);
       sum += p.state().f_b.norm() - g_nav;

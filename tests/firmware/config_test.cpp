@@ -142,7 +142,7 @@ TEST(Cli, OptionsOverrideTheFile) {
                            "euler=40", "--position-m", "1,2,3", "--pacing", "realtime"});
   std::remove(path);
   ASSERT_TRUE(r.config) << r.message;
-  EXPECT_EQ(r.config->node_id, 7);           // option wins
+  EXPECT_EQ(r.config->node_id, 7);             // option wins
   EXPECT_EQ(r.config->can_interface, "can1");  // file kept
   EXPECT_EQ(r.config->heading_deg, 10.0);
   EXPECT_EQ(r.config->board, BoardKind::kSim);

@@ -23,19 +23,18 @@ std::uint32_t bits(float x) { return std::bit_cast<std::uint32_t>(x); }
   const auto cmp = [&](const char* what, const float* x, const float* y, int n) {
     for (int i = 0; i < n; ++i) {
       if (bits(x[i]) != bits(y[i])) {
-        return ::testing::AssertionFailure()
-               << what << "[" << i << "] differs at seq " << a.seq << ": " << x[i] << " vs " << y[i];
+        return ::testing::AssertionFailure() << what << "[" << i << "] differs at seq " << a.seq
+                                             << ": " << x[i] << " vs " << y[i];
       }
     }
     return ::testing::AssertionSuccess();
   };
-  for (auto r : {cmp("q_nb", a.q_nb.coeffs().data(), b.q_nb.coeffs().data(), 4),
-                 cmp("w_b", a.w_b.data(), b.w_b.data(), 3),
-                 cmp("wdot_b", a.wdot_b.data(), b.wdot_b.data(), 3),
-                 cmp("f_b", a.f_b.data(), b.f_b.data(), 3),
-                 cmp("a_n", a.a_n.data(), b.a_n.data(), 3),
-                 cmp("v_n", a.v_n.data(), b.v_n.data(), 3),
-                 cmp("r_n", a.r_n.data(), b.r_n.data(), 3)}) {
+  for (auto r :
+       {cmp("q_nb", a.q_nb.coeffs().data(), b.q_nb.coeffs().data(), 4),
+        cmp("w_b", a.w_b.data(), b.w_b.data(), 3),
+        cmp("wdot_b", a.wdot_b.data(), b.wdot_b.data(), 3),
+        cmp("f_b", a.f_b.data(), b.f_b.data(), 3), cmp("a_n", a.a_n.data(), b.a_n.data(), 3),
+        cmp("v_n", a.v_n.data(), b.v_n.data(), 3), cmp("r_n", a.r_n.data(), b.r_n.data(), 3)}) {
     if (!r) return r;
   }
   return ::testing::AssertionSuccess();
@@ -50,7 +49,7 @@ std::vector<nav::NavState<float>> host_only_run(const SimRig& rig) {
   std::vector<nav::NavState<float>> out;
   out.reserve(rig.tap->samples().size());
   for (const RawSample& s : rig.tap->samples()) {
-    p->process(s.counts, s.t_ns, s.seq, (s.flags & sample_flags::kCrcError) == 0);
+    p->process(s);
     out.push_back(p->state());
   }
   return out;

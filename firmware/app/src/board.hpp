@@ -22,8 +22,8 @@ struct Board {
   std::unique_ptr<EpochSink> sink;
   std::unique_ptr<CommandCodec> codec;  // null: commands not handled
   std::unique_ptr<hal::Clock> clock;
-  std::unique_ptr<hal::Watchdog> watchdog;  // null: none
-  calib_file::CalibrationData defaults;     // nominal calibration of this board
+  std::unique_ptr<hal::Watchdog> watchdog;             // null: none
+  calib_file::CalibrationData defaults;                // nominal calibration of this board
   std::optional<calib_file::CalibrationData> factory;  // used when no file is configured
   std::function<bool()> finished = [] { return false; };
   /// SCHED_FIFO + mlockall as configured; returns a warning when not permitted ("" when done).

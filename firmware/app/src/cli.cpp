@@ -39,13 +39,15 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   auto* o_sim = app.add_option("--sim", scenario,
                                "run on the simulated board with this scenario (name or .toml; "
                                "sets board.kind = \"sim\" and sim.scenario)");
-  auto* o_board = app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim"}));
+  auto* o_board =
+      app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim"}));
   auto* o_spi = app.add_option("--spi-device", spi, "adc.spi_device");
   auto* o_chip = app.add_option("--gpio-chip", chip, "adc.gpio_chip");
   auto* o_line = app.add_option("--drdy-line", line, "adc.drdy_line (offset or name)");
   auto* o_rate = app.add_option("--sample-rate", rate, "adc.sample_rate_hz");
   auto* o_can = app.add_option("--can", can_if, "can.interface");
-  auto* o_log = app.add_option("--can-log", can_log, "can.log_file (candump log instead of an interface)");
+  auto* o_log =
+      app.add_option("--can-log", can_log, "can.log_file (candump log instead of an interface)");
   auto* o_node = app.add_option("--node-id", node, "can.node_id");
   auto* o_div = app.add_option("--divider", dividers,
                                "output.NAME = N (repeatable), NAME a message of [output]: epoch "
@@ -71,11 +73,13 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                    ->check(CLI::IsMember({"none", "systemd", "device"}));
   auto* o_wdd = app.add_option("--watchdog-device", wd_device, "watchdog.device");
   auto* o_level = app.add_option("--log-level", level, "log.level");
-  auto* o_pacing = app.add_option("--pacing", pacing, "sim.pacing")
-                       ->check(CLI::IsMember({"fast", "realtime"}));
+  auto* o_pacing =
+      app.add_option("--pacing", pacing, "sim.pacing")->check(CLI::IsMember({"fast", "realtime"}));
   auto* o_dur = app.add_option("--duration", duration, "sim.duration_s (0 = the scenario's)");
   auto* o_sdir = app.add_option("--scenario-dir", scenario_dir, "sim.scenario_dir");
   app.add_flag("--check-config", out.check_only, "validate the configuration and exit");
+  app.add_option("--latency-csv", out.latency_csv,
+                 "benchmark: write the data-ready → CAN latency histogram (us,count) here");
   app.add_flag("--print-default-config", print_default, "print the commented default and exit");
 
   try {
@@ -139,18 +143,17 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   }
   (void)o_div;
   if (o_comp->count()) {
-    c.compensator = pick(compensator, std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
-                         std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration,
-                                                          CompensatorChoice::kNone,
-                                                          CompensatorChoice::kPaper,
-                                                          CompensatorChoice::kExact});
+    c.compensator = pick(
+        compensator, std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
+        std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration, CompensatorChoice::kNone,
+                                         CompensatorChoice::kPaper, CompensatorChoice::kExact});
   }
   if (o_cal->count()) c.calibration_file = calib;
   if (o_grav->count()) {
-    c.gravity = pick(gravity, std::array<const char*, 3>{"standard", "constant", "normal"},
-                     std::array<GravityChoice, 3>{GravityChoice::kStandard,
-                                                  GravityChoice::kConstant,
-                                                  GravityChoice::kNormal});
+    c.gravity =
+        pick(gravity, std::array<const char*, 3>{"standard", "constant", "normal"},
+             std::array<GravityChoice, 3>{GravityChoice::kStandard, GravityChoice::kConstant,
+                                          GravityChoice::kNormal});
   }
   if (o_g->count()) c.gravity_mps2 = g;
   if (o_lat->count()) c.latitude_deg = lat;

@@ -96,7 +96,8 @@ class Reader {
     if (const toml::node* n = find(key)) {
       std::string allowed;
       for (std::size_t i = 0; i < N; ++i) {
-        allowed += (i == 0 ? "\"" : (i + 1 == N ? " or \"" : ", \"")) + std::string(names[i]) + "\"";
+        allowed +=
+            (i == 0 ? "\"" : (i + 1 == N ? " or \"" : ", \"")) + std::string(names[i]) + "\"";
       }
       if (!n->is_string()) fail(key, n, "must be " + allowed);
       const std::string s = n->value<std::string>().value_or("");
@@ -126,7 +127,8 @@ class Reader {
   // The first key present in the file that no reader asked for.
   void reject_unknown(const toml::table& t, const std::string& prefix) {
     for (const auto& [k, node] : t) {
-      const std::string p = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      const std::string p =
+          prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
       if (const toml::table* sub = node.as_table(); sub != nullptr && known_tables_.count(p) != 0) {
         reject_unknown(*sub, p);
       } else if (known_.count(p) == 0) {
@@ -179,11 +181,11 @@ void read_all(Reader& r, FwConfig& c) {
     r.integer("output." + std::string(kMessageNames[m]), d, 0, kMaxDivider);
     c.dividers[m] = static_cast<std::uint16_t>(d);
   }
-  r.choice("navigation.compensator", c.compensator,
-           std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
-           std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration,
-                                            CompensatorChoice::kNone, CompensatorChoice::kPaper,
-                                            CompensatorChoice::kExact});
+  r.choice(
+      "navigation.compensator", c.compensator,
+      std::array<const char*, 4>{"calibration", "none", "paper", "exact"},
+      std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration, CompensatorChoice::kNone,
+                                       CompensatorChoice::kPaper, CompensatorChoice::kExact});
   r.choice("navigation.gravity", c.gravity,
            std::array<const char*, 3>{"standard", "constant", "normal"},
            std::array<GravityChoice, 3>{GravityChoice::kStandard, GravityChoice::kConstant,
@@ -262,8 +264,7 @@ std::string validate(const FwConfig& c, const std::string& origin) {
   }
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     if (c.dividers[m] > kMaxDivider) {
-      return bad(("output." + std::string(kMessageNames[m])).c_str(),
-                 std::to_string(c.dividers[m]),
+      return bad(("output." + std::string(kMessageNames[m])).c_str(), std::to_string(c.dividers[m]),
                  "must be 0 (off) .. " + std::to_string(kMaxDivider));
     }
   }
@@ -277,10 +278,9 @@ std::string validate(const FwConfig& c, const std::string& origin) {
   }
   for (std::size_t m = 2; m < kNumMessages; ++m) {
     if (c.dividers[m] % epoch_div != 0) {
-      return bad(("output." + std::string(kMessageNames[m])).c_str(),
-                 std::to_string(c.dividers[m]),
-                 "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) +
-                     ")");
+      return bad(
+          ("output." + std::string(kMessageNames[m])).c_str(), std::to_string(c.dividers[m]),
+          "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) + ")");
     }
   }
   if (!(c.gravity_mps2 >= 9.7 && c.gravity_mps2 <= 9.9)) {
@@ -330,8 +330,7 @@ std::string validate(const FwConfig& c, const std::string& origin) {
                  "must be a scenario name or a .toml file");
     }
     if (!(c.sim_duration_s >= 0.0 && c.sim_duration_s <= 86400.0)) {
-      return bad("sim.duration_s", num(c.sim_duration_s),
-                 "must be 0 (the scenario's) .. 86400 s");
+      return bad("sim.duration_s", num(c.sim_duration_s), "must be 0 (the scenario's) .. 86400 s");
     }
   }
   return "";
@@ -426,8 +425,7 @@ int message_index(std::string_view name) {
   return -1;
 }
 
-nav::CompensatorKind resolve_compensator(CompensatorChoice choice,
-                                         nav::CompensatorKind from_file) {
+nav::CompensatorKind resolve_compensator(CompensatorChoice choice, nav::CompensatorKind from_file) {
   switch (choice) {
     case CompensatorChoice::kCalibration:
       return from_file;

@@ -13,9 +13,7 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
 std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
-  const std::uint64_t h = calib_file::checksum(d);
-  const auto id = static_cast<std::uint32_t>(h ^ (h >> 32));
-  return id == 0 ? 1u : id;
+  return calib_file::cal_id_of(d);  // one rule, shared with gfins-calibrate's report
 }
 
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
@@ -38,9 +36,9 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
   p.alignment_samples =
       static_cast<std::uint32_t>(std::llround(std::max(1.0, c.alignment_s * c.sample_rate_hz)));
   p.heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
-  p.r0_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
-                            static_cast<float>(c.position_m[1]),
-                            static_cast<float>(c.position_m[2]));
+  p.r0_n =
+      nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
+                       static_cast<float>(c.position_m[2]));
   return p;
 }
 
@@ -48,9 +46,9 @@ LoopOptions loop_options(const FwConfig& c) {
   LoopOptions o;
   o.sample_rate_hz = c.sample_rate_hz;
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
-  o.initial_position_n = nav::Vec3<float>(static_cast<float>(c.position_m[0]),
-                                          static_cast<float>(c.position_m[1]),
-                                          static_cast<float>(c.position_m[2]));
+  o.initial_position_n =
+      nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
+                       static_cast<float>(c.position_m[2]));
   return o;
 }
 
@@ -69,8 +67,7 @@ calib_file::CalibrationData nominal_calibration(double volts_per_count) {
   return d;
 }
 
-StartupCalibration load_calibration(const FwConfig& c,
-                                    const calib_file::CalibrationData& defaults,
+StartupCalibration load_calibration(const FwConfig& c, const calib_file::CalibrationData& defaults,
                                     const calib_file::CalibrationData* factory) {
   StartupCalibration out;
   std::string why;

@@ -210,6 +210,12 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
   return fnv1a64(canonical_serialisation(data, version));
 }
 
+std::uint32_t cal_id_of(const CalibrationData& data) {
+  const std::uint64_t h = checksum(data);
+  const auto id = static_cast<std::uint32_t>((h ^ (h >> 32)) & 0xFFFFFFFFu);
+  return id == 0 ? 1u : id;
+}
+
 std::string utc_now_iso8601() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};

@@ -26,9 +26,9 @@ enum class CompensatorChoice : std::uint8_t { kCalibration, kNone, kPaper, kExac
 /// (0 = off), in the CAN message table's order (docs/can-interface.md; MessageId 0..13). The
 /// names are the keys of [output] (and of --divider NAME=N).
 inline constexpr std::array<std::string_view, 14> kMessageNames = {
-    "epoch",    "status",   "quaternion",  "euler",      "rate",          "angular_accel",
-    "accel",    "velocity", "position_ne", "position_d", "health_adc",    "health_system",
-    "sensors_a", "sensors_b"};
+    "epoch",         "status",        "quaternion", "euler",       "rate",
+    "angular_accel", "accel",         "velocity",   "position_ne", "position_d",
+    "health_adc",    "health_system", "sensors_a",  "sensors_b"};
 inline constexpr std::size_t kNumMessages = kMessageNames.size();
 /// Defaults of the CAN message table: 100 Hz navigation at 1 kHz (50 Hz Euler angles and angular
 /// acceleration), 1 Hz health, raw sensor outputs off; the bus budget is in
@@ -40,7 +40,7 @@ inline constexpr std::uint16_t kMaxDivider = 10000;
 /// ADS131M06 output data rates reachable with its 8.192 MHz clock (datasheet §8.4.2.2, OSR
 /// 1024..8192 → f_MOD / OSR with f_MOD = 4.096 MHz).
 inline constexpr std::array<double, 4> kSampleRatesHz = {500.0, 1000.0, 2000.0, 4000.0};
-inline constexpr int kMaxNodeId = 15;  // 4 bits of the identifier (docs/can-interface.md)
+inline constexpr int kMaxNodeId = 15;      // 4 bits of the identifier (docs/can-interface.md)
 inline constexpr int kMaxRtPriority = 99;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
 
 struct FwConfig {
@@ -63,10 +63,10 @@ struct FwConfig {
   // [navigation]
   CompensatorChoice compensator = CompensatorChoice::kCalibration;
   GravityChoice gravity = GravityChoice::kStandard;
-  double gravity_mps2 = 9.80665;  // kConstant
-  double latitude_deg = 0.0;      // kNormal
-  double height_m = 0.0;          // kNormal
-  double heading_deg = 0.0;       // initial heading (nothing on board senses it)
+  double gravity_mps2 = 9.80665;       // kConstant
+  double latitude_deg = 0.0;           // kNormal
+  double height_m = 0.0;               // kNormal
+  double heading_deg = 0.0;            // initial heading (nothing on board senses it)
   std::array<double, 3> position_m{};  // initial position, NED from the alignment point
   double alignment_s = 1.0;            // time at rest averaged by the static alignment
 
@@ -131,6 +131,7 @@ struct CliResult {
   std::optional<FwConfig> config;
   std::string config_source;  // the file the configuration came from ("" = built-in defaults)
   bool check_only = false;    // --check-config: validate and exit
+  std::string latency_csv;    // --latency-csv: write the edge→CAN latency histogram (benchmark)
   int exit_code = 0;          // when !config
   std::string message;        // printed when !config (stdout for exit 0, stderr otherwise)
 };

@@ -36,22 +36,22 @@ struct HealthCounters {
 /// Event bits (marked *) stay set for kEventHoldSamples after the event so a status frame sent at
 /// a lower rate still shows it; the counters are exact.
 namespace status_bits {
-inline constexpr std::uint32_t kAligned = 1u << 0;        // static alignment done
-inline constexpr std::uint32_t kSampleGap = 1u << 1;     // * samples missing (edges lost)
-inline constexpr std::uint32_t kInputInvalid = 1u << 2;   // this sample was rejected
-inline constexpr std::uint32_t kCompensated = 1u << 3;    // misalignment compensation active
-inline constexpr std::uint32_t kCrcError = 1u << 6;       // * ADC CRC error
-inline constexpr std::uint32_t kSaturated = 1u << 7;      // * a channel at full scale
-inline constexpr std::uint32_t kStuckChannel = 1u << 8;   // a channel stuck now
-inline constexpr std::uint32_t kUncalibrated = 1u << 9;   // nominal defaults in use
-inline constexpr std::uint32_t kLoopOverrun = 1u << 10;   // * a cycle overran its period
-inline constexpr std::uint32_t kCanTxDrop = 1u << 11;     // * CAN frames dropped
-inline constexpr std::uint32_t kCaptureActive = 1u << 12; // calibration capture running
-inline constexpr std::uint32_t kDegraded = 1u << 13;      // navigation output not trustworthy
-inline constexpr std::uint32_t kAdcRecovered = 1u << 14;  // * the ADC was reset/reconfigured
-inline constexpr std::uint32_t kDataReadyLost = 1u << 15; // * no data-ready edge in time
-inline constexpr std::uint32_t kBusOff = 1u << 16;        // * CAN controller went bus-off
-inline constexpr std::uint32_t kExtraEdge = 1u << 17;     // * data-ready without a conversion
+inline constexpr std::uint32_t kAligned = 1u << 0;         // static alignment done
+inline constexpr std::uint32_t kSampleGap = 1u << 1;       // * samples missing (edges lost)
+inline constexpr std::uint32_t kInputInvalid = 1u << 2;    // this sample was rejected
+inline constexpr std::uint32_t kCompensated = 1u << 3;     // misalignment compensation active
+inline constexpr std::uint32_t kCrcError = 1u << 6;        // * ADC CRC error
+inline constexpr std::uint32_t kSaturated = 1u << 7;       // * a channel at full scale
+inline constexpr std::uint32_t kStuckChannel = 1u << 8;    // a channel stuck now
+inline constexpr std::uint32_t kUncalibrated = 1u << 9;    // nominal defaults in use
+inline constexpr std::uint32_t kLoopOverrun = 1u << 10;    // * a cycle overran its period
+inline constexpr std::uint32_t kCanTxDrop = 1u << 11;      // * CAN frames dropped
+inline constexpr std::uint32_t kCaptureActive = 1u << 12;  // calibration capture running
+inline constexpr std::uint32_t kDegraded = 1u << 13;       // navigation output not trustworthy
+inline constexpr std::uint32_t kAdcRecovered = 1u << 14;   // * the ADC was reset/reconfigured
+inline constexpr std::uint32_t kDataReadyLost = 1u << 15;  // * no data-ready edge in time
+inline constexpr std::uint32_t kBusOff = 1u << 16;         // * CAN controller went bus-off
+inline constexpr std::uint32_t kExtraEdge = 1u << 17;      // * data-ready without a conversion
 }  // namespace status_bits
 
 /// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).

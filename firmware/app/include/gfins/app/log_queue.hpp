@@ -15,8 +15,8 @@ enum class LogLevel : std::uint8_t { kTrace, kDebug, kInfo, kWarn, kError };
 
 struct LogRecord {
   static constexpr std::size_t kMaxArgs = 4;
-  std::int64_t t_ns = 0;        // monotonic time of the event (the sample's edge time)
-  const char* format = "";      // fmt-style "{}" placeholders; a literal (static storage)
+  std::int64_t t_ns = 0;    // monotonic time of the event (the sample's edge time)
+  const char* format = "";  // fmt-style "{}" placeholders; a literal (static storage)
   std::array<std::int64_t, kMaxArgs> args{};
   LogLevel level = LogLevel::kInfo;
 };

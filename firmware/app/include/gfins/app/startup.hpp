@@ -34,8 +34,7 @@ struct StartupCalibration {
 /// and `message` says why; the file is never modified. With no file configured and a `factory`
 /// calibration (the simulated board's: its scenario's true parameters), that one is used as a
 /// calibration.
-StartupCalibration load_calibration(const FwConfig& c,
-                                    const calib_file::CalibrationData& defaults,
+StartupCalibration load_calibration(const FwConfig& c, const calib_file::CalibrationData& defaults,
                                     const calib_file::CalibrationData* factory = nullptr);
 
 /// Nominal calibration of a board whose chain has `volts_per_count` at the sensor: Table 1
