@@ -13,9 +13,7 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
 std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
-  const std::uint64_t h = calib_file::checksum(d);
-  const auto id = static_cast<std::uint32_t>(h ^ (h >> 32));
-  return id == 0 ? 1u : id;
+  return calib_file::cal_id_of(d);  // one rule, shared with gfins-calibrate's report
 }
 
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
