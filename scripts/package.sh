@@ -30,5 +30,5 @@ done
 debs=("$out"/*.deb)
 echo "=== lintian ${#debs[@]} package(s)"
 # --fail-on error: warnings are shown but only errors fail the build.
-lintian --fail-on error --no-tag-display-limit "${debs[@]}"
+lintian --fail-on error --tag-display-limit 0 "${debs[@]}"
 echo "package.sh: ${#debs[@]} package(s) in $out, lintian: no errors"
