@@ -9,10 +9,14 @@ packages=(
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
   libgpiod-dev gpiod can-utils libsystemd-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy python3-can nodejs
   clang-format clang-tidy valgrind
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
 )
+
+# npm installs the CAN test's third-party DBC reader (tests/can/independent): Debian's package,
+# unless the installed Node.js already bundles npm.
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do

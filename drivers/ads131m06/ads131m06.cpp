@@ -86,9 +86,10 @@ Status Ads131m06::make_table(const Ads131m06Config& c,
       gain2 = static_cast<std::uint16_t>(gain2 | v);
     }
   }
-  const auto clock = static_cast<std::uint16_t>(
-      reg::clock::kReservedKeep | reg::clock::kChannelEnableMask |
-      (osr.value() << reg::clock::kOsrShift) | static_cast<unsigned>(c.power_mode));
+  const auto clock =
+      static_cast<std::uint16_t>(reg::clock::kReservedKeep | reg::clock::kChannelEnableMask |
+                                 (static_cast<unsigned>(osr.value()) << reg::clock::kOsrShift) |
+                                 static_cast<unsigned>(c.power_mode));
   // Order: MODE first (clears RESET, turns on the input CRC), CLOCK last (it restarts the
   // conversions at the new OSR once the gains are set).
   table = {RegisterSetting{reg::Reg::kMode, mode}, RegisterSetting{reg::Reg::kGain1, gain1},

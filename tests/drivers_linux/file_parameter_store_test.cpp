@@ -15,11 +15,13 @@
 #include <sstream>
 #include <string>
 
+#include "drivers_linux/failing_os.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
 
 namespace gfins::drivers::lnx {
 namespace {
 
+using testing::FailingOs;
 using ::testing::HasSubstr;
 
 class TempDir {
@@ -54,50 +56,6 @@ std::size_t count_entries(const std::filesystem::path& dir) {
   for (const auto& e : std::filesystem::directory_iterator(dir)) n += e.exists() ? 1 : 0;
   return n;
 }
-
-// The real kernel, except that the call making step `fail_at` fails with `err` (close still
-// closes: the descriptor must not leak even when close reports an error).
-class FailingOs : public Os {
- public:
-  FailingOs(SaveStep fail_at, int err) : fail_at_(fail_at), err_(err) {}
-
-  int mkostemp(char* t, int flags) override {
-    if (fail_at_ == SaveStep::kCreateTemp) return fail();
-    temp_fd_ = Os::mkostemp(t, flags);
-    return temp_fd_;
-  }
-  long write(int fd, const void* b, std::size_t n) override {
-    if (fail_at_ == SaveStep::kWrite) return fail();
-    return Os::write(fd, b, n < 5 ? n : 5);  // short writes: the backend must loop
-  }
-  int fsync(int fd) override {
-    const bool dir = fd != temp_fd_;  // the temporary is closed before the folder is opened
-    if ((fail_at_ == SaveStep::kSyncFile && !dir) || (fail_at_ == SaveStep::kSyncDir && dir)) {
-      return fail();
-    }
-    return Os::fsync(fd);
-  }
-  int close(int fd) override {
-    const int r = Os::close(fd);
-    if (fd != temp_fd_) return r;
-    temp_fd_ = -1;  // the folder's descriptor may reuse the number
-    if (fail_at_ == SaveStep::kCloseFile) return fail();
-    return r;
-  }
-  int rename(const char* a, const char* b) override {
-    if (fail_at_ == SaveStep::kRename) return fail();
-    return Os::rename(a, b);
-  }
-
- private:
-  int fail() {
-    errno = err_;
-    return -1;
-  }
-  SaveStep fail_at_;
-  int err_;
-  int temp_fd_ = -1;
-};
 
 std::span<const char> bytes(const std::string& s) { return {s.data(), s.size()}; }
 

@@ -236,3 +236,26 @@ TEST_F(SimulatedAdcTest, RegisterUpsetIsFoundByReVerification) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SimulatedAdcConfig, MatchesTheBehaviouralParametersAndFindsAClock) {
+  // 1 kHz: the nominal 8.192 MHz CLKIN and OSR 4096 (8.192 MHz / 2 / 4096 = 1000 Hz).
+  auto c = SimulatedAdc::config_for(1.2, 1.0, 1.0 / 8.33, 1000.0);
+  ASSERT_TRUE(c.is_ok());
+  EXPECT_DOUBLE_EQ(c->adc.clkin_hz, 8.192e6);
+  // 100 Hz is not reachable from 8.192 MHz (250 Hz is the slowest); the largest CLKIN below it
+  // that makes 100 Hz exact is 2 · 100 · 16384 = 3.2768 MHz.
+  c = SimulatedAdc::config_for(1.2, 2.0, 0.5, 100.0);
+  ASSERT_TRUE(c.is_ok());
+  EXPECT_DOUBLE_EQ(c->adc.clkin_hz, 3.2768e6);
+  EXPECT_EQ(c->adc.pga_gain[5], 2);
+  SimulatedAdc adc(c.value());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.driver().osr(), 16384u);
+  EXPECT_DOUBLE_EQ(adc.volts_per_count(0), 1.2 / (2.0 * 8388608.0 * 0.5));
+  EXPECT_FALSE(SimulatedAdc::config_for(1.2, 3.0, 1.0, 1000.0).is_ok());    // gain 3
+  EXPECT_FALSE(SimulatedAdc::config_for(1.2, 1.0, 1.0, 100000.0).is_ok());  // > 32 kHz
+}
+
+}  // namespace

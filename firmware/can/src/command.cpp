@@ -185,10 +185,12 @@ std::array<hal::CanFrame, kCaptureResultFrames> encode_capture_result(const Capt
   std::size_t n = 0;
   for (std::uint8_t c = 0; c < 6; ++c) {
     const ChannelCapture& ch = r.channels[c];
-    out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartMean + c),
-                              put(0, sig(m, Field::kRspMean, c), ch.mean_counts), node_id);
+    out[n++] = response_frame(
+        kOpStartCapture, token, static_cast<std::uint8_t>(kPartMean + c),
+        put(0, sig(m, Field::kRspMean, c), static_cast<double>(ch.mean_counts)), node_id);
     out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartStd + c),
-                              put(0, sig(m, Field::kRspStd, c), ch.std_counts), node_id);
+                              put(0, sig(m, Field::kRspStd, c), static_cast<double>(ch.std_counts)),
+                              node_id);
     std::uint64_t p = put(0, sig(m, Field::kRspCount, c), ch.count);
     p = insert_bits(p, sig(m, Field::kRspSaturated, c), ch.saturated ? 1u : 0u);
     p = insert_bits(p, sig(m, Field::kRspMotion, c), ch.motion ? 1u : 0u);

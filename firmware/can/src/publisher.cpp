@@ -13,10 +13,10 @@ constexpr std::size_t idx(MessageId m) { return static_cast<std::size_t>(m); }
 /// body-to-NED rotation (yaw about z_n, then pitch, then roll). Pitch clamps the asin argument
 /// against rounding just beyond ±1.
 double euler_angle(const nav::Quat<float>& qf, std::uint8_t axis) {
-  const double w = qf.w();
-  const double x = qf.x();
-  const double y = qf.y();
-  const double z = qf.z();
+  const auto w = static_cast<double>(qf.w());
+  const auto x = static_cast<double>(qf.x());
+  const auto y = static_cast<double>(qf.y());
+  const auto z = static_cast<double>(qf.z());
   switch (axis) {
     case 0:
       return std::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
@@ -74,7 +74,8 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
     case Field::kQuaternion: {
       // q and -q are the same rotation; the bus carries the one with w >= 0.
       const double sign = n.q_nb.w() < 0.0f ? -1.0 : 1.0;
-      const double c[4] = {n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()};
+      const double c[4] = {static_cast<double>(n.q_nb.w()), static_cast<double>(n.q_nb.x()),
+                           static_cast<double>(n.q_nb.y()), static_cast<double>(n.q_nb.z())};
       return sign * c[index & 3u];
     }
     case Field::kEuler:

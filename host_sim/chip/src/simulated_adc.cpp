@@ -10,6 +10,41 @@ SimulatedAdc::SimulatedAdc(const SimulatedAdcConfig& c)
   line_.set_listener(this);
 }
 
+Result<SimulatedAdcConfig> SimulatedAdc::config_for(double vref_v, double gain,
+                                                    double input_divider, double sample_rate_hz) {
+  constexpr double kNominalClkinHz = 8.192e6;  // high-resolution mode (§6.3)
+  if (!(vref_v > 0) || !(input_divider > 0) || !(sample_rate_hz > 0) || !std::isfinite(vref_v) ||
+      !std::isfinite(input_divider) || !std::isfinite(sample_rate_hz)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "sim adc: vref, divider and rate must be positive and finite");
+  }
+  int g = -1;
+  for (int code = 0; code < 8; ++code) {
+    if (gain == static_cast<double>(1 << code)) g = 1 << code;
+  }
+  if (g < 0) return Status(ErrorCode::kInvalidArgument, "sim adc: PGA gain must be 1, 2, ..., 128");
+  SimulatedAdcConfig c;
+  c.adc.vref_v = vref_v;
+  c.adc.sample_rate_hz = sample_rate_hz;
+  c.adc.pga_gain.fill(static_cast<std::uint8_t>(g));
+  for (auto& ch : c.sensors) ch.divider = input_divider;
+  c.adc.clkin_hz = kNominalClkinHz;
+  if (!drivers::Ads131m06::osr_code_for(sample_rate_hz, kNominalClkinHz).is_ok()) {
+    double best = 0.0;
+    for (const std::uint32_t osr : drivers::ads131m06::kOsrValues) {
+      const double clkin = 2.0 * sample_rate_hz * static_cast<double>(osr);  // §8.3.6/§8.3.7
+      if (clkin <= kNominalClkinHz && clkin > best) best = clkin;
+    }
+    if (best == 0.0) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "sim adc: no OSR gives this rate with CLKIN <= 8.192 MHz");
+    }
+    c.adc.clkin_hz = best;
+  }
+  c.read_timeout_ns = static_cast<std::int64_t>(2e9 / sample_rate_hz);
+  return c;
+}
+
 Status SimulatedAdc::start() {
   const Result<drivers::Qa1100FrontEnd> fe =
       drivers::Qa1100FrontEnd::create(config_.sensors, config_.adc);

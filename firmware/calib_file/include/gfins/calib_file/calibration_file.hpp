@@ -7,13 +7,13 @@
 #pragma once
 
 #include <filesystem>
-#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 
 #include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/hal/parameter_store.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::calib_file {
@@ -66,32 +66,22 @@ std::string to_toml_text(const CalibrationData& data);
 FileResult<CalibrationData> parse_calibration_text(std::string_view text,
                                                    std::string_view file_name);
 
-/// Reads and parses a file; a file that cannot be read fails with kIoError (errno text).
+/// Loads the stored bytes and parses them; `name` labels the messages. A store that cannot be
+/// read fails with kIoError (the store's message and the OS reason); more than
+/// hal::ParameterStore::kMaxBytes is kInvalidArgument (not a calibration file).
+FileResult<CalibrationData> load_calibration(hal::ParameterStore& store, std::string_view name);
+
+/// Validates `data` (kOutOfRange naming the key, nothing stored) and replaces the stored bytes
+/// with its TOML text through the store's atomic save. A store failure comes back with the
+/// store's code and message (for lnx::FileParameterStore: the step that failed, whether the
+/// previous file is unchanged, and the OS reason).
+FileStatus save_calibration(hal::ParameterStore& store, const CalibrationData& data,
+                            std::string_view name);
+
+/// The same on a file at `path` through lnx::FileParameterStore (drivers/linux): the atomic save
+/// writes a temporary file in the same folder, fsyncs it, renames it over `path` and fsyncs the
+/// folder; a failure before the rename leaves an existing `path` untouched.
 FileResult<CalibrationData> load_calibration_file(const std::filesystem::path& path);
-
-/// Steps of the atomic save, in order; the test seam can make any of them fail.
-enum class SaveStep : std::uint8_t {
-  kCreateTemp,  // mkstemp in the target's directory
-  kWrite,       // write the whole text
-  kSyncFile,    // fsync the temporary file
-  kCloseFile,   // close it (reports deferred write errors)
-  kRename,      // rename over the target (the commit point)
-  kSyncDir,     // fsync the directory so the rename itself is durable
-};
-const char* to_string(SaveStep step);
-
-struct SaveOptions {
-  /// Test seam: called before each step; returning an errno value (non-zero) makes that step fail
-  /// with it as if the OS had returned it.
-  std::function<int(SaveStep)> inject_failure;
-};
-
-/// Validates `data` (kOutOfRange naming the key, nothing written) and writes it atomically:
-/// temporary file in the same directory, fsync, rename over `path`, fsync of the directory.
-/// A failure before the rename removes the temporary file and leaves an existing `path`
-/// untouched. A failure of the directory fsync (after the rename) is reported as kIoError: the
-/// new file is in place but its durability across a power cut is not guaranteed.
-FileStatus save_calibration_file(const std::filesystem::path& path, const CalibrationData& data,
-                                 const SaveOptions& options = {});
+FileStatus save_calibration_file(const std::filesystem::path& path, const CalibrationData& data);
 
 }  // namespace gfins::calib_file

@@ -502,37 +502,37 @@ inline constexpr std::uint8_t kPartCount = 0x30;    // + channel
 inline constexpr double kMeanFactor = 1.0 / 256.0;  // ADC counts
 inline constexpr double kStdFactor = 1.0 / 4096.0;  // ADC counts
 
-#define GFINS_CAN_CHANNEL_SIGNALS(N, C)                                                       \
-  SignalDef{.name = "MeanCh" #N,                                                              \
-            .field = Field::kRspMean,                                                         \
-            .index = C,                                                                       \
-            .start_bit = 24,                                                                  \
-            .length = 32,                                                                     \
-            .is_signed = true,                                                                \
-            .factor = kMeanFactor,                                                            \
-            .unit = "count",                                                                  \
-            .min = -8388608.0,                                                                \
-            .max = 8388607.0,                                                                 \
-            .mux = kPartMean + C,                                                             \
-            .instant = kOverCapture,                                                          \
-            .comment = "Capture: mean ADC code of channel " #N},                              \
-      SignalDef{.name = "StdCh" #N,                                                           \
-                .field = Field::kRspStd,                                                      \
-                .index = C,                                                                   \
-                .start_bit = 24,                                                              \
-                .length = 32,                                                                 \
-                .factor = kStdFactor,                                                         \
-                .unit = "count",                                                              \
-                .min = 0.0,                                                                   \
-                .max = 1048575.0,                                                             \
-                .mux = kPartStd + C,                                                          \
-                .instant = kOverCapture,                                                      \
-                .comment = "Capture: standard deviation of channel " #N},                     \
-      unsigned_int("CountCh" #N, Field::kRspCount, C, 24, 16, 65535.0, kPartCount + C, {},    \
-                   kOverCapture, "Capture: samples averaged on channel " #N),                 \
-      unsigned_int("SaturatedCh" #N, Field::kRspSaturated, C, 40, 1, 1.0, kPartCount + C, {}, \
-                   kOverCapture, "Capture: channel " #N " reached full scale"),               \
-      unsigned_int("MotionCh" #N, Field::kRspMotion, C, 41, 1, 1.0, kPartCount + C, {},       \
+#define GFINS_CAN_CHANNEL_SIGNALS(N, C)                                                           \
+  SignalDef{.name = "MeanCh" #N,                                                                  \
+            .field = Field::kRspMean,                                                             \
+            .index = (C),                                                                         \
+            .start_bit = 24,                                                                      \
+            .length = 32,                                                                         \
+            .is_signed = true,                                                                    \
+            .factor = kMeanFactor,                                                                \
+            .unit = "count",                                                                      \
+            .min = -8388608.0,                                                                    \
+            .max = 8388607.0,                                                                     \
+            .mux = kPartMean + (C),                                                               \
+            .instant = kOverCapture,                                                              \
+            .comment = "Capture: mean ADC code of channel " #N},                                  \
+      SignalDef{.name = "StdCh" #N,                                                               \
+                .field = Field::kRspStd,                                                          \
+                .index = (C),                                                                     \
+                .start_bit = 24,                                                                  \
+                .length = 32,                                                                     \
+                .factor = kStdFactor,                                                             \
+                .unit = "count",                                                                  \
+                .min = 0.0,                                                                       \
+                .max = 1048575.0,                                                                 \
+                .mux = kPartStd + (C),                                                            \
+                .instant = kOverCapture,                                                          \
+                .comment = "Capture: standard deviation of channel " #N},                         \
+      unsigned_int("CountCh" #N, Field::kRspCount, (C), 24, 16, 65535.0, kPartCount + (C), {},    \
+                   kOverCapture, "Capture: samples averaged on channel " #N),                     \
+      unsigned_int("SaturatedCh" #N, Field::kRspSaturated, (C), 40, 1, 1.0, kPartCount + (C), {}, \
+                   kOverCapture, "Capture: channel " #N " reached full scale"),                   \
+      unsigned_int("MotionCh" #N, Field::kRspMotion, (C), 41, 1, 1.0, kPartCount + (C), {},       \
                    kOverCapture, "Capture: channel " #N " varied more than a static pose allows")
 
 inline constexpr std::array<SignalDef, 39> kResponseSignals{{

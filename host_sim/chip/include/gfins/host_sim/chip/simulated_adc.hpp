@@ -36,6 +36,16 @@ class SimulatedAdc : private SimDataReadyLine::Listener {
   SimulatedAdc(const SimulatedAdc&) = delete;  // the driver holds references to members
   SimulatedAdc& operator=(const SimulatedAdc&) = delete;
 
+  /// The configuration matching the behavioural AdcModel's parameters (reference, PGA gain,
+  /// divider in front of the pins, rate), so the two converters give the same codes. The PGA
+  /// gain must be one of 1, 2, 4, ..., 128. CLKIN stays 8.192 MHz when an OSR reaches the rate
+  /// from it (§8.3.7: 250 Hz ... 32 kHz in powers of two); otherwise the simulated board gets
+  /// the largest CLKIN ≤ 8.192 MHz that makes the rate exact (100 Hz: OSR 16384, CLKIN
+  /// 3.2768 MHz) — a real board at such a rate needs that oscillator. kInvalidArgument when
+  /// nothing fits.
+  static Result<SimulatedAdcConfig> config_for(double vref_v, double gain, double input_divider,
+                                               double sample_rate_hz);
+
   /// Starts the driver against the model (reset, identity, configuration with read-back) and
   /// checks that the model now converts at the configured rate. kInvalidArgument for a front
   /// end or ADC configuration that cannot be built.

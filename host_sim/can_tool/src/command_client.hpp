@@ -1,0 +1,31 @@
+// gfins-can cmd: send one command on a bus and wait for its response frame(s) with a timeout.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "gfins/can/command.hpp"
+#include "gfins/hal/can_bus.hpp"
+
+namespace gfins::can_tool {
+
+struct CommandOutcome {
+  enum class Kind { kOk, kRejected, kTimeout, kSendFailed } kind = Kind::kTimeout;
+  can::ResponseFrame status;   // the status frame (or the calibration id frame)
+  can::CaptureResult capture;  // StartCapture: the collected result
+  bool capture_complete = false;
+  std::string text;  // one-paragraph human-readable outcome
+};
+
+struct CommandTimeouts {
+  std::chrono::milliseconds response{1000};  // until the first response frame
+  std::chrono::milliseconds capture{0};      // StartCapture: until CaptureDone (0: N/rate + 5 s)
+  double sample_rate_hz = 1000.0;            // to size the capture timeout
+};
+
+/// Sends `c` to `node_id` and waits. Frames from other nodes, other tokens and data frames are
+/// skipped. Waiting uses the bus's receive timeout and a steady clock.
+CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t node_id,
+                           const CommandTimeouts& t);
+
+}  // namespace gfins::can_tool

@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""Command-line behaviour of gfins-can, run without a shell (argument vectors only).
+
+- every corpus log: exit 0 when clean, 3 when problems; each expected problem printed as
+  FILE:LINE: KIND; a summary at the end;
+- '-' reads stdin; a missing file is named and gives exit 2 while the other files still decode;
+- a hostile file name (spaces, quotes, ';', newline, leading '-') is just a name;
+- --help lists the exit codes, --version prints the version;
+- csv/json/line/table views produce one record per epoch;
+- can-utils' log2asc converts a log frame for frame;
+- plot writes a PNG (when the build can start the plot script).
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+
+
+def run(argv, stdin=None):
+    return subprocess.run(argv, input=stdin, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def expected(path):
+    epochs, issues = 0, []
+    for line in open(path):
+        line = line.rstrip('\n')
+        if line.startswith('# epochs '):
+            epochs = int(line[9:])
+        elif line:
+            n, kind = line.split(' ', 1)
+            issues.append((int(n), kind))
+    return epochs, issues
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--gfins-can', required=True)
+    ap.add_argument('--gen', required=True)
+    ap.add_argument('--corpus', required=True)
+    ap.add_argument('--workdir', required=True)
+    a = ap.parse_args()
+    exe = a.gfins_can
+    os.makedirs(a.workdir, exist_ok=True)
+
+    # Corpus: exit codes, FILE:LINE: KIND for each problem, a summary.
+    cases = sorted(f[:-9] for f in os.listdir(a.corpus) if f.endswith('.expected'))
+    check(len(cases) >= 12, 'corpus has fewer than 12 cases')
+    for c in cases:
+        log = os.path.join(a.corpus, c + '.log')
+        epochs, issues = expected(os.path.join(a.corpus, c + '.expected'))
+        r = run([exe, 'decode', log, '--view', 'csv'])
+        err = r.stderr.decode(errors='replace')
+        check(r.returncode == (3 if issues else 0), f'{c}: exit {r.returncode}')
+        rows = r.stdout.decode().splitlines()
+        check(len(rows) == epochs + 1, f'{c}: {len(rows) - 1} CSV rows, expected {epochs}')
+        for n, kind in issues:
+            check(f'{log}:{n}: {kind}:' in err, f'{c}: "{log}:{n}: {kind}:" not reported')
+        check('summary:' in err, f'{c}: no summary')
+
+    clean = os.path.join(a.corpus, 'clean.log')
+    data = open(clean, 'rb').read()
+
+    # stdin
+    r = run([exe, 'decode', '-', '--view', 'json'], stdin=data)
+    check(r.returncode == 0, f'stdin: exit {r.returncode}')
+    recs = [json.loads(l) for l in r.stdout.decode().splitlines()]
+    check(len(recs) == 10 and 'Qw' in recs[0], 'stdin: 10 JSON epochs with Qw')
+
+    # missing file among good ones: named, exit 2, the others still decoded
+    r = run([exe, 'decode', clean, os.path.join(a.workdir, 'does-not-exist.log'), clean,
+             '--view', 'line'])
+    err = r.stderr.decode()
+    check(r.returncode == 2, f'missing file: exit {r.returncode}')
+    check('does-not-exist.log' in err and 'No such file' in err, 'missing file not named')
+    check(len(r.stdout.decode().splitlines()) == 20, 'files around the missing one not decoded')
+
+    # hostile file name
+    hostile = os.path.join(a.workdir, "-x; rm -rf ' \"$(id)\"\nlog.log")
+    with open(hostile, 'wb') as f:
+        f.write(data)
+    r = run([exe, 'decode', '--view', 'none', '--', hostile])
+    check(r.returncode == 0, f'hostile name: exit {r.returncode} {r.stderr.decode()}')
+
+    # help, version, usage errors
+    r = run([exe, '--help'])
+    out = r.stdout.decode()
+    check(r.returncode == 0 and 'Exit codes' in out and '3  decoded' in out, '--help exit codes')
+    r = run([exe, '--version'])
+    check(r.returncode == 0 and r.stdout.decode().startswith('gfins-can '), '--version')
+    r = run([exe, 'decode', '--view', 'nonsense', clean])
+    check(r.returncode == 1, f'bad view: exit {r.returncode}')
+    r = run([exe, 'bogus'])
+    check(r.returncode == 1, f'bad subcommand: exit {r.returncode}')
+    r = run([exe, 'cmd', '--iface', 'no-such-can9', 'reset'])
+    check(r.returncode == 2 and 'no-such-can9' in r.stderr.decode(),
+          f'cmd on a missing interface: exit {r.returncode}')
+
+    # views
+    for view in ('line', 'table'):
+        r = run([exe, 'decode', clean, '--view', view])
+        check(r.returncode == 0 and len(r.stdout) > 100, f'{view} view')
+
+    # can-utils reads our logs: log2asc converts every line (one "Rx" record per frame).
+    log2asc = shutil.which('log2asc')
+    check(log2asc is not None, 'log2asc (can-utils) not installed')
+    if log2asc:
+        r = run([log2asc, '-I', clean, 'can0'])
+        rx = [l for l in r.stdout.decode().splitlines() if ' Rx ' in l]
+        check(r.returncode == 0 and len(rx) == len(data.splitlines()),
+              f'log2asc: {len(rx)} records for {len(data.splitlines())} lines')
+        check(rx and rx[0].split()[-8:] == ['40', '4B', '4C', '00', '00', '00', '02', '0A'],
+              'log2asc: first frame data differ')
+
+    # plot
+    png = os.path.join(a.workdir, 'plot.png')
+    if os.path.exists(png):
+        os.remove(png)
+    longer = os.path.join(a.workdir, 'ten-seconds.log')
+    with open(longer, 'wb') as f:
+        subprocess.run([a.gen, 'log', '10'], stdout=f, check=True)
+    r = run([exe, 'plot', longer, '-o', png])
+    if r.returncode == 6 and 'built without' in r.stderr.decode():
+        print('cli: plot skipped: this build cannot start helper programs')
+    else:
+        check(r.returncode == 0, f'plot: exit {r.returncode}: {r.stderr.decode()}')
+        check(os.path.exists(png) and open(png, 'rb').read(8) == b'\x89PNG\r\n\x1a\n',
+              'plot: no PNG')
+
+    print(f'cli: {len(failures)} failed checks')
+    for f in failures:
+        print('  ' + f)
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,141 @@
+// gfins-can cmd against an in-process board: each command gets its response; an error response
+// is reported as a rejection; no board means a timeout.
+#include "command_client.hpp"
+
+#include <gtest/gtest.h>
+
+#include <deque>
+
+#include "gfins/can/signal_codec.hpp"
+
+namespace gfins::can_tool {
+namespace {
+
+constexpr std::uint8_t kNode = 4;
+
+/// A bus with a board behind it: every command frame sent is decoded as the firmware would and
+/// answered (status, calibration id, capture result), plus unrelated traffic in between.
+class BoardBus final : public hal::CanBus {
+ public:
+  bool answer = true;
+  int sent = 0;
+
+ private:
+  Status do_send(const hal::CanFrame& f) override {
+    ++sent;
+    if (!answer) return Status::ok();
+    // Unrelated traffic first: a data frame and a response with another token.
+    hal::CanFrame noise;
+    noise.id = 0x140 + kNode;
+    noise.len = 8;
+    can::seal_frame(noise);
+    rx_.push_back(noise);
+    rx_.push_back(
+        can::encode_response(can::Response{f.data[0], static_cast<std::uint8_t>(f.data[1] + 1),
+                                           can::ResultCode::kFailed, 0},
+                             kNode));
+    const can::DecodedCommand d = can::decode_command(f, kNode);
+    if (!d.addressed) return Status::ok();
+    if (!d.ok()) {
+      rx_.push_back(can::encode_response(can::error_response(d.error), kNode));
+      return Status::ok();
+    }
+    const can::Command& c = d.command;
+    const auto op = static_cast<std::uint8_t>(c.opcode);
+    switch (c.opcode) {
+      case can::Opcode::kReportCalibrationId:
+        rx_.push_back(can::encode_calibration_id_response(c.token, 0x1234ABCD, kNode));
+        break;
+      case can::Opcode::kStartCapture: {
+        rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, c.samples}, kNode));
+        can::CaptureResult r;
+        r.pose = c.pose;
+        r.samples = c.samples;
+        for (std::size_t k = 0; k < 6; ++k) {
+          r.channels[k] = {100.0f * static_cast<float>(k), 2.0f, c.samples, false, k == 1};
+        }
+        for (const auto& fr : can::encode_capture_result(r, c.token, kNode)) rx_.push_back(fr);
+        break;
+      }
+      default:
+        rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, c.divider}, kNode));
+    }
+    return Status::ok();
+  }
+  Result<hal::CanFrame> do_receive(std::int64_t) override {
+    if (rx_.empty()) return Status(ErrorCode::kTimeout, "no frame");
+    const hal::CanFrame f = rx_.front();
+    rx_.pop_front();
+    return f;
+  }
+  hal::CanBusState do_state() const override { return hal::CanBusState::kErrorActive; }
+  hal::CanCounters do_counters() const override { return {}; }
+  std::deque<hal::CanFrame> rx_;
+};
+
+CommandTimeouts short_timeouts() {
+  CommandTimeouts t;
+  t.response = std::chrono::milliseconds(50);
+  t.capture = std::chrono::milliseconds(50);
+  return t;
+}
+
+TEST(CommandClient, EveryCommandGetsItsResponse) {
+  BoardBus bus;
+  for (can::Opcode op :
+       {can::Opcode::kRealign, can::Opcode::kResetNavigation, can::Opcode::kSetCompensator,
+        can::Opcode::kSetDivider, can::Opcode::kReloadCalibration}) {
+    can::Command c;
+    c.opcode = op;
+    c.token = 10;
+    c.message = can::MessageId::kEuler;
+    c.divider = 40;
+    const CommandOutcome r = run_command(bus, c, kNode, short_timeouts());
+    EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
+    EXPECT_EQ(r.status.token, 10);
+  }
+}
+
+TEST(CommandClient, CalibrationIdAndCapture) {
+  BoardBus bus;
+  can::Command c;
+  c.opcode = can::Opcode::kReportCalibrationId;
+  c.token = 1;
+  CommandOutcome r = run_command(bus, c, kNode, short_timeouts());
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk);
+  EXPECT_EQ(r.status.cal_id, 0x1234ABCDu);
+  EXPECT_NE(r.text.find("0x1234ABCD"), std::string::npos);
+  c.opcode = can::Opcode::kStartCapture;
+  c.pose = 9;
+  c.samples = 300;
+  r = run_command(bus, c, kNode, short_timeouts());
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
+  ASSERT_TRUE(r.capture_complete);
+  EXPECT_EQ(r.capture.pose, 9);
+  EXPECT_EQ(r.capture.channels[5].mean_counts, 500.0f);
+  EXPECT_TRUE(r.capture.channels[1].motion);
+}
+
+TEST(CommandClient, OutOfRangeCommandIsRejected) {
+  BoardBus bus;
+  can::Command c;
+  c.opcode = can::Opcode::kStartCapture;
+  c.token = 3;
+  c.pose = 200;  // beyond 63: the board answers OutOfRange
+  c.samples = 10;
+  const CommandOutcome r = run_command(bus, c, kNode, short_timeouts());
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kRejected);
+  EXPECT_EQ(r.status.result, can::ResultCode::kOutOfRange);
+  EXPECT_NE(r.text.find("OutOfRange"), std::string::npos);
+}
+
+TEST(CommandClient, NoBoardTimesOut) {
+  BoardBus bus;
+  bus.answer = false;
+  const CommandOutcome r = run_command(bus, can::Command{}, kNode, short_timeouts());
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kTimeout);
+  EXPECT_EQ(bus.sent, 1);
+}
+
+}  // namespace
+}  // namespace gfins::can_tool
