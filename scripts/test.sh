@@ -46,13 +46,14 @@ cmake --preset cortex-m4f >/dev/null
 cmake --build --preset cortex-m4f -j "$jobs"
 ./scripts/embedded_size.sh | tail -n 25
 
-step "cross builds: aarch64 and armhf (multiarch), unit tests under qemu-user"
+# The whole suite is cross-built and run under qemu-user for aarch64; armhf is built for its
+# package only (programs), which keeps .ci/run inside its 30 minutes (docs/ci.md): the full
+# armhf suite is `ctest --preset armhf-linux` after `cmake --build --preset armhf-linux`.
+step "cross build aarch64 (multiarch), unit tests under qemu-aarch64-static"
 ./scripts/install-cross-deps.sh
-for preset in aarch64-linux armhf-linux; do
-  cmake --preset "$preset" >/dev/null
-  cmake --build --preset "$preset" -j "$jobs"
-  ctest --preset "$preset" -j "$jobs" | tee "$log_dir/ctest-$preset.log"
-done
+cmake --preset aarch64-linux >/dev/null
+cmake --build --preset aarch64-linux -j "$jobs"
+ctest --preset aarch64-linux -j "$jobs" | tee "$log_dir/ctest-aarch64-linux.log"
 
 step "Debian packages (amd64, arm64, armhf) and lintian"
 ./scripts/package.sh deb-amd64 aarch64-linux armhf-linux
