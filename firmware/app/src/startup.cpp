@@ -12,12 +12,6 @@ namespace {
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
-std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
-  const std::uint64_t h = calib_file::checksum(d);
-  const auto id = static_cast<std::uint32_t>(h ^ (h >> 32));
-  return id == 0 ? 1u : id;
-}
-
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
                                            const calib_file::CalibrationData& d) {
   nav::PipelineConfig<float> p;
@@ -75,7 +69,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
   std::string why;
   if (c.calibration_file.empty() && factory != nullptr) {
     out.set.config = pipeline_config(c, *factory);
-    out.set.cal_id = calibration_id(*factory);
+    out.set.cal_id = calib_file::calibration_id(*factory);
     out.set.calibrated = true;
     out.from_file = true;  // a real calibration, not the flagged defaults
     out.message = "factory calibration of the board (" + factory->source + ")";
@@ -87,7 +81,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
     if (loaded.is_ok()) {
       out.set.config = pipeline_config(c, loaded.value());
-      out.set.cal_id = calibration_id(loaded.value());
+      out.set.cal_id = calib_file::calibration_id(loaded.value());
       out.set.calibrated = true;
       out.from_file = true;
       char id[16];
@@ -120,7 +114,7 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());
-    s.cal_id = calibration_id(loaded.value());
+    s.cal_id = calib_file::calibration_id(loaded.value());
     s.calibrated = true;
     return s;
   };

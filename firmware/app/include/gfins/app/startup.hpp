@@ -13,10 +13,8 @@
 
 namespace gfins::app {
 
-/// 32-bit calibration identity published on CAN: the file's FNV-1a 64 checksum folded to 32
-/// bits (high XOR low). 0 is reserved for "uncalibrated defaults" (a file folding to 0 is
-/// published as 1).
-std::uint32_t calibration_id(const calib_file::CalibrationData& d);
+// The calibration identity published on CAN is calib_file::calibration_id() (the one the
+// calibration tool prints); 0 is reserved for "uncalibrated defaults".
 
 /// Pipeline configuration from the firmware configuration and a calibration.
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c, const calib_file::CalibrationData& d);
