@@ -12,6 +12,10 @@ namespace {
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
+std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
+  return calib_file::cal_id_of(d);  // one rule, shared with gfins-calibrate's report
+}
+
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
                                            const calib_file::CalibrationData& d) {
   nav::PipelineConfig<float> p;
@@ -69,7 +73,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
   std::string why;
   if (c.calibration_file.empty() && factory != nullptr) {
     out.set.config = pipeline_config(c, *factory);
-    out.set.cal_id = calib_file::calibration_id(*factory);
+    out.set.cal_id = calib_file::cal_id_of(*factory);
     out.set.calibrated = true;
     out.from_file = true;  // a real calibration, not the flagged defaults
     out.message = "factory calibration of the board (" + factory->source + ")";
@@ -81,7 +85,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
     if (loaded.is_ok()) {
       out.set.config = pipeline_config(c, loaded.value());
-      out.set.cal_id = calib_file::calibration_id(loaded.value());
+      out.set.cal_id = calib_file::cal_id_of(loaded.value());
       out.set.calibrated = true;
       out.from_file = true;
       char id[16];
@@ -114,7 +118,7 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());
-    s.cal_id = calib_file::calibration_id(loaded.value());
+    s.cal_id = calib_file::cal_id_of(loaded.value());
     s.calibrated = true;
     return s;
   };

@@ -13,8 +13,9 @@
 
 namespace gfins::app {
 
-// The calibration identity published on CAN is calib_file::calibration_id() (the one the
-// calibration tool prints); 0 is reserved for "uncalibrated defaults".
+/// The calibration identity published on CAN: calib_file::cal_id_of() (the one the calibration
+/// tool prints); 0 is reserved for "uncalibrated defaults".
+std::uint32_t calibration_id(const calib_file::CalibrationData& d);
 
 /// Pipeline configuration from the firmware configuration and a calibration.
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c, const calib_file::CalibrationData& d);
