@@ -2,6 +2,8 @@
 // the status bits published with every epoch (docs/faults.md maps each fault to all of these).
 #pragma once
 
+#include "gfins/can/epoch.hpp"
+
 #include <array>
 #include <cstdint>
 
@@ -36,22 +38,24 @@ struct HealthCounters {
 /// Event bits (marked *) stay set for kEventHoldSamples after the event so a status frame sent at
 /// a lower rate still shows it; the counters are exact.
 namespace status_bits {
-inline constexpr std::uint32_t kAligned = 1u << 0;         // static alignment done
-inline constexpr std::uint32_t kSampleGap = 1u << 1;       // * samples missing (edges lost)
-inline constexpr std::uint32_t kInputInvalid = 1u << 2;    // this sample was rejected
-inline constexpr std::uint32_t kCompensated = 1u << 3;     // misalignment compensation active
-inline constexpr std::uint32_t kCrcError = 1u << 6;        // * ADC CRC error
-inline constexpr std::uint32_t kSaturated = 1u << 7;       // * a channel at full scale
-inline constexpr std::uint32_t kStuckChannel = 1u << 8;    // a channel stuck now
-inline constexpr std::uint32_t kUncalibrated = 1u << 9;    // nominal defaults in use
-inline constexpr std::uint32_t kLoopOverrun = 1u << 10;    // * a cycle overran its period
-inline constexpr std::uint32_t kCanTxDrop = 1u << 11;      // * CAN frames dropped
-inline constexpr std::uint32_t kCaptureActive = 1u << 12;  // calibration capture running
-inline constexpr std::uint32_t kDegraded = 1u << 13;       // navigation output not trustworthy
-inline constexpr std::uint32_t kAdcRecovered = 1u << 14;   // * the ADC was reset/reconfigured
-inline constexpr std::uint32_t kDataReadyLost = 1u << 15;  // * no data-ready edge in time
-inline constexpr std::uint32_t kBusOff = 1u << 16;         // * CAN controller went bus-off
-inline constexpr std::uint32_t kExtraEdge = 1u << 17;      // * data-ready without a conversion
+// One source: the CAN protocol's bit positions (firmware/can/include/gfins/can/epoch.hpp), under
+// the names the firmware's health code uses.
+inline constexpr std::uint32_t kAligned = can::status_bits::kAligned;            // alignment done
+inline constexpr std::uint32_t kSampleGap = can::status_bits::kSampleGap;        // * edges lost
+inline constexpr std::uint32_t kInputInvalid = can::status_bits::kInputInvalid;  // rejected
+inline constexpr std::uint32_t kCompensated = can::status_bits::kCompensated;
+inline constexpr std::uint32_t kCrcError = can::status_bits::kAdcCrcError;    // *
+inline constexpr std::uint32_t kSaturated = can::status_bits::kAdcSaturated;  // *
+inline constexpr std::uint32_t kStuckChannel = can::status_bits::kAdcChannelStuck;
+inline constexpr std::uint32_t kUncalibrated = can::status_bits::kNominalCalibration;
+inline constexpr std::uint32_t kLoopOverrun = can::status_bits::kLoopOverrun;  // *
+inline constexpr std::uint32_t kCanTxDrop = can::status_bits::kCanTxDropped;   // *
+inline constexpr std::uint32_t kCaptureActive = can::status_bits::kCaptureActive;
+inline constexpr std::uint32_t kDegraded = can::status_bits::kHealthDegraded;
+inline constexpr std::uint32_t kAdcRecovered = can::status_bits::kAdcRecovered;    // *
+inline constexpr std::uint32_t kDataReadyLost = can::status_bits::kDataReadyLost;  // *
+inline constexpr std::uint32_t kBusOff = can::status_bits::kBusOff;                // *
+inline constexpr std::uint32_t kExtraEdge = can::status_bits::kExtraEdge;          // *
 }  // namespace status_bits
 
 /// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).

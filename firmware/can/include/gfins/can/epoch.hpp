@@ -38,7 +38,11 @@ inline constexpr std::uint32_t kLoopOverrun = 1u << 10;        // the sample loo
 inline constexpr std::uint32_t kCanTxDropped = 1u << 11;       // CAN frames were dropped
 inline constexpr std::uint32_t kCaptureActive = 1u << 12;      // calibration capture running
 inline constexpr std::uint32_t kHealthDegraded = 1u << 13;     // any health counter grew recently
-inline constexpr std::uint32_t kAllBits = (1u << 20) - 1;      // width of the bus field
+inline constexpr std::uint32_t kAdcRecovered = 1u << 14;       // the ADC was reset and reconfigured
+inline constexpr std::uint32_t kDataReadyLost = 1u << 15;      // no data-ready edge in time
+inline constexpr std::uint32_t kBusOff = 1u << 16;             // the CAN controller went bus-off
+inline constexpr std::uint32_t kExtraEdge = 1u << 17;      // a data-ready edge without a conversion
+inline constexpr std::uint32_t kAllBits = (1u << 20) - 1;  // width of the bus field
 static_assert(kAligned == nav::nav_status::kAligned && kSampleGap == nav::nav_status::kSampleGap &&
                   kInputInvalid == nav::nav_status::kInputInvalid &&
                   kCompensated == nav::nav_status::kCompensated,
