@@ -136,8 +136,10 @@ gyroscope and publishes them on SocketCAN. Runs as the systemd service
 gfins-fw (Type=notify, watchdog, restart on failure) under its own user;
 configuration in /etc/gfins, calibration in /var/lib/gfins.")
 set(CPACK_DEBIAN_BOARD_PACKAGE_DEPENDS "adduser, init-system-helpers (>= 1.52)")
+# The configuration is a conffile: dpkg keeps the administrator's edits over updates.
+file(WRITE ${PROJECT_BINARY_DIR}/packaging/gfins-fw/conffiles "${GFINS_FULL_CONFDIR}/gfins-fw.toml\n")
 set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_EXTRA
-    "${GFINS_PKG_DIR}/deb/postinst;${GFINS_PKG_DIR}/deb/prerm;${GFINS_PKG_DIR}/deb/postrm")
+    "${GFINS_PKG_DIR}/deb/postinst;${GFINS_PKG_DIR}/deb/prerm;${GFINS_PKG_DIR}/deb/postrm;${PROJECT_BINARY_DIR}/packaging/gfins-fw/conffiles")
 set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 
 set(CPACK_DEBIAN_TOOLS_PACKAGE_NAME gfins-tools)

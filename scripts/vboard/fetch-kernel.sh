@@ -4,6 +4,7 @@
 # $vboard_cache/root/<kver>. The version comes from the mirror (apt-cache depends
 # linux-image-amd64). Idempotent: a .deb already in the cache is never fetched again, an
 # unpacked tree is never unpacked again. Prints the kernel ABI name on stdout.
+# GFINS_VBOARD_OFFLINE=1: fail instead of downloading (proves a warm cache downloads nothing).
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 vb_require apt-get:apt dpkg:dpkg
@@ -33,6 +34,8 @@ for spec in "${wanted[@]}"; do
   if compgen -G "$debs/${name}_${debver/:/%3a}_*.deb" >/dev/null; then
     continue
   fi
+  [ "${GFINS_VBOARD_OFFLINE:-0}" != 1 ] ||
+    vb_die "GFINS_VBOARD_OFFLINE=1 but $spec is not in the cache $debs"
   vb_log "downloading $spec"
   downloaded=$((downloaded + 1))
   # The cache belongs to root, not to apt's sandbox user: download as root, quietly.

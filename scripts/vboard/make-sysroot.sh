@@ -19,6 +19,8 @@ if [ -e "$root/.complete" ]; then
   echo "$root"
   exit 0
 fi
+[ "${GFINS_VBOARD_OFFLINE:-0}" != 1 ] ||
+  vb_die "GFINS_VBOARD_OFFLINE=1 but the debootstrap root $root is not in the cache"
 debs=$vboard_cache/debootstrap-debs
 mkdir -p "$debs"
 rm -rf "$root"

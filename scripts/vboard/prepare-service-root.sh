@@ -34,6 +34,9 @@ cp -a "$pristine" "$out"
 mkdir -p "$out/lib/modules/$kver/extra" "$out/vboard"
 while read -r m; do cp "$staged/lib/modules/$m" "$out/lib/modules/$kver/extra/"; done \
   <"$staged/lib/modules/load-order"
+for f in modules.builtin modules.builtin.modinfo modules.order; do
+  cp "$vboard_cache/root/$kver/lib/modules/$kver/$f" "$out/lib/modules/$kver/" 2>/dev/null || true
+done
 depmod -b "$out" "$kver" || vb_die "depmod in the service root failed"
 cp "$staged/vboard/drdy-toggle" "$out/vboard/"
 cp "$here/service/"*.sh "$out/vboard/"

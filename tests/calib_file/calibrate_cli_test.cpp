@@ -224,6 +224,34 @@ TEST(CalibrateCli, BothRoutesUseAndNameTheStatedSigma) {
   EXPECT_THAT(r.output, HasSubstr("no σ stated with the means, so from the fit residuals"));
 }
 
+TEST(CalibrateCli, AVerificationPoseShowsTheResidualsAndCatchesAWrongOne) {
+  // Given a calibration from Tables 4/5,
+  const TempDir dir;
+  const auto cal = dir.path() / "cal.toml";
+  ASSERT_EQ(run_cli(dir, "--means " + kGolden +
+                             " --latitude 24.8 --device-id v --adc-lsb 1e-7 -o " + cal.string())
+                .exit_code,
+            0);
+  // when the same poses are checked against it, then every residual is within 5 sigma;
+  RunResult r = run_cli(dir, "--verify " + cal.string() + " --means " + kGolden);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("pose 1 sensor a2: residual"));
+  EXPECT_THAT(r.output, HasSubstr("verification passed"));
+  // and a pose whose sensor 3 reads 50 mV off (a mis-seated jig: ~0.1 g on SF 0.5 V/g, 18x the
+  // predicted sigma of ~2.7 mV) fails, naming the sensor and the pose.
+  std::string text = read_text(kGolden);
+  const auto at = text.find("\n3,2,");
+  ASSERT_NE(at, std::string::npos);
+  const auto end = text.find('\n', at + 1);
+  const double v = std::stod(text.substr(at + 5, end - at - 5)) + 0.05;
+  text.replace(at, end - at, "\n3,2," + std::to_string(v));
+  const auto bad = dir.path() / "verify.csv";
+  write_text(bad, text);
+  r = run_cli(dir, "--verify " + cal.string() + " --means " + bad.string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("verification failed: sensor a3 in pose 2"));
+}
+
 TEST(CalibrateCli, ADryRunNeedsNeitherAdcLsbNorDeviceIdNorGravity) {
   const TempDir dir;
   const RunResult r = run_cli(dir, "--means " + kGolden + " --dry-run");

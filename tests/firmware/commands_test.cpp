@@ -117,7 +117,7 @@ TEST_F(Commands, CaptureAveragesNSamplesPerChannel) {
   c.kind = CommandKind::kCaptureCalibration;
   c.pose = 4;
   c.samples = 500;
-  EXPECT_EQ(exec(c).result, CommandResult::kAccepted);
+  EXPECT_EQ(exec(c).result, CommandResult::kOk);
   EXPECT_TRUE(rig_->loop->capture_active());
   EXPECT_EQ(exec(c).result, CommandResult::kBusy);  // one capture at a time
   const std::size_t first = rig_->tap->samples().size();
@@ -125,28 +125,31 @@ TEST_F(Commands, CaptureAveragesNSamplesPerChannel) {
   EXPECT_FALSE(rig_->loop->capture_active());
   const CaptureResult& cap = rig_->loop->last_capture();
   EXPECT_EQ(cap.pose, 4);
-  EXPECT_FALSE(cap.motion);
+  EXPECT_EQ(cap.samples, 500);
+  EXPECT_FALSE(cap.motion());
   // Oracle: the same statistics computed here from the raw samples the loop read.
   const auto& samples = rig_->tap->samples();
   ASSERT_EQ(samples.size(), first + 500);
   const double lsb = rig_->adc->volts_per_count();
   for (std::size_t j = 0; j < 6; ++j) {
     double sum = 0, sum2 = 0;
-    for (std::size_t i = first; i < samples.size(); ++i) sum += samples[i].counts[j] * lsb;
+    for (std::size_t i = first; i < samples.size(); ++i) sum += samples[i].counts[j];
     const double mean = sum / 500.0;
     for (std::size_t i = first; i < samples.size(); ++i) {
-      sum2 += (samples[i].counts[j] * lsb - mean) * (samples[i].counts[j] * lsb - mean);
+      sum2 += (samples[i].counts[j] - mean) * (samples[i].counts[j] - mean);
     }
     const double sd = std::sqrt(sum2 / 499.0);
     EXPECT_EQ(cap.channels[j].count, 500u);
     EXPECT_FALSE(cap.channels[j].saturated);
+    EXPECT_FALSE(cap.channels[j].motion);
     // float storage of the result: 2^-24 relative, plus the running-mean rounding
-    EXPECT_NEAR(cap.channels[j].mean_v, mean, 1e-6 * std::abs(mean) + 1e-9);
-    EXPECT_NEAR(cap.channels[j].std_v, sd, 1e-4 * sd);
-    // The scenario's white noise is 1 mg per sensor at 1 V/g = 1e-3 V; the sample standard
-    // deviation of N = 500 has a relative spread of 1/sqrt(2N) = 3.2 %: 15 % is 4.7 sigma
-    // (false failure 2.6e-6 per channel).
-    EXPECT_NEAR(cap.channels[j].std_v, 1e-3, 0.15e-3);
+    EXPECT_NEAR(cap.channels[j].mean_counts, mean, 1e-6 * std::abs(mean) + 1e-3);
+    EXPECT_NEAR(cap.channels[j].std_counts, sd, 1e-4 * sd);
+    // The scenario's white noise is 1 mg per sensor: 1e-3 g · SF (V/g) / lsb (V/count) codes; the
+    // sample standard deviation of N = 500 has a relative spread of 1/sqrt(2N) = 3.2 %: 15 % is
+    // 4.7 sigma (false failure 2.6e-6 per channel).
+    const double sigma_counts = 1e-3 * rig_->factory.sensors[j].scale_v_per_g / lsb;
+    EXPECT_NEAR(cap.channels[j].std_counts, sigma_counts, 0.15 * sigma_counts);
   }
 }
 

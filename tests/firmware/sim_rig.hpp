@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "gfins/app/can_adapters.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/epoch_sinks.hpp"
 #include "gfins/app/logger.hpp"
@@ -38,50 +39,32 @@ class TapSource final : public app::SampleSource {
   std::vector<RawSample> samples_;
 };
 
-/// Stands in for the CAN publisher until the protocol's Publisher is wired in: one 8-byte frame
-/// per epoch whose seq is a multiple of 10 (100 Hz at 1 kHz), carrying the sample counter.
-class StubPublisher final : public app::EpochSink {
- public:
-  explicit StubPublisher(hal::CanBus& bus) : bus_(bus) {}
-  void publish(const app::Epoch& e) override {
-    if (e.nav.seq % 10 != 0) return;
-    hal::CanFrame f;
-    f.id = 0x100;
-    f.len = 8;
-    for (std::size_t i = 0; i < 4; ++i) f.data[i] = static_cast<std::uint8_t>(e.nav.seq >> (8 * i));
-    (void)bus_.send(f);
-  }
-  Status set_divider(std::size_t m, std::uint16_t) override {
-    return m < app::kNumMessages ? Status::ok() : Status(ErrorCode::kOutOfRange, "message");
-  }
-
- private:
-  hal::CanBus& bus_;
-};
-
 struct SimRig {
   /// `scenario`: a name in host_sim/scenarios; `seconds`: run length (samples = seconds·rate+1).
   SimRig(const std::string& scenario, double seconds, const sim_board::FaultPlan& faults = {},
          std::size_t can_capacity = 1u << 16) {
-    auto p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
+    const auto p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
     if (!p.is_ok()) throw std::runtime_error(p.error().message);
-    s = std::move(p).value();
+    s = p.value();
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
     stream = sim_board::make_scenario_stream(s);
-    adc = sim_board::make_adc_chain(s);
+    adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
+    if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
     source = std::make_unique<sim_board::SimSampleSource>(
         *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
     source->set_faults(faults);
     tap = std::make_unique<TapSource>(*source, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
-    publisher = std::make_unique<StubPublisher>(*bus);
+    publisher = std::make_unique<app::CanEpochSink>(*bus, kNode, app::to_can_dividers(config));
+    codec = std::make_unique<app::CanCommandCodec>(kNode);
     recording = std::make_unique<app::RecordingSink>(publisher.get(), samples);
     log = std::make_unique<app::FwLogQueue>();
     factory = sim_board::scenario_calibration(s, adc->volts_per_count());
     cal = app::load_calibration(config, factory, &factory).set;
     loop = std::make_unique<app::SampleLoop>(*tap, *bus, *recording, clock, *log);
+    loop->set_command_codec(codec.get());
   }
 
   void configure() {
@@ -111,12 +94,14 @@ struct SimRig {
   app::FwConfig config;
   std::uint32_t samples = 0;
   std::unique_ptr<sim_board::SensorStream> stream;
-  std::unique_ptr<sim_board::AdcChain> adc;
+  static constexpr std::uint8_t kNode = 1;
+  std::unique_ptr<sim_board::ChipAdc> adc;
   sim_board::SampleClock clock;
   std::unique_ptr<sim_board::SimSampleSource> source;
   std::unique_ptr<TapSource> tap;
   std::unique_ptr<sim_board::MemoryCanBus> bus;
-  std::unique_ptr<StubPublisher> publisher;
+  std::unique_ptr<app::CanEpochSink> publisher;
+  std::unique_ptr<app::CanCommandCodec> codec;
   std::unique_ptr<app::RecordingSink> recording;
   std::unique_ptr<app::FwLogQueue> log;
   calib_file::CalibrationData factory;

@@ -78,6 +78,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   auto* o_dur = app.add_option("--duration", duration, "sim.duration_s (0 = the scenario's)");
   auto* o_sdir = app.add_option("--scenario-dir", scenario_dir, "sim.scenario_dir");
   app.add_flag("--check-config", out.check_only, "validate the configuration and exit");
+  app.add_option("--latency-csv", out.latency_csv,
+                 "benchmark: write the data-ready → CAN latency histogram (us,count) here");
   app.add_flag("--print-default-config", print_default, "print the commented default and exit");
 
   try {

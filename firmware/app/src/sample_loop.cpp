@@ -80,11 +80,10 @@ SampleLoop::Cycle SampleLoop::step() {
     update_adc_counters(sample_index_);
   }
 
-  const std::uint32_t tx_before = bus_.counters().tx_frames;
-  if (r.is_ok()) out_.publish(epoch_);
+  // Latency: edge → the epoch's frames handed to the bus backend (cycles that sent frames).
+  const std::uint32_t frames = r.is_ok() ? out_.publish(epoch_) : 0;
+  if (frames > 0) latency_.add(clock_.now_ns() - t_edge);
   bus_.service();
-  const std::int64_t t_sent = clock_.now_ns();
-  if (r.is_ok() && bus_.counters().tx_frames != tx_before) latency_.add(t_sent - t_edge);
   update_can_counters(sample_index_, t_edge);
 
   handle_commands(t_edge);
@@ -212,8 +211,9 @@ void SampleLoop::on_sample(const RawSample& s) {
   }
   if (!crc_ok || saturated != 0) ++health_.rejected_samples;
 
-  // A CRC error means the counts are not a measurement: the pipeline skips the sample and
-  // integrates across the hole with the next good one; it rejects saturated samples itself.
+  // A CRC error means the counts are not a measurement: the pipeline skips the sample (and a
+  // saturated one) and integrates across the hole with the next good one.
+  if (crc_ok && saturated == 0) last_good_ = s;
   pipeline_.process(s);
   if (capture_.active && crc_ok) capture_add(s);
   build_epoch(s);
@@ -261,31 +261,29 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
   for (int i = 0; i < kMaxCommandsPerCycle; ++i) {
     const Result<hal::CanFrame> f = bus_.receive(0);
     if (!f.is_ok()) return;  // kTimeout: nothing waiting
-    if (!codec_->is_command(f.value())) continue;
-    Command partial{};
-    const Result<Command> c = codec_->decode(f.value(), partial);
+    const DecodedFrame d = codec_->decode(f.value());
+    if (!d.addressed) continue;
     Response r;
-    if (!c.is_ok()) {
-      r.kind = partial.kind;
-      r.token = partial.token;
-      r.result = c.status().code() == ErrorCode::kOutOfRange ? CommandResult::kOutOfRange
-                                                             : CommandResult::kMalformed;
+    if (!d.ok) {
+      r.raw_opcode = d.raw_opcode;
+      r.token = d.token;
+      r.result = d.error;
       ++health_.command_errors;
-      log(LogLevel::kWarn, t_ns, "command frame id {:#x} rejected: error code {}", f.value().id,
-          static_cast<std::int64_t>(c.status().code()));
+      log(LogLevel::kWarn, t_ns, "command frame id {:#x} rejected: result {}", f.value().id,
+          static_cast<std::int64_t>(d.error));
     } else {
-      execute(c.value(), r);
+      execute(d.command, r);
       log(LogLevel::kInfo, t_ns, "command {} token {} -> result {}",
-          static_cast<std::int64_t>(c.value().kind), c.value().token,
+          static_cast<std::int64_t>(d.command.kind), d.command.token,
           static_cast<std::int64_t>(r.result));
     }
-    send_response(r);
+    if (!r.deferred) send_response(r);
   }
 }
 
 void SampleLoop::send_response(const Response& r) {
   if (codec_ == nullptr) return;
-  std::array<hal::CanFrame, 16> frames{};
+  std::array<hal::CanFrame, 24> frames{};
   const std::size_t n = codec_->encode(r, frames);
   for (std::size_t i = 0; i < n && i < frames.size(); ++i) (void)bus_.send(frames[i]);
 }
@@ -296,19 +294,14 @@ Status SampleLoop::reconfigure_keep_navigation(const nav::PipelineConfig<float>&
   if (const Status s = pipeline_.configure(cfg); !s.is_ok()) return s;
   // configure() restarts alignment; a running navigation continues from its current state
   // with the new compensation instead.
-  if (navigating) {
-    RawSample last;
-    last.seq = state.seq;
-    last.t_ns = state.t_ns;
-    last.counts = last_counts_;
-    pipeline_.start_at(state, last);
-  }
+  if (navigating) pipeline_.start_at(state, last_good_);
   return Status::ok();
 }
 
 void SampleLoop::execute(const Command& c, Response& r) {
   r = Response{};
   r.kind = c.kind;
+  r.raw_opcode = static_cast<std::uint8_t>(c.kind);
   r.token = c.token;
   r.cal_id = cal_.cal_id;
   r.calibrated = cal_.calibrated;
@@ -349,6 +342,7 @@ void SampleLoop::execute(const Command& c, Response& r) {
       }
       if (!out_.set_divider(c.message, c.divider).is_ok())
         return reject(CommandResult::kOutOfRange);
+      r.value = c.divider;
       break;
     case CommandKind::kReportCalibration:
       break;
@@ -361,27 +355,26 @@ void SampleLoop::execute(const Command& c, Response& r) {
       capture_.active = true;
       capture_.command = c;
       capture_.target = c.samples;
-      r.result = CommandResult::kAccepted;
+      r.value = c.samples;
       break;
     case CommandKind::kReloadCalibration:
       if (reload_ == nullptr) return reject(CommandResult::kFailed);
       if (reload_pending_ || !reload_->request(cal_.config)) return reject(CommandResult::kBusy);
       reload_pending_ = true;
       reload_token_ = c.token;
-      r.result = CommandResult::kAccepted;
+      r.deferred = true;  // answered when the worker is done (poll_reload)
       break;
     default:
-      return reject(CommandResult::kMalformed);
+      return reject(CommandResult::kUnknownOpcode);
   }
   ++health_.commands;
 }
 
 void SampleLoop::capture_add(const RawSample& s) {
-  const auto& fe = pipeline_.front_end().params();
   for (std::size_t j = 0; j < kAdcChannels; ++j) {
     if (s.counts[j] >= kAdcCodeMax || s.counts[j] <= kAdcCodeMin) capture_.saturated[j] = true;
     // Welford's running mean and sum of squares (numerically stable for long captures).
-    const double v = static_cast<double>(s.counts[j]) * static_cast<double>(fe.volts_per_count[j]);
+    const auto v = static_cast<double>(s.counts[j]);
     const double n = static_cast<double>(++capture_.n[j]);
     const double d = v - capture_.mean[j];
     capture_.mean[j] += d / n;
@@ -394,28 +387,31 @@ void SampleLoop::capture_finish() {
   const auto& fe = pipeline_.front_end().params();
   Response r;
   r.kind = CommandKind::kCaptureCalibration;
+  r.raw_opcode = static_cast<std::uint8_t>(r.kind);
   r.token = capture_.command.token;
   r.result = CommandResult::kOk;
   r.cal_id = cal_.cal_id;
   r.calibrated = cal_.calibrated;
   r.has_capture = true;
   r.capture.pose = capture_.command.pose;
+  r.capture.samples = capture_.command.samples;
   for (std::size_t j = 0; j < kAdcChannels; ++j) {
     CaptureChannel& ch = r.capture.channels[j];
     const std::uint32_t n = capture_.n[j];
     ch.count = n;
-    ch.mean_v = static_cast<float>(capture_.mean[j]);
-    const double var = n > 1 ? capture_.m2[j] / static_cast<double>(n - 1) : 0.0;
-    ch.std_v = static_cast<float>(std::sqrt(var));
+    ch.mean_counts = static_cast<float>(capture_.mean[j]);
+    const double sd = n > 1 ? std::sqrt(capture_.m2[j] / static_cast<double>(n - 1)) : 0.0;
+    ch.std_counts = static_cast<float>(sd);
     ch.saturated = capture_.saturated[j];
-    if (std::sqrt(var) > kCaptureMotionStdG * static_cast<double>(fe.scale_v_per_g[j])) {
-      r.capture.motion = true;
-    }
+    // counts → g through the channel's LSB (V/count) and scale factor (V/g)
+    const double g_per_count =
+        static_cast<double>(fe.volts_per_count[j]) / static_cast<double>(fe.scale_v_per_g[j]);
+    ch.motion = sd * g_per_count > kCaptureMotionStdG;
   }
   capture_.active = false;
   last_capture_ = r.capture;
   log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}", r.capture.pose,
-      r.capture.channels[0].count, r.capture.motion ? 1 : 0);
+      r.capture.channels[0].count, r.capture.motion() ? 1 : 0);
   send_response(r);
 }
 
@@ -427,6 +423,7 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
   reload_pending_ = false;
   Response r;
   r.kind = CommandKind::kReloadCalibration;
+  r.raw_opcode = static_cast<std::uint8_t>(r.kind);
   r.token = reload_token_;
   r.result = CommandResult::kFailed;
   if (p == ReloadWorker::Poll::kReady) {

@@ -210,6 +210,11 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
   return fnv1a64(canonical_serialisation(data, version));
 }
 
+std::uint32_t calibration_id(const CalibrationData& data) {
+  const auto id = static_cast<std::uint32_t>(checksum(data) & 0xFFFFFFFFu);
+  return id == 0 ? 1u : id;
+}
+
 std::string utc_now_iso8601() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};

@@ -5,7 +5,8 @@
 #include <cmath>
 #include <thread>
 
-#include "gfins/host_sim/adc_model.hpp"
+#include "gfins/host_sim/chip/simulated_adc.hpp"
+#include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 
 namespace gfins::sim_board {
@@ -26,7 +27,7 @@ Status SteadyClock::do_sleep_until_ns(std::int64_t t_ns) {
 
 // ---- Sample source ----------------------------------------------------------------------------
 
-SimSampleSource::SimSampleSource(SensorStream& stream, AdcChain& adc, hal::Clock& clock,
+SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock,
                                  SampleClock* sample_clock, Pacing pacing, double sample_rate_hz,
                                  std::uint32_t samples)
     : stream_(stream),
@@ -71,63 +72,45 @@ Result<RawSample> SimSampleSource::do_read_sample(std::int64_t timeout_ns) {
     if (remaining_ == 0) return Status(ErrorCode::kUnavailable, "sim: scenario finished");
     return Status(ErrorCode::kTimeout, "sim: no data-ready edge");
   }
-  // A spurious edge: the driver finds no new conversion behind it and counts it; the loop only
-  // sees the next real one.
-  if (extra_pending_) {
-    extra_pending_ = false;
-    ++extra_.extra_edges;
-  }
-  // Lost edges: those conversions are never read.
-  while (remaining_ > 1 && contains(faults_.missing_edges, next_seq_)) {
-    (void)stream_.volts(next_seq_++);
+  // Conversions until one is read: a lost edge or a chip reset costs the conversion it hits.
+  for (;;) {
+    const std::uint32_t seq = next_seq_++;
     --remaining_;
-  }
-  const std::uint32_t seq = next_seq_++;
-  --remaining_;
-  std::array<double, 6> v = stream_.volts(seq);
-  const std::int64_t t = edge_time(seq);
-  if (pacing_ == Pacing::kRealTime) (void)clock_.sleep_until_ns(t);
-  if (sample_clock_ != nullptr) sample_clock_->set(t);
-  if (faults_.reset_at != 0 && seq == faults_.reset_at) {
-    // The chip reset itself (brown-out, ESD): the driver sees the reset status, reconfigures and
-    // loses the conversions of the recovery (two periods).
-    ++extra_.chip_resets;
-    for (int i = 0; i < 2 && remaining_ > 1; ++i) {
-      (void)stream_.volts(next_seq_++);
-      --remaining_;
+    const std::array<double, 6> v = stream_.volts(seq);
+    const std::int64_t t = edge_time(seq);
+    if (pacing_ == Pacing::kRealTime) (void)clock_.sleep_until_ns(t);
+    if (sample_clock_ != nullptr) sample_clock_->set(t);
+    const auto in = [seq](std::uint32_t from, std::uint32_t until) {
+      return seq >= from && (until == 0 || seq < until);
+    };
+    if (faults_.reset_at != 0 && seq == faults_.reset_at) adc_.power_on_reset();
+    if (contains(faults_.missing_edges, seq)) adc_.drop_edge();
+    if (contains(faults_.extra_edge_after, seq - 1)) adc_.extra_edge();
+    if (contains(faults_.crc_error_at, seq)) adc_.corrupt_next_frame();
+    if (faults_.saturated_channel >= 0) {
+      if (seq == faults_.saturated_from) adc_.saturate_channel(faults_.saturated_channel);
+      if (seq == faults_.saturated_until) adc_.clear_channel_faults();
     }
+    if (faults_.stuck_channel >= 0 && seq == faults_.stuck_until && faults_.stuck_until != 0) {
+      adc_.clear_channel_faults();
+    }
+    Result<RawSample> r = adc_.convert(v, seq, t);
+    if (r.is_ok() && faults_.stuck_channel >= 0 && seq == faults_.stuck_from &&
+        in(faults_.stuck_from, faults_.stuck_until)) {
+      // From the next conversion on the channel repeats this one's code.
+      const auto j = static_cast<std::size_t>(faults_.stuck_channel);
+      adc_.stick_channel(faults_.stuck_channel, r.value().counts[j]);
+    }
+    if (r.is_ok() || remaining_ == 0) return r;
+    if (r.status().code() != ErrorCode::kUnavailable && r.status().code() != ErrorCode::kDataLoss) {
+      return r;
+    }
+    // kUnavailable: the edge was lost; kDataLoss: the driver found the chip reset and has
+    // reconfigured it. Either way no sample for this conversion: the loop sees the next one.
   }
-  Result<RawSample> r = adc_.convert(v, seq, t);
-  if (!r.is_ok()) return r;
-  RawSample s = r.value();
-  const auto in = [seq](std::uint32_t from, std::uint32_t until) {
-    return seq >= from && (until == 0 || seq < until);
-  };
-  if (faults_.stuck_channel >= 0 && in(faults_.stuck_from, faults_.stuck_until)) {
-    const auto j = static_cast<std::size_t>(faults_.stuck_channel);
-    if (seq == faults_.stuck_from) frozen_[j] = s.counts[j];
-    s.counts[j] = frozen_[j];
-  }
-  if (faults_.saturated_channel >= 0 && in(faults_.saturated_from, faults_.saturated_until)) {
-    s.counts[static_cast<std::size_t>(faults_.saturated_channel)] = kAdcCodeMax;
-    s.flags |= sample_flags::kSaturated;
-  }
-  if (contains(faults_.crc_error_at, seq)) {
-    s.flags |= sample_flags::kCrcError;
-    ++extra_.crc_errors;
-  }
-  if (contains(faults_.extra_edge_after, seq)) extra_pending_ = true;
-  return s;
 }
 
-app::AdcCounters SimSampleSource::do_counters() const {
-  app::AdcCounters c = adc_.counters();
-  c.crc_errors += extra_.crc_errors;
-  c.extra_edges += extra_.extra_edges;
-  c.chip_resets += extra_.chip_resets;
-  c.missed_edges += extra_.missed_edges;
-  return c;
-}
+app::AdcCounters SimSampleSource::do_counters() const { return adc_.counters(); }
 
 // ---- CAN bus in memory ----------------------------------------------------------------------
 
@@ -189,62 +172,49 @@ Result<hal::CanFrame> MemoryCanBus::do_receive(std::int64_t /*timeout_ns*/) {
 
 namespace {
 
+// The host's one sample source (host_sim/sample_source.hpp) up to the sensor voltages: the
+// simulated board puts its own converter (the chip model, with its data-ready line and fault
+// injection) behind them, so the source runs without one.
 class ScenarioStream final : public SensorStream {
  public:
-  explicit ScenarioStream(const sim::Scenario& s)
-      : traj_(std::move(sim::make_trajectory(s.trajectory))
-                  .value()),  // kind checked by load_scenario
-        model_(nav::table1_geometry<double>(s.rho_m), errors(s), sim::gravity_model(s), s.rate_hz,
-               s.seed),
-        rate_hz_(s.rate_hz) {}
+  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj)
+      : traj_(std::move(traj)),
+        source_(*traj_,
+                sim::SensorArrayModel(nav::table1_geometry<double>(s.rho_m), errors(s),
+                                      sim::gravity_model(s), s.rate_hz, s.seed),
+                nullptr, s.rate_hz) {
+    if (s.noise_uniform) source_.set_uniform_noise_mps2(s.noise_mps2, s.seed);
+  }
 
-  std::array<double, 6> volts(std::uint32_t seq) override {
-    const sim::TruthState x = traj_->at(static_cast<double>(seq) / rate_hz_);
-    const sim::SensorArrayModel::Volts v = model_.volts(x);
+  std::array<double, 6> volts(std::uint32_t /*seq*/) override {
+    // Index-driven: conversion k is the source's k-th sample (the caller asks in order).
+    const Result<sim::SourceSample> x = source_.next();
+    const sim::SensorArrayModel::Volts& v = x.value().volts;
     return {v(0), v(1), v(2), v(3), v(4), v(5)};
   }
 
+  /// The scenario's sensors as the host's scenario runner builds them: through a converter they
+  /// have the QA-1100's scale factor (1.33 V/g into 1 kΩ), plus the scenario's errors.
   static sim::ArrayErrors errors(const sim::Scenario& s) {
     sim::ArrayErrors e;
     e.misalignment = s.misalignment;
     e.temperature_c = s.temperature_c;
+    const double qa1100_sf = sim::AccelErrors::qa1100_typical().scale_v_per_g;
     for (std::size_t j = 0; j < 6; ++j) {
       sim::AccelErrors& a = e.sensors[j];
       if (s.qa1100) a = sim::AccelErrors::qa1100_typical();
+      a.scale_v_per_g = qa1100_sf;
       a.bias_g += s.bias_mps2[j] / nav::kStandardGravity;
-      if (s.noise_mps2 > 0 || !s.qa1100) a.noise_g = s.noise_mps2 / nav::kStandardGravity;
+      if (s.noise_mps2 > 0 || !s.qa1100) {
+        a.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / nav::kStandardGravity;
+      }
     }
     return e;
   }
 
  private:
   std::unique_ptr<sim::Trajectory> traj_;
-  sim::SensorArrayModel model_;
-  double rate_hz_;
-};
-
-class BehaviouralAdc final : public AdcChain {
- public:
-  explicit BehaviouralAdc(const sim::Scenario& s) : model_(config(s)) {}
-  Status start() override { return Status::ok(); }
-  Result<RawSample> convert(const std::array<double, 6>& volts, std::uint32_t seq,
-                            std::int64_t t_ns) override {
-    Eigen::Matrix<double, 6, 1> v;
-    for (int j = 0; j < 6; ++j) v(j) = volts[static_cast<std::size_t>(j)];
-    RawSample r = model_.sample(v, seq);
-    r.t_ns = t_ns;
-    return r;
-  }
-  double volts_per_count() const override { return model_.volts_per_count(); }
-  app::AdcCounters counters() const override { return {}; }
-
- private:
-  static sim::AdcConfig config(const sim::Scenario& s) {
-    sim::AdcConfig c;
-    c.sample_rate_hz = s.rate_hz;
-    return c;
-  }
-  sim::AdcModel model_;
+  sim::SampleSource source_;
 };
 
 std::string device_id_for(const std::string& name) {
@@ -260,12 +230,53 @@ std::string device_id_for(const std::string& name) {
 }  // namespace
 
 std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s) {
-  return std::make_unique<ScenarioStream>(s);
+  auto traj = sim::make_trajectory(s.trajectory);
+  if (!traj.is_ok()) return nullptr;
+  return std::make_unique<ScenarioStream>(s, std::move(traj).value());
 }
 
-std::unique_ptr<AdcChain> make_adc_chain(const sim::Scenario& s) {
-  return std::make_unique<BehaviouralAdc>(s);
+// ---- The chip -----------------------------------------------------------------------------
+
+struct ChipAdc::Impl {
+  explicit Impl(const sim::SimulatedAdcConfig& c) : adc(c) {}
+  sim::SimulatedAdc adc;
+};
+
+namespace {
+sim::SimulatedAdcConfig chip_config(double sample_rate_hz) {
+  sim::SimulatedAdcConfig c;
+  c.adc.sample_rate_hz = sample_rate_hz;
+  return c;
 }
+}  // namespace
+
+ChipAdc::ChipAdc(double sample_rate_hz)
+    : impl_(std::make_unique<Impl>(chip_config(sample_rate_hz))) {}
+ChipAdc::~ChipAdc() = default;
+Status ChipAdc::start() { return impl_->adc.start(); }
+Result<RawSample> ChipAdc::convert(const std::array<double, 6>& volts, std::uint32_t seq,
+                                   std::int64_t t_ns) {
+  return impl_->adc.convert(volts, seq, t_ns);
+}
+double ChipAdc::volts_per_count() const { return impl_->adc.volts_per_count(0); }
+app::AdcCounters ChipAdc::counters() const {
+  const drivers::Ads131m06Counters& d = impl_->adc.driver().counters();
+  app::AdcCounters c;
+  c.crc_errors = d.crc_errors;
+  c.missed_edges = d.missed_edges;
+  c.extra_edges = d.extra_edges;
+  c.chip_resets = d.chip_resets;
+  return c;
+}
+void ChipAdc::corrupt_next_frame() { impl_->adc.chip().corrupt_output_crc(1); }
+void ChipAdc::stick_channel(int ch, std::int32_t code) {
+  impl_->adc.chip().stick_channel(ch, code);
+}
+void ChipAdc::saturate_channel(int ch) { impl_->adc.chip().saturate_channel(ch, true); }
+void ChipAdc::clear_channel_faults() { impl_->adc.chip().clear_channel_faults(); }
+void ChipAdc::power_on_reset() { impl_->adc.chip().power_on_reset(); }
+void ChipAdc::drop_edge() { impl_->adc.drop_edges(1); }
+void ChipAdc::extra_edge() { impl_->adc.inject_extra_edges(1); }
 
 calib_file::CalibrationData scenario_calibration(const sim::Scenario& s, double volts_per_count) {
   calib_file::CalibrationData d;

@@ -253,7 +253,7 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   }
   run.notes.push_back(recording_file + ": " + std::to_string(rec.samples_v.size()) +
                       " samples at " + fmt("%g", options.rate_hz) + " Hz, " +
-                      std::to_string(intervals.size()) + " still intervals, " +
+                      std::to_string(intervals.size()) + " static intervals, " +
                       std::to_string(usable.size()) + " usable, " + std::to_string(refused.size()) +
                       " poses refused");
   for (const auto& r : refused) run.notes.push_back(r);
@@ -528,6 +528,76 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
     rep.lines.push_back(
         "  note: runs about body x, y, z alone never see the radial component of a sensor's "
         "offset; add the two face-diagonal mountings (docs/calibration.md, location runs)");
+  }
+  return rep;
+}
+
+FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
+                                            const std::optional<std::vector<Pose>>& poses,
+                                            const calib_file::CalibrationData& cal,
+                                            const std::string& means_file) {
+  std::map<int, std::array<double, 3>> pose_of;
+  if (poses) {
+    for (const Pose& p : *poses) pose_of[p.attitude] = p.f_b_g;
+  }
+  const auto theta_of = [&cal](const calib_file::CalibrationData& d) {
+    return nav::misaligned_geometry(calib_file::nominal_geometry<double>(d),
+                                    calib_file::misalignment<double>(d))
+        .theta_b;
+  };
+  const auto theta = theta_of(cal);
+  VerifyReport rep;
+  rep.lines.push_back("verification against the calibration of device " + cal.device_id +
+                      ": residual P - SF (b + theta*.a) per pose and sensor (mV), z = residual / "
+                      "predicted sigma (mean noise and the file's own uncertainties)");
+  for (const MeanRow& m : means) {
+    std::array<double, 3> a{};
+    if (poses) {
+      const auto it = pose_of.find(m.attitude);
+      if (it == pose_of.end()) {
+        return bad(means_file + ":" + std::to_string(m.line) + ": attitude " +
+                   std::to_string(m.attitude) + " is not in the poses file");
+      }
+      a = it->second;
+    } else {
+      if (m.attitude > 6) {
+        return bad(means_file + ":" + std::to_string(m.line) + ": attitude " +
+                   std::to_string(m.attitude) + " is not in Tables 2/3; give --poses");
+      }
+      const bool alpha = in_set(nav::kSetAlpha, m.sensor - 1);
+      a = (alpha ? calib::table3_attitudes<double>()
+                 : calib::table2_attitudes<double>())[static_cast<std::size_t>(m.attitude - 1)];
+    }
+    const auto j = static_cast<std::size_t>(m.sensor - 1);
+    const auto& s = cal.sensors[j];
+    const nav::Vec3<double> av(a[0], a[1], a[2]);
+    const double proj = theta[j].dot(av);
+    const double predicted = s.scale_v_per_g * (s.bias_g + proj);  // eq. (16), g = T = 1
+    const double res = m.mean_v - predicted;
+    // Predicted σ: the mean's own, and the file's σ of SF, b and every angle of the sensor's set
+    // (first order; the angles by a one-σ perturbation of each).
+    double var = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
+    var += (s.bias_g + proj) * (s.bias_g + proj) * s.scale_sigma_v_per_g * s.scale_sigma_v_per_g;
+    var += s.scale_v_per_g * s.scale_v_per_g * s.bias_sigma_g * s.bias_sigma_g;
+    for (const bool alpha : {false, true}) {
+      for (std::size_t i = 0; i < 6; ++i) {
+        calib_file::CalibrationData e = cal;
+        auto& set = alpha ? e.alpha : e.beta;
+        set.angle_deg[i] += set.angle_sigma_deg[i];
+        const double d = s.scale_v_per_g * (theta_of(e)[j].dot(av) - proj);
+        var += d * d;
+      }
+    }
+    const double sigma = std::sqrt(var);
+    const double z = sigma > 0.0 ? res / sigma : 0.0;
+    if (std::abs(z) > rep.max_abs_z) {
+      rep.max_abs_z = std::abs(z);
+      rep.worst_sensor = m.sensor;
+      rep.worst_pose = m.attitude;
+    }
+    rep.lines.push_back("  pose " + std::to_string(m.attitude) + " sensor a" +
+                        std::to_string(m.sensor) + ": residual " + fmt("%9.4f", res * 1e3) +
+                        " mV, sigma " + fmt("%.3g", sigma * 1e3) + " mV, z " + fmt("%6.2f", z));
   }
   return rep;
 }

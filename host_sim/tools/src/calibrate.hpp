@@ -98,4 +98,19 @@ void print_report(std::ostream& out, const CalibrationRun& run);
 /// One line per problem the verdict flags, empty when the verdict is good.
 std::vector<std::string> verdict_warnings(const calib::MultiAttitudeResult<double>& r);
 
+/// Verification poses against an installed calibration: per pose and sensor the residual
+/// P − SF (b + θ*·a) (eq. (16), a in local g) and its z, the residual over its predicted σ (the
+/// stated σ of the mean and the file's own σ of SF, b and the angles, first order). Poses
+/// without a poses file are numbered as in Tables 2/3.
+struct VerifyReport {
+  std::vector<std::string> lines;
+  double max_abs_z = 0.0;
+  int worst_sensor = 0;  // 1-based
+  int worst_pose = 0;
+};
+FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
+                                            const std::optional<std::vector<Pose>>& poses,
+                                            const calib_file::CalibrationData& cal,
+                                            const std::string& means_file);
+
 }  // namespace gfins::tools

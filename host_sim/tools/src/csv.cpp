@@ -239,13 +239,16 @@ FileResult<Recording> read_gfr(const std::filesystem::path& path) {
   rec.crc_error.reserve(r.samples.size());
   for (const RawSample& smp : r.samples) {
     std::array<double, 6> v{};
-    std::uint8_t sat = (smp.flags & sample_flags::kSaturated) != 0 ? 0x3F : 0;
+    std::uint8_t sat = 0;
     for (std::size_t j = 0; j < 6; ++j) {
       v[j] = static_cast<double>(smp.counts[j]) * rec.volts_per_count[j];
       if (smp.counts[j] >= kAdcCodeMax || smp.counts[j] <= kAdcCodeMin) {
         sat = static_cast<std::uint8_t>(sat | (1u << j));
       }
     }
+    // The flag says some channel saturated; the codes say which. A flag without a code at full
+    // scale (the driver saw it, the code was then clamped) marks every channel.
+    if ((smp.flags & sample_flags::kSaturated) != 0 && sat == 0) sat = 0x3F;
     rec.samples_v.push_back(v);
     rec.saturated_mask.push_back(sat);
     rec.crc_error.push_back((smp.flags & sample_flags::kCrcError) != 0 ? 1 : 0);

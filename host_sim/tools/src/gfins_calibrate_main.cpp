@@ -40,6 +40,7 @@ struct Options {
   std::string means;
   std::string recording;
   std::string location_runs;
+  std::string verify;
   double rate_hz = 0.0;
   double still_std_v = 2e-3;
   std::vector<double> nominal_sf;
@@ -216,6 +217,35 @@ int calibrate(const Options& o, const std::optional<Recording>& rec, Calibration
   return kExitOk;
 }
 
+// Verification poses against an installed file: residuals and z, exit 3 beyond kVerifyMaxZ.
+// 5σ: a correct calibration exceeds it on one of 36 residuals with probability 2e-5 (Gaussian).
+constexpr double kVerifyMaxZ = 5.0;
+int verify(const Options& o) {
+  const auto cal = calib_file::load_calibration_file(o.verify);
+  if (!cal.is_ok()) return fail(kExitInput, cal.status().message());
+  std::optional<std::vector<Pose>> poses;
+  if (!o.poses.empty()) {
+    const auto p = read_poses(o.poses);
+    if (!p.is_ok()) return fail(kExitInput, p.status().message());
+    poses = p.value();
+  }
+  const auto means = read_means(o.means);
+  if (!means.is_ok()) return fail(kExitInput, means.status().message());
+  const auto rep = verify_calibration(means.value(), poses, cal.value(), o.means);
+  if (!rep.is_ok()) return fail(kExitInput, rep.status().message());
+  for (const auto& line : rep.value().lines) std::cout << line << "\n";
+  if (rep.value().max_abs_z > kVerifyMaxZ) {
+    return fail(kExitVerdict, "verification failed: sensor a" +
+                                  std::to_string(rep.value().worst_sensor) + " in pose " +
+                                  std::to_string(rep.value().worst_pose) + " is " +
+                                  num(rep.value().max_abs_z) +
+                                  " sigma from the calibration (limit 5): the pose, the jig or "
+                                  "the file is not what it should be");
+  }
+  std::cout << "verification passed: largest |z| " << num(rep.value().max_abs_z) << " (limit 5)\n";
+  return kExitOk;
+}
+
 int run(const Options& o) {
   std::optional<Recording> rec;
   if (!o.recording.empty()) {
@@ -304,9 +334,10 @@ int run(const Options& o) {
   }
   const auto saved = calib_file::save_calibration_file(o.output, data);
   if (!saved.is_ok()) return fail(kExitWrite, saved.message());
-  char sum[32];
-  std::snprintf(sum, sizeof sum, "fnv1a64:%016llx",
-                static_cast<unsigned long long>(calib_file::checksum(data)));
+  char sum[64];
+  std::snprintf(sum, sizeof sum, "fnv1a64:%016llx, calibration id 0x%08x",
+                static_cast<unsigned long long>(calib_file::checksum(data)),
+                static_cast<unsigned>(calib_file::calibration_id(data)));
   std::cout << "\nwrote " << o.output << " (device " << data.device_id << ", " << sum << ")\n";
   return kExitOk;
 }
@@ -372,10 +403,18 @@ int calibrate_main(int argc, char** argv) {
       ->check(CLI::IsMember({"none", "paper", "exact"}));
   app.add_flag("--force", o.force, "write the file even when the verdict is not good");
   app.add_flag("--dry-run", o.dry_run, "report only, write nothing");
+  app.add_option("--verify", o.verify,
+                 "check verification poses (--means, --poses) against this installed calibration "
+                 "file: residuals and z per pose and sensor; exit 3 beyond 5 sigma")
+      ->check(CLI::ExistingFile);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitInput;
+  }
+  if (!o.verify.empty()) {
+    if (o.means.empty()) return fail(kExitInput, "--verify needs --means (and --poses)");
+    return verify(o);
   }
   if (!o.means.empty() && !o.recording.empty()) {
     return fail(kExitInput, "give one orientation input: --means FILE or --recording FILE");

@@ -106,6 +106,28 @@ class Compensator {
     s = p_ * s_raw - d_ * x;
   }
 
+  /// Folds the fused form into the solver's M for the per-sample path: with u = M s the
+  /// integrator's input, u = M P s** − M D [m(ω); ω̇] = F [s**; m(ω); ω̇], F = [M P | −M D]
+  /// (padded to ArraySolver::kRows rows), one product instead of three. Call after create() with
+  /// the solver the integrator uses (the nominal one for kPaper).
+  void fold_into(const ArraySolver<T, 6>& solver) {
+    const auto& m = solver.padded_m();
+    fold_.template leftCols<6>() = m * p_;
+    fold_.template rightCols<9>() = -(m * d_);
+  }
+
+  /// u = M s for the integrator (Strapdown::step_linear) from the front-end output s**, with
+  /// this compensator applied: kPaper uses the folded F of fold_into(); the others, which pass
+  /// the outputs through, return the solver's M s**.
+  typename ArraySolver<T, 6>::PaddedVec padded_linear_part(const ArraySolver<T, 6>& solver,
+                                                           const Outputs& s_raw, const Vec3<T>& w_b,
+                                                           const Vec3<T>& wdot_b) const {
+    if (kind_ != CompensatorKind::kPaper) return solver.padded_linear_part(s_raw);
+    Eigen::Matrix<T, 15, 1> x;
+    x << s_raw, centripetal_monomials(w_b), wdot_b;
+    return fold_.lazyProduct(x);
+  }
+
   /// The paper's sequence as printed (misprints fixed): location compensation (27)/(28), then
   /// orientation compensation (29)/(30), set by set.
   void apply_reference(const Outputs& s_raw, const Vec3<T>& w_b, const Vec3<T>& wdot_b,
@@ -167,6 +189,8 @@ class Compensator {
   Mat3<T> c_alpha_inv_ = Mat3<T>::Identity();
   Mat6<T> p_ = Mat6<T>::Identity();
   Eigen::Matrix<T, 6, 9> d_ = Eigen::Matrix<T, 6, 9>::Zero();
+  Eigen::Matrix<T, ArraySolver<T, 6>::kRows, 15> fold_ =
+      Eigen::Matrix<T, ArraySolver<T, 6>::kRows, 15>::Zero();
 };
 
 }  // namespace gfins::nav

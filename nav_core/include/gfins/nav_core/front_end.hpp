@@ -10,6 +10,7 @@
 // the calibrated ones; orientation and location errors are the compensator's job.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -75,11 +76,21 @@ class FrontEnd {
   /// s**_j = (counts_j · LSB_j / SF_j − b_j) · g_cal (m/s²). Returns a mask of the channels whose
   /// code sits at the converter's full scale (saturated: the value is not a measurement).
   std::uint32_t convert(const std::array<std::int32_t, N>& counts, Outputs& s) const {
+    // Conversion and the range of the codes in one branch-free loop (the compiler vectorises
+    // it); the per-channel mask is built only when a code reaches a rail, which is rare.
+    std::int32_t lo = counts[0];
+    std::int32_t hi = counts[0];
+    for (int j = 0; j < N; ++j) {
+      const std::int32_t c = counts[static_cast<std::size_t>(j)];
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
+      s(j) = gain_(j) * static_cast<T>(c) - offset_(j);
+    }
+    if (lo > kAdcCodeMin && hi < kAdcCodeMax) return 0;
     std::uint32_t saturated = 0;
     for (int j = 0; j < N; ++j) {
       const std::int32_t c = counts[static_cast<std::size_t>(j)];
       if (c >= kAdcCodeMax || c <= kAdcCodeMin) saturated |= 1u << j;
-      s(j) = gain_(j) * static_cast<T>(c) - offset_(j);
     }
     return saturated;
   }

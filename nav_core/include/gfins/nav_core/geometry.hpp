@@ -78,6 +78,15 @@ class ArraySolver {
  public:
   using Outputs = Eigen::Matrix<T, N, 1>;
   using MapMatrix = Eigen::Matrix<T, 6, N>;
+  /// Rows of the stored M and K, and of u = M s: six, rounded up to whole SIMD packets of T
+  /// (padded_rows); the extra rows are zero.
+  static constexpr int kRows = padded_rows<T>(6);
+  /// Rows of the stored bottom (specific-force) rows of K: three, rounded up the same way.
+  static constexpr int kForceRows = padded_rows<T>(3);
+  using PaddedVec = Eigen::Matrix<T, kRows, 1>;
+  using PaddedMap = Eigen::Matrix<T, kRows, N>;
+  using PaddedK = Eigen::Matrix<T, kRows, 6>;
+  using PaddedKForce = Eigen::Matrix<T, kForceRows, 6>;
 
   /// Builds M and K from a geometry, computing in double whatever T is. Fails with kSingular
   /// when the design is singular or its condition number exceeds max_condition; fails with
@@ -91,18 +100,28 @@ class ArraySolver {
   /// Angular acceleration ω̇ (rad/s², body) and specific force f (m/s², body, at o_b) from the
   /// outputs s (m/s², along each axis) and the current angular rate ω (rad/s, body).
   void solve(const Outputs& s, const Vec3<T>& w, Vec3<T>& wdot_b, Vec3<T>& f_b) const {
-    const Vec6<T> u = m_ * s - k_ * centripetal_monomials(w);
+    const PaddedVec u = m_.lazyProduct(s) - k_.lazyProduct(centripetal_monomials(w));
     wdot_b = u.template head<3>();
-    f_b = u.template tail<3>();
+    f_b = u.template segment<3>(3);
   }
 
   /// The linear part M s (ω-independent); the integrator reuses it across predictor/corrector.
-  Vec6<T> linear_part(const Outputs& s) const { return m_ * s; }
+  Vec6<T> linear_part(const Outputs& s) const { return padded_linear_part(s).template head<6>(); }
+  /// M s in the padded layout the integrator takes (Strapdown::step_linear).
+  PaddedVec padded_linear_part(const Outputs& s) const { return m_.lazyProduct(s); }
   /// The centripetal correction K m(ω) that solve() subtracts.
-  Vec6<T> centripetal_part(const Vec3<T>& w) const { return k_ * centripetal_monomials(w); }
+  Vec6<T> centripetal_part(const Vec3<T>& w) const {
+    return k_.lazyProduct(centripetal_monomials(w)).template head<6>();
+  }
 
-  const MapMatrix& m() const { return m_; }
-  const Mat6<T>& k() const { return k_; }
+  /// M (6×N) and K (6×6), views of the padded storage.
+  auto m() const { return m_.template topRows<6>(); }
+  auto k() const { return k_.template topRows<6>(); }
+  /// The padded storage itself, for the per-sample products.
+  const PaddedMap& padded_m() const { return m_; }
+  const PaddedK& padded_k() const { return k_; }
+  /// Rows 3..5 of K (the specific-force rows), padded.
+  const PaddedKForce& padded_k_force() const { return k_force_; }
   double condition_number() const { return condition_; }
   const ArrayGeometry<T, N>& geometry() const { return geometry_; }
 
@@ -110,8 +129,9 @@ class ArraySolver {
   Outputs predict(const Vec3<T>& wdot_b, const Vec3<T>& f_b, const Vec3<T>& w) const;
 
  private:
-  MapMatrix m_ = MapMatrix::Zero();
-  Mat6<T> k_ = Mat6<T>::Zero();
+  PaddedMap m_ = PaddedMap::Zero();
+  PaddedK k_ = PaddedK::Zero();
+  PaddedKForce k_force_ = PaddedKForce::Zero();
   double condition_ = 0.0;
   ArrayGeometry<T, N> geometry_{};
 };

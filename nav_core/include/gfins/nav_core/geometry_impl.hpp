@@ -68,8 +68,9 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   k = k.unaryExpr([ktiny](double x) { return std::abs(x) < ktiny ? 0.0 : x; });
 
   ArraySolver solver;
-  solver.m_ = m.template cast<T>();
-  solver.k_ = k.template cast<T>();
+  solver.m_.template topRows<6>() = m.template cast<T>();
+  solver.k_.template topRows<6>() = k.template cast<T>();
+  solver.k_force_.template topRows<3>() = k.template bottomRows<3>().template cast<T>();
   solver.condition_ = cond;
   solver.geometry_ = geometry;
   return solver;

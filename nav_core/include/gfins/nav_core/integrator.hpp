@@ -74,36 +74,45 @@ class Strapdown {
 
   /// Advances to the sample s_k taken dt_s after the previous one.
   void step(const Outputs& s_k, T dt_s, std::int64_t t_ns, std::uint32_t seq) {
+    step_linear(solver_.padded_linear_part(s_k), dt_s, t_ns, seq);
+  }
+
+  /// step() with u_k = M s_k already formed (padded layout of ArraySolver::kRows): the pipeline
+  /// folds the paper compensator into this product (Compensator::padded_linear_part).
+  void step_linear(const typename Solver::PaddedVec& u, T dt_s, std::int64_t t_ns,
+                   std::uint32_t seq) {
     const T h = dt_s;
     const Vec3<T> w0 = state_.w_b;
     const Vec3<T> wdot0 = state_.wdot_b;
     const Vec3<T> a0 = state_.a_n;
     const Vec3<T> v0 = v_.sum;
 
-    const Vec6<T> u = solver_.linear_part(s_k);
-    const Mat6<T>& k = solver_.k();
     // When K's top rows are zero (a symmetric array such as Table 1, where ω̇ = S s/(2ρ) of
     // eq. (4)/(6) has no centripetal term) the predictor is exact and ω̇ needs no product: same
     // values as the general case, which would subtract exact zeros, for a third fewer operations.
     Vec3<T> wdot_pred = u.template head<3>();
     if (!wdot_free_of_w_) {
       const Vec3<T> w_pred = w0 + h * wdot0;
-      wdot_pred -= k.template topRows<3>() * centripetal_monomials(w_pred);
+      // The whole padded product (whole SIMD packets) is cheaper than its three top rows.
+      wdot_pred -= solver_.padded_k().lazyProduct(centripetal_monomials(w_pred)).template head<3>();
     }
     const Vec3<T> w1 = w0 + (h / T(2)) * (wdot0 + wdot_pred);
     const Vec6<T> m1 = centripetal_monomials(w1);
-    Vec6<T> full = u;
+    Vec3<T> wdot1;
+    Vec3<T> f1;
     if (wdot_free_of_w_) {
-      full.template tail<3>() -= k.template bottomRows<3>() * m1;
+      wdot1 = u.template head<3>();
+      f1 = u.template segment<3>(3) - solver_.padded_k_force().lazyProduct(m1).template head<3>();
     } else {
-      full -= k * m1;
+      const typename Solver::PaddedVec full = u - solver_.padded_k().lazyProduct(m1);
+      wdot1 = full.template head<3>();
+      f1 = full.template segment<3>(3);
     }
 
     const Vec3<T> phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * w0.cross(w1);
     Quat<T> q1 = state_.q_nb * quat_from_rotation_vector(phi);
     q1.normalize();
 
-    const Vec3<T> f1 = full.template tail<3>();
     const Vec3<T> a1 = q1 * f1 + gravity_.g_n(r_.sum);
     v_.add((h / T(2)) * (a0 + a1));
     r_.add(h * v0 + (h * h / T(6)) * (T(2) * a0 + a1));
@@ -112,7 +121,7 @@ class Strapdown {
     state_.seq = seq;
     state_.q_nb = q1;
     state_.w_b = w1;
-    state_.wdot_b = full.template head<3>();
+    state_.wdot_b = wdot1;
     state_.f_b = f1;
     state_.a_n = a1;
     state_.v_n = v_.sum;
@@ -125,7 +134,7 @@ class Strapdown {
  private:
   /// True when ω̇ does not depend on ω (the top three rows of K are exactly zero).
   static bool wdot_independent_of_rate(const Solver& solver) {
-    return (solver.k().template topRows<3>().array() == T(0)).all();
+    return (solver.padded_k().template topRows<3>().array() == T(0)).all();
   }
 
   Solver solver_{};  // owned copy (a few hundred bytes), so the integrator can be copied

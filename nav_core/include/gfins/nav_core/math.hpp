@@ -23,6 +23,16 @@ using Mat6 = Eigen::Matrix<T, 6, 6>;
 template <typename T>
 using Quat = Eigen::Quaternion<T>;
 
+/// `rows` rounded up to whole SIMD packets of T: 8 for six floats with SSE (packets of 4), 6 for
+/// six doubles (packets of 2), `rows` itself without SIMD (Cortex-M4F). The per-sample products
+/// keep their matrices with zero rows up to this count, so that Eigen evaluates every column as
+/// whole packets instead of one packet plus scalar leftovers (docs/performance.md).
+template <typename T>
+constexpr int padded_rows(int rows) {
+  constexpr int kPacket = Eigen::internal::packet_traits<T>::size;
+  return (rows + kPacket - 1) / kPacket * kPacket;
+}
+
 /// An array of N zero vectors. Eigen leaves fixed-size matrices uninitialised even when
 /// value-initialised (`std::array<Vec3, N> a{}` holds garbage), so members are defaulted with this.
 template <typename T, std::size_t N>
@@ -53,9 +63,11 @@ Quat<T> quat_from_rotation_vector(const Vec3<T>& phi) {
   T c;  // cos(|phi|/2)
   T s;  // sin(|phi|/2)/|phi|
   if (a2 < T(0.01)) {
-    const T x = a2 / T(4);  // (|phi|/2)^2
-    c = T(1) - x / T(2) + x * x / T(24) - x * x * x / T(720);
-    s = (T(1) - x / T(6) + x * x / T(120) - x * x * x / T(5040)) / T(2);
+    // Horner form, constant reciprocals: cos y = 1 − y²/2 + y⁴/24 − y⁶/720 and
+    // sin(y)/(2y) = 1/2 − y²/12 + y⁴/240 − y⁶/10080 with y = |phi|/2 (no division per sample).
+    const T x = a2 * T(0.25);  // y² = (|phi|/2)²
+    c = T(1) + x * (T(-0.5) + x * (T(1) / T(24) - x * (T(1) / T(720))));
+    s = T(0.5) + x * (T(-1) / T(12) + x * (T(1) / T(240) - x * (T(1) / T(10080))));
   } else {
     const T a = std::sqrt(a2);
     c = std::cos(a / T(2));

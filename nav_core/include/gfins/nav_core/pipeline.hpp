@@ -68,6 +68,7 @@ class NavPipeline {
     config_ = config;
     front_end_ = fe.value();
     compensator_ = comp.value();
+    compensator_.fold_into(solver.value());
     strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
     aligner_.reset();
     have_seen_ = false;
@@ -172,9 +173,10 @@ class NavPipeline {
     if (dseq != 1) status |= nav_status::kSampleGap;  // lost or rejected samples in between
     last_seq_ = seq;
     const NavState<T>& st = strapdown_.state();
-    Outputs s;
-    compensator_.apply(s_raw, st.w_b, st.wdot_b, s);
-    strapdown_.step(s, period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq), t_ns, seq);
+    // u = M s with the compensator folded in (Compensator::fold_into): one product per sample.
+    strapdown_.step_linear(
+        compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b),
+        period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq), t_ns, seq);
     strapdown_.mutable_state().status = status;
     mark_compensated();
     return phase_;

@@ -131,6 +131,7 @@ struct CliResult {
   std::optional<FwConfig> config;
   std::string config_source;  // the file the configuration came from ("" = built-in defaults)
   bool check_only = false;    // --check-config: validate and exit
+  std::string latency_csv;    // --latency-csv: write the edge→CAN latency histogram (benchmark)
   int exit_code = 0;          // when !config
   std::string message;        // printed when !config (stdout for exit 0, stderr otherwise)
 };

@@ -14,13 +14,13 @@ namespace gfins::app {
 class RecordingSink final : public EpochSink {
  public:
   RecordingSink(EpochSink* next, std::size_t reserve) : next_(next) { epochs_.reserve(reserve); }
-  void publish(const Epoch& e) override {
+  std::uint32_t publish(const Epoch& e) override {
     if (epochs_.size() < epochs_.capacity()) {
       epochs_.push_back(e);
     } else {
       ++overflow_;
     }
-    if (next_ != nullptr) next_->publish(e);
+    return next_ != nullptr ? next_->publish(e) : 0;
   }
   Status set_divider(std::size_t m, std::uint16_t d) override {
     return next_ != nullptr ? next_->set_divider(m, d) : Status::ok();
@@ -37,9 +37,10 @@ class RecordingSink final : public EpochSink {
 /// Keeps the last epoch and a count (no bus).
 class CountingSink final : public EpochSink {
  public:
-  void publish(const Epoch& e) override {
+  std::uint32_t publish(const Epoch& e) override {
     last_ = e;
     ++count_;
+    return 0;
   }
   Status set_divider(std::size_t m, std::uint16_t) override {
     return m < 14 ? Status::ok() : Status(ErrorCode::kOutOfRange, "no such message");

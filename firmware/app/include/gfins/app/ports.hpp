@@ -65,8 +65,9 @@ class SampleSource {
 class EpochSink {
  public:
   virtual ~EpochSink() = default;
-  /// Once per sample; sends what the message dividers select. Never blocks.
-  virtual void publish(const Epoch& e) = 0;
+  /// Once per sample; sends what the message dividers select. Never blocks. Returns how many
+  /// frames it handed to the bus (accepted or refused).
+  virtual std::uint32_t publish(const Epoch& e) = 0;
   /// Divider of message `message` (index in kMessageNames); 0 = off.
   [[nodiscard]] virtual Status set_divider(std::size_t message, std::uint16_t divider) = 0;
 };
@@ -94,50 +95,69 @@ struct Command {
   std::uint16_t samples = 0;                                       // kCaptureCalibration
 };
 
+/// Result of a command; the values are the CAN response's Result codes (docs/can-interface.md).
 enum class CommandResult : std::uint8_t {
   kOk = 0,
-  kMalformed = 1,   // frame could not be decoded
-  kOutOfRange = 2,  // a parameter outside its domain
-  kBusy = 3,        // a capture or reload is already running
-  kFailed = 4,      // executed but failed (reload: bad file; the previous calibration stays)
-  kAccepted = 5,    // started; a second response follows (capture, reload)
+  kUnknownOpcode = 1,
+  kBadLength = 2,
+  kBadCrc = 3,
+  kOutOfRange = 4,  // a parameter outside its domain
+  kMalformed = 5,   // frame could not be decoded
+  kBusy = 6,        // a capture or reload is already running
+  kFailed = 7,      // executed but failed (reload: bad file; the previous calibration stays)
+  kNotReady = 8,    // not possible in the current mode
 };
 
-/// Calibration capture statistics of one channel, in volts at the sensor.
+/// Calibration capture statistics of one channel, in ADC codes.
 struct CaptureChannel {
-  float mean_v = 0;
-  float std_v = 0;
+  float mean_counts = 0;
+  float std_counts = 0;
   std::uint32_t count = 0;  // samples averaged (CRC-error samples are skipped)
   bool saturated = false;   // a sample at full scale was seen
+  bool motion = false;      // the spread says the board moved (the pose was not static)
 };
 
 struct CaptureResult {
   std::uint8_t pose = 0;
+  std::uint16_t samples = 0;
   std::array<CaptureChannel, kAdcChannels> channels{};
-  bool motion = false;  // some channel's spread says the board moved (capture not static)
+  bool motion() const {
+    for (const auto& c : channels) {
+      if (c.motion) return true;
+    }
+    return false;
+  }
 };
 
 struct Response {
   CommandKind kind = CommandKind::kReportCalibration;
+  std::uint8_t raw_opcode = 0;  // of a frame that did not decode (kind is then meaningless)
   std::uint8_t token = 0;
   CommandResult result = CommandResult::kOk;
+  std::uint32_t value = 0;   // accepted divider / capture N
   std::uint32_t cal_id = 0;  // kReportCalibration / kReloadCalibration
   bool calibrated = false;   // kReportCalibration
+  bool deferred = false;     // no response now: it follows when the work is done (reload)
   bool has_capture = false;
   CaptureResult capture{};  // kCaptureCalibration, final response
 };
 
 /// Command frames in, response frames out (the CAN protocol's codec behind it).
+struct DecodedFrame {
+  bool addressed = false;  // a command frame for this node (others are ignored, not answered)
+  bool ok = false;
+  Command command{};
+  CommandResult error = CommandResult::kOk;  // why not ok
+  std::uint8_t raw_opcode = 0;
+  std::uint8_t token = 0;
+};
+
 class CommandCodec {
  public:
   virtual ~CommandCodec() = default;
-  /// Whether `f` is a command addressed to this node (others are ignored, not answered).
-  virtual bool is_command(const hal::CanFrame& f) const = 0;
-  /// kInvalidArgument/kOutOfRange for a malformed or out-of-range command; `partial` then holds
-  /// what could be read (kind, token) so the error response can be addressed.
-  virtual Result<Command> decode(const hal::CanFrame& f, Command& partial) const = 0;
-  /// The response frames (a capture result takes several); returns how many were written.
-  virtual std::size_t encode(const Response& r, std::array<hal::CanFrame, 16>& frames) const = 0;
+  virtual DecodedFrame decode(const hal::CanFrame& f) const = 0;
+  /// The response frames (a capture result takes 20); returns how many were written.
+  virtual std::size_t encode(const Response& r, std::array<hal::CanFrame, 24>& frames) const = 0;
 };
 
 }  // namespace gfins::app

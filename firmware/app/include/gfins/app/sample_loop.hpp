@@ -48,6 +48,8 @@ class LatencyHistogram {
   std::int64_t max_ns() const { return max_ns_; }
   /// Upper edge of the bin holding quantile q (0..1), µs.
   double quantile_us(double q) const;
+  /// Count of bin b ([b, b+1) µs; the last bin holds everything beyond).
+  std::uint32_t bin(std::size_t b) const { return bins_[b]; }
 
  private:
   std::array<std::uint32_t, kBins> bins_{};
@@ -139,6 +141,7 @@ class SampleLoop {
   Epoch epoch_{};
   LatencyHistogram latency_{};
   std::array<std::int32_t, kAdcChannels> last_counts_{};
+  RawSample last_good_{};  // the last sample the core could integrate (warm restarts)
   std::uint32_t last_seq_ = 0;
   bool have_seq_ = false;
   std::uint8_t reload_token_ = 0;

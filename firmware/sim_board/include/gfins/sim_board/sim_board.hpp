@@ -58,16 +58,36 @@ class SensorStream {
   virtual std::array<double, 6> volts(std::uint32_t seq) = 0;
 };
 
-/// The ADC between the sensor voltages and the RawSample: the ADS131M06 chip model driven
-/// through the real driver once that lands (SimulatedAdc), a behavioural model until then.
-class AdcChain {
+/// The ADC between the sensor voltages and the RawSample: the register-level ADS131M06 model
+/// behind the simulated SPI and data-ready line, read by the real driver (sim::SimulatedAdc).
+/// Faults are injected into the chip and the line, where they happen on the board.
+class ChipAdc {
  public:
-  virtual ~AdcChain() = default;
-  virtual Status start() = 0;
-  virtual Result<RawSample> convert(const std::array<double, 6>& volts, std::uint32_t seq,
-                                    std::int64_t t_ns) = 0;
-  virtual double volts_per_count() const = 0;
-  virtual app::AdcCounters counters() const = 0;
+  explicit ChipAdc(double sample_rate_hz);
+  ~ChipAdc();
+  ChipAdc(const ChipAdc&) = delete;
+  ChipAdc& operator=(const ChipAdc&) = delete;
+
+  Status start();
+  /// Conversion `seq` of the sensor voltages at edge time t_ns, read through the driver.
+  /// kUnavailable for a conversion whose data-ready edge was lost (drop_edge()).
+  Result<RawSample> convert(const std::array<double, 6>& volts, std::uint32_t seq,
+                            std::int64_t t_ns);
+  /// Volts at the sensor per count (divider and ADC LSB).
+  double volts_per_count() const;
+  app::AdcCounters counters() const;
+
+  void corrupt_next_frame();  // output CRC error on the next frame
+  void stick_channel(int ch, std::int32_t code);
+  void saturate_channel(int ch);
+  void clear_channel_faults();
+  void power_on_reset();  // the chip resets before the next conversion
+  void drop_edge();       // the next conversion's data-ready edge is lost
+  void extra_edge();      // a spurious edge before the next conversion
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 /// Faults injected per conversion index (seq) or on the data-ready line.
@@ -75,7 +95,7 @@ struct FaultPlan {
   std::vector<std::uint32_t> crc_error_at;      // frame of this seq arrives with a bad CRC
   std::vector<std::uint32_t> missing_edges;     // the edge of this seq is lost (conversion unseen)
   std::vector<std::uint32_t> extra_edge_after;  // a spurious edge after this seq's edge
-  std::uint32_t reset_at = 0;                   // chip resets before this seq (0 = never)
+  std::uint32_t reset_at = 0;                   // the chip resets before this seq (0 = never)
   std::uint32_t silent_from = 0;                // no edges from this seq on ... (0 = never)
   std::uint32_t silent_edges = 0;               // ... for this many periods
   int stuck_channel = -1;                       // this channel's code freezes from stuck_from
@@ -91,7 +111,7 @@ enum class Pacing : std::uint8_t { kFast, kRealTime };
 /// The data-ready line and the ADC of the simulated board, as the loop sees them.
 class SimSampleSource final : public app::SampleSource {
  public:
-  SimSampleSource(SensorStream& stream, AdcChain& adc, hal::Clock& clock, SampleClock* sample_clock,
+  SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock, SampleClock* sample_clock,
                   Pacing pacing, double sample_rate_hz, std::uint32_t samples);
 
   void set_faults(const FaultPlan& f) { faults_ = f; }
@@ -107,7 +127,7 @@ class SimSampleSource final : public app::SampleSource {
   static bool contains(const std::vector<std::uint32_t>& v, std::uint32_t x);
 
   SensorStream& stream_;
-  AdcChain& adc_;
+  ChipAdc& adc_;
   hal::Clock& clock_;
   SampleClock* sample_clock_;
   Pacing pacing_;
@@ -117,10 +137,7 @@ class SimSampleSource final : public app::SampleSource {
   std::uint32_t next_seq_ = 0;
   std::uint32_t remaining_;
   FaultPlan faults_{};
-  app::AdcCounters extra_{};  // counted here: faults the stand-in ADC cannot see itself
-  bool extra_pending_ = false;
   std::uint32_t silent_left_ = 0;
-  std::array<std::int32_t, 6> frozen_{};
 };
 
 /// An in-memory CAN bus: frames sent are kept (fixed capacity, the oldest overwritten), frames
@@ -156,11 +173,9 @@ class MemoryCanBus final : public hal::CanBus {
   hal::CanCounters counters_{};
 };
 
-/// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample.
+/// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
+/// null when the scenario's trajectory cannot be built.
 std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
-
-/// The behavioural ADC (host_sim AdcModel) until the register-level chip model lands.
-std::unique_ptr<AdcChain> make_adc_chain(const sim::Scenario& s);
 
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.

@@ -1,0 +1,320 @@
+// The simulated board's CAN output, decoded (docs/can-interface.md): every data frame's CRC is
+// valid, its counter ties it to its epoch, and every navigation value equals the NavState the
+// loop handed to the publisher within that signal's quantisation (factor/2, or the documented
+// limit for a clipped value). And each command, valid and malformed, as frames in and response
+// frames out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "gfins/app/reload_worker.hpp"
+#include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/can/command.hpp"
+#include "gfins/can/message_table.hpp"
+#include "gfins/can/signal_codec.hpp"
+#include "sim_rig.hpp"
+
+namespace gfins::app {
+namespace {
+
+using testing::SimRig;
+
+// The value a signal should carry for an epoch, read here from the NavState and the firmware's
+// epoch (not from the publisher's own field accessor) for every navigation and health field.
+double expected_value(const Epoch& e, const can::SignalDef& s) {
+  const auto& n = e.nav;
+  const int i = s.index;
+  switch (s.field) {
+    case can::Field::kVelocity:
+      return n.v_n(i);
+    case can::Field::kPosition:
+      return n.r_n(i);
+    case can::Field::kRate:
+      return n.w_b(i);
+    case can::Field::kAngularAccel:
+      return n.wdot_b(i);
+    case can::Field::kAccel:
+      return n.f_b(i);
+    case can::Field::kQuaternion: {
+      const double c[4] = {n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()};
+      return (n.q_nb.w() < 0 ? -1.0 : 1.0) * c[i];  // the bus carries the w >= 0 one
+    }
+    case can::Field::kSensorAccel:
+      return e.accel_mps2[static_cast<std::size_t>(i)];
+    case can::Field::kCalId:
+      return e.cal_id;
+    case can::Field::kMissedEdges:
+      return e.health.missed_edges;
+    case can::Field::kAdcCrcErrors:
+      return e.health.crc_errors;
+    case can::Field::kAdcResets:
+      return e.health.adc_resets;
+    case can::Field::kSaturatedSamples:
+      return e.health.saturated_samples;
+    case can::Field::kCanTxDropped:
+      return e.health.can_tx_dropped;
+    case can::Field::kBusOffEvents:
+      return e.health.bus_off_events;
+    case can::Field::kLoopOverruns:
+      return e.health.loop_overruns;
+    default:  // Euler angles, mode, flags, time: the protocol's own mapping
+      return can::epoch_field(to_can_epoch(e), s.field, s.index);
+  }
+}
+
+TEST(CanOutput, DecodedFramesEqualTheNavStateWithinQuantisation) {
+  SimRig rig("rest", 3.0);
+  rig.configure();
+  rig.run();
+  const auto frames = rig.bus->sent();
+  ASSERT_GT(frames.size(), 1000u);
+  std::size_t epoch_index = 0, compared = 0;
+  const Epoch* current = nullptr;
+  std::int64_t last_counter = -1;
+  for (const hal::CanFrame& f : frames) {
+    std::uint8_t node = 0;
+    const can::MessageDef* m = can::find_message(f.id, &node);
+    ASSERT_NE(m, nullptr) << std::hex << f.id;
+    ASSERT_EQ(node, SimRig::kNode);
+    ASSERT_TRUE(can::crc_ok(f)) << m->name;
+    const std::uint64_t p = can::payload_of(f);
+    std::int64_t counter = -1;
+    for (const auto& s : m->signals) {
+      if (s.field == can::Field::kCounter)
+        counter = static_cast<std::int64_t>(can::extract_bits(p, s));
+    }
+    if (m->id == can::MessageId::kEpoch) {
+      // The epoch frame opens an epoch: find it by its 16-bit sample count, in order.
+      const auto& sc = m->signals[can::signal_index(*m, "SampleCount")];
+      const auto count = static_cast<std::uint32_t>(can::extract_bits(p, sc));
+      const auto& epochs = rig.recording->epochs();
+      while (epoch_index < epochs.size() && (epochs[epoch_index].nav.seq & 0xFFFFu) != count) {
+        ++epoch_index;
+      }
+      ASSERT_LT(epoch_index, epochs.size()) << "no epoch with sample count " << count;
+      current = &epochs[epoch_index];
+      if (last_counter >= 0) {
+        EXPECT_EQ(counter, (last_counter + 1) % 16);  // continuous
+      }
+      last_counter = counter;
+    }
+    ASSERT_NE(current, nullptr);
+    EXPECT_EQ(counter, last_counter) << m->name << ": counter ties the frame to its epoch";
+    for (const auto& s : m->signals) {
+      if (s.field == can::Field::kCounter || s.field == can::Field::kCrc) continue;
+      const std::uint64_t bits = can::extract_bits(p, s);
+      const double x = expected_value(*current, s);
+      if (s.overflow == can::Overflow::kWrap) {
+        const double m2 = std::ldexp(1.0, s.length);
+        double want = std::fmod(std::floor((x - s.offset) / s.factor + 0.5), m2);
+        if (want < 0) want += m2;
+        EXPECT_EQ(static_cast<double>(bits), want) << m->name << "." << s.name;
+      } else {
+        const double got = can::decode_signal(s, bits);
+        const double clipped = std::clamp(x, s.min, s.max);
+        // round to nearest: at most half a step, plus the float→double rounding of the value
+        EXPECT_LE(std::abs(got - clipped), 0.5 * s.factor * (1 + 1e-9) + 1e-9 * std::abs(x))
+            << m->name << "." << s.name << " seq " << current->nav.seq;
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 5000u);  // 300 epochs of about 24 signals each
+}
+
+// ---- Commands as frames ---------------------------------------------------------------------
+
+class CanCommands : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    rig_ = std::make_unique<SimRig>("rest", 10.0);
+    path_ = std::filesystem::temp_directory_path() /
+            ("gfins_fw_cal_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+             ".toml");
+    rig_->config.calibration_file = path_.string();
+    worker_ = std::make_unique<ReloadWorker>(calibration_reloader(rig_->config));
+    rig_->loop->set_reload_worker(worker_.get());
+    rig_->configure();
+    rig_->run_cycles(1500);
+    ASSERT_EQ(rig_->loop->mode(), Mode::kNavigating);
+  }
+  void TearDown() override { std::filesystem::remove(path_); }
+
+  // Sends one frame to the board, runs `cycles` cycles, returns the responses decoded.
+  std::vector<can::ResponseFrame> round_trip(const hal::CanFrame& f, std::uint32_t cycles = 2) {
+    rig_->bus->clear_sent();
+    EXPECT_TRUE(rig_->bus->inject_rx(f));
+    rig_->run_cycles(cycles);
+    std::vector<can::ResponseFrame> out;
+    for (const hal::CanFrame& r : rig_->bus->sent()) {
+      const auto d = can::decode_response(r);
+      if (d.is_ok()) out.push_back(d.value());
+    }
+    return out;
+  }
+  std::vector<can::ResponseFrame> send(const can::Command& c, std::uint32_t cycles = 2) {
+    return round_trip(can::encode_command(c, SimRig::kNode), cycles);
+  }
+  static const can::ResponseFrame* part(const std::vector<can::ResponseFrame>& v, int p) {
+    for (const auto& r : v) {
+      if (r.part == p) return &r;
+    }
+    return nullptr;
+  }
+  static can::Command cmd(can::Opcode op, std::uint8_t token) {
+    can::Command c;
+    c.opcode = op;
+    c.token = token;
+    return c;
+  }
+
+  std::unique_ptr<SimRig> rig_;
+  std::unique_ptr<ReloadWorker> worker_;
+  std::filesystem::path path_;
+};
+
+TEST_F(CanCommands, Realign) {
+  can::Command c = cmd(can::Opcode::kRealign, 11);
+  c.heading_rad = 0.25f;
+  const auto r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(part(r, 0)->token, 11);
+  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+  EXPECT_NEAR(rig_->loop->pipeline().config().heading_rad, 0.25f, 1e-3f);  // heading signal step
+}
+
+TEST_F(CanCommands, ResetNavigation) {
+  const auto r = send(cmd(can::Opcode::kResetNavigation, 12));
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+}
+
+TEST_F(CanCommands, SetCompensatorValidAndOutOfRange) {
+  can::Command c = cmd(can::Opcode::kSetCompensator, 13);
+  c.compensator = nav::CompensatorKind::kExact;
+  auto r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(rig_->loop->pipeline().config().compensator, nav::CompensatorKind::kExact);
+  c.compensator = static_cast<nav::CompensatorKind>(3);  // beyond none/paper/exact
+  r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOutOfRange);
+  EXPECT_EQ(rig_->loop->pipeline().config().compensator, nav::CompensatorKind::kExact);
+}
+
+TEST_F(CanCommands, SetDividerValidAndAgainstTheTableRules) {
+  can::Command c = cmd(can::Opcode::kSetDivider, 14);
+  c.message = can::MessageId::kEuler;
+  c.divider = 40;
+  auto r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(part(r, 0)->value, 40u);
+  c.divider = 15;  // not a multiple of the epoch divider (10)
+  r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOutOfRange);
+}
+
+TEST_F(CanCommands, ReportCalibrationId) {
+  const auto r = send(cmd(can::Opcode::kReportCalibrationId, 15));
+  ASSERT_NE(part(r, 0), nullptr);
+  ASSERT_NE(part(r, 1), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(part(r, 1)->cal_id, calibration_id(rig_->factory));
+}
+
+TEST_F(CanCommands, CaptureSendsTheResultFrames) {
+  can::Command c = cmd(can::Opcode::kStartCapture, 16);
+  c.pose = 5;
+  c.samples = 300;
+  const auto r = send(c, 310);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  can::CaptureAssembler a;
+  for (const auto& f : r) a.add(f);
+  ASSERT_TRUE(a.complete());
+  EXPECT_EQ(a.result().pose, 5);
+  EXPECT_EQ(a.result().samples, 300);
+  for (std::size_t j = 0; j < 6; ++j) {
+    EXPECT_EQ(a.result().channels[j].count, 300);
+    EXPECT_FALSE(a.result().channels[j].motion);
+    // The frames carry what the loop computed, within the signal's quantisation.
+    const auto& mine = rig_->loop->last_capture().channels[j];
+    EXPECT_NEAR(a.result().channels[j].mean_counts, mine.mean_counts,
+                std::max(1.0, 1e-6 * std::abs(static_cast<double>(mine.mean_counts))));
+  }
+}
+
+TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
+  // Given a valid calibration file (the factory one with another device id)
+  calib_file::CalibrationData d = rig_->factory;
+  d.device_id = "reloaded-board";
+  d.created_utc = "2026-01-01T00:00:00Z";
+  ASSERT_TRUE(calib_file::save_calibration_file(path_, d).is_ok());
+  auto r = send(cmd(can::Opcode::kReloadCalibration, 17), 1);
+  for (int i = 0; i < 200 && part(r, 0) == nullptr; ++i) {  // the worker thread reads the file
+    rig_->bus->clear_sent();
+    rig_->run_cycles(1);
+    for (const hal::CanFrame& f : rig_->bus->sent()) {
+      if (auto x = can::decode_response(f); x.is_ok()) r.push_back(x.value());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  ASSERT_NE(part(r, 1), nullptr);
+  EXPECT_EQ(part(r, 1)->cal_id, calibration_id(d));
+  EXPECT_EQ(rig_->loop->cal_id(), calibration_id(d));
+  // When the file is then corrupted (truncated) and reloaded
+  {
+    std::FILE* f = std::fopen(path_.c_str(), "w");
+    std::fputs("[calibration\n", f);
+    std::fclose(f);
+  }
+  r = send(cmd(can::Opcode::kReloadCalibration, 18), 1);
+  for (int i = 0; i < 200 && part(r, 0) == nullptr; ++i) {
+    rig_->bus->clear_sent();
+    rig_->run_cycles(1);
+    for (const hal::CanFrame& f : rig_->bus->sent()) {
+      if (auto x = can::decode_response(f); x.is_ok()) r.push_back(x.value());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  // Then the board answers "failed" and keeps the last good calibration
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);
+  EXPECT_EQ(rig_->loop->cal_id(), calibration_id(d));
+}
+
+TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {
+  const auto before = rig_->loop->pipeline().config().compensator;
+  const std::uint32_t cmd_errors = rig_->loop->health().command_errors;
+  can::Command c = cmd(can::Opcode::kSetCompensator, 19);
+  c.compensator = nav::CompensatorKind::kExact;
+  hal::CanFrame bad_crc = can::encode_command(c, SimRig::kNode);
+  bad_crc.data[7] ^= 0x5A;
+  auto r = round_trip(bad_crc);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kBadCrc);
+  hal::CanFrame short_frame = can::encode_command(c, SimRig::kNode);
+  short_frame.len = 5;
+  r = round_trip(short_frame);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kBadLength);
+  EXPECT_EQ(rig_->loop->pipeline().config().compensator, before);
+  EXPECT_EQ(rig_->loop->health().command_errors, cmd_errors + 2);
+  // A command for another node is not answered.
+  r = round_trip(can::encode_command(c, SimRig::kNode + 1));
+  EXPECT_EQ(part(r, 0), nullptr);
+  EXPECT_EQ(rig_->loop->pipeline().config().compensator, before);
+}
+
+}  // namespace
+}  // namespace gfins::app
