@@ -12,12 +12,6 @@ namespace {
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
-std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
-  const std::uint64_t h = calib_file::checksum(d);
-  const auto id = static_cast<std::uint32_t>(h ^ (h >> 32));
-  return id == 0 ? 1u : id;
-}
-
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
                                            const calib_file::CalibrationData& d) {
   nav::PipelineConfig<float> p;
