@@ -39,11 +39,11 @@ TEST(HilWire, SampleFrameLayout) {
   ASSERT_EQ(w.size(), 52u);
   EXPECT_EQ(w[0], 'G');
   EXPECT_EQ(w[1], 'H');
-  EXPECT_EQ(w[2], 2);   // last sample
-  EXPECT_EQ(w[3], 52);  // length
+  EXPECT_EQ(w[2], 2);     // last sample
+  EXPECT_EQ(w[3], 52);    // length
   EXPECT_EQ(w[4], 0xD0);  // index, little-endian
   EXPECT_EQ(w[7], 0xA0);
-  EXPECT_EQ(w[8], 0x04);  // seq
+  EXPECT_EQ(w[8], 0x04);   // seq
   EXPECT_EQ(w[12], 0x18);  // t_ns
   EXPECT_EQ(w[19], 0x11);
   EXPECT_EQ(w[20], 0xFF);  // counts[0] = -1, two's complement
@@ -106,9 +106,15 @@ class HilReplay : public ::testing::Test {
 
   // gfins-fw --board hil on an ephemeral loopback port; returns the port it bound.
   int start_firmware() {
-    const std::vector<std::string> argv = {GFINS_FW_EXE, "--board", "hil", "--hil-port", "0",
-                                           "--hil-port-file", (dir_ / "port").string(),
-                                           "--watchdog", "none"};
+    const std::vector<std::string> argv = {GFINS_FW_EXE,
+                                           "--board",
+                                           "hil",
+                                           "--hil-port",
+                                           "0",
+                                           "--hil-port-file",
+                                           (dir_ / "port").string(),
+                                           "--watchdog",
+                                           "none"};
     lnx::SpawnOptions so;
     so.stdout_path = (dir_ / "fw.out").string();
     so.stderr_path = (dir_ / "fw.err").string();
@@ -147,16 +153,17 @@ class HilReplay : public ::testing::Test {
 
 // The firmware's default output dividers (docs/can-interface.md): one epoch every 10 samples.
 constexpr int kEpochDivider = 10;
-constexpr int kRate = 1000;       // Hz, the firmware's default adc.sample_rate_hz
-constexpr int kSeconds = 3;       // a few seconds of a moving scenario
-constexpr int kSamples = kSeconds * kRate + 1;            // samples 0..3000
+constexpr int kRate = 1000;                     // Hz, the firmware's default adc.sample_rate_hz
+constexpr int kSeconds = 3;                     // a few seconds of a moving scenario
+constexpr int kSamples = kSeconds * kRate + 1;  // samples 0..3000
 constexpr int kEpochs = (kSamples - 1) / kEpochDivider + 1;  // seq 0, 10, ..., 3000
 
 TEST_F(HilReplay, EveryEpochArrivesAndEqualsTheHostCoreRun) {
   const int port = start_firmware();
   ASSERT_GT(port, 0) << fw_log();
-  const auto host = run_host(port, {"--scenario", "maneuver", "--scenario-dir",
-                                    GFINS_SCENARIO_DIR, "--duration", std::to_string(kSeconds)},
+  const auto host = run_host(port,
+                             {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR,
+                              "--duration", std::to_string(kSeconds)},
                              "host.out");
   const std::string out = slurp(dir_ / "host.out");
   EXPECT_TRUE(host.ok()) << lnx::describe(host) << "\n" << out << slurp(dir_ / "host.out.err");
@@ -183,10 +190,11 @@ TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   const int port = start_firmware();
   ASSERT_GT(port, 0) << fw_log();
   constexpr int kAbortAfter = 1500;
-  const auto cut = run_host(port, {"--scenario", "maneuver", "--scenario-dir",
-                                   GFINS_SCENARIO_DIR, "--duration", std::to_string(kSeconds),
-                                   "--abort-after", std::to_string(kAbortAfter)},
-                            "cut.out");
+  const auto cut =
+      run_host(port,
+               {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR, "--duration",
+                std::to_string(kSeconds), "--abort-after", std::to_string(kAbortAfter)},
+               "cut.out");
   const std::string out = slurp(dir_ / "cut.out");
   EXPECT_TRUE(cut.exited && cut.code == 1) << lnx::describe(cut) << out;
   EXPECT_NE(out.find("INCOMPLETE: connection reset by this host after " +
@@ -196,9 +204,9 @@ TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   EXPECT_NE(out.find("of " + std::to_string(kEpochs) + " epochs"), std::string::npos) << out;
   // The firmware kept its loop: a second host connects, sends a short stream with one corrupted
   // sample frame, which is refused and counted; the run ends after that stream's last sample.
-  const auto second = run_host(port, {"--scenario", "maneuver", "--scenario-dir",
-                                      GFINS_SCENARIO_DIR, "--duration", "0.05",
-                                      "--corrupt-at", "5"},
+  const auto second = run_host(port,
+                               {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR,
+                                "--duration", "0.05", "--corrupt-at", "5"},
                                "second.out");
   const std::string out2 = slurp(dir_ / "second.out");
   EXPECT_TRUE(second.exited && second.code == 1) << out2;

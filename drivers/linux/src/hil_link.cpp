@@ -329,8 +329,7 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
       ++counters_.connections;
       continue;
     }
-    const hil::ParseResult pr =
-        hil::parse(std::span<const std::uint8_t>(rx_.data(), rx_len_));
+    const hil::ParseResult pr = hil::parse(std::span<const std::uint8_t>(rx_.data(), rx_len_));
     if (pr.error == hil::ParseError::kNone || pr.error == hil::ParseError::kBadCrc) {
       std::memmove(rx_.data(), rx_.data() + pr.used, rx_len_ - pr.used);
       rx_len_ -= pr.used;

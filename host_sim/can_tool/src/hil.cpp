@@ -1,6 +1,5 @@
 #include "hil.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -25,10 +24,18 @@ namespace {
 namespace lnx = drivers::lnx;
 constexpr std::int64_t kNsPerMs = 1000000;
 
+// Roll, pitch, yaw (ZYX) of the quaternion as published (docs/can-interface.md): the standard
+// formulas on the float quaternion's components, not renormalised (the core keeps |q| = 1 to a
+// few float ulps; renormalising here would move an angle by up to ~1e-7 rad, a visible part of
+// the 1e-4 rad step).
 std::array<double, 3> euler_zyx(const nav::Quat<float>& qf) {
-  const Eigen::Matrix3d r = qf.cast<double>().normalized().toRotationMatrix();
-  return {std::atan2(r(2, 1), r(2, 2)), -std::asin(std::clamp(r(2, 0), -1.0, 1.0)),
-          std::atan2(r(1, 0), r(0, 0))};
+  const auto w = static_cast<double>(qf.w());
+  const auto x = static_cast<double>(qf.x());
+  const auto y = static_cast<double>(qf.y());
+  const auto z = static_cast<double>(qf.z());
+  return {std::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)),
+          std::asin(std::clamp(2.0 * (w * y - z * x), -1.0, 1.0)),
+          std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))};
 }
 
 struct Input {
@@ -62,7 +69,8 @@ bool scenario_samples(const HilOptions& o, Input& in, std::ostream& err) {
   const auto n = static_cast<std::uint32_t>(std::llround(duration * s.rate_hz)) + 1;
   in.samples.reserve(n);
   for (std::uint32_t k = 0; k < n; ++k) {
-    const auto t_ns = static_cast<std::int64_t>(std::llround(static_cast<double>(k) * 1e9 / s.rate_hz));
+    const auto t_ns =
+        static_cast<std::int64_t>(std::llround(static_cast<double>(k) * 1e9 / s.rate_hz));
     auto r = adc.convert(stream->volts(k), k, t_ns);
     if (!r.is_ok()) {
       err << "gfins-can hil: sample " << k << ": " << r.status().message() << "\n";
@@ -87,7 +95,7 @@ struct Comparison {
   std::uint64_t epochs = 0;
   std::uint64_t values = 0;
   std::uint64_t mismatches = 0;
-  std::uint64_t unknown_epochs = 0;  // SampleCount matching no published sample
+  std::uint64_t unknown_epochs = 0;           // SampleCount matching no published sample
   std::map<std::string, double> worst_steps;  // per signal: largest |difference| in steps
 };
 
@@ -105,7 +113,8 @@ void compare_epoch(const DecodedEpoch& e, const nav::NavState<float>& n, Compari
         want = static_cast<double>(static_cast<std::uint32_t>(n.t_ns / 1000));
         break;
       case can::Field::kQuaternion:
-        want = qsign * std::array<double, 4>{n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()}[s.index];
+        want =
+            qsign * std::array<double, 4>{n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()}[s.index];
         break;
       case can::Field::kEuler:
         want = eul[s.index];
@@ -128,11 +137,13 @@ void compare_epoch(const DecodedEpoch& e, const nav::NavState<float>& n, Compari
       default:
         continue;  // mode, status and health: the loop's, not the core's
     }
-    if (std::isnan(e.values[i])) continue;  // not available / saturated: flagged by the decoder
+    if (std::isnan(e.values[i])) continue;  // not available: flagged by the decoder
+    // Outside the signal's range the encoder saturates at the documented limit (and flags it in
+    // the status frame): the core's value as the bus can carry it.
+    if (s.max > s.min) want = std::clamp(want, s.min, s.max);
     // Half a quantisation step, 1e-9 of a step for double rounding, 1e-9 rad for the two Euler
     // formulas (same float quaternion, different operation order).
-    const double tol =
-        0.5 * s.factor * (1 + 1e-9) + (s.field == can::Field::kEuler ? 1e-9 : 0.0);
+    const double tol = 0.5 * s.factor * (1 + 1e-9) + (s.field == can::Field::kEuler ? 1e-9 : 0.0);
     const double diff = std::abs(e.values[i] - want);
     double& worst = c.worst_steps[std::string(s.name)];
     worst = std::max(worst, diff / s.factor);
@@ -216,9 +227,9 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   auto client = lnx::HilClient::connect(o.address, static_cast<std::uint16_t>(o.port));
   if (!client.is_ok()) {
     err << "gfins-can hil: " << o.address << ":" << o.port << ": " << client.status().message()
-        << (client.status().os_error() != 0 ? std::string(": ") +
-                                                  std::strerror(client.status().os_error())
-                                            : std::string())
+        << (client.status().os_error() != 0
+                ? std::string(": ") + std::strerror(client.status().os_error())
+                : std::string())
         << "\n";
     return 2;
   }
@@ -318,8 +329,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       << ", CAN frames received " << can_frames << "\n";
   out << "  epochs: expected " << published.size() << ", decoded " << cmp.epochs
       << ", matching no sample " << cmp.unknown_epochs << "\n";
-  out << "  values compared " << cmp.values << ", outside quantisation " << cmp.mismatches
-      << "\n";
+  out << "  values compared " << cmp.values << ", outside quantisation " << cmp.mismatches << "\n";
   out << "  decoder: frames " << sum.frames << ", ok " << sum.frames_ok << ", problems "
       << sum.total_issues() << "\n";
   for (std::size_t k = 0; k < sum.issues.size(); ++k) {
@@ -332,13 +342,13 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   out << "  largest difference: " << worst << " quantisation step(s)\n";
   const bool complete = failure.empty() && cmp.epochs == published.size();
   if (!failure.empty()) {
-    out << "  INCOMPLETE: " << failure << "; received " << cmp.epochs << " of "
-        << published.size() << " epochs (up to sample " << acked << ")\n";
+    out << "  INCOMPLETE: " << failure << "; received " << cmp.epochs << " of " << published.size()
+        << " epochs (up to sample " << acked << ")\n";
   }
   const bool equal = cmp.mismatches == 0 && cmp.unknown_epochs == 0 && sum.total_issues() == 0;
-  out << "  result: " << (complete && equal ? "IDENTICAL (within quantisation)"
-                                            : (equal ? "consistent so far, but incomplete"
-                                                     : "DIFFERENT"))
+  out << "  result: "
+      << (complete && equal ? "IDENTICAL (within quantisation)"
+                            : (equal ? "consistent so far, but incomplete" : "DIFFERENT"))
       << "\n";
   return complete && equal && naks == 0 ? 0 : 1;
 }

@@ -141,8 +141,7 @@ class HilServer {
 /// The host end: a blocking TCP client.
 class HilClient {
  public:
-  static Result<std::unique_ptr<HilClient>> connect(const std::string& address,
-                                                    std::uint16_t port);
+  static Result<std::unique_ptr<HilClient>> connect(const std::string& address, std::uint16_t port);
   ~HilClient();
   HilClient(const HilClient&) = delete;
   HilClient& operator=(const HilClient&) = delete;
