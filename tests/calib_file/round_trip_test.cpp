@@ -154,3 +154,19 @@ TEST(Checksum, CanonicalSerialisationIsKeyEqualsBitPatternLines) {
 
 }  // namespace
 }  // namespace gfins::calib_file
+
+namespace gfins::calib_file {
+namespace {
+
+TEST(CalibrationId, IsTheChecksumFoldedTo32BitsAndChangesWithAnyValue) {
+  // docs/calibration.md, install: cal_id = h ^ (h >> 32) of the file's FNV-1a 64 checksum.
+  const CalibrationData d = testing::table6_data();
+  const std::uint64_t h = fnv1a64(canonical_serialisation(d));
+  EXPECT_EQ(cal_id_of(d), static_cast<std::uint32_t>(h ^ (h >> 32)));
+  CalibrationData e = d;
+  e.sensors[4].bias_g = std::nextafter(e.sensors[4].bias_g, 1.0);  // one ulp
+  EXPECT_NE(cal_id_of(e), cal_id_of(d));
+}
+
+}  // namespace
+}  // namespace gfins::calib_file

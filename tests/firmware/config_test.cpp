@@ -114,6 +114,7 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[output]\nepoch = 0\nstatus = 0\n", {"output.epoch = 0"}},
       {"[log]\nlevel = \"loud\"\n", {"log.level = \"loud\"", "\"warn\""}},
       {"[can]\ninterface = \"can0/../x\"\n", {"can.interface", "without '/'"}},
+      {"[adc]\nspi_device = \"/dev/sda\"\n", {"adc.spi_device = \"/dev/sda\"", "/dev/spidevB.C"}},
       {"[can]\nnodeid = 3\n", {"bad.toml:2", "unknown key 'can.nodeid'"}},
       {"[cann]\nnode_id = 3\n", {"unknown key 'cann'"}},
       {"[can\nnode_id = 3\n", {"bad.toml:1", "TOML syntax"}},

@@ -77,11 +77,7 @@ McSigma monte_carlo(const Trajectory& traj, double duration_s, const std::vector
       return s;
     };
     nav::Strapdown<double> sd(solver, gravity);
-    nav::NavState<double> init;
-    init.q_nb = truth[0].q_nb;
-    init.w_b = truth[0].w_b;
-    init.v_n = truth[0].v_n;
-    init.r_n = truth[0].r_n;
+    const nav::NavState<double> init = to_nav_state<double>(truth[0]);
     sd.initialize(init, noisy(0));
     std::size_t next = 0;
     for (std::size_t k = 1; k <= steps && next < check_k.size(); ++k) {

@@ -47,14 +47,7 @@ struct Errors {
   Vec3<double> phi, dr, dv, dw;
 };
 
-NavState<double> initial_state(const sim::TruthState& x) {
-  NavState<double> s;
-  s.q_nb = x.q_nb;
-  s.w_b = x.w_b;
-  s.v_n = x.v_n;
-  s.r_n = x.r_n;
-  return s;
-}
+NavState<double> initial_state(const sim::TruthState& x) { return sim::to_nav_state<double>(x); }
 
 /// Runs the strapdown over the trajectory with bias_mps2 added to sensor kSensor and returns the
 /// navigation states at every sample.

@@ -35,7 +35,7 @@ Final run(const sim::Trajectory& traj, const RunOptions& o) {
     for (int j = 0; j < 6 && o.noise_mps2 > 0; ++j) s(j) += o.noise_mps2 * n01(rng);
     return Vec6<T>(s.template cast<T>());
   };
-  nav.initialize(testing::truth_as_state(traj.at(0)).template cast<T>(), outputs_at(0));
+  nav.initialize(sim::to_nav_state<T>(traj.at(0)), outputs_at(0));
   const auto steps = static_cast<std::uint32_t>(std::llround(o.duration_s / o.dt_s));
   for (std::uint32_t k = 1; k <= steps; ++k) {
     nav.step(outputs_at(k * o.dt_s), static_cast<T>(o.dt_s), 0, k);

@@ -1,5 +1,10 @@
 // Test support: runs a truth trajectory through the strapdown integrator with an ideal array
 // (optionally with white noise) and reports the navigation errors against the truth.
+//
+// Below the sample seam on purpose: these helpers test the integrator as a unit (convergence
+// order, stability, float vs double), whose truncation errors ADC quantisation would mask (one
+// count is 0.9 µg, a random walk in ω). Everything that tests a sample's path goes through
+// host_sim's SampleSource and NavLoop (docs/architecture.md, "One path for a sample").
 #pragma once
 
 #include <cmath>
@@ -45,15 +50,6 @@ inline ArrayGeometry<double, 6> run_geometry(const RunOptions& opts) {
   return misaligned_geometry(nominal, m);
 }
 
-inline NavState<double> truth_as_state(const sim::TruthState& x) {
-  NavState<double> s;
-  s.q_nb = x.q_nb;
-  s.w_b = x.w_b;
-  s.v_n = x.v_n;
-  s.r_n = x.r_n;
-  return s;
-}
-
 inline NavErrors errors_against(const NavState<double>& nav, const sim::TruthState& truth) {
   NavErrors e;
   e.attitude_rad = truth.q_nb.angularDistance(nav.q_nb);
@@ -83,7 +79,7 @@ NavErrors run_trajectory(const sim::Trajectory& traj, const RunOptions& opts) {
     }
     return Vec6<T>(s.template cast<T>());
   };
-  nav.initialize(truth_as_state(traj.at(0.0)).template cast<T>(), outputs_at(0.0));
+  nav.initialize(sim::to_nav_state<T>(traj.at(0.0)), outputs_at(0.0));
   const auto steps = static_cast<long>(std::llround(opts.duration_s / opts.dt_s));
   double max_norm_err = 0;
   for (long k = 1; k <= steps; ++k) {

@@ -94,8 +94,7 @@ Status SocketCan::open_socket() {
   }
   Status s = apply_filters();
   if (!s.is_ok()) return s;
-  sockaddr_can addr;
-  std::memset(&addr, 0, sizeof addr);
+  sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = static_cast<int>(ifindex_);
   if (os_.bind(fd_, &addr, sizeof addr) != 0) {
@@ -151,8 +150,7 @@ bool SocketCan::tx_push(const hal::CanFrame& f) {
 // One write(2) of one frame; kOk, kResourceExhausted for "try later", kUnavailable for a gone
 // interface, kIoError otherwise (the caller decides what to do with the frame).
 Status SocketCan::write_frame(const hal::CanFrame& f) {
-  can_frame raw;
-  std::memset(&raw, 0, sizeof raw);
+  can_frame raw{};
   raw.can_id = f.id | (f.extended ? CAN_EFF_FLAG : 0U);
   raw.len = f.len;
   std::memcpy(raw.data, f.data.data(), f.len);
@@ -226,8 +224,7 @@ void SocketCan::try_recover() {
     // Deleted and re-created: the old binding is gone (NETDEV_UNREGISTER), bind a new socket.
     if (!open_socket().is_ok()) return;
   }
-  ifreq req;
-  std::memset(&req, 0, sizeof req);
+  ifreq req{};
   std::memcpy(req.ifr_name, name_.data(), kNameMax);  // NUL-terminated, length checked at open
   if (os_.ioctl(fd_, SIOCGIFFLAGS, &req) != 0) return;
   if ((req.ifr_flags & IFF_UP) == 0) return;
@@ -271,7 +268,7 @@ void SocketCan::handle_error_frame(std::uint32_t can_id, const std::array<std::u
 
 void SocketCan::drain_rx() {
   for (int i = 0; i < kMaxReadsPerDrain && state_ != hal::CanBusState::kDown; ++i) {
-    can_frame raw;
+    can_frame raw{};
     const long n = os_.read(fd_, &raw, sizeof raw);
     if (n < 0) {
       const int err = errno;

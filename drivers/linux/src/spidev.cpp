@@ -72,8 +72,7 @@ Spidev::Spidev(Os& os, int fd, const SpidevConfig& config) : os_(os), fd_(fd), c
 Spidev::~Spidev() { (void)os_.close(fd_); }
 
 Status Spidev::do_transfer(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  spi_ioc_transfer xfer;
-  std::memset(&xfer, 0, sizeof xfer);
+  spi_ioc_transfer xfer{};
   // The kernel ABI carries user pointers as __u64 (spidev.h).
   xfer.tx_buf = reinterpret_cast<std::uintptr_t>(tx.data());
   xfer.rx_buf = reinterpret_cast<std::uintptr_t>(rx.data());

@@ -114,7 +114,7 @@ BoardResult make_sim_board(const FwConfig& c) {
     out.error = parsed.error().message;
     return out;
   }
-  const sim::Scenario s = parsed.value();
+  const sim::Scenario& s = parsed.value();
   if (s.rate_hz != c.sample_rate_hz) {
     out.error = "scenario " + s.name + " runs at " + std::to_string(s.rate_hz) +
                 " Hz but adc.sample_rate_hz is " + std::to_string(c.sample_rate_hz);

@@ -242,8 +242,17 @@ std::string validate(const FwConfig& c, const std::string& origin) {
     return bad("adc.sample_rate_hz", num(c.sample_rate_hz),
                "must be 500, 1000, 2000 or 4000 (ADS131M06 data rates at 8.192 MHz)");
   }
-  if (!printable_path(c.spi_device)) {
-    return bad("adc.spi_device", "\"" + c.spi_device + "\"", "must be a device path");
+  // spidev names its nodes /dev/spidevB.C (bus B, chip select C).
+  const std::string spidev = "/dev/spidev";
+  const std::string bc =
+      c.spi_device.rfind(spidev, 0) == 0 ? c.spi_device.substr(spidev.size()) : "";
+  const auto dot = bc.find('.');
+  const auto digits = [](const std::string& t) {
+    return !t.empty() && t.size() < 4 && t.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (dot == std::string::npos || !digits(bc.substr(0, dot)) || !digits(bc.substr(dot + 1))) {
+    return bad("adc.spi_device", "\"" + c.spi_device + "\"",
+               "must be a spidev node /dev/spidevB.C (bus B, chip select C)");
   }
   if (!printable_path(c.gpio_chip)) {
     return bad("adc.gpio_chip", "\"" + c.gpio_chip + "\"", "must be a chip name or path");

@@ -122,7 +122,8 @@ int main(int argc, char** argv) {
   try {
     const gfins::app::CliResult cli = gfins::app::parse_command_line(argc, argv);
     if (!cli.config) {
-      std::fputs(cli.message.c_str(), cli.exit_code == 0 ? stdout : stderr);
+      // Nothing to do if printing the message fails: the exit code carries the outcome.
+      (void)std::fputs(cli.message.c_str(), cli.exit_code == 0 ? stdout : stderr);
       return cli.exit_code;
     }
     if (cli.check_only) {

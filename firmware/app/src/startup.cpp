@@ -12,6 +12,10 @@ namespace {
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 }
 
+std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
+  return calib_file::cal_id_of(d);  // one rule, shared with gfins-calibrate's report
+}
+
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
                                            const calib_file::CalibrationData& d) {
   nav::PipelineConfig<float> p;

@@ -210,8 +210,9 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
   return fnv1a64(canonical_serialisation(data, version));
 }
 
-std::uint32_t calibration_id(const CalibrationData& data) {
-  const auto id = static_cast<std::uint32_t>(checksum(data) & 0xFFFFFFFFu);
+std::uint32_t cal_id_of(const CalibrationData& data) {
+  const std::uint64_t h = checksum(data);
+  const auto id = static_cast<std::uint32_t>((h ^ (h >> 32)) & 0xFFFFFFFFu);
   return id == 0 ? 1u : id;
 }
 

@@ -71,15 +71,8 @@ void check(const Status& st) {
 }  // namespace
 
 nav::NavState<double> truth_nav_state(const TruthState& x, const nav::GravityModel<double>& g) {
-  NavPoint s;
-  s.t_ns = static_cast<std::int64_t>(std::llround(x.t_s * 1e9));
-  s.q_nb = x.q_nb;
-  s.w_b = x.w_b;
-  s.wdot_b = x.wdot_b;
-  s.f_b = x.q_nb.conjugate() * (x.a_n - g.g_n(x.r_n));
-  s.a_n = x.a_n;
-  s.v_n = x.v_n;
-  s.r_n = x.r_n;
+  NavPoint s = to_nav_state<double>(x);
+  s.f_b = x.q_nb.conjugate() * (x.a_n - g.g_n(x.r_n));  // what to_nav_state cannot know
   return s;
 }
 

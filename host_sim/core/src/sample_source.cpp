@@ -1,7 +1,10 @@
 #include "gfins/host_sim/sample_source.hpp"
 
+#include "gfins/host_sim/chip/simulated_adc.hpp"
+
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
 #include <utility>
 
 namespace gfins::sim {
@@ -15,10 +18,42 @@ Result<RawSample> BehaviouralAdc::convert(const std::array<double, 6>& sensor_vo
   return s;
 }
 
+namespace {
+
+/// The register-level converter: the ADS131M06 chip model, a simulated data-ready line and the
+/// real driver (host_sim/chip, SimulatedAdc), configured to match `config` (reference, PGA gain,
+/// divider, rate) so its codes equal the behavioural model's within 1 LSB
+/// (tests/host_sim/simulated_adc_test.cpp). Its driver checks CRCs, the status word and the
+/// edge sequence of every frame exactly as on the board.
+class RegisterLevelAdc final : public SourceAdc {
+ public:
+  explicit RegisterLevelAdc(const SimulatedAdcConfig& c) : adc_(c) {}
+  Status start() { return adc_.start(); }
+  Result<RawSample> convert(const std::array<double, 6>& sensor_volts, std::uint32_t seq,
+                            std::int64_t t_ns) override {
+    return adc_.convert(sensor_volts, seq, t_ns);
+  }
+  double volts_per_count() const override { return adc_.volts_per_count(0); }
+
+ private:
+  SimulatedAdc adc_;
+};
+
+}  // namespace
+
 std::unique_ptr<SourceAdc> make_source_adc(const AdcConfig& config) {
-  // The one place that picks the host's converter: the register-level SimulatedAdc replaces
-  // this line when host_sim/chip lands.
-  return std::make_unique<BehaviouralAdc>(config);
+  // The one place that picks the host's converter: the register-level SimulatedAdc, so every
+  // host run goes trajectory → sensor model → ADS131M06 registers and frames → the board's
+  // driver → RawSample. AdcConfig's group delay and jitter do not apply: the source gives the
+  // edge time. A configuration the chip cannot do is a set-up error (host code: it throws, like
+  // AdcModel's constructor).
+  const Result<SimulatedAdcConfig> c = SimulatedAdc::config_for(
+      config.vref_v, config.gain, config.input_divider, config.sample_rate_hz);
+  if (!c.is_ok()) throw std::invalid_argument(c.status().message());
+  auto adc = std::make_unique<RegisterLevelAdc>(c.value());
+  const Status st = adc->start();
+  if (!st.is_ok()) throw std::invalid_argument(st.message());
+  return adc;
 }
 
 SampleSource::SampleSource(const Trajectory& trajectory, SensorArrayModel sensors,

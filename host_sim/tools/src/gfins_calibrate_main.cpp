@@ -337,7 +337,7 @@ int run(const Options& o) {
   char sum[64];
   std::snprintf(sum, sizeof sum, "fnv1a64:%016llx, calibration id 0x%08x",
                 static_cast<unsigned long long>(calib_file::checksum(data)),
-                static_cast<unsigned>(calib_file::calibration_id(data)));
+                static_cast<unsigned>(calib_file::cal_id_of(data)));
   std::cout << "\nwrote " << o.output << " (device " << data.device_id << ", " << sum << ")\n";
   return kExitOk;
 }

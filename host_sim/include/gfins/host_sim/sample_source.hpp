@@ -9,7 +9,8 @@
 //
 // The converter is the seam: SourceAdc has the signature of the register-level SimulatedAdc
 // (host_sim/chip: chip model + data-ready line + the real ADS131M06 driver). make_source_adc()
-// is the one place that chooses it; today it is the behavioural AdcModel (adc_model.hpp).
+// is the one place that chooses it: the register-level SimulatedAdc; BehaviouralAdc
+// (AdcModel, adc_model.hpp) remains for tests and benchmarks that want the fast model.
 //
 // Sample k has seq = k and t_ns = round(k · 1e9 / rate): driven by index, never by a clock.
 #pragma once

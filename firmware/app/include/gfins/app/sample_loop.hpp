@@ -39,8 +39,9 @@ class LatencyHistogram {
  public:
   static constexpr std::size_t kBins = 20000;  // 0..20 ms
   void add(std::int64_t ns) {
+    constexpr auto kLast = static_cast<std::int64_t>(kBins) - 1;
     const std::int64_t us = ns < 0 ? 0 : ns / 1000;
-    ++bins_[static_cast<std::size_t>(us < static_cast<std::int64_t>(kBins) ? us : kBins - 1)];
+    ++bins_[static_cast<std::size_t>(us < kLast ? us : kLast)];
     ++count_;
     if (ns > max_ns_) max_ns_ = ns;
   }

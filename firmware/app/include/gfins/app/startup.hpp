@@ -13,9 +13,10 @@
 
 namespace gfins::app {
 
-/// The 32-bit calibration identity published on CAN is calib_file::calibration_id (one
-/// definition, shared with gfins-calibrate's report; 0 is reserved for "uncalibrated").
-using calib_file::calibration_id;
+/// 32-bit calibration identity published on CAN: the file's FNV-1a 64 checksum folded to 32
+/// bits (high XOR low). 0 is reserved for "uncalibrated defaults" (a file folding to 0 is
+/// published as 1).
+std::uint32_t calibration_id(const calib_file::CalibrationData& d);
 
 /// Pipeline configuration from the firmware configuration and a calibration.
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c, const calib_file::CalibrationData& d);

@@ -125,9 +125,10 @@ std::string canonical_serialisation(const CalibrationData& data,
 /// FNV-1a 64-bit over canonical_serialisation(data, version).
 std::uint64_t checksum(const CalibrationData& data, std::int64_t version = kFormatVersion);
 /// The identity of a calibration on the bus (the status frame's cal_id, can::Epoch::cal_id):
-/// the low 32 bits of checksum(data), with 0 (reserved for "nominal parameters, no file")
-/// mapped to 1. Two files with the same values have the same identity.
-std::uint32_t calibration_id(const CalibrationData& data);
+/// checksum(data) folded to 32 bits (h ^ h >> 32, the rule gfins-fw uses), with 0 (reserved
+/// for "nominal parameters, no file") mapped to 1. Two files with the same values have the same
+/// identity.
+std::uint32_t cal_id_of(const CalibrationData& data);
 /// FNV-1a 64-bit of arbitrary bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
 std::uint64_t fnv1a64(const std::string& bytes);
 

@@ -27,10 +27,10 @@
 namespace gfins::drivers::lnx {
 
 struct CandumpFileBusConfig {
-  std::string_view path;                        // the log file, created or truncated
-  std::string_view interface = "can0";          // the name written on every line
-  std::size_t buffer_bytes = 64 * 1024;         // at least kCandumpLineMax
-  std::int64_t flush_interval_ns = 1000000000;  // service() writes at most this late
+  std::string_view path;                              // the log file, created or truncated
+  std::string_view interface = "can0";                // the name written on every line
+  std::size_t buffer_bytes = std::size_t{64} * 1024;  // at least CandumpFileBus::kLineMax
+  std::int64_t flush_interval_ns = 1000000000;        // service() writes at most this late
 };
 
 class CandumpFileBus final : public hal::CanBus {
