@@ -97,8 +97,8 @@ void run(const char* scalar, nav::CompensatorKind kind, const std::vector<Counts
   } else {
     const double ns_core = time_ns(core, samples);
     const double ns_base = time_ns(base, samples);
-    std::printf("%-7s %-6s %12.1f %12.1f %8.2f\n", scalar, nav::to_string(kind), ns_core,
-                ns_base, ns_base / ns_core);
+    std::printf("%-7s %-6s %12.1f %12.1f %8.2f\n", scalar, nav::to_string(kind), ns_core, ns_base,
+                ns_base / ns_core);
   }
   consume(core.pipeline().state());
   consume(base.state());

@@ -13,6 +13,7 @@
 
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
+#include "gfins/host_sim/recording.hpp"
 
 namespace gfins {
 namespace {
@@ -218,6 +219,37 @@ TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   // more in flight, all delivered before the reset).
   EXPECT_NE(log.find("2 connection(s), 1 dropped"), std::string::npos) << log;
   EXPECT_NE(log.find("1 CRC errors"), std::string::npos) << log;
+}
+
+TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
+  // A recording written here: 2 s of codes that move (a slow ramp on every channel, different
+  // per channel), so the navigation state changes from epoch to epoch.
+  constexpr int kRecSamples = 2 * kRate + 1;
+  std::vector<RawSample> samples(kRecSamples);
+  for (int k = 0; k < kRecSamples; ++k) {
+    RawSample& s = samples[static_cast<std::size_t>(k)];
+    s.seq = static_cast<std::uint32_t>(k);
+    s.t_ns = static_cast<std::int64_t>(k) * 1000000;
+    for (int j = 0; j < 6; ++j)
+      s.counts[static_cast<std::size_t>(j)] = 100000 * (j - 2) + k * (j + 1);
+  }
+  sim::RecordingHeader h;
+  h.sample_rate_hz = kRate;
+  const fs::path rec = dir_ / "stream.gfr";
+  ASSERT_TRUE(sim::write_recording(rec.string(), h, samples).is_ok());
+  const int port = start_firmware();
+  ASSERT_GT(port, 0) << fw_log();
+  const auto host = run_host(port, {"--recording", rec.string()}, "rec.out");
+  const std::string out = slurp(dir_ / "rec.out");
+  EXPECT_TRUE(host.ok()) << lnx::describe(host) << "\n" << out << slurp(dir_ / "rec.out.err");
+  const std::string e = std::to_string((kRecSamples - 1) / kEpochDivider + 1);
+  EXPECT_NE(out.find("epochs: expected " + e + ", decoded " + e), std::string::npos) << out;
+  EXPECT_NE(out.find("outside quantisation 0"), std::string::npos) << out;
+  EXPECT_NE(out.find("IDENTICAL"), std::string::npos) << out;
+  const std::string log = fw_log();
+  EXPECT_NE(log.find("stopped after " + std::to_string(kRecSamples) + " samples"),
+            std::string::npos)
+      << log;
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Hardware-in-the-loop replay link over TCP (docs/hil.md). POSIX sockets, non-blocking, poll(2)
 // for every wait, so a silent host costs the loop one read timeout and never blocks it.
 #include "gfins/drivers/lnx/hil_link.hpp"
+#include "gfins/recording/codec.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -48,16 +49,8 @@ void seal(std::array<std::uint8_t, N>& f) {
 
 }  // namespace
 
-std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
-  // CRC-32 of IEEE 802.3 (reflected polynomial 0xEDB88320), bitwise: the link carries 52 bytes
-  // per sample, a table buys nothing measurable.
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::uint8_t b : bytes) {
-    c ^= b;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) != 0 ? (c >> 1) ^ 0xEDB88320u : c >> 1;
-  }
-  return c ^ 0xFFFFFFFFu;
-}
+// The one CRC-32 of the project (the recording format's, nav_core/recording).
+std::uint32_t crc32(std::span<const std::uint8_t> bytes) { return recording::crc32(bytes); }
 
 SampleWire encode_sample(std::uint32_t index, const RawSample& s, bool last) {
   SampleWire f{};
