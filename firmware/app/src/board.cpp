@@ -290,8 +290,12 @@ constexpr std::int64_t kIdleWaitNs = 1000000000;
 /// samples' edge times (driven by the sample index, never by the wall clock).
 class HilSource final : public SampleSource {
  public:
-  HilSource(lnx::HilServer& server, sim_board::SampleClock& clock, double volts_per_count)
-      : server_(server), clock_(clock), volts_per_count_(volts_per_count) {}
+  HilSource(lnx::HilServer& server, sim_board::SampleClock& clock, double volts_per_count,
+            double sample_rate_hz)
+      : server_(server),
+        clock_(clock),
+        volts_per_count_(volts_per_count),
+        period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sample_rate_hz))) {}
 
  private:
   Result<RawSample> do_read_sample(std::int64_t timeout_ns) override {
@@ -299,8 +303,26 @@ class HilSource final : public SampleSource {
     // of a few sample periods, so the loop (and its log) ticks at 1 Hz until a host connects.
     const std::int64_t wait = server_.connected() ? timeout_ns : std::max(timeout_ns, kIdleWaitNs);
     Result<RawSample> r = server_.read_sample(wait);
-    if (r.is_ok()) clock_.set(r.value().t_ns);
-    return r;
+    if (!r.is_ok()) return r;
+    RawSample s = r.value();
+    // A new connection is a new stream whose counter and time start again; the loop keeps its
+    // state and counters, so it sees the new stream continue the old one one period later
+    // (no false missed edges, no time going back). Its navigation is not reset (docs/hil.md).
+    const std::uint32_t conn = server_.counters().connections;
+    if (conn != connection_) {
+      if (delivered_) {
+        seq_offset_ = last_seq_ + 1u - s.seq;
+        t_offset_ = last_t_ns_ + period_ns_ - s.t_ns;
+      }
+      connection_ = conn;
+    }
+    s.seq += seq_offset_;
+    s.t_ns += t_offset_;
+    last_seq_ = s.seq;
+    last_t_ns_ = s.t_ns;
+    delivered_ = true;
+    clock_.set(s.t_ns);
+    return s;
   }
   AdcCounters do_counters() const override {
     // A replay frame with a bad CRC is the link's version of an ADC frame CRC error; a dropped
@@ -313,6 +335,13 @@ class HilSource final : public SampleSource {
   lnx::HilServer& server_;
   sim_board::SampleClock& clock_;
   double volts_per_count_;
+  std::int64_t period_ns_;
+  std::uint32_t connection_ = 0;
+  bool delivered_ = false;
+  std::uint32_t last_seq_ = 0;
+  std::int64_t last_t_ns_ = 0;
+  std::uint32_t seq_offset_ = 0;
+  std::int64_t t_offset_ = 0;
 };
 
 struct HilParts {
@@ -369,7 +398,7 @@ BoardResult make_hil_board(const FwConfig& c) {
   spdlog::info("hil: waiting for gfins-can hil on {}:{}", c.hil_address, srv->port());
   auto b = std::make_unique<Board>();
   auto clock = std::make_unique<sim_board::SampleClock>();
-  b->source = std::make_unique<HilSource>(*srv, *clock, lsb);
+  b->source = std::make_unique<HilSource>(*srv, *clock, lsb, c.sample_rate_hz);
   b->clock = std::move(clock);
   b->finished = [srv] { return srv->finished(); };
   // The frames go back to the host on the replay connection (a hal::CanBus of the link); the
