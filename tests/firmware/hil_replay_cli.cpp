@@ -219,6 +219,9 @@ TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   // more in flight, all delivered before the reset).
   EXPECT_NE(log.find("2 connection(s), 1 dropped"), std::string::npos) << log;
   EXPECT_NE(log.find("1 CRC errors"), std::string::npos) << log;
+  // Counters continuous across the reconnection: the one sample missing from the loop's
+  // sequence is the corrupted one (the second stream continues the first, docs/hil.md).
+  EXPECT_NE(log.find("health: missed edges 1,"), std::string::npos) << log;
 }
 
 TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {

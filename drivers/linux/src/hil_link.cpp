@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 namespace gfins::drivers::lnx {
@@ -287,14 +288,16 @@ HilServer::~HilServer() {
 
 hal::CanBus& HilServer::bus() { return *bus_; }
 
-void HilServer::drop(const std::string& why) {
+void HilServer::drop(const char* why, int os_error) {
   if (conn_fd_ >= 0) ::close(conn_fd_);
   conn_fd_ = -1;
   rx_len_ = 0;
   if (!finished_) ++counters_.drops;
-  last_event_ = why + " after " + std::to_string(expected_index_) +
-                " sample(s) of this connection (" + std::to_string(counters_.samples) +
-                " in all); waiting for a new connection";
+  // Called from the loop: formatted into a fixed buffer, no allocation.
+  (void)std::snprintf(last_event_.data(), last_event_.size(),
+                      "%s%s%s after %u sample(s) of this connection (%u in all)", why,
+                      os_error != 0 ? ": " : "", os_error != 0 ? std::strerror(os_error) : "",
+                      expected_index_, counters_.samples);
 }
 
 bool HilServer::send_bytes(std::span<const std::uint8_t> b) {
@@ -349,7 +352,9 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
     }
     if (pr.error != hil::ParseError::kNeedMore) {
       ++counters_.frame_errors;
-      drop(std::string("hil: bad frame from the host: ") + hil::to_string(pr.error));
+      drop(pr.error == hil::ParseError::kBadMagic  ? "hil: bad frame from the host: bad magic"
+           : pr.error == hil::ParseError::kBadType ? "hil: bad frame from the host: unknown type"
+                                                   : "hil: bad frame from the host: bad length");
       return Status(ErrorCode::kIoError, "hil: bad frame from the host (connection closed)");
     }
     if (!wait_fd(conn_fd_, POLLIN, deadline)) {
@@ -365,8 +370,9 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
       if (finished_) return Status(ErrorCode::kTimeout, "hil: stream complete");
       return Status(ErrorCode::kIoError, "hil: connection dropped mid-stream");
     } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-      drop(std::string("hil: receive failed: ") + std::strerror(errno));
-      return Status(ErrorCode::kIoError, "hil: connection dropped mid-stream", errno);
+      const int e = errno;
+      drop("hil: receive failed", e);
+      return Status(ErrorCode::kIoError, "hil: connection dropped mid-stream", e);
     }
   }
 }

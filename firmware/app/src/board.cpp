@@ -423,7 +423,8 @@ BoardResult make_hil_board(const FwConfig& c) {
         "hil: {} connection(s), {} dropped, {} samples, {} CRC errors, {} bad frames, {} CAN "
         "frames sent, {} not sent{}",
         h.connections, h.drops, h.samples, h.crc_errors, h.frame_errors, h.can_sent, h.can_dropped,
-        srv->last_event().empty() ? "" : "; last event: " + srv->last_event());
+        srv->last_event()[0] == '\0' ? std::string()
+                                     : std::string("; last event: ") + srv->last_event());
   };
   b->keep_alive = parts;
   out.board = std::move(b);

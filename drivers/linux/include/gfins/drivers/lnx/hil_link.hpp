@@ -116,14 +116,14 @@ class HilServer {
   bool finished() const { return finished_; }
   const HilCounters& counters() const { return counters_; }
   /// Text of the last connection event (drop, bad frame) for the log; "" when none.
-  const std::string& last_event() const { return last_event_; }
+  const char* last_event() const { return last_event_.data(); }
   /// The loop's CAN bus: frames go to the host on the connection; receive() never has any.
   hal::CanBus& bus();
 
  private:
   HilServer() = default;
   class Bus;
-  void drop(const std::string& why);
+  void drop(const char* why, int os_error = 0);
   bool send_bytes(std::span<const std::uint8_t> b);
 
   int listen_fd_ = -1;
@@ -134,7 +134,7 @@ class HilServer {
   std::vector<std::uint8_t> rx_;  // received, not yet parsed (start-up allocation)
   std::size_t rx_len_ = 0;
   HilCounters counters_{};
-  std::string last_event_;
+  std::array<char, 192> last_event_{};
   std::unique_ptr<Bus> bus_;
 };
 
