@@ -106,6 +106,16 @@ foreach(c IN LISTS gfins_components)
   install(FILES ${gz} DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${pkg} COMPONENT ${c})
 endforeach()
 
+# What the packages hold and nothing else (scripts/package.sh builds this, not the tests).
+set(gfins_package_deps ${gfins_tool_targets})
+if(TARGET gfins-fw)
+  list(APPEND gfins_package_deps gfins-fw)
+endif()
+foreach(c IN LISTS gfins_components)
+  list(APPEND gfins_package_deps gfins_changelog_${c})
+endforeach()
+add_custom_target(gfins_package_programs DEPENDS ${gfins_package_deps})
+
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME gfins)
 # Empty: each package's first description line is its summary (CPackDeb would otherwise put

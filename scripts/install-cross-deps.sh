@@ -14,12 +14,27 @@ for a in "${archs[@]}"; do
   for p in "${target_dev[@]}"; do packages+=("$p:$a"); done
 done
 
+# Tests that start a cross-built program through a shell or posix_spawn (the CLI tests) need the
+# kernel to hand foreign executables to qemu-user: mount binfmt_misc if needed and enable the
+# handlers qemu-user-static registers (the arm64/armhf loaders and libraries are the multiarch
+# packages installed here, so no -L sysroot is needed).
+enable_binfmt() {
+  [ -e /proc/sys/fs/binfmt_misc/status ] ||
+    mount -t binfmt_misc binfmt_misc /proc/sys/fs/binfmt_misc ||
+    { echo "install-cross-deps: cannot mount binfmt_misc: cross-built programs started by tests will fail" >&2; return 1; }
+  for h in qemu-aarch64 qemu-arm; do
+    [ -e "/proc/sys/fs/binfmt_misc/$h" ] || update-binfmts --enable "$h" ||
+      { echo "install-cross-deps: update-binfmts --enable $h failed" >&2; return 1; }
+  done
+}
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-cross-deps: all ${#packages[@]} packages present"
+  [ "$(id -u)" -ne 0 ] || enable_binfmt
   exit 0
 fi
 if [ "$(id -u)" -ne 0 ]; then
@@ -66,3 +81,4 @@ if ! apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; 
   done
 fi
 echo "install-cross-deps: done"
+enable_binfmt

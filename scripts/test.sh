@@ -32,7 +32,7 @@ cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
   nav_core_no_malloc_check calibration_no_malloc_check can_publisher_no_malloc_check \
-  gfins_can_decode_bench
+  gfins_can_decode_bench gfins-fw firmware_no_alloc_check
 
 step "host-release: hour-long runs (label long) and heap checks (label heap)"
 ctest --preset host-release -j "$jobs" -L 'long|heap' | tee "$log_dir/ctest-release.log"
@@ -47,13 +47,14 @@ cmake --preset cortex-m4f >/dev/null
 cmake --build --preset cortex-m4f -j "$jobs"
 ./scripts/embedded_size.sh | tail -n 25
 
-step "cross builds: aarch64 and armhf (multiarch), unit tests under qemu-user"
+# The whole suite is cross-built and run under qemu-user for aarch64; armhf is built for its
+# package only (programs), which keeps .ci/run inside its 30 minutes (docs/ci.md): the full
+# armhf suite is `ctest --preset armhf-linux` after `cmake --build --preset armhf-linux`.
+step "cross build aarch64 (multiarch), unit tests under qemu-aarch64-static"
 ./scripts/install-cross-deps.sh
-for preset in aarch64-linux armhf-linux; do
-  cmake --preset "$preset" >/dev/null
-  cmake --build --preset "$preset" -j "$jobs"
-  ctest --preset "$preset" -j "$jobs" | tee "$log_dir/ctest-$preset.log"
-done
+cmake --preset aarch64-linux >/dev/null
+cmake --build --preset aarch64-linux -j "$jobs"
+ctest --preset aarch64-linux -j "$jobs" | tee "$log_dir/ctest-aarch64-linux.log"
 
 step "Debian packages (amd64, arm64, armhf) and lintian"
 ./scripts/package.sh deb-amd64 aarch64-linux armhf-linux

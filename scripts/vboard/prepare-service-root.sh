@@ -29,6 +29,24 @@ pristine=$("$here/make-sysroot.sh")
 staged=$vboard_cache/initramfs/root
 [ -e "$staged/lib/modules/load-order" ] || vb_die "no staged initramfs: run make-initramfs.sh first"
 
+# The package's run-time dependencies come from the mirror as `apt install ./gfins-fw.deb`
+# would fetch them: installed once into the cached root (apt-get satisfy with the package's own
+# Depends field), so the copy below stays a clean root plus exactly what the package asks for.
+if [ -n "$deb" ]; then
+  [ -e "$deb" ] || vb_die "package $deb missing"
+  deps=$(dpkg-deb -f "$deb" Depends)
+  stamp=$pristine/.deps-$(echo "$deps" | md5sum | cut -c1-16)
+  if [ -n "$deps" ] && [ ! -e "$stamp" ]; then
+    [ "${GFINS_VBOARD_OFFLINE:-0}" != 1 ] ||
+      vb_die "GFINS_VBOARD_OFFLINE=1 but the dependencies of $(basename "$deb") are not in the cached root"
+    vb_log "installing the dependencies of $(basename "$deb") in the cached root: $deps"
+    { chroot "$pristine" apt-get update -qq && \
+      DEBIAN_FRONTEND=noninteractive chroot "$pristine" apt-get satisfy -y -qq --no-install-recommends "$deps" && \
+      chroot "$pristine" apt-get clean; } >"$vboard_cache/service-apt.log" 2>&1 ||
+      { tail -n 20 "$vboard_cache/service-apt.log" >&2; vb_die "cannot install the dependencies of $(basename "$deb") ($deps) from the mirror"; }
+    touch "$stamp"
+  fi
+fi
 rm -rf "$out"
 cp -a "$pristine" "$out"
 mkdir -p "$out/lib/modules/$kver/extra" "$out/vboard"

@@ -227,7 +227,7 @@ TEST_F(CanCommands, ReportCalibrationId) {
   ASSERT_NE(part(r, 0), nullptr);
   ASSERT_NE(part(r, 1), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
-  EXPECT_EQ(part(r, 1)->cal_id, calibration_id(rig_->factory));
+  EXPECT_EQ(part(r, 1)->cal_id, calib_file::cal_id_of(rig_->factory));
 }
 
 TEST_F(CanCommands, CaptureSendsTheResultFrames) {
@@ -270,8 +270,8 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
   ASSERT_NE(part(r, 1), nullptr);
-  EXPECT_EQ(part(r, 1)->cal_id, calibration_id(d));
-  EXPECT_EQ(rig_->loop->cal_id(), calibration_id(d));
+  EXPECT_EQ(part(r, 1)->cal_id, calib_file::cal_id_of(d));
+  EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(d));
   // When the file is then corrupted (truncated) and reloaded
   {
     std::FILE* f = std::fopen(path_.c_str(), "w");
@@ -290,7 +290,7 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
   // Then the board answers "failed" and keeps the last good calibration
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);
-  EXPECT_EQ(rig_->loop->cal_id(), calibration_id(d));
+  EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(d));
 }
 
 TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {

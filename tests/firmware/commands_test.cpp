@@ -108,7 +108,7 @@ TEST_F(Commands, ReportCalibrationGivesTheIdentityInUse) {
   c.kind = CommandKind::kReportCalibration;
   const Response r = exec(c);
   EXPECT_EQ(r.result, CommandResult::kOk);
-  EXPECT_EQ(r.cal_id, calibration_id(rig_->factory));
+  EXPECT_EQ(r.cal_id, calib_file::cal_id_of(rig_->factory));
   EXPECT_TRUE(r.calibrated);
 }
 

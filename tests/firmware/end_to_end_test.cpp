@@ -126,7 +126,7 @@ TEST(EndToEnd, EpochCarriesCalibrationIdentityAndMode) {
   EXPECT_EQ(epochs.back().mode, Mode::kNavigating);
   EXPECT_NE(epochs.back().status_bits & status_bits::kAligned, 0u);
   EXPECT_EQ(epochs.back().status_bits & status_bits::kUncalibrated, 0u);
-  EXPECT_EQ(epochs.back().cal_id, calibration_id(rig.factory));
+  EXPECT_EQ(epochs.back().cal_id, calib_file::cal_id_of(rig.factory));
   EXPECT_NE(epochs.back().cal_id, 0u);
 }
 

@@ -17,11 +17,15 @@
 namespace gfins::app {
 
 struct Board {
+  // Declaration order is destruction order reversed: what others refer to comes first (the
+  // simulated parts and the clock outlive the source and the bus, whose destructor flushes a
+  // candump file with clock time).
+  std::shared_ptr<void> keep_alive;  // objects the parts below refer to
+  std::unique_ptr<hal::Clock> clock;
   std::unique_ptr<SampleSource> source;
   std::unique_ptr<hal::CanBus> bus;
   std::unique_ptr<EpochSink> sink;
-  std::unique_ptr<CommandCodec> codec;  // null: commands not handled
-  std::unique_ptr<hal::Clock> clock;
+  std::unique_ptr<CommandCodec> codec;                 // null: commands not handled
   std::unique_ptr<hal::Watchdog> watchdog;             // null: none
   calib_file::CalibrationData defaults;                // nominal calibration of this board
   std::optional<calib_file::CalibrationData> factory;  // used when no file is configured
@@ -31,7 +35,6 @@ struct Board {
     return std::string();
   };
   std::function<void()> close = [] {};
-  std::shared_ptr<void> keep_alive;  // objects the parts above refer to
 };
 
 struct BoardResult {

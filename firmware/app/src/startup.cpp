@@ -73,7 +73,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
   std::string why;
   if (c.calibration_file.empty() && factory != nullptr) {
     out.set.config = pipeline_config(c, *factory);
-    out.set.cal_id = calibration_id(*factory);
+    out.set.cal_id = calib_file::cal_id_of(*factory);
     out.set.calibrated = true;
     out.from_file = true;  // a real calibration, not the flagged defaults
     out.message = "factory calibration of the board (" + factory->source + ")";
@@ -85,7 +85,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
     if (loaded.is_ok()) {
       out.set.config = pipeline_config(c, loaded.value());
-      out.set.cal_id = calibration_id(loaded.value());
+      out.set.cal_id = calib_file::cal_id_of(loaded.value());
       out.set.calibrated = true;
       out.from_file = true;
       char id[16];
@@ -118,7 +118,7 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());
-    s.cal_id = calibration_id(loaded.value());
+    s.cal_id = calib_file::cal_id_of(loaded.value());
     s.calibrated = true;
     return s;
   };

@@ -44,12 +44,21 @@ if [ "$WANT_FW" = 1 ]; then
     pass "fw-installed: $(dpkg-query -W -f='${Package} ${Version} ${Architecture}' gfins-fw)"
     id gfins >/dev/null 2>&1 && pass "fw-user: $(id gfins)" || fail "fw-user: no user gfins"
     active() { [ "$(prop gfins-fw ActiveState)" = active ]; }
-    if wait_for 60 active; then
+    # active, or failed for good (StartLimitBurst reached): no point waiting longer.
+    settled() { active || [ "$(prop gfins-fw ActiveState)" = failed ]; }
+    wait_for 60 settled
+    if active; then
       pass "fw-active: Type=notify service reached active (READY=1); status '$(prop gfins-fw StatusText)'"
     else
       fail "fw-active: state $(prop gfins-fw ActiveState)/$(prop gfins-fw SubState) after 60 s"
-      journalctl -u gfins-fw --no-pager | tail -n 30 | sed 's/^/VBOARD-LOG fw: /'
+      journalctl -u gfins-fw --no-pager | grep -E 'critical|error|Failed' | tail -n 8 | sed 's/^/VBOARD-LOG fw: /' | tee -a $out
     fi
+    if ! active; then
+      # Nothing below can happen without a running service: say so instead of waiting.
+      for c in fw-runs-as-gfins fw-frames fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
+        fail "$c: not reached, gfins-fw.service is $(prop gfins-fw ActiveState) (NRestarts $(prop gfins-fw NRestarts))"
+      done
+    else
     pid=$(prop gfins-fw MainPID)
     user=$(ps -o user= -p "$pid" 2>/dev/null | tr -d ' ')
     [ "$user" = gfins ] && pass "fw-runs-as-gfins: MainPID $pid runs as $user" ||
@@ -75,6 +84,7 @@ if [ "$WANT_FW" = 1 ]; then
     frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
     [ "$frames" -eq 20 ] && pass "fw-frames-after-restart: frames on vcan0 again" ||
       fail "fw-frames-after-restart: $frames of 20 frames within 5 s"
+    fi
   fi
 fi
 

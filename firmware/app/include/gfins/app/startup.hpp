@@ -13,9 +13,8 @@
 
 namespace gfins::app {
 
-/// 32-bit calibration identity published on CAN: the file's FNV-1a 64 checksum folded to 32
-/// bits (high XOR low). 0 is reserved for "uncalibrated defaults" (a file folding to 0 is
-/// published as 1).
+/// The calibration identity published on CAN: calib_file::cal_id_of() (the one the calibration
+/// tool prints); 0 is reserved for "uncalibrated defaults".
 std::uint32_t calibration_id(const calib_file::CalibrationData& d);
 
 /// Pipeline configuration from the firmware configuration and a calibration.
