@@ -421,7 +421,7 @@ Status HilClient::receive(std::int64_t timeout_ns, std::vector<hil::Frame>& out)
   if (!wait_fd(fd_, POLLIN, now_ns() + timeout_ns)) {
     return Status(ErrorCode::kTimeout, "hil: nothing from the board");
   }
-  std::array<std::uint8_t, 65536> buf;
+  std::array<std::uint8_t, 65536> buf{};
   const ssize_t n = ::recv(fd_, buf.data(), buf.size(), 0);
   if (n < 0) {
     if (errno == EINTR || errno == EAGAIN) return Status::ok();

@@ -102,6 +102,7 @@ struct Comparison {
 void compare_epoch(const DecodedEpoch& e, const nav::NavState<float>& n, Comparison& c,
                    std::ostream& out) {
   const auto& cols = columns();
+  const auto d = [](float v) { return static_cast<double>(v); };
   const double qsign = n.q_nb.w() < 0 ? -1.0 : 1.0;
   const auto eul = euler_zyx(n.q_nb);
   for (std::size_t i = 0; i < cols.size(); ++i) {
@@ -113,26 +114,26 @@ void compare_epoch(const DecodedEpoch& e, const nav::NavState<float>& n, Compari
         want = static_cast<double>(static_cast<std::uint32_t>(n.t_ns / 1000));
         break;
       case can::Field::kQuaternion:
-        want =
-            qsign * std::array<double, 4>{n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()}[s.index];
+        want = qsign * std::array<double, 4>{d(n.q_nb.w()), d(n.q_nb.x()), d(n.q_nb.y()),
+                                             d(n.q_nb.z())}[s.index];
         break;
       case can::Field::kEuler:
         want = eul[s.index];
         break;
       case can::Field::kRate:
-        want = n.w_b[s.index];
+        want = d(n.w_b[s.index]);
         break;
       case can::Field::kAngularAccel:
-        want = n.wdot_b[s.index];
+        want = d(n.wdot_b[s.index]);
         break;
       case can::Field::kAccel:
-        want = n.f_b[s.index];
+        want = d(n.f_b[s.index]);
         break;
       case can::Field::kVelocity:
-        want = n.v_n[s.index];
+        want = d(n.v_n[s.index]);
         break;
       case can::Field::kPosition:
-        want = n.r_n[s.index];
+        want = d(n.r_n[s.index]);
         break;
       default:
         continue;  // mode, status and health: the loop's, not the core's
