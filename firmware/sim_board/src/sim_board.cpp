@@ -136,7 +136,7 @@ bool MemoryCanBus::inject_rx(const hal::CanFrame& f) {
 
 std::vector<hal::CanFrame> MemoryCanBus::sent() const {
   std::vector<hal::CanFrame> out;
-  const std::size_t n = std::min<std::uint64_t>(total_, ring_.size());
+  const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(total_, ring_.size()));
   out.reserve(n);
   const std::size_t start = total_ > ring_.size() ? head_ : 0;
   for (std::size_t i = 0; i < n; ++i) out.push_back(ring_[(start + i) % ring_.size()]);

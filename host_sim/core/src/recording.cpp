@@ -75,7 +75,8 @@ HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const 
   }
   return error_at(c.code, 0,
                   "sample " + std::to_string(s.seq) + ": count " +
-                      std::to_string(s.counts[c.found]) + " is not a 24-bit two's-complement code");
+                      std::to_string(s.counts[static_cast<std::size_t>(c.found)]) +
+                      " is not a 24-bit two's-complement code");
 }
 
 HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
@@ -252,9 +253,9 @@ HostResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
   } else {
     if (remaining == 0) return false;
     const std::uint64_t full = rpb * kRecordingRecordBytes + kRecordingCrcBytes;
-    n = remaining >= full
-            ? rpb
-            : (remaining - std::min(remaining, kRecordingCrcBytes)) / kRecordingRecordBytes;
+    n = remaining >= full ? rpb
+                          : (remaining - std::min<std::uint64_t>(remaining, kRecordingCrcBytes)) /
+                                kRecordingRecordBytes;
     if (remaining < full &&
         (n == 0 || n * kRecordingRecordBytes + kRecordingCrcBytes != remaining)) {
       const std::uint64_t at = pos_ + (remaining / kRecordingRecordBytes) * kRecordingRecordBytes;

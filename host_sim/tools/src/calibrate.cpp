@@ -235,9 +235,10 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
     std::uint64_t n_sat = 0;
     std::uint64_t n_crc = 0;
     for (std::uint64_t k = it.start_index; k < it.end_index && k < rec.saturated_mask.size(); ++k) {
-      sat = static_cast<std::uint8_t>(sat | rec.saturated_mask[k]);
-      n_sat += rec.saturated_mask[k] != 0 ? 1 : 0;
-      n_crc += rec.crc_error[k];
+      const auto i = static_cast<std::size_t>(k);  // < size(): fits size_t on 32-bit boards too
+      sat = static_cast<std::uint8_t>(sat | rec.saturated_mask[i]);
+      n_sat += rec.saturated_mask[i] != 0 ? 1 : 0;
+      n_crc += rec.crc_error[i];
     }
     const std::string where = "pose at " + span_text(it.start_index, it.end_index, options.rate_hz);
     if (sat != 0) {
