@@ -32,7 +32,7 @@ cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
-  can_publisher_no_malloc_check gfins-can
+  can_publisher_no_malloc_check gfins-can gfins_can_decode_bench
 
 step "host-release: hour-long runs (label long) and heap checks (label heap)"
 ctest --preset host-release -j "$jobs" -L 'long|heap' | tee "$log_dir/ctest-release.log"

@@ -7,7 +7,7 @@
 - a hostile file name (spaces, quotes, ';', newline, leading '-') is just a name;
 - --help lists the exit codes, --version prints the version;
 - csv/json/line/table views produce one record per epoch;
-- can-utils' log2asc converts a log frame for frame;
+- can-utils' log2asc converts a log frame for frame, and asc2log's output decodes again;
 - plot writes a PNG (when the build can start the plot script).
 """
 import argparse
@@ -119,6 +119,18 @@ def main():
               f'log2asc: {len(rx)} records for {len(data.splitlines())} lines')
         check(rx and rx[0].split()[-8:] == ['40', '4B', '4C', '00', '00', '00', '02', '0A'],
               'log2asc: first frame data differ')
+
+        # ... and what can-utils writes is read back: asc2log turns the ASC into candump lines
+        # (with the trailing direction flag " R"); gfins-can decodes the same 10 clean epochs.
+        asc2log = shutil.which('asc2log')
+        check(asc2log is not None, 'asc2log (can-utils) not installed')
+        if asc2log:
+            back = run([asc2log], stdin=r.stdout)
+            check(back.stdout.decode().splitlines()[0].endswith('100#404B4C000000020A R'),
+                  'asc2log: unexpected first line')
+            d = run([exe, 'decode', '-', '--view', 'csv'], stdin=back.stdout)
+            check(d.returncode == 0 and len(d.stdout.decode().splitlines()) == 11,
+                  f'asc2log output: exit {d.returncode}, {d.stderr.decode()}')
 
     # plot
     png = os.path.join(a.workdir, 'plot.png')

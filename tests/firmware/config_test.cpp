@@ -102,7 +102,7 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[can]\nnode_id = 40\n", {"bad.toml:2", "can.node_id = 40", "0..15"}},
       {"[can]\nnode_id = \"1\"\n", {"can.node_id", "integer"}},
       {"[adc]\nsample_rate_hz = 1234\n", {"adc.sample_rate_hz = 1234", "500, 1000, 2000 or 4000"}},
-      {"[board]\nkind = \"arm\"\n", {"board.kind = \"arm\"", "\"linux\" or \"sim\""}},
+      {"[board]\nkind = \"arm\"\n", {"board.kind = \"arm\"", "\"linux\", \"sim\" or \"hil\""}},
       {"[navigation]\ncompensator = \"best\"\n", {"navigation.compensator", "\"paper\""}},
       {"[navigation]\nposition_m = [1, 2]\n", {"navigation.position_m", "3 numbers"}},
       {"[navigation]\nlatitude_deg = 91\n", {"navigation.latitude_deg = 91", "-90..90"}},

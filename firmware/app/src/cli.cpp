@@ -27,7 +27,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       "publishes on CAN; --sim runs the same program on the simulated board.",
       "gfins-fw"};
   std::string config_file, board, spi, chip, line, can_if, can_log, compensator, calib, gravity,
-      watchdog, wd_device, level, scenario, scenario_dir, pacing;
+      watchdog, wd_device, level, scenario, scenario_dir, pacing, hil_address, hil_port_file;
+  int hil_port = 0;
   double rate = 0, g = 0, lat = 0, height = 0, heading = 0, align = 0, duration = 0;
   std::vector<double> position;
   std::vector<std::string> dividers;
@@ -40,7 +41,11 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                                "run on the simulated board with this scenario (name or .toml; "
                                "sets board.kind = \"sim\" and sim.scenario)");
   auto* o_board =
-      app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim"}));
+      app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim", "hil"}));
+  auto* o_hil_addr = app.add_option("--hil-address", hil_address, "hil.address");
+  auto* o_hil_port = app.add_option("--hil-port", hil_port, "hil.port (0: ephemeral)")
+                         ->check(CLI::Range(0, 65535));
+  auto* o_hil_file = app.add_option("--hil-port-file", hil_port_file, "hil.port_file");
   auto* o_spi = app.add_option("--spi-device", spi, "adc.spi_device");
   auto* o_chip = app.add_option("--gpio-chip", chip, "adc.gpio_chip");
   auto* o_line = app.add_option("--drdy-line", line, "adc.drdy_line (offset or name)");
@@ -107,7 +112,13 @@ CliResult parse_command_line(int argc, const char* const* argv) {
     out.config_source = config_file;
   }
 
-  if (o_board->count()) c.board = board == "sim" ? BoardKind::kSim : BoardKind::kLinux;
+  if (o_board->count()) {
+    c.board =
+        board == "sim" ? BoardKind::kSim : (board == "hil" ? BoardKind::kHil : BoardKind::kLinux);
+  }
+  if (o_hil_addr->count()) c.hil_address = hil_address;
+  if (o_hil_port->count()) c.hil_port = hil_port;
+  if (o_hil_file->count()) c.hil_port_file = hil_port_file;
   if (o_sim->count()) {
     c.board = BoardKind::kSim;
     c.sim_scenario = scenario;

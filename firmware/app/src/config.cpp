@@ -164,11 +164,11 @@ class Reader {
 
 void read_all(Reader& r, FwConfig& c) {
   for (const char* t : {"board", "adc", "can", "output", "navigation", "calibration", "realtime",
-                        "watchdog", "log", "sim"}) {
+                        "watchdog", "log", "sim", "hil"}) {
     r.table(t);
   }
-  r.choice("board.kind", c.board, std::array<const char*, 2>{"linux", "sim"},
-           std::array<BoardKind, 2>{BoardKind::kLinux, BoardKind::kSim});
+  r.choice("board.kind", c.board, std::array<const char*, 3>{"linux", "sim", "hil"},
+           std::array<BoardKind, 3>{BoardKind::kLinux, BoardKind::kSim, BoardKind::kHil});
   r.text("adc.spi_device", c.spi_device);
   r.text("adc.gpio_chip", c.gpio_chip);
   r.line("adc.drdy_line", c.drdy_line);
@@ -209,6 +209,9 @@ void read_all(Reader& r, FwConfig& c) {
   r.choice("sim.pacing", c.pacing, std::array<const char*, 2>{"fast", "realtime"},
            std::array<Pacing, 2>{Pacing::kFast, Pacing::kRealTime});
   r.number("sim.duration_s", c.sim_duration_s);
+  r.text("hil.address", c.hil_address);
+  r.integer("hil.port", c.hil_port, 0, 65535);
+  r.text("hil.port_file", c.hil_port_file);
 }
 
 bool printable_path(const std::string& s) {
@@ -389,7 +392,9 @@ ConfigResult load_config(const std::string& path, FwConfig base) {
   return parse_config(text.str(), path, std::move(base));
 }
 
-const char* to_string(BoardKind b) { return b == BoardKind::kSim ? "sim" : "linux"; }
+const char* to_string(BoardKind b) {
+  return b == BoardKind::kSim ? "sim" : (b == BoardKind::kHil ? "hil" : "linux");
+}
 const char* to_string(Pacing p) { return p == Pacing::kRealTime ? "realtime" : "fast"; }
 const char* to_string(GravityChoice g) {
   switch (g) {

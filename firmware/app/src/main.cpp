@@ -90,7 +90,7 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
       static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),
       st.r_n.y(), st.r_n.z());
   // Latency and CPU use mean something only against the wall clock (not in fast pacing).
-  if (loop->latency().count() > 0 &&
+  if (loop->latency().count() > 0 && cfg.board != BoardKind::kHil &&
       !(cfg.board == BoardKind::kSim && cfg.pacing == Pacing::kFast)) {
     spdlog::info("latency edge → CAN: p50 {} µs, p99 {} µs, max {:.1f} µs over {} epochs",
                  loop->latency().quantile_us(0.5), loop->latency().quantile_us(0.99),

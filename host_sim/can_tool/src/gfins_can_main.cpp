@@ -20,6 +20,11 @@
 #include "generate.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
+#if GFINS_CAN_HAVE_HIL
+#include <iostream>
+
+#include "hil.hpp"
+#endif
 
 #ifndef GFINS_VERSION
 #define GFINS_VERSION "0.0.0"
@@ -329,6 +334,38 @@ int main_impl(int argc, char** argv) {
   capture->add_option("--samples", samples, "N samples")->required()->check(CLI::Range(1, 65535));
   auto* reload = cmd->add_subcommand("reload", "reload the calibration file");
 
+#if GFINS_CAN_HAVE_HIL
+  HilOptions ho;
+  auto* hil = app.add_subcommand(
+      "hil",
+      "hardware-in-the-loop replay: stream samples to gfins-fw --board hil, compare its "
+      "frames with a host-only core run (docs/hil.md)");
+  hil->add_option("--address", ho.address, "the board's IPv4 address")->capture_default_str();
+  hil->add_option("--port", ho.port, "the board's replay port")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  auto* hil_src = hil->add_option_group("source");
+  hil_src->add_option("--scenario", ho.scenario, "synthetic stream: a scenario name or .toml");
+  hil_src->add_option("--recording", ho.recording, "recorded stream: a .gfr file");
+  hil_src->require_option(1);
+  hil->add_option("--scenario-dir", ho.scenario_dir, "folder of the named scenarios");
+  hil->add_option("--duration", ho.duration_s, "scenario: seconds to replay (0 = its duration)")
+      ->check(CLI::Range(0.0, 86400.0));
+  hil->add_option("--fw-config", ho.fw_config,
+                  "the firmware's configuration file (calibration, dividers, heading)");
+  hil->add_option("--window", ho.window, "samples in flight before an acknowledgement")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  hil->add_option("--timeout-ms", ho.timeout_ms, "longest silence of the board")
+      ->check(CLI::Range(1, 600000))
+      ->capture_default_str();
+  hil->add_option("--abort-after", ho.abort_after,
+                  "test: reset the connection after sending N samples")
+      ->check(CLI::NonNegativeNumber);
+  hil->add_option("--corrupt-at", ho.corrupt_at, "test: send sample N with a corrupted CRC")
+      ->check(CLI::NonNegativeNumber);
+#endif
+
   std::uint8_t dbc_node = 0;
   std::string dbc_out;
   auto* dbc = app.add_subcommand("dbc", "print the DBC generated from the message table");
@@ -343,6 +380,9 @@ int main_impl(int argc, char** argv) {
   }
 
   if (dec->parsed()) return run_decode(d);
+#if GFINS_CAN_HAVE_HIL
+  if (hil->parsed()) return run_hil(ho, std::cout, std::cerr);
+#endif
   if (plot->parsed()) return run_plot(plot_log, plot_png, plot_node, plot_script);
   if (dbc->parsed()) {
     std::FILE* out = open_output(dbc_out);

@@ -15,8 +15,8 @@
 
 namespace gfins::app {
 
-enum class BoardKind : std::uint8_t { kLinux, kSim };
-enum class Pacing : std::uint8_t { kFast, kRealTime };  // simulated board only
+enum class BoardKind : std::uint8_t { kLinux, kSim, kHil };  // kHil: docs/hil.md
+enum class Pacing : std::uint8_t { kFast, kRealTime };       // simulated board only
 enum class GravityChoice : std::uint8_t { kStandard, kConstant, kNormal };
 enum class WatchdogKind : std::uint8_t { kNone, kSystemd, kDevice };
 /// "calibration" = the compensator the calibration file names.
@@ -89,6 +89,11 @@ struct FwConfig {
   std::string sim_scenario_dir;  // empty: the installed scenarios next to the binary
   Pacing pacing = Pacing::kFast;
   double sim_duration_s = 0.0;  // 0 = the scenario's duration
+
+  // [hil] hardware-in-the-loop replay (docs/hil.md): samples arrive over TCP from gfins-can hil
+  std::string hil_address = "127.0.0.1";  // IPv4 address to listen on
+  int hil_port = 7476;                    // 0: an ephemeral port (written to hil_port_file)
+  std::string hil_port_file;              // non-empty: the bound port is written here
 };
 
 /// Outcome of loading: the configuration, or the first problem.
