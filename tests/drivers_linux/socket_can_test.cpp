@@ -375,6 +375,31 @@ TEST(SocketCanReceive, ADataFrameIsReturnedWithItsIdFormatAndBytes) {
   EXPECT_EQ(bus->error_counters().tx_timeouts, 1u);
 }
 
+// A burst longer than the backend's queue is not cut short: frames beyond kRxQueue stay in the
+// kernel's socket buffer until the caller collects (the virtual board's 200-frame burst lost
+// frames 64..127 before this).
+TEST(SocketCanReceive, ABurstLongerThanTheQueueArrivesWholeAndInOrder) {
+  FakeCanKernel k;
+  auto bus = open_on(k);
+  constexpr std::uint32_t kBurst = 3 * SocketCan::kRxQueue + 7;
+  for (std::uint32_t i = 0; i < kBurst; ++i) {
+    can_frame f{};
+    f.can_id = i & CAN_SFF_MASK;
+    f.len = 1;
+    f.data[0] = static_cast<std::uint8_t>(i);
+    k.rx.push_back(f);
+  }
+  bus->service();  // fills the queue, leaves the rest in the (fake) kernel
+  for (std::uint32_t i = 0; i < kBurst; ++i) {
+    const auto r = bus->receive(0);
+    ASSERT_TRUE(r.is_ok()) << "frame " << i << ": " << r.status().message();
+    EXPECT_EQ(r->id, i & CAN_SFF_MASK);
+    EXPECT_EQ(r->data[0], static_cast<std::uint8_t>(i));
+  }
+  EXPECT_EQ(bus->counters().rx_frames, kBurst);
+  EXPECT_EQ(bus->counters().rx_dropped, 0u);
+}
+
 TEST(SocketCanReceive, ANoFrameWaitPollsWithTheRemainingTimeThenTimesOut) {
   FakeCanKernel k;
   auto bus = open_on(k);

@@ -268,6 +268,9 @@ void SocketCan::handle_error_frame(std::uint32_t can_id, const std::array<std::u
 
 void SocketCan::drain_rx() {
   for (int i = 0; i < kMaxReadsPerDrain && state_ != hal::CanBusState::kDown; ++i) {
+    // A full queue stops the drain: what is still in the socket stays in the kernel's buffer
+    // (which is much larger) until the caller has collected, instead of being dropped here.
+    if (rx_size_ == kRxQueue) return;
     can_frame raw{};
     const long n = os_.read(fd_, &raw, sizeof raw);
     if (n < 0) {
@@ -289,10 +292,6 @@ void SocketCan::drain_rx() {
       ++counters_.restarts;
     }
     ++counters_.rx_frames;
-    if (rx_size_ == kRxQueue) {
-      ++counters_.rx_dropped;  // the caller has not collected: oldest kept, newest dropped
-      continue;
-    }
     hal::CanFrame& f = rx_[(rx_head_ + rx_size_) % kRxQueue];
     f.extended = (raw.can_id & CAN_EFF_FLAG) != 0;
     f.id = raw.can_id & (f.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
