@@ -67,11 +67,12 @@ ctest --preset aarch64-linux -j "$jobs" | tee "$log_dir/ctest-aarch64-linux.log"
 step "Debian packages (amd64, arm64) and lintian"
 ./scripts/package.sh deb-amd64 aarch64-linux
 
-# infra (Debian's tools on vcan0 and the gpio-sim line) and service (systemd's notify and
-# watchdog in a debootstrap root) pass today; backend, fw and faults need programs that do not
+# infra (Debian's tools on vcan0 and the gpio-sim line), canlog (canplayer replays a firmware
+# candump log on vcan0, gfins-can decodes it live; needs the host-release build above) and
+# service (systemd's notify and watchdog in a debootstrap root) pass today; backend, fw and faults need programs that do not
 # pass or exist yet (docs/deploy.md, "What the VM test checks") and are added here as they do.
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
-./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,service}"
+./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,canlog,service}"
 
 step "clang-tidy"
 ./scripts/check-tidy.sh build/host-release

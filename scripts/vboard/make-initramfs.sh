@@ -3,7 +3,7 @@
 #   busybox (busybox-static) as the shell and core utilities, /init = scripts/vboard/init.sh,
 #   the kernel modules for CAN (can, can-raw, can-dev, vcan), configfs and the gpio-sim module,
 #   Debian's iproute2 `ip` (busybox's cannot create a vcan link), can-utils candump/cangen/
-#   cansend, the libgpiod tools, the drdy-toggle helper (built static here), the in-VM test
+#   cansend/canplayer, the libgpiod tools, the drdy-toggle helper (built static here), the in-VM test
 #   (vm-test.sh), and every program named with --bin (project binaries) or --file, each dynamic
 #   program with the shared libraries `ldd` lists, copied to the same paths.
 #
@@ -28,7 +28,7 @@ done
 [ -n "$out" ] || vb_die "make-initramfs.sh: -o OUT missing"
 
 vb_require /bin/busybox:busybox-static cpio:cpio gzip:gzip ldd:libc-bin gcc:gcc \
-  /usr/sbin/ip:iproute2 candump:can-utils cangen:can-utils cansend:can-utils \
+  /usr/sbin/ip:iproute2 candump:can-utils cangen:can-utils cansend:can-utils canplayer:can-utils \
   gpiodetect:gpiod gpioinfo:gpiod gpiomon:gpiod gpioset:gpiod gpioget:gpiod
 file /bin/busybox | grep -q 'statically linked' ||
   vb_die "/bin/busybox is not the static one: install Debian package 'busybox-static'"
@@ -96,7 +96,7 @@ copy_with_libs() {
   fi
 }
 copy_with_libs /usr/sbin/ip /usr/sbin/ip
-for p in candump cangen cansend gpiodetect gpioinfo gpiomon gpioset gpioget; do
+for p in candump cangen cansend canplayer gpiodetect gpioinfo gpiomon gpioset gpioget; do
   copy_with_libs "$(command -v "$p")" "/usr/bin/$p"
 done
 

@@ -3,7 +3,7 @@
 # data-ready line and the project's programs, runs the in-VM test (vm-test.sh) and turns the
 # console into a pass/fail and an exit status (0 = every check passed).
 #
-#   scripts/vboard/run.sh [--stages infra,backend,fw,faults,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
+#   scripts/vboard/run.sh [--stages infra,backend,fw,faults,canlog,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
 #                         [--build-dir DIR] [--smp N] [--icount SHIFT|off] [--service-icount SHIFT|off]
 #
 # Every step is idempotent and cached under .cache/vboard (see common.sh): the first run
@@ -13,7 +13,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 
-stages=infra,backend,fw,faults,service
+stages=infra,backend,fw,faults,canlog,service
 rate=500
 timeout_s=600
 build_dir=$vboard_repo/build/host-release
@@ -48,16 +48,30 @@ vb_log "kernel $kver ready (+$(elapsed)s)"
 # Programs and files per stage; a missing one fails here, naming it.
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
 args=()
-for s in backend fw faults; do
+# Stage canlog replays a candump log written by the firmware's file sink on the host.
+if want canlog; then
+  fw=$build_dir/firmware/app/gfins-fw
+  [ -x "$fw" ] || vb_die "stage canlog: $fw not built (it writes the log canplayer replays)"
+  mkdir -p "$vboard_cache/canlog"
+  rm -f "$vboard_cache/canlog/fw-rest.log"
+  "$fw" --sim rest --calibration "" --duration 2 --can-log "$vboard_cache/canlog/fw-rest.log" \
+    >"$vboard_cache/canlog/fw-rest.out" 2>&1 ||
+    vb_die "stage canlog: gfins-fw --sim rest --can-log failed (see $vboard_cache/canlog/fw-rest.out)"
+  [ -s "$vboard_cache/canlog/fw-rest.log" ] || vb_die "stage canlog: gfins-fw wrote no log"
+fi
+for s in backend fw faults canlog; do
   want "$s" || continue
   stage_script=$here/stage-$s.sh
   [ -e "$stage_script" ] || vb_die "stage '$s' has no scripts/vboard/stage-$s.sh yet"
   args+=(--file "$stage_script:/vboard/stage-$s.sh")
-  # The stage script lists what it needs in "# needs: build:<path> | file:<host>:<vm>" lines.
+  # The stage script lists what it needs in "# needs: build:<path> | repo:<path>:<vm> |
+  # cache:<path>:<vm>" lines (paths in the build folder, the repository, the vboard cache).
   while read -r need; do
     case $need in
       build:*) args+=(--bin "$build_dir/${need#build:}") ;;
       repo:*) spec=${need#repo:}; args+=(--file "$vboard_repo/${spec%%:*}:${spec#*:}") ;;
+      cache:*) spec=${need#cache:}; args+=(--file "$vboard_cache/${spec%%:*}:${spec#*:}") ;;
+      *) vb_die "$stage_script: unknown need '$need'" ;;
     esac
   done < <(sed -n 's/^# needs: //p' "$stage_script")
 done
