@@ -10,12 +10,12 @@ mapfile -t files < <(git ls-files 'nav_core/*.cpp' 'hal/*.cpp' 'drivers/*.cpp' '
 [ ${#files[@]} -gt 0 ] || { echo "check-tidy: nothing to check"; exit 0; }
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-set +o pipefail
+# A finding makes clang-tidy (and so xargs) exit non-zero: record it instead of letting set -e
+# end the script before the findings are printed.
+tidy_status=0
 printf '%s\n' "${files[@]}" |
   xargs -P "${GFINS_JOBS:-$(nproc)}" -n 1 clang-tidy -p "$build" --quiet \
-    --extra-arg=-Wno-unknown-warning-option >"$log" 2>&1
-tidy_status=$?
-set -o pipefail
+    --extra-arg=-Wno-unknown-warning-option >"$log" 2>&1 || tidy_status=$?
 { grep -v -E '^[0-9]+ warnings? generated|^Suppressed|^Use -header-filter' "$log" || true; }
 if [ "$tidy_status" -ne 0 ] || grep -q -E 'error:|warning:' "$log"; then
   echo "check-tidy: findings above (clang-tidy exit status $tidy_status)" >&2

@@ -3,13 +3,12 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>  // environ (the caller's environment, handed to the child unchanged)
 
 #include <cerrno>
 #include <cstring>
 #include <utility>
 #include <vector>
-
-extern char** environ;  // POSIX: the caller's environment, handed to the child unchanged
 
 namespace gfins::drivers::lnx {
 namespace {

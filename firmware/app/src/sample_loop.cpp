@@ -12,8 +12,6 @@ namespace {
 // the counter so nothing is lost from the record, only from the log.
 constexpr std::uint32_t kLogEverySamples = 1000;
 
-constexpr std::int64_t kNsPerS = 1000000000;
-
 }  // namespace
 
 double LatencyHistogram::quantile_us(double q) const {

@@ -13,7 +13,7 @@ namespace gfins::hal {
 class ParameterStore {
  public:
   /// Largest blob a store must hold (a calibration file is a few kB of TOML).
-  static constexpr std::size_t kMaxBytes = 64 * 1024;
+  static constexpr std::size_t kMaxBytes = std::size_t{64} * 1024;
 
   virtual ~ParameterStore() = default;
 

@@ -76,12 +76,15 @@ using HostStatus = HostResult<Done>;
 /// `GFINS_TRY(decl, expr);`: evaluates expr (a HostResult); on error returns the error from the
 /// enclosing function (whose return type must be constructible from HostError), else declares
 /// `decl` from the value.
+// `decl` is a declaration (`auto x`), which parentheses would break.
+// NOLINTBEGIN(bugprone-macro-parentheses)
 #define GFINS_TRY(decl, expr)                                              \
   auto GFINS_TRY_CONCAT(gfins_try_, __LINE__) = (expr);                    \
   if (!GFINS_TRY_CONCAT(gfins_try_, __LINE__).is_ok()) {                   \
     return std::move(GFINS_TRY_CONCAT(gfins_try_, __LINE__)).take_error(); \
   }                                                                        \
   decl = std::move(GFINS_TRY_CONCAT(gfins_try_, __LINE__)).value()
+// NOLINTEND(bugprone-macro-parentheses)
 
 /// `GFINS_TRY_STATUS(expr);`: the same for a result whose value is not needed.
 #define GFINS_TRY_STATUS(expr)                          \
