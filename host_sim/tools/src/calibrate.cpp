@@ -541,7 +541,7 @@ FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
   if (poses) {
     for (const Pose& p : *poses) pose_of[p.attitude] = p.f_b_g;
   }
-  const auto theta_of = [&cal](const calib_file::CalibrationData& d) {
+  const auto theta_of = [](const calib_file::CalibrationData& d) {
     return nav::misaligned_geometry(calib_file::nominal_geometry<double>(d),
                                     calib_file::misalignment<double>(d))
         .theta_b;

@@ -52,14 +52,20 @@ FileStatus check_header(const CsvTable& t, const std::vector<std::string>& requi
     bool known = false;
     for (const std::string& a : accepted) known = known || a == h;
     if (!known) {
-      return bad(t.file + ": header column '" + h + "' is not a known column; " + names +
-                 "; found: " + join(t.header));
+      std::string msg = t.file + ": header column '" + h + "' is not a known column; ";
+      msg += names;
+      msg += "; found: ";
+      msg += join(t.header);
+      return bad(msg);
     }
   }
   for (const std::string& r : required) {
     if (t.column(r) < 0) {
-      return bad(t.file + ": the header has no column '" + r + "'; " + names +
-                 "; found: " + join(t.header));
+      std::string msg = t.file + ": the header has no column '" + r + "'; ";
+      msg += names;
+      msg += "; found: ";
+      msg += join(t.header);
+      return bad(msg);
     }
   }
   return FileStatus::ok();
