@@ -14,6 +14,7 @@
 
 #include "calib_file/calib_test_data.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "support/run_cli.hpp"
 
 namespace gfins::calib_file {
 namespace {
@@ -36,20 +37,11 @@ constexpr double kRoutesAgreeTol = 1e-9;
 const std::string kGolden = std::string(GFINS_TEST_DATA_DIR) + "/paper_tables_4_5.csv";
 constexpr const char* kAdcLsb = "1.430511474609375e-07";  // 1.2 V / 2^23
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
+using RunResult = test::CliResult;
 
+// The tool runs without a shell (tests/support/run_cli.hpp).
 RunResult run_cli(const TempDir& dir, const std::string& args) {
-  const auto log = dir.path() / "cli.log";
-  const std::string cmd =
-      std::string(GFINS_CALIBRATE_EXE) + " " + args + " > " + log.string() + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.output = read_text(log);
-  return r;
+  return test::run_tool(GFINS_CALIBRATE_EXE, args, dir.path());
 }
 
 TEST(CalibrateCli, PaperTablesGiveAFileCarryingTable6) {
@@ -263,7 +255,9 @@ TEST(CalibrateCli, SettingsAreCheckedBeforeSolvingWithReadableBounds) {
   const TempDir dir;
   const std::string out = " -o " + (dir.path() / "c.toml").string();
   const std::string base = "--means " + kGolden + " --latitude 24.8" + out;
-  RunResult r = run_cli(dir, base + " --device-id 'a b' --adc-lsb 1e-7");
+  std::vector<std::string> args = test::split_at_spaces(base);
+  args.insert(args.end(), {"--device-id", "a b", "--adc-lsb", "1e-7"});
+  RunResult r = test::run_tool(GFINS_CALIBRATE_EXE, args, dir.path());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.output, HasSubstr("--device-id (device_id): \"a b\" is not 1 to 64 characters"));
   EXPECT_THAT(r.output, Not(HasSubstr("verdict")));  // nothing was solved

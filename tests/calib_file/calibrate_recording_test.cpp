@@ -15,6 +15,7 @@
 #include "calib_file/calib_test_data.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/host_sim/recording.hpp"
+#include "support/run_cli.hpp"
 
 namespace gfins::calib_file {
 namespace {
@@ -30,20 +31,11 @@ constexpr double kRateHz = 100.0;
 constexpr double kNoiseV = 1e-4;          // per sample
 constexpr double kLsb = 5.0 / 8388608.0;  // ±5 V over 24 bits
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;
-};
+using RunResult = test::CliResult;
 
+// The tool runs without a shell (tests/support/run_cli.hpp).
 RunResult run_cli(const TempDir& dir, const std::string& args) {
-  const auto log = dir.path() / "cli.log";
-  const std::string cmd =
-      std::string(GFINS_CALIBRATE_EXE) + " " + args + " > " + log.string() + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.output = read_text(log);
-  return r;
+  return test::run_tool(GFINS_CALIBRATE_EXE, args, dir.path());
 }
 
 // A board obeying eq. (16) with Table 6 as truth, recorded through a 24-bit ADC: each pose of
