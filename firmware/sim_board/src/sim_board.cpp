@@ -193,21 +193,13 @@ class ScenarioStream final : public SensorStream {
     return {v(0), v(1), v(2), v(3), v(4), v(5)};
   }
 
-  /// The scenario's sensors as the host's scenario runner builds them: through a converter they
-  /// have the QA-1100's scale factor (1.33 V/g into 1 kΩ), plus the scenario's errors.
+  /// The scenario's sensors as the host's scenario runner builds them (sim::array_errors). The
+  /// simulated board always has its converter, so a scenario written without one (the paper's
+  /// §6.3) still gets the QA-1100 scale factor here.
   static sim::ArrayErrors errors(const sim::Scenario& s) {
-    sim::ArrayErrors e;
-    e.misalignment = s.misalignment;
-    e.temperature_c = s.temperature_c;
-    const double qa1100_sf = sim::AccelErrors::qa1100_typical().scale_v_per_g;
-    for (std::size_t j = 0; j < 6; ++j) {
-      sim::AccelErrors& a = e.sensors[j];
-      if (s.qa1100) a = sim::AccelErrors::qa1100_typical();
-      a.scale_v_per_g = qa1100_sf;
-      a.bias_g += s.bias_mps2[j] / nav::kStandardGravity;
-      if (s.noise_mps2 > 0 || !s.qa1100) {
-        a.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / nav::kStandardGravity;
-      }
+    sim::ArrayErrors e = sim::array_errors(s);
+    if (!s.adc) {
+      for (auto& a : e.sensors) a.scale_v_per_g = sim::AccelErrors::qa1100_typical().scale_v_per_g;
     }
     return e;
   }

@@ -27,26 +27,6 @@ struct Stream {
   std::array<double, 6> scale_v_per_g{};  // nominal SF of each sensor, what the front end is told
 };
 
-ArrayErrors array_errors(const Scenario& s) {
-  ArrayErrors errors;
-  errors.misalignment = s.misalignment;
-  errors.temperature_c = s.temperature_c;
-  const double g = nav::kStandardGravity;
-  const double qa1100_sf = AccelErrors::qa1100_typical().scale_v_per_g;
-  for (std::size_t j = 0; j < 6; ++j) {
-    AccelErrors& e = errors.sensors[j];
-    if (s.qa1100) e = AccelErrors::qa1100_typical();
-    // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
-    // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
-    // out).
-    if (s.adc) e.scale_v_per_g = qa1100_sf;
-    e.bias_g += s.bias_mps2[j] / g;
-    // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
-    if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
-  }
-  return errors;
-}
-
 HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
   const ArrayErrors errors = array_errors(s);
   SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
@@ -175,6 +155,26 @@ std::string source_name(MisalignmentSource m) {
 }
 
 }  // namespace
+
+ArrayErrors array_errors(const Scenario& s) {
+  ArrayErrors errors;
+  errors.misalignment = s.misalignment;
+  errors.temperature_c = s.temperature_c;
+  const double g = nav::kStandardGravity;
+  const double qa1100_sf = AccelErrors::qa1100_typical().scale_v_per_g;
+  for (std::size_t j = 0; j < 6; ++j) {
+    AccelErrors& e = errors.sensors[j];
+    if (s.qa1100) e = AccelErrors::qa1100_typical();
+    // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
+    // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
+    // out).
+    if (s.adc) e.scale_v_per_g = qa1100_sf;
+    e.bias_g += s.bias_mps2[j] / g;
+    // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
+    if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
+  }
+  return errors;
+}
 
 Vec3d SampleRecord::att_err_b() const {
   Quatd dq = truth.q_nb.conjugate() * q_nb_est;

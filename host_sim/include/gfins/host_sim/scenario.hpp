@@ -18,6 +18,7 @@
 
 #include "gfins/host_sim/error.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/calibration/multi_attitude.hpp"
 #include "gfins/nav_core/compensator.hpp"
@@ -194,6 +195,11 @@ using ProgressFn = std::function<void(double)>;
 /// Simulates a multi-attitude calibration of the array of `s` (true misalignment and biases),
 /// with its CalibrationSpec and seed. Fails when the solver fails.
 HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s);
+
+/// The sensor errors of a scenario as the sample source's SensorArrayModel takes them: its
+/// misalignment and temperature, QA-1100 typical errors when asked, its biases and noise; behind
+/// a converter (`adc`, every scenario but the paper's §6.3) the QA-1100 scale factor.
+ArrayErrors array_errors(const Scenario& s);
 
 /// Scalar of the navigation core a run uses: float is the board's, double the host reference.
 enum class NavScalar : std::uint8_t { kFloat, kDouble };
