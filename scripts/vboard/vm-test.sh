@@ -67,9 +67,10 @@ if want infra; then
   check gpiodetect "gpiodetect lists $gpiochip" sh -c "gpiodetect | grep -q '^$gpiochip '"
   check gpioinfo-name "gpioinfo names line 0 adc-drdy" sh -c "gpioinfo $gpiochip | grep -q '\"adc-drdy\"'"
 
-  # Edges at the nominal rate: gpiomon must see every one, spaced one period apart.
+  # Data-ready edges (falling: the ADS131M06's DRDY is active low) at the nominal rate: gpiomon
+# must see every one, spaced one period apart.
   n=$((rate * 4))
-  gpiomon --rising-edge --num-events=$n --format='%s %n' $gpiochip 0 >/tmp/infra-gpiomon.log &
+  gpiomon --falling-edge --num-events=$n --format='%s %n' $gpiochip 0 >/tmp/infra-gpiomon.log &
   mon_pid=$!
   sleep 1
   drdy-toggle "$pull" "$rate" $n >/tmp/infra-toggle.log
@@ -90,7 +91,7 @@ if want infra; then
   measure gpiomon-max-gap-periods "$2"
   measure gpiomon-gaps-over-1.5-periods "$3"
   skipped=$(sed -n 's/.*skipped=\([0-9]*\).*/\1/p' /tmp/infra-toggle.log)
-  check gpiomon-edges "gpiomon saw $got of $n rising edges at $rate Hz (toggler skipped ${skipped:-?})" \
+  check gpiomon-edges "gpiomon saw $got of $n falling (data-ready) edges at $rate Hz (toggler skipped ${skipped:-?})" \
     [ "$got" -eq $n -a "${skipped:-1}" -eq 0 ]
 
   # The toggler alone at several rates: how often it is late (> 1/4 period) or stalls a period.
@@ -99,7 +100,7 @@ if want infra; then
   done
 
   # What the VM reaches at most (as fast as the sysfs writes go, gpiomon reading).
-  gpiomon --rising-edge --silent $gpiochip 0 &
+  gpiomon --falling-edge --silent $gpiochip 0 &
   mon_pid=$!
   sleep 1
   drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
