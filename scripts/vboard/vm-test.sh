@@ -4,7 +4,7 @@
 #   VBOARD-CHECK PASS|FAIL <name>: <what was measured>
 # and measurements print "VBOARD-MEASURE <name> <value>"; the last line is
 #   VBOARD-RESULT PASS|FAIL checks=N failed=F
-# Stages come from the kernel command line: vboard.stages=infra,backend,fw,faults,canlog (default all).
+# Stages come from the kernel command line: vboard.stages=infra,backend,fw,cmd,faults,canlog (default all).
 # A stage whose program is missing FAILS naming it: nothing is skipped silently.
 failed=0
 checks=0
@@ -19,7 +19,7 @@ measure() { echo "VBOARD-MEASURE $1 $2"; }
 param() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" /proc/cmdline; }
 
 stages=$(param vboard.stages)
-[ -n "$stages" ] || stages=infra,backend,fw,faults,canlog
+[ -n "$stages" ] || stages=infra,backend,fw,cmd,faults,canlog
 rate=$(param vboard.rate)
 [ -n "$rate" ] || rate=500
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
@@ -109,7 +109,7 @@ if want infra; then
   measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
 fi
 
-for s in backend fw faults canlog; do
+for s in backend fw cmd faults canlog; do
   want $s || continue
   if [ -e /vboard/stage-$s.sh ]; then
     . /vboard/stage-$s.sh
