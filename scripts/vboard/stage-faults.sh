@@ -37,25 +37,25 @@ drdy-toggle "$pull" "$rate" >/tmp/faults-toggle.log &
 toggle_pid=$!
 fw_start /tmp/faults-fw.log
 check faults-fw-start "gfins-fw runs on vcan0 with data-ready edges" [ $? -eq 0 ]
-sleep 2
-window baseline 3
-check faults-baseline "$w_epochs epochs in 3 s, $w_jumps counter jumps, flags $w_flags, missed $w_missed, dropped $w_dropped" \
+sleep 1
+window baseline 2
+check faults-baseline "$w_epochs epochs in 2 s, $w_jumps counter jumps, flags $w_flags, missed $w_missed, dropped $w_dropped" \
   [ "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 -a "$w_missed" -eq 0 -a "$w_dropped" -eq 0 ]
 
 ip link set down vcan0
 sleep 1
 ip link set up vcan0
-window vcan 3
+window vcan 2
 check faults-vcan-reported "after vcan0 down 1 s and up: CanTxDropped $w_dropped, status bit 11 (CAN frames dropped) $(bit $w_flags 11 && echo set || echo clear)" \
   [ "$w_dropped" -gt 0 ] && bit $w_flags 11
-check faults-vcan-recovered "alive $(fw_alive); $w_epochs epochs in 3 s after, $w_jumps counter jumps" \
+check faults-vcan-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $w_jumps counter jumps" \
   [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
 
 missed_before=$w_missed
 kill -STOP $toggle_pid
 sleep 1
 kill -CONT $toggle_pid
-window drdy 3
+window drdy 2
 # About rate x 1 s of edges lost; at least half of them (the stop lasts "sleep 1" of guest time).
 check faults-drdy-reported "after 1 s without edges: MissedEdges $missed_before -> $w_missed (>= $((rate / 2)) more), status bit 15 (data-ready lost) $(bit $w_flags 15 && echo set || echo clear)" \
   [ "$w_missed" -ge $((missed_before + rate / 2)) ] && bit $w_flags 15

@@ -13,7 +13,7 @@
 # needs: cache:fw/scenarios/vboard-rest.toml:/opt/share/gfins/scenarios/vboard-rest.toml
 # needs: cache:fw/ref.csv:/vboard/fw-ref.csv
 . /vboard/fw-common.sh
-fw_seconds=10
+fw_seconds=4
 edges=$((rate * fw_seconds))
 # The default epoch divider (docs/can-interface.md): one epoch per 10 samples, the first at
 # sample 0, so samples 0 .. edges-1 give ceil(edges / 10) epochs.

@@ -65,7 +65,7 @@ class FakeKernelGpio final : public lnx::GpiodApi {
   std::deque<std::vector<std::int64_t>> batches;
 };
 
-constexpr double kRateHz = 1000.0;        // the "rest" scenario's rate (host_sim/scenarios)
+constexpr double kRateHz = 1000.0;           // the "rest" scenario's rate (host_sim/scenarios)
 constexpr std::int64_t kPeriodNs = 1000000;  // 1 / kRateHz
 constexpr std::int64_t kT0Ns = 5000000000;   // an arbitrary CLOCK_MONOTONIC time of the 1st edge
 // Kernel timestamps jitter around the nominal period; 20 % of a period still rounds to the
@@ -108,10 +108,8 @@ TEST(SimGpioPacing, EachConversionTakesItsEdgesKernelTimeAndSequenceAndMissedEdg
 
   // Edges of conversions 0, 1, 2, then 3 lost (the next edge two periods later), 4, 5; the
   // second batch arrives at once, as the kernel queues them while the reader is busy.
-  const std::vector<std::int64_t> t = {kT0Ns,
-                                       kT0Ns + kPeriodNs + kJitterNs,
-                                       kT0Ns + 2 * kPeriodNs - kJitterNs,
-                                       kT0Ns + 4 * kPeriodNs,
+  const std::vector<std::int64_t> t = {kT0Ns, kT0Ns + kPeriodNs + kJitterNs,
+                                       kT0Ns + 2 * kPeriodNs - kJitterNs, kT0Ns + 4 * kPeriodNs,
                                        kT0Ns + 5 * kPeriodNs + kJitterNs};
   kernel.batches = {{t[0]}, {t[1], t[2]}, {t[3], t[4]}};
   const std::vector<std::uint32_t> expected_seq = {0, 1, 2, 4, 5};

@@ -55,19 +55,30 @@ if [ "$WANT_FW" = 1 ]; then
     fi
     if ! active; then
       # Nothing below can happen without a running service: say so instead of waiting.
-      for c in fw-runs-as-gfins fw-frames fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
+      for c in fw-runs-as-gfins fw-frames fw-watchdog-pings fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
         fail "$c: not reached, gfins-fw.service is $(prop gfins-fw ActiveState) (NRestarts $(prop gfins-fw NRestarts))"
       done
     else
     pid=$(prop gfins-fw MainPID)
-    user=$(ps -o user= -p "$pid" 2>/dev/null | tr -d ' ')
-    [ "$user" = gfins ] && pass "fw-runs-as-gfins: MainPID $pid runs as $user" ||
-      fail "fw-runs-as-gfins: MainPID $pid runs as '${user:-?}'"
+    # The real and effective uid from the kernel (the minimal root has no procps).
+    uids=$(sed -n 's/^Uid:[[:space:]]*\([0-9]*\)[[:space:]]*\([0-9]*\).*/\1 \2/p' "/proc/$pid/status")
+    want_uid=$(id -u gfins)
+    [ "$uids" = "$want_uid $want_uid" ] && pass "fw-runs-as-gfins: MainPID $pid runs as uid $want_uid (gfins)" ||
+      fail "fw-runs-as-gfins: MainPID $pid runs as uid(s) '${uids:-?}', gfins is $want_uid"
     policy=$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *//p' | head -n 1)
     say "VBOARD-INFO fw scheduling: $policy"
     frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
     [ "$frames" -eq 20 ] && pass "fw-frames: 20 frames on vcan0 from the service" ||
       fail "fw-frames: $frames of 20 frames on vcan0 within 5 s"
+    # The loop's WATCHDOG=1 pings: over more than WatchdogSec the service stays the same process.
+    wd_us=$(prop gfins-fw WatchdogUSec)
+    n0=$(prop gfins-fw NRestarts)
+    sleep 3
+    if [ "$(prop gfins-fw MainPID)" = "$pid" ] && [ "$(prop gfins-fw NRestarts)" = "$n0" ] && active; then
+      pass "fw-watchdog-pings: same PID $pid and NRestarts $n0 after 3 s > WatchdogSec ($wd_us)"
+    else
+      fail "fw-watchdog-pings: PID $pid -> $(prop gfins-fw MainPID), NRestarts $n0 -> $(prop gfins-fw NRestarts) within 3 s (WatchdogSec $wd_us)"
+    fi
 
     # A hung loop: stop the process; the watchdog must fire and systemd restart it.
     before=$(prop gfins-fw NRestarts)
