@@ -5,6 +5,7 @@
 #
 #   scripts/vboard/run.sh [--stages infra,backend,fw,cmd,faults,canlog,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
 #                         [--build-dir DIR] [--smp N] [--icount SHIFT|off] [--service-icount SHIFT|off]
+#                         [--measure]   (infra also measures the toggler alone at 250-4000 Hz and at full speed)
 #
 # Every step is idempotent and cached under .cache/vboard (see common.sh): the first run
 # installs the host packages, downloads the kernel, headers and source (about 220 MB) and builds
@@ -22,6 +23,7 @@ icount=0          # data-ready timing stages: guest time counts instructions (do
 service_icount=off  # systemd boot: icount's sleep=off would warp time over every 9p wait
 service_deb=""
 service_config=""
+measure=0
 while [ $# -gt 0 ]; do
   case $1 in
     --stages) stages=$2; shift 2 ;;
@@ -33,7 +35,8 @@ while [ $# -gt 0 ]; do
     --service-icount) service_icount=$2; shift 2 ;;
     --deb) service_deb=$2; shift 2 ;;
     --fw-config) service_config=$2; shift 2 ;;
-    -h | --help) sed -n '2,12p' "$0"; exit 0 ;;
+    --measure) measure=1; shift ;;
+    -h | --help) sed -n '2,13p' "$0"; exit 0 ;;
     *) vb_die "run.sh: unknown argument '$1' (try --help)" ;;
   esac
 done
@@ -156,7 +159,7 @@ verdict() {
 
 vm_stages=$(echo ",$stages," | sed 's/,service,/,/g; s/^,//; s/,$//')
 if [ -n "$vm_stages" ]; then
-  boot vm "vboard.stages=$vm_stages vboard.rate=$rate"
+  boot vm "vboard.stages=$vm_stages vboard.rate=$rate vboard.measure=$measure"
   verdict "$log" || overall=1
 fi
 

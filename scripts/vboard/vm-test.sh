@@ -48,6 +48,7 @@ echo "VBOARD-INFO gpio-sim chip=$gpiochip pull=$pull"
 
 # --- stage infra: the infrastructure checked with Debian's own tools ---------------------------
 if want infra; then
+  infra_t0=$(cut -d' ' -f1 /proc/uptime)
   n=200
   candump -L -n $n vcan0 >/tmp/infra-candump.log &
   dump_pid=$!
@@ -95,24 +96,32 @@ if want infra; then
     [ "$got" -eq $n -a "${skipped:-1}" -eq 0 ]
 
   # The toggler alone at several rates: how often it is late (> 1/4 period) or stalls a period.
-  for r in 250 500 1000 2000 4000; do
+  # About 12 s of guest time: only with run.sh --measure (vboard.measure=1), not in CI.
+  [ "$(param vboard.measure)" = 1 ] && for r in 250 500 1000 2000 4000; do
     measure toggle-alone-$r "$(drdy-toggle "$pull" $r $((r * 2)) | sed 's/drdy-toggle: //')"
   done
 
   # What the VM reaches at most (as fast as the sysfs writes go, gpiomon reading).
-  gpiomon --falling-edge --silent $gpiochip 0 &
-  mon_pid=$!
-  sleep 1
-  drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
-  kill $mon_pid 2>/dev/null
-  wait $mon_pid 2>/dev/null
-  measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
+  if [ "$(param vboard.measure)" = 1 ]; then
+    gpiomon --falling-edge --silent $gpiochip 0 &
+    mon_pid=$!
+    sleep 1
+    drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
+    kill $mon_pid 2>/dev/null
+    wait $mon_pid 2>/dev/null
+    measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
+  fi
+  measure stage-infra-guest-seconds "$(awk -v a="$infra_t0" -v b="$(cut -d' ' -f1 /proc/uptime)" 'BEGIN { printf "%.1f", b - a }')"
 fi
 
+uptime_s() { cut -d' ' -f1 /proc/uptime; }
 for s in backend fw cmd faults canlog; do
   want $s || continue
   if [ -e /vboard/stage-$s.sh ]; then
+    t0=$(uptime_s)
     . /vboard/stage-$s.sh
+    # Guest seconds per stage (icount: instructions / 1e9), for the CI cost figures.
+    measure stage-$s-guest-seconds "$(awk -v a="$t0" -v b="$(uptime_s)" 'BEGIN { printf "%.1f", b - a }')"
   else
     fail "stage-$s: its program is not in the image (see scripts/vboard/run.sh)"
   fi
