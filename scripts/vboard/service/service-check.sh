@@ -7,15 +7,18 @@ out=/var/log/vboard-result
 failed=0
 checks=0
 say() { echo "$*"; echo "$*" >>$out; }
-pass() { checks=$((checks + 1)); say "VBOARD-CHECK PASS $*"; }
-fail() { checks=$((checks + 1)); failed=$((failed + 1)); say "VBOARD-CHECK FAIL $*"; }
+up() { cut -d' ' -f1 /proc/uptime; }
+# Each check ends with the guest uptime it was decided at: where the stage's time goes.
+pass() { checks=$((checks + 1)); say "VBOARD-CHECK PASS $* [t=$(up)s]"; }
+fail() { checks=$((checks + 1)); failed=$((failed + 1)); say "VBOARD-CHECK FAIL $* [t=$(up)s]"; }
 prop() { systemctl show -p "$2" --value "$1"; }
-wait_for() { # wait_for SECONDS COMMAND...: poll every 0.2 s until the command succeeds
-  n=$(($1 * 5))
+wait_for() { # wait_for SECONDS COMMAND...: poll every 0.5 s until the command succeeds
+  # (each poll runs systemctl, which costs an emulated guest a good fraction of a second)
+  n=$(($1 * 2))
   shift
   while [ $n -gt 0 ]; do
     "$@" && return 0
-    sleep 0.2
+    sleep 0.5
     n=$((n - 1))
   done
   return 1
