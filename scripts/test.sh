@@ -52,6 +52,10 @@ fw_log="$log_dir/fw-rest.log"
 # while they run (docs/install.md); about 20 s.
 step "host-release: installed programs away from the trees (tests/install/install_test.sh)"
 ./tests/install/install_test.sh build/host-release
+# The README rows and docs blocks marked <!-- runnable -->, as written, after what bootstrap.sh
+# leaves (out/gfins installed); about 20 s.
+step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
+./tests/install/runnable_docs.py --build build/host-release
 
 step "cortex-m4f: bare-metal build of the navigation core and the soft-double check"
 cmake --preset cortex-m4f >/dev/null

@@ -25,7 +25,8 @@ class ScenarioLookupFs : public ::testing::Test {
  protected:
   void SetUp() override {
     std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("gfins-lookup-" + std::to_string(rd()) + std::to_string(rd()));
+    dir_ =
+        fs::temp_directory_path() / ("gfins-lookup-" + std::to_string(rd()) + std::to_string(rd()));
     fs::create_directories(dir_);
     old_cwd_ = fs::current_path();
   }
@@ -56,8 +57,8 @@ TEST(ScenarioLookup, PathOrNameByItsSpelling) {
 //   drvie -> drive 2 (two substitutions), spni -> spin 2, xyzzy -> every name > 2 and no
 //   containment; rest-calib is contained in rest-calibrated (5 edits) and contains rest (6).
 TEST(ScenarioLookup, ClosestNamesByEditDistance) {
-  const std::vector<std::string> names = {"coning", "drive", "drive-qa1100", "rest",
-                                          "rest-calibrated", "spin"};
+  const std::vector<std::string> names = {"coning", "drive",           "drive-qa1100",
+                                          "rest",   "rest-calibrated", "spin"};
   EXPECT_EQ(closest_names("drvie", names), std::vector<std::string>({"drive"}));
   EXPECT_EQ(closest_names("spni", names), std::vector<std::string>({"spin"}));
   EXPECT_TRUE(closest_names("xyzzy", names).empty());

@@ -100,8 +100,7 @@ HostResult<Scenario> load_scenario(const std::string& file_or_name) {
   if (is_scenario_path(file_or_name)) return load_file(file_or_name);
   const auto dir = builtin_scenario_dir();
   if (!dir.is_ok()) {
-    return HostError{dir.error().code,
-                     "scenario '" + file_or_name + "': " + dir.error().message};
+    return HostError{dir.error().code, "scenario '" + file_or_name + "': " + dir.error().message};
   }
   return load_scenario(file_or_name, dir.value());
 }
