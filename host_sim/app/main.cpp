@@ -29,14 +29,15 @@ int sim_main(int argc, char** argv) {
   app::DefaultOptions o;
   o.scalar = GFINS_NAV_SCALAR_DEFAULT;
   CLI::App cli{"gfins-sim: scenarios through the gyro-free navigation core"};
-  cli.footer(
+  const std::string footer =
       "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
       "scenario rejected; 3 CSV written but plotting failed (PNG asked for).\n"
       "A scenario argument with a '/' or ending in .toml is a file (./drive), otherwise a "
       "built-in name (gfins-sim list).\n"
       "Environment: GFINS_SCENARIO_DIR (built-in scenarios), GFINS_SCRIPTS_DIR (plot scripts; "
       "both default to ../share/gfins/ next to this program), GFINS_PYTHON (python3 with "
-      "matplotlib).");
+      "matplotlib).";
+  cli.footer(footer);
   cli.set_version_flag("--version", gfins::version::version_line("gfins-sim"));
   const auto scenario_dir = gfins::sim::builtin_scenario_dir();
   const std::vector<std::string> names = scenario_dir.is_ok()
@@ -98,6 +99,7 @@ int sim_main(int argc, char** argv) {
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
   }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
+  for (auto* c : {run_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
   cli.require_subcommand(0, 1);
   try {
     cli.parse(argc, argv);

@@ -74,6 +74,12 @@ for p in "${programs[@]}"; do
   done
 done
 
+# The oracle for --version: git's own description of the checkout (build and test run on the same
+# commit in scripts/test.sh; "-dirty" is left out because an edit after the build changes it).
+expected_rev=unknown
+if command -v git >/dev/null && rev=$(git -C "$src" describe --always --dirty 2>/dev/null); then
+  expected_rev=${rev%-dirty}
+fi
 # The oracle for `list`: the scenario files of the source tree, read before it goes away.
 expected_list=$(cd "$src/host_sim/scenarios" && ls -1 -- *.toml | sed 's/\.toml$//' | sort)
 
@@ -123,6 +129,9 @@ for p in "${programs[@]}"; do
   if expect 0 "$bin/$p" --version; then
     grep -q -E "^$p [0-9]+\.[0-9]+\.[0-9]+ \(git [^)]+\)$" "$log" ||
       fail "$p --version printed '$(cat "$log")', not '$p X.Y.Z (git REV)'"
+    got_rev=$(sed -n 's/.*(git \(.*\))$/\1/p' "$log")
+    [ "${got_rev%-dirty}" = "$expected_rev" ] ||
+      fail "$p --version: revision '$got_rev', git describe says '$expected_rev'"
   fi
   expect 0 "$bin/$p" --help && log_has "Exit codes" "$p --help"
 done
