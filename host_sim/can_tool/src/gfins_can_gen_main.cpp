@@ -30,7 +30,7 @@ constexpr const char* kUsage =
 int main(int argc, char** argv) {
   using namespace gfins::can_tool;
   if (argc < 2) {
-    std::fputs(kUsage, stderr);
+    (void)std::fputs(kUsage, stderr);  // the exit code says it either way
     return 1;
   }
   if (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
