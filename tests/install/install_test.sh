@@ -81,7 +81,7 @@ if command -v git >/dev/null && rev=$(git -C "$src" describe --always --dirty 2>
   expected_rev=${rev%-dirty}
 fi
 # The oracle for `list`: the scenario files of the source tree, read before it goes away.
-expected_list=$(cd "$src/host_sim/scenarios" && ls -1 -- *.toml | sed 's/\.toml$//' | sort)
+expected_list=$(for f in "$src"/host_sim/scenarios/*.toml; do basename "$f" .toml; done | sort)
 
 # --- 3. the trees go away --------------------------------------------------------------------
 case "$build/" in
@@ -131,7 +131,7 @@ for p in "${programs[@]}"; do
       fail "$p --version printed '$(cat "$log")', not '$p X.Y.Z (git REV)'"
     got_rev=$(sed -n 's/.*(git \(.*\))$/\1/p' "$log")
     [ "${got_rev%-dirty}" = "$expected_rev" ] ||
-      fail "$p --version: revision '$got_rev', git describe says '$expected_rev'"
+      fail "$p --version: revision '$got_rev', git describe says '$expected_rev' (a stale build? cmake --build $build --target gfins_package_programs)"
   fi
   expect 0 "$bin/$p" --help && log_has "Exit codes" "$p --help"
 done
