@@ -53,7 +53,7 @@ fw_log="$log_dir/fw-rest.log"
 step "host-release: installed programs away from the trees (tests/install/install_test.sh)"
 ./tests/install/install_test.sh build/host-release
 # The README rows and docs blocks marked <!-- runnable -->, as written, after what bootstrap.sh
-# leaves (out/gfins installed); about 20 s.
+# leaves (out/gfins installed); about 30 s.
 step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
 ./tests/install/runnable_docs.py --build build/host-release
 
