@@ -43,6 +43,11 @@ outer() {
       "private mount namespace with the source and build trees hidden" >&2
     exit 2
   fi
+  if ! unshare --mount --propagation private true 2>/dev/null; then
+    echo "install_test: unshare --mount is not permitted here (it needs CAP_SYS_ADMIN, e.g. a" \
+      "container started without it): the trees cannot be hidden from the programs under test" >&2
+    exit 2
+  fi
   work=$(mktemp -d "${TMPDIR:-/tmp}/gfins-install-test.XXXXXX")
   trap 'rm -rf "$work"' EXIT
   prefix=$work/prefix
