@@ -84,6 +84,8 @@ if want fw; then
     vb_die "stage fw: the host-only reference run failed (see $fwc/ref.out)"
   "$can_tool" decode "$fwc/ref.log" --view csv -o "$fwc/ref.csv" --quiet 2>"$fwc/ref-decode.out" ||
     vb_die "stage fw: gfins-can decode of the host-only reference failed (see $fwc/ref-decode.out)"
+  # The reference's CPU (libm's ifunc variants follow it); the VM prints the guest's.
+  vb_log "stage fw: host CPU $(grep -m1 '^flags' /proc/cpuinfo | tr -s ' \t' ' ')"
 fi
 for s in backend fw cmd faults canlog; do
   want "$s" || continue
