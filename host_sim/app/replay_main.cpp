@@ -64,9 +64,8 @@ int dump(const std::string& path) {
   std::printf("# version %u, %u channels, %u records per block, record_count %s\n",
               static_cast<unsigned>(h.version), static_cast<unsigned>(h.channel_count),
               static_cast<unsigned>(h.records_per_block),
-              h.record_count == sim::kRecordCountUnknown
-                  ? "unknown (writer not closed)"
-                  : std::to_string(h.record_count).c_str());
+              h.record_count == sim::kRecordCountUnknown ? "unknown (writer not closed)"
+                                                         : std::to_string(h.record_count).c_str());
   std::printf("# sample_rate_hz %.9g\n", h.sample_rate_hz);
   for (std::size_t j = 0; j < 6; ++j) {
     const auto& r = h.geometry.rho_b[j];
@@ -112,8 +111,8 @@ int dump(const std::string& path) {
 /// factor, no compensation; a calibration file replaces the front end, geometry, misalignment
 /// and compensator (as on the board, calib_file::apply_to).
 gfins::sim::HostResult<nav::PipelineConfig<double>> config_of(const ReplayOptions& o,
-                                                             const sim::RecordingHeader& h,
-                                                             std::string& what) {
+                                                              const sim::RecordingHeader& h,
+                                                              std::string& what) {
   nav::PipelineConfig<double> c;
   c.nominal = h.geometry;
   const double sf = sim::AccelErrors::qa1100_typical().scale_v_per_g;
@@ -202,8 +201,9 @@ void write_row(std::FILE* f, double t_s, const nav::NavState<T>& s) {
 }
 
 void print_report(std::FILE* f, const sim::NavReport& r, double rate_hz) {
-  std::fprintf(f, "samples offered %" PRIu64 ", navigating %" PRIu64 " (alignment: the first %" PRIu64
-                  "), rejected %" PRIu64 " (CRC error %" PRIu64 ", saturated %" PRIu64 ")\n",
+  std::fprintf(f,
+               "samples offered %" PRIu64 ", navigating %" PRIu64 " (alignment: the first %" PRIu64
+               "), rejected %" PRIu64 " (CRC error %" PRIu64 ", saturated %" PRIu64 ")\n",
                r.samples, r.navigating, r.samples - r.navigating - r.rejected, r.rejected,
                r.invalid, r.flagged_saturated);
   std::fprintf(f, "gaps in the sample counter: %zu, samples missing: %" PRIu64 "\n", r.gaps.size(),
@@ -214,8 +214,7 @@ void print_report(std::FILE* f, const sim::NavReport& r, double rate_hz) {
     std::fprintf(f,
                  "  gap at sample %" PRIu64 " (t = %.6f s): expected seq %" PRIu32 ", saw %" PRIu32
                  ", %" PRIu32 " missing\n",
-                 g.index, static_cast<double>(g.index) / rate_hz, g.expected_seq, g.seq,
-                 g.missing);
+                 g.index, static_cast<double>(g.index) / rate_hz, g.expected_seq, g.seq, g.missing);
   }
   if (r.gaps.size() > kListed) std::fprintf(f, "  ... %zu more\n", r.gaps.size() - kListed);
   std::fprintf(f, "output hash (FNV-1a-64 of every navigation state): %016" PRIx64 "\n",
@@ -269,9 +268,9 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   if (summary == nullptr) return fail("cannot write " + summary_path, app::kExitError);
   for (std::FILE* f : {stdout, summary}) {
     std::fprintf(f, "gfins-replay %s: %g Hz, %s, %s\n", o.recording.c_str(), h.sample_rate_hz,
-                 cal_text.c_str(), app::scalar_text(std::is_same_v<T, float>
-                                                        ? sim::NavScalar::kFloat
-                                                        : sim::NavScalar::kDouble));
+                 cal_text.c_str(),
+                 app::scalar_text(std::is_same_v<T, float> ? sim::NavScalar::kFloat
+                                                           : sim::NavScalar::kDouble));
     print_report(f, r, h.sample_rate_hz);
     if (r.navigating > 0) {
       const auto& v = last.v_n;
@@ -289,8 +288,8 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
               summary_path.c_str());
   if (r.navigating == 0) {
     return fail("no navigation state: the recording (" + std::to_string(r.samples) +
-                    " samples) ends within the alignment of " + std::to_string(cfg.alignment_samples) +
-                    " samples (--align-s)",
+                    " samples) ends within the alignment of " +
+                    std::to_string(cfg.alignment_samples) + " samples (--align-s)",
                 app::kExitBadInput);
   }
   if (!o.out.plot) return app::kExitOk;
@@ -364,7 +363,8 @@ int replay_main(int argc, char** argv) {
   cli.add_option("--cal", o.cal,
                  "calibration file (docs/calibration-file.md); without it: nominal scale "
                  "factor, no compensation");
-  auto* out_opt = cli.add_option("-o,--out", o.out.dir, "output folder (default replay-out/<stem>)");
+  auto* out_opt =
+      cli.add_option("-o,--out", o.out.dir, "output folder (default replay-out/<stem>)");
   cli.add_flag("--no-plot", no_plot, "write CSV only, no PNG");
   cli.add_option("--scalar", o.out.scalar,
                  "navigation core scalar: float (the board's float32 core) or double")
@@ -373,9 +373,9 @@ int replay_main(int argc, char** argv) {
   cli.add_option("--decimate", o.out.decimate, "write every N-th state to navigation.csv")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
-  cli.add_option("--align-s", o.align_s, "static alignment at the start, s")
-      ->capture_default_str();
-  cli.add_option("--heading-deg", o.heading_deg, "initial heading (nothing on board senses it), deg")
+  cli.add_option("--align-s", o.align_s, "static alignment at the start, s")->capture_default_str();
+  cli.add_option("--heading-deg", o.heading_deg,
+                 "initial heading (nothing on board senses it), deg")
       ->check(CLI::Range(-360.0, 360.0))
       ->capture_default_str();
   cli.add_option("--gravity", o.gravity_mps2, "local gravity of the navigation model, m/s^2")

@@ -4,9 +4,9 @@ namespace gfins::sim::app {
 
 HostResult<std::string> output_dir(const OutputOptions& o, const std::string& fallback) {
   if (o.dir_given && o.dir.empty()) {
-    return HostError{ErrorCode::kInvalidArgument,
-                     "-o/--out is empty: give the output folder (or leave -o out for " +
-                         fallback + ")"};
+    return HostError{
+        ErrorCode::kInvalidArgument,
+        "-o/--out is empty: give the output folder (or leave -o out for " + fallback + ")"};
   }
   return o.dir.empty() ? fallback : o.dir;
 }
