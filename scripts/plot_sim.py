@@ -49,8 +49,13 @@ def column(d, key, i):
     return d[f"{pre}_{AXES[i]}_{unit}"]
 
 
-def plot_vec(ax, d, key, scale=1.0, label_prefix=""):
-    names = Q[key][2]
+# The paper's §6.3 navigation frame is not NED: gravity along its −z (docs/simulation.md).
+PAPER_NAV = ["nav x", "nav y", "nav z"]
+
+
+def plot_vec(ax, d, key, scale=1.0, label_prefix="", names=None):
+    if names is None or Q[key][2] is BODY:
+        names = Q[key][2]
     for i in range(3):
         ax.plot(d["t_s"], column(d, key, i) * scale, color=COLORS[i], lw=1,
                 label=label_prefix + names[i])
@@ -66,14 +71,15 @@ def save(fig, path):
     print("  " + path)
 
 
-def nav_errors(before, after, title, path):
+def nav_errors(before, after, title, path, nav_names=None):
     fig, axs = plt.subplots(3, 2, figsize=(10, 7), sharex=True)
     rows = [("err_att", 180 / np.pi, "attitude error, body (deg)"),
             ("err_v", 1, "velocity error, NED (m/s)"), ("err_r", 1, "position error, NED (m)")]
     for r, (pre, k, lab) in enumerate(rows):
         for c, (d, which) in enumerate([(before, "before"), (after, "after")]):
-            plot_vec(axs[r][c], d, pre, k)
-            axs[r][c].set_ylabel(lab)
+            plot_vec(axs[r][c], d, pre, k, names=nav_names)
+            axs[r][c].set_ylabel(lab if nav_names is None else lab.replace("NED", "nav frame"),
+                                 fontsize=8)
             if r == 0:
                 axs[r][c].set_title(which + " compensation")
     fig.suptitle(title, fontsize=10)
@@ -141,7 +147,7 @@ def cmd_paper63(d, core):
         data = {"before": load(f"{d}/{cfg}_before.csv"), "after": load(f"{d}/{cfg}_after.csv")}
         for fig_name, which, pre, title, key in FIGS:
             fig, ax = plt.subplots(figsize=(6.4, 3.6))
-            plot_vec(ax, data[which], pre)
+            plot_vec(ax, data[which], pre, names=PAPER_NAV)
             lo, hi = PAPER[key]
             ax.axhline(lo, color="k", ls="--", lw=0.8, label="paper's bounds")
             ax.axhline(hi, color="k", ls="--", lw=0.8)
@@ -154,7 +160,7 @@ def cmd_paper63(d, core):
             save(fig, f"{d}/{fig_name}_{cfg}.png")
         nav_errors(data["before"], data["after"],
                    f"§6.3 navigation errors, {cfg} ({core} core): {assume}",
-                   f"{d}/nav_errors_{cfg}.png")
+                   f"{d}/nav_errors_{cfg}.png", nav_names=PAPER_NAV)
 
 
 def cmd_montecarlo(d, title):

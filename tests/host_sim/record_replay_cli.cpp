@@ -197,8 +197,8 @@ TEST_F(RecordReplay, RecordingHoldsExactlyTheSamplesTheRunNavigated) {
   x0.q_nb = nav::quat_from_euler(3.0 * M_PI / 180, -2.0 * M_PI / 180, 45.0 * M_PI / 180);
   pipeline->start_at(to_nav_state<float>(x0, 0), rec.value().samples.front());
   const auto& all = rec.value().samples;
-  const NavReport r = run_samples(
-      *pipeline, std::span<const RawSample>(all.data() + 1, all.size() - 1));
+  const NavReport r =
+      run_samples(*pipeline, std::span<const RawSample>(all.data() + 1, all.size() - 1));
   EXPECT_EQ(r.samples, n - 1);
   EXPECT_EQ(r.output_hash, o.value().compensated.report.output_hash)
       << "the recording is not the stream the run navigated";
@@ -216,7 +216,7 @@ TEST_F(RecordReplay, DumpPrintsTheHeaderAndEverySampleWithVolts) {
   EXPECT_NE(d.output.find("# sample_rate_hz 200"), std::string::npos) << d.output.substr(0, 800);
   EXPECT_NE(d.output.find("record_count 1001"), std::string::npos);
   const Csv c = read_csv_text(d.output);
-  const std::vector<std::string> want = {"seq",    "t_ns",    "count_1", "count_2", "count_3",
+  const std::vector<std::string> want = {"seq",     "t_ns",    "count_1", "count_2", "count_3",
                                          "count_4", "count_5", "count_6", "v_1_V",   "v_2_V",
                                          "v_3_V",   "v_4_V",   "v_5_V",   "v_6_V",   "flags"};
   EXPECT_EQ(c.header, want);
@@ -246,10 +246,10 @@ TEST_F(RecordReplay, DumpPrintsTheHeaderAndEverySampleWithVolts) {
 
 TEST_F(RecordReplay, ReplayIsBitExactRunToRunAndTheScalarFlagIsHonoured) {
   const std::string gfr = path("rest.gfr");
-  ASSERT_EQ(sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot",
-                 "--record", gfr})
-                .exit_code,
-            kExitOk);
+  ASSERT_EQ(
+      sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot", "--record", gfr})
+          .exit_code,
+      kExitOk);
   std::map<std::string, std::string> hash;
   for (const std::string scalar : {"float", "double"}) {
     for (int k = 0; k < 2; ++k) {
@@ -286,10 +286,10 @@ TEST_F(RecordReplay, ReplayIsBitExactRunToRunAndTheScalarFlagIsHonoured) {
 
 TEST_F(RecordReplay, ReplayRefusesACorruptRecordingNamingTheOffset) {
   const std::string gfr = path("rest.gfr");
-  ASSERT_EQ(sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot",
-                 "--record", gfr})
-                .exit_code,
-            kExitOk);
+  ASSERT_EQ(
+      sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot", "--record", gfr})
+          .exit_code,
+      kExitOk);
   {
     std::fstream f(gfr, std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(384 + 32 * 300);  // inside block 1 (records 256..511)
@@ -308,8 +308,8 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
   // Given the built-in calibration scenario (Tables 2/3 poses, Table 6 truth, no noise)
   // recorded by gfins-sim,
   const std::string poses = path("poses.gfr");
-  const auto rec = sim({"run", "calibration-tables23", "-o", path("cal-run"), "--no-plot",
-                        "--record", poses});
+  const auto rec =
+      sim({"run", "calibration-tables23", "-o", path("cal-run"), "--no-plot", "--record", poses});
   ASSERT_EQ(rec.exit_code, kExitOk) << rec.output;
   // when gfins-calibrate solves it,
   const std::string cal = path("cal.toml");
@@ -327,11 +327,9 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
   constexpr double kAngleTolDeg = 10.0 * kHalfLsbG * 180.0 / M_PI;  // 2.6e-4 deg
   const auto t6 = nav::paper_table6::misalignment<double>();
   for (std::size_t i = 0; i < 6; ++i) {
-    EXPECT_NEAR(data.value().beta.angle_deg[i], t6.orientation.beta[i] * 180 / M_PI,
-                kAngleTolDeg)
+    EXPECT_NEAR(data.value().beta.angle_deg[i], t6.orientation.beta[i] * 180 / M_PI, kAngleTolDeg)
         << "beta " << i;
-    EXPECT_NEAR(data.value().alpha.angle_deg[i], t6.orientation.alpha[i] * 180 / M_PI,
-                kAngleTolDeg)
+    EXPECT_NEAR(data.value().alpha.angle_deg[i], t6.orientation.alpha[i] * 180 / M_PI, kAngleTolDeg)
         << "alpha " << i;
     // The simulated sensors have the QA-1100's 1.33 V/g and no bias (scenario_run.cpp).
     EXPECT_NEAR(data.value().sensors[i].scale_v_per_g, 1.33, 10 * kHalfLsbG * 1.33);
@@ -341,10 +339,10 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
   // And a recording at rest of the same (misaligned) array, replayed with that calibration,
   // stays near the alignment point, while without it the misalignment makes it drift away.
   const std::string rest = path("rest.gfr");
-  ASSERT_EQ(sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot",
-                 "--record", rest})
-                .exit_code,
-            kExitOk);
+  ASSERT_EQ(
+      sim({"run", file("rest.toml", kRestTable6), "-o", path("run"), "--no-plot", "--record", rest})
+          .exit_code,
+      kExitOk);
   const auto with = replay({rest, "--cal", cal, "-o", path("with"), "--no-plot"});
   ASSERT_EQ(with.exit_code, kExitOk) << with.output;
   const auto without = replay({rest, "-o", path("without"), "--no-plot"});
@@ -413,8 +411,9 @@ TEST_F(RecordReplay, FloatAndDoubleCoresAgreeWithinTheFloatEpsilonBoundAndDiffer
     // The float run's estimates are binary32 values, the double run's are not.
     for (double v : rf) ASSERT_TRUE(printed_from_float(v)) << v;
   }
-  std::printf("float vs double over %.0f s: |dw| %.3g rad/s (bound %.3g), |dr| %.3g m (bound %.3g)\n",
-              t, diff_w, bound_w, diff_r, bound_r);
+  std::printf(
+      "float vs double over %.0f s: |dw| %.3g rad/s (bound %.3g), |dr| %.3g m (bound %.3g)\n", t,
+      diff_w, bound_w, diff_r, bound_r);
   EXPECT_LT(diff_w, bound_w);
   EXPECT_LT(diff_r, bound_r);
   // A run that ignored the flag would give identical columns.
