@@ -105,6 +105,80 @@ int dump(const std::string& path) {
   return app::kExitOk;
 }
 
+// ---- means (rate-table runs for gfins-calibrate --location-runs) -----------------------------
+
+struct MeansOptions {
+  std::string recording;
+  int mounting = 0;
+  std::vector<double> up_b;
+  double rate_rad_s = 0.0;
+  bool header = false;
+};
+
+/// One row of gfins-calibrate's --location-runs input (docs/calibration.md, §5): the mean and
+/// per-sample standard deviation of each sensor's output (V) over the whole revolutions of a
+/// rate-table recording, with the mounting, the body axis pointing up and the table rate.
+int means(const MeansOptions& o) {
+  const double up_norm =
+      std::sqrt(o.up_b[0] * o.up_b[0] + o.up_b[1] * o.up_b[1] + o.up_b[2] * o.up_b[2]);
+  if (!(up_norm > 0.0) || !std::isfinite(up_norm)) {
+    return fail("--up: the body axis pointing up must be a non-zero vector", app::kExitBadInput);
+  }
+  auto rec = sim::read_recording(o.recording);
+  if (!rec.is_ok()) return fail(rec.error().message, app::kExitBadInput);
+  const sim::RecordingHeader& h = rec.value().header;
+  const auto& smp = rec.value().samples;
+  // Whole revolutions: a real table wobbles once per turn, and whole turns average it out.
+  const double per_rev = 2.0 * M_PI / o.rate_rad_s * h.sample_rate_hz;  // samples
+  const double revs = std::floor(static_cast<double>(smp.size()) / per_rev);
+  if (revs < 1.0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "%s: %zu samples at %g Hz are less than one revolution at %g rad/s (%.0f "
+                  "samples)",
+                  o.recording.c_str(), smp.size(), h.sample_rate_hz, o.rate_rad_s, per_rev);
+    return fail(buf, app::kExitBadInput);
+  }
+  const auto n = static_cast<std::size_t>(std::llround(revs * per_rev));
+  std::array<double, 6> sum{};
+  std::array<double, 6> sum2{};
+  std::size_t flagged = 0;
+  for (std::size_t k = 0; k < n && k < smp.size(); ++k) {
+    if ((smp[k].flags & (gfins::sample_flags::kCrcError | gfins::sample_flags::kSaturated)) != 0) {
+      ++flagged;
+      continue;
+    }
+    for (std::size_t j = 0; j < 6; ++j) {
+      const double v = static_cast<double>(smp[k].counts[j]) * h.volts_per_count[j];
+      sum[j] += v;
+      sum2[j] += v * v;
+    }
+  }
+  if (flagged > 0) {
+    return fail(o.recording + ": " + std::to_string(flagged) +
+                    " samples flagged with a CRC error or saturation inside the revolutions: "
+                    "their means are not the sensors'",
+                app::kExitBadInput);
+  }
+  const auto count = static_cast<double>(std::min(n, smp.size()));
+  if (o.header) {
+    std::printf(
+        "mounting,axis_x,axis_y,axis_z,rate_rad_s,mean_v1,mean_v2,mean_v3,mean_v4,mean_v5,"
+        "mean_v6,std_v1,std_v2,std_v3,std_v4,std_v5,std_v6,count\n");
+  }
+  std::printf("%d,%.9g,%.9g,%.9g,%.9g", o.mounting, o.up_b[0] / up_norm, o.up_b[1] / up_norm,
+              o.up_b[2] / up_norm, o.rate_rad_s);
+  for (std::size_t j = 0; j < 6; ++j) std::printf(",%.12g", sum[j] / count);
+  for (std::size_t j = 0; j < 6; ++j) {
+    const double m = sum[j] / count;
+    // Sample standard deviation; a noise-free recording can round to a tiny negative variance.
+    const double var = std::max(0.0, (sum2[j] - count * m * m) / (count - 1.0));
+    std::printf(",%.6g", std::sqrt(var));
+  }
+  std::printf(",%.0f\n", count);
+  return std::fflush(stdout) == 0 ? app::kExitOk : app::kExitError;
+}
+
 // ---- navigate ---------------------------------------------------------------------------------
 
 /// The pipeline configuration: the recording's LSB and geometry, the QA-1100's nominal scale
@@ -352,9 +426,33 @@ int replay_main(int argc, char** argv) {
     }
     return dump(path);
   }
+  if (argc >= 2 && std::string(argv[1]) == "means") {
+    CLI::App cli{
+        "gfins-replay means: one row of gfins-calibrate --location-runs (docs/calibration.md "
+        "§5) from a rate-table recording: per-sensor mean and standard deviation (V) over its "
+        "whole revolutions",
+        "gfins-replay means"};
+    cli.footer(footer);
+    MeansOptions m;
+    cli.add_option("recording", m.recording, "rate-table recording (.gfr)")->required();
+    cli.add_option("--mounting", m.mounting, "fixture pose of the run (0..7)")
+        ->check(CLI::Range(0, 7))
+        ->required();
+    cli.add_option("--up", m.up_b, "body axis pointing up (x y z)")->expected(3)->required();
+    cli.add_option("--rate-rad-s", m.rate_rad_s, "table rate, rad/s")
+        ->check(CLI::Range(0.1, 100.0))
+        ->required();
+    cli.add_flag("--header", m.header, "print the CSV header line first");
+    try {
+      cli.parse(argc - 1, argv + 1);
+    } catch (const CLI::ParseError& e) {
+      return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
+    }
+    return means(m);
+  }
   CLI::App cli{
       "gfins-replay: navigate a raw-sample recording (.gfr) through the navigation core, or "
-      "print it (gfins-replay dump FILE.gfr)",
+      "print it (gfins-replay dump FILE.gfr), or average a rate-table run (gfins-replay means)",
       "gfins-replay"};
   cli.footer(footer);
   ReplayOptions o;
