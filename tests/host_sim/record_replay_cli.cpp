@@ -564,6 +564,7 @@ rate_dps = 90
       {{"run", huge, "--no-plot"}, {"1e+11 samples", "GiB", "limit of 2 GiB"}},
       {{"montecarlo", huge, "-n", "2", "--no-plot"}, {"GiB", "limit of 2 GiB"}},
       {{"run", short_run, "--no-plot"}, {"at least 2 samples", "duration_s 0.004"}},
+      {{"-d", "0.001", "-r", "100"}, {"at least 2 samples", "duration_s 0.001"}},
       {{"run", wrong_key, "--no-plot"},
        {"trajectory.rate_dps", "does not apply to trajectory kind \"rest\"", "kind, euler_deg"}},
       {{"covariance", rest, "--at", "7", "--no-plot"}, {"--at 7", "outside the run", "(0, 5]"}},
