@@ -314,8 +314,15 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   std::uint64_t written = 0;
   nav::NavState<T> last{};
   std::uint64_t since = every;  // write the first state
+  // Progress on a terminal, from the record count of a closed recording.
+  const sim::ProgressFn progress =
+      h.record_count != sim::kRecordCountUnknown ? app::tty_progress("replay") : sim::ProgressFn{};
+  const std::uint64_t step = std::max<std::uint64_t>(h.record_count / 100, 1);
   const auto result = sim::replay_recording<T>(
-      o.recording, *pipeline, [&](std::uint64_t, const nav::NavState<T>& s) {
+      o.recording, *pipeline, [&](std::uint64_t index, const nav::NavState<T>& s) {
+        if (progress && (index % step == 0 || index + 1 == h.record_count)) {
+          progress(static_cast<double>(index + 1) / static_cast<double>(h.record_count));
+        }
         if (!have_t0) {
           have_t0 = true;
           t0_ns = s.t_ns;
@@ -328,6 +335,7 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   // The last state always ends the file (decimated or not), so the CSV reaches the end.
   if (result.is_ok() && have_t0 && (since - 1) % every != 0) {
     write_row(csv, static_cast<double>(last.t_ns - t0_ns) * 1e-9, last);
+    ++written;
   }
   if (auto c = app::close_output(csv, csv_path); !c.is_ok()) {
     return fail(c.error().message, app::kExitError);
@@ -357,7 +365,7 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   if (auto c = app::close_output(summary, summary_path); !c.is_ok()) {
     return fail(c.error().message, app::kExitError);
   }
-  std::printf("written: %s (%" PRIu64 " rows%s), %s\n", csv_path.c_str(), written + 1,
+  std::printf("written: %s (%" PRIu64 " states%s), %s\n", csv_path.c_str(), written,
               every > 1 ? (", every " + std::to_string(every) + "th state").c_str() : "",
               summary_path.c_str());
   if (r.navigating == 0) {
