@@ -44,7 +44,7 @@ HostStatus check_options(const Scenario& s, const CovarianceOptions& c) {
 
 }  // namespace
 
-int cmd_covariance(const std::string& name, const CovarianceOptions& c, OutputOptions out) {
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, const OutputOptions& out) {
   namespace nav = gfins::nav;
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);

@@ -9,7 +9,7 @@
 namespace gfins::sim::app {
 
 int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
-                   OutputOptions out) {
+                   const OutputOptions& out) {
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
   const Scenario& s = loaded.value();

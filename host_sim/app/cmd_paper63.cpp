@@ -20,7 +20,7 @@ struct Paper63Config {
 
 }  // namespace
 
-int cmd_paper63(OutputOptions out) {
+int cmd_paper63(const OutputOptions& out) {
   const auto dir = output_dir(out, "sim-out/paper63");
   if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
   const auto scalar = nav_scalar(out.scalar);

@@ -18,7 +18,7 @@ int record(const Scenario& s, const ScenarioOutcome& o, const std::string& path)
 
 }  // namespace
 
-int cmd_run(const std::string& name, OutputOptions out) {
+int cmd_run(const std::string& name, const OutputOptions& out) {
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
   const Scenario& s = loaded.value();

@@ -33,21 +33,21 @@ struct OutputOptions {
 };
 
 /// gfins-sim run FILE|NAME: without and with compensation, CSV, summary, PNG.
-int cmd_run(const std::string& name, OutputOptions out);
+int cmd_run(const std::string& name, const OutputOptions& out);
 
 /// gfins-sim paper63: the paper's §6.3 in four configurations.
-int cmd_paper63(OutputOptions out);
+int cmd_paper63(const OutputOptions& out);
 
 /// gfins-sim montecarlo [NAME]: N seeds, envelopes and growth slopes.
 int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
-                   OutputOptions out);
+                   const OutputOptions& out);
 
 /// gfins-sim covariance [NAME]: predicted 1σ envelopes and error budget (docs/error-model.md).
 struct CovarianceOptions {
   double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;
   std::vector<double> times_s;
 };
-int cmd_covariance(const std::string& name, const CovarianceOptions& c, OutputOptions out);
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, const OutputOptions& out);
 
 /// gfins-sim list: the scenarios of host_sim/scenarios with their descriptions.
 int cmd_list();

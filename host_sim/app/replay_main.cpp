@@ -396,7 +396,8 @@ int run_navigate(ReplayOptions& o) {
   auto reader = sim::RecordingReader::open(o.recording);
   if (!reader.is_ok()) return fail(reader.error().message, app::kExitBadInput);
   const sim::RecordingHeader h = reader.value().header();
-  if (h.record_count != sim::kRecordCountUnknown && h.record_count < 2) {
+  // (record_count of an unclosed recording is kRecordCountUnknown, the largest value.)
+  if (h.record_count < 2) {
     return fail(o.recording + ": " + std::to_string(h.record_count) +
                     " samples: navigation needs at least 2",
                 app::kExitBadInput);

@@ -83,6 +83,7 @@ double pose_sequence_duration_s(std::size_t poses, double dwell_s, double slew_s
 std::unique_ptr<Trajectory> make_pose_sequence(const std::vector<std::array<double, 3>>& f_b_g,
                                                double dwell_s, double slew_s, const Vec3d& up_n) {
   std::vector<Quatd> q;
+  q.reserve(f_b_g.size() + 1);
   for (const auto& a : f_b_g) {
     // q_nb a_j = up_n: the sensed specific force of the pose points up in the navigation frame.
     q.push_back(Quatd::FromTwoVectors(Vec3d(a[0], a[1], a[2]).normalized(), up_n.normalized()));

@@ -207,8 +207,12 @@ void check_trajectory_keys(const toml::table& tr, const Reader& rd, const std::s
     if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
     std::string list;
     for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
-    rd.fail(&v, "trajectory." + key,
-            "does not apply to trajectory kind \"" + kind + "\" (its keys: " + list + ")");
+    std::string what = "does not apply to trajectory kind \"";
+    what += kind;
+    what += "\" (its keys: ";
+    what += list;
+    what += ")";
+    rd.fail(&v, "trajectory." + key, what);
   }
 }
 
