@@ -24,6 +24,7 @@
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/replay.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/host_sim/version.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 #include "run_options.hpp"
 
@@ -464,6 +465,7 @@ int replay_main(int argc, char** argv) {
       "print it (gfins-replay dump FILE.gfr), or average a rate-table run (gfins-replay means)",
       "gfins-replay"};
   cli.footer(footer);
+  cli.set_version_flag("--version", gfins::version::version_line("gfins-replay"));
   ReplayOptions o;
   bool no_plot = false;
   cli.add_option("recording", o.recording, "raw-sample recording (.gfr)")->required();
