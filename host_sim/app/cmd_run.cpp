@@ -27,6 +27,13 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
   const auto scalar = nav_scalar(out.scalar);
   if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
   if (auto c = check_run_size(s); !c.is_ok()) return fail(c.error(), kExitBadInput);
+  if (!out.record.empty() && !s.adc) {
+    return fail({ErrorCode::kInvalidArgument,
+                 "--record: scenario " + s.name +
+                     " has no converter (sensors.adc = false, the paper's §6.3 in m/s²); a "
+                     "recording holds ADC counts"},
+                kExitBadInput);
+  }
   const std::string& out_dir = dir.value();
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim run %s\n  navigation: %s\n", describe(s).c_str(),

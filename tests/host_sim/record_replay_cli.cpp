@@ -571,6 +571,8 @@ rate_dps = 90
       {{"covariance", rest, "--at", "-1", "--no-plot"}, {"--at -1", "outside the run"}},
       {{"covariance", rest, "--bias-ug", "-3", "--no-plot"}, {"--bias-ug -3", ">= 0"}},
       {{"run", rest, "-o", "", "--no-plot"}, {"-o/--out is empty"}},
+      {{"run", "paper-6.3", "--record", path("p.gfr"), "--no-plot", "-o", path("p63")},
+       {"--record", "sensors.adc = false"}},
       {{"paper63", "-o", "", "--no-plot"}, {"-o/--out is empty"}},
   };
   for (const auto& c : cases) {
@@ -583,6 +585,8 @@ rate_dps = 90
   }
   // Nothing was written by the refused runs (checked before any folder is made).
   EXPECT_FALSE(fs::exists("sim-out/huge"));
+  EXPECT_FALSE(fs::exists(path("p.gfr")));
+  EXPECT_FALSE(fs::exists(path("p63")));
   const auto r = replay({path("missing.gfr"), "-o", ""});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   EXPECT_NE(r.output.find("missing.gfr"), std::string::npos) << r.output;
