@@ -168,7 +168,7 @@ ArrayErrors array_errors(const Scenario& s) {
     // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
     // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
     // out).
-    if (s.adc) e.scale_v_per_g = qa1100_sf;
+    if (s.adc) e.scale_v_per_g = s.scale_v_per_g[j] > 0 ? s.scale_v_per_g[j] : qa1100_sf;
     e.bias_g += s.bias_mps2[j] / g;
     // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
     if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
