@@ -21,6 +21,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -126,6 +127,30 @@ class HostEnd final : public hal::CanBus {
 
 // ---- The simulated board with the firmware's loop, CAN codec and reload worker --------------
 
+/// Passes samples through, keeping every 10th one's codes when asked (the optional figure).
+class TraceSource final : public app::SampleSource {
+ public:
+  explicit TraceSource(app::SampleSource& inner) : inner_(inner) {}
+  struct Point {
+    double t_s;
+    std::array<std::int32_t, 6> counts;
+  };
+  bool record = false;
+  std::vector<Point> points;
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override {
+    Result<RawSample> r = inner_.read_sample(timeout_ns);
+    if (record && r.is_ok() && r.value().seq % 10 == 0) {
+      points.push_back({static_cast<double>(r.value().t_ns) * 1e-9, r.value().counts});
+    }
+    return r;
+  }
+  app::AdcCounters do_counters() const override { return inner_.counters(); }
+  double do_volts_per_count() const override { return inner_.volts_per_count(); }
+  app::SampleSource& inner_;
+};
+
 struct Board {
   explicit Board(const std::filesystem::path& cal_file, const sim_board::FaultPlan& faults = {}) {
     const auto p = sim::load_scenario("calibration-board", GFINS_SCENARIO_DIR);
@@ -141,9 +166,12 @@ struct Board {
     source = std::make_unique<sim_board::SimSampleSource>(
         *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
     source->set_faults(faults);
+    tap = std::make_unique<TraceSource>(*source);
+    tap->record = std::getenv("GFINS_CAL_E2E_OUT") != nullptr;
     period_ns = std::llround(1e9 / s.rate_hz);
     board_bus = std::make_unique<BoardEnd>(wire);
-    host_bus = std::make_unique<HostEnd>(wire, [this] { return step(); }, period_ns);
+    host_bus = std::make_unique<HostEnd>(
+        wire, [this] { return step(); }, period_ns);
     sink = std::make_unique<app::CanEpochSink>(*board_bus, kNode, app::to_can_dividers(config));
     codec = std::make_unique<app::CanCommandCodec>(kNode);
     log = std::make_unique<app::FwLogQueue>();
@@ -151,7 +179,7 @@ struct Board {
     const auto cal =
         app::load_calibration(config, app::nominal_calibration(adc->volts_per_count()));
     reload = std::make_unique<app::ReloadWorker>(app::calibration_reloader(config));
-    loop = std::make_unique<app::SampleLoop>(*source, *board_bus, *sink, clock, *log);
+    loop = std::make_unique<app::SampleLoop>(*tap, *board_bus, *sink, clock, *log);
     loop->set_command_codec(codec.get());
     loop->set_reload_worker(reload.get());
     if (const Status st = loop->configure(cal.set, app::loop_options(config)); !st.is_ok()) {
@@ -191,6 +219,7 @@ struct Board {
   std::unique_ptr<sim_board::ChipAdc> adc;
   sim_board::SampleClock clock;
   std::unique_ptr<sim_board::SimSampleSource> source;
+  std::unique_ptr<TraceSource> tap;
   std::unique_ptr<BoardEnd> board_bus;
   std::unique_ptr<HostEnd> host_bus;
   std::unique_ptr<app::CanEpochSink> sink;
@@ -224,12 +253,14 @@ void write(const std::filesystem::path& p, const std::string& text) {
 struct TruthCheck {
   double max_z = 0;  // largest |est − true|/σ
   std::string worst;
+  std::vector<std::pair<std::string, double>> z;  // every (est − true)/σ, signed
   bool ok() const { return max_z <= kSigmas; }
 };
 
 TruthCheck compare_with_truth(const calib_file::CalibrationData& d, const sim::Scenario& s) {
   TruthCheck c;
   const auto z = [&c](double est, double truth, double sigma, const std::string& what) {
+    c.z.emplace_back(what.substr(0, what.find(' ', what.find(' ') + 1)), (est - truth) / sigma);
     const double v = std::abs(est - truth) / sigma;
     if (!(v <= c.max_z)) {  // NaN counts as the worst
       c.max_z = std::isfinite(v) ? v : 1e300;
@@ -247,11 +278,12 @@ TruthCheck compare_with_truth(const calib_file::CalibrationData& d, const sim::S
     z(e.bias_g * g_cal, s.bias_mps2[j], e.bias_sigma_g * g_cal, "bias " + n + " (m/s²)");
   }
   constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  const std::array<const char*, 6> names{"xy", "xz", "yx", "yz", "zx", "zy"};  // Table 6 order
   for (std::size_t i = 0; i < 6; ++i) {
     z(d.beta.angle_deg[i], s.misalignment.orientation.beta[i] * kDegPerRad,
-      d.beta.angle_sigma_deg[i], "beta angle " + std::to_string(i));
+      d.beta.angle_sigma_deg[i], std::string("dbeta ") + names[i] + " (deg)");
     z(d.alpha.angle_deg[i], s.misalignment.orientation.alpha[i] * kDegPerRad,
-      d.alpha.angle_sigma_deg[i], "alpha angle " + std::to_string(i));
+      d.alpha.angle_sigma_deg[i], std::string("dalpha ") + names[i] + " (deg)");
   }
   return c;
 }
@@ -285,8 +317,12 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
   SequenceOptions o = b.options();
   o.wait = can_tool::WaitMode::kAuto;
   std::vector<std::string> notes;
+  std::vector<double> capture_end_s;
   SequenceIo io;
-  io.note = [&notes](const std::string& s) { notes.push_back(s); };
+  io.note = [&](const std::string& s) {
+    notes.push_back(s);
+    capture_end_s.push_back(b.now_s());
+  };
   const SequenceResult seq = can_tool::run_capture_sequence(*b.host_bus, plan, o, io);
   ASSERT_TRUE(seq.ok) << seq.error;
   ASSERT_EQ(seq.captures.size(), 12u);
@@ -314,10 +350,10 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
   std::snprintf(lsb_text, sizeof lsb_text, "%.17g", o.adc_lsb_v);
   const auto fresh = dir.path / "calibration.toml.new";
   int rc = -1;
-  std::string out = run_calibrate({"--means", means.string(), "--poses", poses.string(),
-                                   "--latitude", "24.8", "--height", "50", "--device-id",
-                                   "sim-board-1", "--adc-lsb", lsb_text, "-o", fresh.string()},
-                                  dir.path, rc);
+  std::string out = run_calibrate(
+      {"--means", means.string(), "--poses", poses.string(), "--latitude", "24.8", "--height", "50",
+       "--device-id", "sim-board-1", "--adc-lsb", lsb_text, "-o", fresh.string()},
+      dir.path, rc);
   ASSERT_EQ(rc, 0) << out;
   const auto cal = calib_file::load_calibration_file(fresh);
   ASSERT_TRUE(cal.is_ok()) << cal.status().message();
@@ -327,10 +363,10 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
               truth.worst.c_str());
 
   // The paper route (Tables 4/5 layout, eqs. (17)/(18) + least squares) on the same captures.
-  out = run_calibrate({"--means", paper_means.string(), "--latitude", "24.8", "--height", "50",
-                       "--device-id", "sim-board-1", "--adc-lsb", lsb_text, "-o",
-                       (dir.path / "paper.toml").string()},
-                      dir.path, rc);
+  out = run_calibrate(
+      {"--means", paper_means.string(), "--latitude", "24.8", "--height", "50", "--device-id",
+       "sim-board-1", "--adc-lsb", lsb_text, "-o", (dir.path / "paper.toml").string()},
+      dir.path, rc);
   ASSERT_EQ(rc, 0) << out;
   const auto paper = calib_file::load_calibration_file(dir.path / "paper.toml");
   ASSERT_TRUE(paper.is_ok());
@@ -347,15 +383,14 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
     std::swap(swapped[0].f_b_g, swapped[2].f_b_g);
     const auto swapped_poses = dir.path / "poses-swapped.csv";
     write(swapped_poses, can_tool::poses_csv(swapped));
-    out = run_calibrate({"--means", means.string(), "--poses", swapped_poses.string(),
-                         "--latitude", "24.8", "--height", "50", "--device-id", "sim-board-1",
-                         "--adc-lsb", lsb_text, "-o", (dir.path / "swapped.toml").string()},
+    out = run_calibrate({"--means", means.string(), "--poses", swapped_poses.string(), "--latitude",
+                         "24.8", "--height", "50", "--device-id", "sim-board-1", "--adc-lsb",
+                         lsb_text, "-o", (dir.path / "swapped.toml").string()},
                         dir.path, rc);
     EXPECT_EQ(rc, 3) << "a wrong pose order must not give a good verdict:\n" << out;
-    out = run_calibrate({"--means", means.string(), "--poses", swapped_poses.string(),
-                         "--latitude", "24.8", "--height", "50", "--device-id", "sim-board-1",
-                         "--adc-lsb", lsb_text, "--force", "-o",
-                         (dir.path / "swapped.toml").string()},
+    out = run_calibrate({"--means", means.string(), "--poses", swapped_poses.string(), "--latitude",
+                         "24.8", "--height", "50", "--device-id", "sim-board-1", "--adc-lsb",
+                         lsb_text, "--force", "-o", (dir.path / "swapped.toml").string()},
                         dir.path, rc);
     // Forced, either the file layer refuses the result (angles beyond the ±10° small-angle
     // domain: exit 4) or the file it writes fails the truth check.
@@ -386,6 +421,34 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
     std::printf("wrong gravity: largest |error|/σ %.3g (%s)\n", c.max_z, c.worst.c_str());
   }
 
+  // Optional data for docs/figures/calibration-e2e.png (scripts/plot_calibration_e2e.py).
+  if (const char* fig = std::getenv("GFINS_CAL_E2E_OUT"); fig != nullptr) {
+    const std::filesystem::path d(fig);
+    std::ofstream t(d / "trace.csv");
+    t << "t_s,v1,v2,v3,v4,v5,v6\n";
+    for (const auto& p : b.tap->points) {
+      t << p.t_s;
+      for (const std::int32_t c : p.counts) t << "," << c * o.adc_lsb_v;
+      t << "\n";
+    }
+    std::ofstream c(d / "captures.csv");
+    c << "label,t_start_s,t_end_s\n";
+    for (std::size_t i = 0; i < seq.captures.size() && i < capture_end_s.size(); ++i) {
+      c << seq.captures[i].pose.label << "," << capture_end_s[i] - kSamples / b.s.rate_hz << ","
+        << capture_end_s[i] << "\n";
+    }
+    std::ofstream zf(d / "z.csv");
+    zf << "route,parameter,z\n";
+    for (const auto& [k, v] : truth.z) zf << "general," << k << "," << v << "\n";
+    for (const auto& [k, v] : paper_truth.z) zf << "paper," << k << "," << v << "\n";
+    const auto wrong = calib_file::load_calibration_file(dir.path / "wrong-g.toml");
+    if (wrong.is_ok()) {
+      for (const auto& [k, v] : compare_with_truth(wrong.value(), b.s).z) {
+        zf << "standard gravity," << k << "," << v << "\n";
+      }
+    }
+  }
+
   // 3. Install: rename over the configured file (atomic), then ReloadCalibration on CAN.
   ASSERT_TRUE(b.wire.have_status);
   EXPECT_EQ(status_cal_id(b.wire.last_status), 0u);
@@ -409,11 +472,11 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
 
   // 4. The verification pose (the scenario's 13th: a 30° tilt, not one of the twelve).
   std::string error;
-  const auto vplan =
-      can_tool::plan_from_rows({{13, {b.s.trajectory.extra_poses_g[0].x(),
-                                      b.s.trajectory.extra_poses_g[0].y(),
-                                      b.s.trajectory.extra_poses_g[0].z()}}},
-                               error);
+  const auto vplan = can_tool::plan_from_rows(
+      {{13,
+        {b.s.trajectory.extra_poses_g[0].x(), b.s.trajectory.extra_poses_g[0].y(),
+         b.s.trajectory.extra_poses_g[0].z()}}},
+      error);
   ASSERT_EQ(vplan.size(), 1u) << error;
   o.first_token = 100;
   const SequenceResult vseq = can_tool::run_capture_sequence(*b.host_bus, vplan, o, io);
@@ -422,9 +485,9 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
   const auto vposes = dir.path / "verify-poses.csv";
   write(vmeans, can_tool::means_csv(vseq.captures, o.adc_lsb_v, false));
   write(vposes, can_tool::poses_csv(vplan));
-  out = run_calibrate({"--verify", installed.string(), "--means", vmeans.string(), "--poses",
-                       vposes.string()},
-                      dir.path, rc);
+  out = run_calibrate(
+      {"--verify", installed.string(), "--means", vmeans.string(), "--poses", vposes.string()},
+      dir.path, rc);
   EXPECT_EQ(rc, 0) << out;
   EXPECT_NE(out.find("verification passed"), std::string::npos) << out;
   std::printf("%s", out.c_str());
@@ -434,9 +497,9 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
   const auto wrong_jig = dir.path / "verify-poses-25.csv";
   write(wrong_jig, "attitude,fx_g,fy_g,fz_g\n13,0," + std::to_string(std::sin(t25)) + "," +
                        std::to_string(-std::cos(t25)) + "\n");
-  out = run_calibrate({"--verify", installed.string(), "--means", vmeans.string(), "--poses",
-                       wrong_jig.string()},
-                      dir.path, rc);
+  out = run_calibrate(
+      {"--verify", installed.string(), "--means", vmeans.string(), "--poses", wrong_jig.string()},
+      dir.path, rc);
   EXPECT_EQ(rc, 3) << out;
   EXPECT_NE(out.find("verification failed"), std::string::npos) << out;
 }
@@ -505,8 +568,7 @@ TEST(FirmwareCalibration, AWrongPoseOrderIsRefusedNamingThePoseItReadsLike) {
   ASSERT_FALSE(r.ok);
   std::printf("%s\n", r.error.c_str());
   EXPECT_TRUE(r.captures.empty());
-  EXPECT_NE(r.error.find("pose 2 (T2.2) refused: the board is not in this pose"),
-            std::string::npos)
+  EXPECT_NE(r.error.find("pose 2 (T2.2) refused: the board is not in this pose"), std::string::npos)
       << r.error;
   EXPECT_NE(r.error.find("it reads like pose 1 (T2.1): wrong pose order?"), std::string::npos)
       << r.error;

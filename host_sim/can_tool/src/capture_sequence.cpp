@@ -48,8 +48,8 @@ double pose_distance_g(const can::CaptureResult& r, const std::array<double, 3>&
                        const SequenceOptions& o, std::size_t* worst = nullptr) {
   double d = 0.0;
   for (std::size_t j = 0; j < 6; ++j) {
-    const double g = static_cast<double>(r.channels[j].mean_counts) * o.adc_lsb_v /
-                     o.nominal_sf_v_per_g[j];
+    const double g =
+        static_cast<double>(r.channels[j].mean_counts) * o.adc_lsb_v / o.nominal_sf_v_per_g[j];
     const double e = std::abs(g - expected_g(j, f));
     if (e > d) {
       d = e;
@@ -225,8 +225,8 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
     return out;
   }
   std::uint8_t token = o.first_token;
-  const auto max_probes = static_cast<long>(std::ceil(
-      o.pose_timeout_s * o.sample_rate_hz / std::max<double>(1.0, o.probe_samples)));
+  const auto max_probes = static_cast<long>(
+      std::ceil(o.pose_timeout_s * o.sample_rate_hz / std::max<double>(1.0, o.probe_samples)));
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const PlanPose& pose = plan[i];
     // The board numbers captures by pose (0..63): the plan's attitude, wrapped into that range.
@@ -244,9 +244,8 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
             // counting the wait against the pose's timeout.
             last = "no answer from node " + std::to_string(o.node_id) + " (" + p.text + ")";
             settled = 0;
-            const double waited_s =
-                static_cast<double>(o.timeouts.response.count()) * 1e-3 + 5.0 +
-                o.probe_samples / o.sample_rate_hz;
+            const double waited_s = static_cast<double>(o.timeouts.response.count()) * 1e-3 + 5.0 +
+                                    o.probe_samples / o.sample_rate_hz;
             probes += static_cast<long>(
                 std::ceil(waited_s * o.sample_rate_hz / std::max<double>(1.0, o.probe_samples)));
             if (probes >= max_probes) {

@@ -77,8 +77,8 @@ const char* to_string(Refusal r);
 
 struct CaptureCheck {
   Refusal refusal = Refusal::kNone;
-  std::string text;          // "pose 3 (T2.3) refused: ...", empty when accepted
-  int looks_like = -1;       // kWrongPose: index in the plan of the pose it reads like, or -1
+  std::string text;           // "pose 3 (T2.3) refused: ...", empty when accepted
+  int looks_like = -1;        // kWrongPose: index in the plan of the pose it reads like, or -1
   std::uint8_t channels = 0;  // bit i: the channel(s) the refusal names
 };
 
