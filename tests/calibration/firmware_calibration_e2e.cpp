@@ -598,6 +598,46 @@ TEST(FirmwareCalibration, PosesOfTheTablesAreFarApartComparedWithThePoseToleranc
   EXPECT_NEAR(closest, 1.0, 1e-12);
 }
 
+// ---- gfins-can calibrate: bad input is named before anything is sent ------------------------
+
+TEST(GfinsCanCalibrate, BadInputIsNamedWithItsExitStatus) {
+  TempDir dir;
+  const auto run = [&dir](const std::vector<std::string>& args) {
+    return test::run_tool(GFINS_CAN_EXE, args, dir.path);
+  };
+  const std::vector<std::string> base{"calibrate",
+                                      "--iface",
+                                      "gfinsnone0",
+                                      "--adc-lsb",
+                                      "1.1916160583496094e-06",
+                                      "-o",
+                                      (dir.path / "m.csv").string()};
+  const auto with = [&base](std::vector<std::string> extra) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  // A pose of 2 g is not a pose at rest: exit 1, the file and line named.
+  write(dir.path / "bad-poses.csv", "attitude,fx_g,fy_g,fz_g\n1,0,0,-1\n4,0,0,2\n");
+  test::CliResult r = run(with({"--poses", (dir.path / "bad-poses.csv").string()}));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("bad-poses.csv:3: |f| = 2"), std::string::npos) << r.output;
+  // The paper layout belongs to the Tables 2/3 plan.
+  write(dir.path / "poses.csv", "attitude,fx_g,fy_g,fz_g\n1,0,0,-1\n2,0,0,1\n");
+  r = run(with({"--poses", (dir.path / "poses.csv").string(), "--layout", "paper"}));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("--layout paper is the Tables 2/3 plan's"), std::string::npos)
+      << r.output;
+  r = run(with({"--nominal-sf", "1.3", "1.2"}));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("--nominal-sf takes 1 or 6 values"), std::string::npos) << r.output;
+  // No such interface: exit 2, the interface named; nothing written.
+  r = run(base);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("cannot open CAN interface 'gfinsnone0'"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path / "m.csv"));
+}
+
 TEST(FirmwareCalibration, ThePoseSequenceHoldsEachPoseStillAndTurnsSmoothly) {
   const auto p = sim::load_scenario("calibration-board", GFINS_SCENARIO_DIR);
   ASSERT_TRUE(p.is_ok()) << p.error().message;
