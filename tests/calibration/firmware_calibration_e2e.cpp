@@ -345,7 +345,6 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
 
   // 2. gfins-calibrate, general route (every sensor in every pose, stated σ), at the site's
   // latitude: the file is written atomically next to the installed one, then renamed over it.
-  const std::string lsb = std::to_string(o.adc_lsb_v);
   char lsb_text[40];
   std::snprintf(lsb_text, sizeof lsb_text, "%.17g", o.adc_lsb_v);
   const auto fresh = dir.path / "calibration.toml.new";
