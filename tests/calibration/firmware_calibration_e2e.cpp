@@ -521,6 +521,7 @@ TEST(FirmwareCalibration, APoseThatMovedIsRefusedNamingTheChannels) {
   const std::vector<PlanPose> one{plan[1]};
   const SequenceResult r = can_tool::run_capture_sequence(*b.host_bus, one, o, io);
   ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.stop, SequenceResult::Stop::kRefused);
   std::printf("%s\n", r.error.c_str());
   EXPECT_NE(r.error.find("pose 2 (T2.2) refused: the board moved"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find(" mg"), std::string::npos) << r.error;
@@ -545,6 +546,7 @@ TEST(FirmwareCalibration, ASaturatedChannelIsRefusedNamingIt) {
   const std::vector<PlanPose> one{plan[0]};
   const SequenceResult r = can_tool::run_capture_sequence(*b.host_bus, one, o, io);
   ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.stop, SequenceResult::Stop::kRefused);
   std::printf("%s\n", r.error.c_str());
   EXPECT_NE(r.error.find("pose 1 (T2.1) refused: saturated: channel(s) a3 reached"),
             std::string::npos)
@@ -565,12 +567,33 @@ TEST(FirmwareCalibration, AWrongPoseOrderIsRefusedNamingThePoseItReadsLike) {
   };
   const SequenceResult r = can_tool::run_capture_sequence(*b.host_bus, plan, o, io);
   ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.stop, SequenceResult::Stop::kRefused);
   std::printf("%s\n", r.error.c_str());
   EXPECT_TRUE(r.captures.empty());
   EXPECT_NE(r.error.find("pose 2 (T2.2) refused: the board is not in this pose"), std::string::npos)
       << r.error;
   EXPECT_NE(r.error.find("it reads like pose 1 (T2.1): wrong pose order?"), std::string::npos)
       << r.error;
+}
+
+TEST(FirmwareCalibration, AutoModeGivesUpOnAPoseTheBoardNeverTakes) {
+  TempDir dir;
+  Board b(dir.path / "calibration.toml");
+  std::string error;
+  // The face "z down": not one of the scenario's poses (0.45 g from the nearest on a3).
+  const auto plan = can_tool::plan_from_rows({{1, {0.0, 0.0, -1.0}}}, error);
+  ASSERT_EQ(plan.size(), 1u) << error;
+  SequenceOptions o = b.options();
+  o.wait = can_tool::WaitMode::kAuto;
+  o.pose_timeout_s = 2.0;  // board time: ten probes of 0.2 s
+  const SequenceResult r = can_tool::run_capture_sequence(*b.host_bus, plan, o, SequenceIo{});
+  ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.stop, SequenceResult::Stop::kNotReached);
+  EXPECT_NE(r.error.find("pose 1 (P1) not reached after 2 s of probing; last probe: pose 1 (P1) "
+                         "refused: the board is not in this pose"),
+            std::string::npos)
+      << r.error;
+  EXPECT_NEAR(b.now_s(), 2.0, 0.1);  // it probed for the time asked, no longer
 }
 
 TEST(FirmwareCalibration, PosesOfTheTablesAreFarApartComparedWithThePoseTolerance) {

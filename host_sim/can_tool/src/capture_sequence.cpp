@@ -222,6 +222,7 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
   };
   if (!(o.adc_lsb_v > 0.0) || o.samples == 0 || plan.empty()) {
     out.error = "capture sequence: needs a positive ADC LSB, N >= 1 and at least one pose";
+    out.stop = SequenceResult::Stop::kAborted;
     return out;
   }
   std::uint8_t token = o.first_token;
@@ -250,12 +251,14 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
                 std::ceil(waited_s * o.sample_rate_hz / std::max<double>(1.0, o.probe_samples)));
             if (probes >= max_probes) {
               out.error = pose_name(pose) + ": " + last;
+              out.stop = SequenceResult::Stop::kNoAnswer;
               return out;
             }
             continue;
           }
           if (p.kind != CommandOutcome::Kind::kOk) {
             out.error = pose_name(pose) + ": probe capture failed: " + p.text;
+            out.stop = SequenceResult::Stop::kNoAnswer;
             return out;
           }
           const CaptureCheck c = check_capture(p.capture, pose, plan, o);
@@ -265,16 +268,19 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
           if (++probes >= max_probes) {
             out.error = pose_name(pose) + " not reached after " + fmt("%.0f", o.pose_timeout_s) +
                         " s of probing; last probe: " + (last.empty() ? "accepted" : last);
+            out.stop = SequenceResult::Stop::kNotReached;
             return out;
           }
         }
       } else if (!io.await_pose || !io.await_pose(pose, i, plan.size(), refused > 0)) {
         out.error = pose_name(pose) + ": aborted by the operator";
+        out.stop = SequenceResult::Stop::kAborted;
         return out;
       }
       const CommandOutcome r = capture_once(bus, board_pose, o.samples, o, token);
       if (r.kind != CommandOutcome::Kind::kOk) {
         out.error = pose_name(pose) + ": capture failed: " + r.text;
+        out.stop = SequenceResult::Stop::kNoAnswer;
         return out;
       }
       CaptureCheck c = check_capture(r.capture, pose, plan, o);
@@ -293,6 +299,7 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
       note(c.text);
       if (++refused > o.retries) {
         out.error = c.text + " (" + std::to_string(refused) + " attempts; giving up)";
+        out.stop = SequenceResult::Stop::kRefused;
         return out;
       }
     }

@@ -102,7 +102,16 @@ struct SequenceIo {
 };
 
 struct SequenceResult {
+  /// Why the sequence stopped early.
+  enum class Stop : std::uint8_t {
+    kNone,        // every pose captured
+    kRefused,     // a pose refused retries + 1 times
+    kNoAnswer,    // a command got no (complete) answer, or was rejected by the board
+    kNotReached,  // kAuto: the pose was not seen within pose_timeout_s
+    kAborted,     // the operator stopped (await_pose returned false), or bad options
+  };
   bool ok = false;
+  Stop stop = Stop::kNone;
   std::vector<PoseCapture> captures;  // the accepted ones, in plan order
   std::string error;                  // why it stopped (names the pose and the reason)
   int refused = 0;                    // captures refused along the way

@@ -391,7 +391,7 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
   const SequenceResult r = run_capture_sequence(**bus, plan, so, io);
   if (!r.ok) {
     std::fprintf(stderr, "gfins-can calibrate: %s\n", r.error.c_str());
-    return r.error.find("refused") != std::string::npos ? kExitRejected : kExitTimeout;
+    return r.stop == SequenceResult::Stop::kRefused ? kExitRejected : kExitTimeout;
   }
   if (!write_text(o.output, means_csv(r.captures, o.adc_lsb, paper))) {
     std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.output.c_str());
