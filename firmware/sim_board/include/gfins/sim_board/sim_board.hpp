@@ -150,6 +150,9 @@ class MemoryCanBus final : public hal::CanBus {
 
   void refuse(bool on) { refuse_ = on; }
   void bus_off(bool on);
+  /// `n` received frames lost before the board read them, as SocketCAN reports a full socket
+  /// receive queue (SO_RXQ_OVFL: hal::CanCounters::rx_kernel_dropped).
+  void lose_received(std::uint32_t n) { counters_.rx_kernel_dropped += n; }
   /// Host → board frame (commands); false when the receive queue is full.
   bool inject_rx(const hal::CanFrame& f);
   /// Frames sent, oldest first (at most `capacity`); total() counts all ever sent.
