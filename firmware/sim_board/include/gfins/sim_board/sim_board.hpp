@@ -177,8 +177,8 @@ class MemoryCanBus final : public hal::CanBus {
 };
 
 /// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
-/// null when the scenario's trajectory cannot be built.
-std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
+/// a HostError naming what cannot be built (trajectory, sensor model). Never throws.
+sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::Scenario& s);
 
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.
