@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -20,6 +21,7 @@
 #include "capture_sequence.hpp"
 #include "command_client.hpp"
 #include "csv.hpp"
+#include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
 #include "gfins/host_sim/version.hpp"
@@ -44,6 +46,7 @@ enum Exit : int {
   kExitRejected = 4,  // cmd: the board answered with an error result
   kExitTimeout = 5,   // cmd: no response in time, or the command could not be sent
   kExitPlot = 6,      // plot: the plot script could not be run or failed
+  kExitNoFrames = 7,  // decode, plot: readable, no problem, but not one frame arrived
 };
 
 constexpr const char* kExitCodes =
@@ -54,7 +57,8 @@ constexpr const char* kExitCodes =
     "  3  decoded to the end, but problems were found (malformed lines, bad CRCs, drops, ...)\n"
     "  4  cmd: the board rejected the command (error response)\n"
     "  5  cmd: no response before the timeout, or the command could not be sent\n"
-    "  6  plot: the plot script could not be started or failed\n";
+    "  6  plot: the plot script could not be started or failed\n"
+    "  7  decode, plot: no CAN frame at all (idle or wrong interface, empty log), no problem\n";
 
 struct DecodeOptions {
   std::vector<std::string> sources;
@@ -120,17 +124,17 @@ int decode(const DecodeOptions& o, View& view) {
     }
     current = o.iface;
     const auto start = std::chrono::steady_clock::now();
-    std::uint64_t n = 0;
-    while (o.duration_s <= 0 ||
-           std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o.duration_s)) {
-      (*bus)->service();
-      const auto f = (*bus)->receive(100'000'000);
-      if (!f.is_ok()) continue;
-      const auto t = std::chrono::duration_cast<std::chrono::microseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
-      dec.feed_frame(++n, t, *f);
-    }
+    const auto keep_going = [&] {
+      return o.duration_s <= 0 ||
+             std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o.duration_s);
+    };
+    const auto now_us = [] {
+      return static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                           std::chrono::system_clock::now().time_since_epoch())
+                                           .count());
+    };
+    constexpr std::int64_t kPollNs = 100'000'000;  // --duration is honoured within 0.1 s
+    feed_live(**bus, dec, keep_going, now_us, kPollNs);
   }
   for (const std::string& src : o.sources) {
     current = src;
@@ -150,8 +154,19 @@ int decode(const DecodeOptions& o, View& view) {
   dec.finish();
   view.finish();
   print_summary(dec.summary(), stderr);
-  if (input_error) return kExitInput;
-  return dec.summary().total_issues() == 0 ? kExitOk : kExitIssues;
+  switch (decode_end(dec.summary(), input_error)) {
+    case DecodeEnd::kInputError:
+      return kExitInput;
+    case DecodeEnd::kProblems:
+      return kExitIssues;
+    case DecodeEnd::kNoFrames:
+      std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
+                   o.iface.empty() ? "in the input" : "arrived on the interface");
+      return kExitNoFrames;
+    case DecodeEnd::kOk:
+      break;
+  }
+  return kExitOk;
 }
 
 std::FILE* open_output(const std::string& path) {
@@ -204,7 +219,7 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   o.node = node;
   o.quiet = true;
   const int rc = run_decode(o);
-  if (rc == kExitInput || rc == kExitUsage) {
+  if (rc == kExitInput || rc == kExitUsage || rc == kExitNoFrames) {  // nothing to plot
     std::error_code ec;
     fs::remove(csv, ec);
     return rc;

@@ -447,7 +447,16 @@ HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& t)
         make_pose_sequence(calibration_pose_vectors(t), t.dwell_s, t.transition_s));
   }
   if (t.kind == "constant_acceleration") return make_constant_acceleration(t.accel_n_mps2, q0);
-  if (t.kind == "spin" || t.kind == "rate_table") return make_spin(t.axis_b, t.rate_rps, q0);
+  if (t.kind == "spin" || t.kind == "rate_table") {
+    // make_spin throws on a zero or non-finite axis (host code); here, on the simulated board's
+    // path, it is a value.
+    const double n = t.axis_b.norm();
+    if (!(n > 0.0) || !std::isfinite(n)) {
+      return HostError{ErrorCode::kInvalidArgument,
+                       "trajectory '" + t.kind + "': the spin axis must be finite and non-zero"};
+    }
+    return make_spin(t.axis_b, t.rate_rps, q0);
+  }
   if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);
   if (t.kind == "maneuver") return make_maneuver(t.scale);
   if (t.kind == "drive") return make_drive(t.speed_mps, t.turn_amplitude_m, t.turn_period_s);
