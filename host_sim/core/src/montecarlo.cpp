@@ -8,7 +8,8 @@
 namespace gfins::sim {
 
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
-                                            std::uint64_t seed0, const ProgressFn& progress) {
+                                            std::uint64_t seed0, const ProgressFn& progress,
+                                            NavScalar scalar) {
   if (runs < 2) {
     return HostError{ErrorCode::kInvalidArgument, "montecarlo: at least two runs are needed"};
   }
@@ -24,7 +25,7 @@ HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t ru
     Scenario s = base;
     s.seed = seed0 + k;
     s.calibration.seed = seed0 + 100003 * k;
-    GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false));
+    GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false, scalar));
     cal2 += o.calibration.rms_angle_error_rad * o.calibration.rms_angle_error_rad;
     const auto& smp = o.compensated.samples;
     const std::size_t n = smp.size();

@@ -36,9 +36,11 @@ struct MonteCarloResult {
 };
 
 /// Runs the scenario `runs` times (compensated run only): run k uses noise seed seed0 + k and
-/// calibration seed seed0 + 100003 k. `progress` gets the fraction of runs done.
+/// calibration seed seed0 + 100003 k. `progress` gets the fraction of runs done. `scalar` is the
+/// navigation core's (gfins-sim: float, the board's, unless --scalar double).
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
-                                            std::uint64_t seed0, const ProgressFn& progress = {});
+                                            std::uint64_t seed0, const ProgressFn& progress = {},
+                                            NavScalar scalar = NavScalar::kDouble);
 
 /// Least-squares slope of log y against log t over the samples with t in [t_lo, t_hi] and y > 0.
 /// Returns NaN with fewer than two such samples.
