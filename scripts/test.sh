@@ -79,8 +79,9 @@ step "Debian packages (amd64, arm64) and lintian"
 # One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
 # backends' real-kernel checks), fw / cmd / faults (the unchanged gfins-fw paced by the gpio-sim
 # line, on vcan0: output within one quantisation step of a host-only run, every CAN command,
-# kernel-made faults) and canlog; a second boot runs service (systemd: the amd64 package above installed in a clean
-# root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in docs/ci.md.
+# kernel-made faults) and canlog; a second boot runs service (systemd: the amd64 package above
+# installed in a clean root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in
+# docs/ci.md.
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
 fw_deb=$(ls out/deb/gfins-fw_*_amd64.deb | head -n 1)
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
