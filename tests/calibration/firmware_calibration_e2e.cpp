@@ -160,7 +160,9 @@ struct Board {
     config.node_id = kNode;
     config.calibration_file = cal_file.string();
     samples = static_cast<std::uint32_t>(std::llround(s.duration_s * s.rate_hz)) + 1;
-    stream = sim_board::make_scenario_stream(s);
+    auto made = sim_board::make_scenario_stream(s);
+    if (!made.is_ok()) throw std::runtime_error(made.error().message);
+    stream = std::move(made).value();
     adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
     if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
     source = std::make_unique<sim_board::SimSampleSource>(
