@@ -85,6 +85,12 @@ int sim_main(int argc, char** argv) {
     c->add_option("-o,--out", out_dir, "output folder (default sim-out/<name>)");
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
   }
+  std::size_t jobs = 0;  // 0: one thread per hardware thread (host_sim/parallel.hpp)
+  for (auto* c : {mc, cov}) {
+    c->add_option("-j,--jobs", jobs,
+                  "threads (default: the hardware's); the output does not depend on it")
+        ->check(CLI::Range(1, 1024));
+  }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
   cli.require_subcommand(0, 1);
   try {
@@ -95,7 +101,8 @@ int sim_main(int argc, char** argv) {
   }
   if (*run_cmd) return app::cmd_run(scenario_name, out_dir, !no_plot);
   if (*p63) return app::cmd_paper63(out_dir, !no_plot);
-  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
+  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out_dir, !no_plot);
+  cov_opts.jobs = jobs;
   if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
   if (*list_cmd) return app::cmd_list();
   return app::cmd_default(o);
