@@ -70,7 +70,8 @@ void ordered_parallel_for(std::size_t n, std::size_t jobs, Produce&& produce, Co
       std::size_t k = 0;
       {
         std::unique_lock lock(mutex);
-        changed.wait(lock, [&] { return stop || next_claim >= n || next_claim < consumed + window; });
+        changed.wait(lock,
+                     [&] { return stop || next_claim >= n || next_claim < consumed + window; });
         if (stop || next_claim >= n) return;
         k = next_claim++;
       }
