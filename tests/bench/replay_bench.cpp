@@ -14,7 +14,11 @@
 //                          file written to the temporary folder at set-up, reads it block by
 //                          block, checks every CRC, decodes and navigates (issue 13: ≥ 5000×
 //                          real time at 1 kHz on one core, i.e. ≥ 5 M samples/s);
-//   BM_ReadFile            the same file read and decoded block by block, no navigation.
+//   BM_ReadFile            the same file read and decoded block by block, no navigation;
+//   BM_ReadFileAndNavigate<T>  the file read and decoded by RecordingReader, each sample handed
+//                          to NavPipeline<T>::process() directly: what replay_recording() does
+//                          without NavLoop's report and FNV-1a output hash (which is byte-serial
+//                          and costs about as much as the navigation itself in double).
 // The file is read from the page cache after the first iteration, as when a recording is
 // replayed again; the first read from the disk itself is not what is measured.
 //
@@ -204,6 +208,37 @@ void BM_ReadFile(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * d.file.size()));
 }
 
+template <typename T>
+void BM_ReadFileAndNavigate(benchmark::State& state) {
+  const Data& d = data();
+  if (d.path.empty()) {
+    state.SkipWithError("could not write the recording to the temporary folder");
+    return;
+  }
+  const auto cfg = d.config<T>();
+  std::vector<RawSample> block;
+  std::uint64_t navigating = 0;
+  for (auto _ : state) {
+    nav::NavPipeline<T> p;
+    if (!p.configure(cfg).is_ok()) state.SkipWithError("pipeline configuration failed");
+    auto reader = RecordingReader::open(d.path);
+    if (!reader.is_ok()) {
+      state.SkipWithError(reader.error().message.c_str());
+      break;
+    }
+    navigating = 0;
+    for (;;) {
+      const auto more = reader.value().next_block(block);
+      if (!more.is_ok() || !more.value()) break;
+      for (const auto& x : block) {
+        navigating += p.process(x) == nav::PipelinePhase::kNavigating ? 1 : 0;
+      }
+    }
+    benchmark::DoNotOptimize(p.state());
+  }
+  set_rates(state, navigating);
+}
+
 BENCHMARK(BM_Replay<float>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Replay<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeAndReplay<float>)->Unit(benchmark::kMillisecond);
@@ -212,6 +247,8 @@ BENCHMARK(BM_Decode)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReplayFile<float>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReplayFile<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadFile)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadFileAndNavigate<float>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadFileAndNavigate<double>)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace gfins::sim
