@@ -1,8 +1,9 @@
 # Installation and Debian packages (docs/deploy.md).
 #
 # `cmake --install <build> [--prefix P]` puts the programs in P/bin, the scenarios in
-# P/share/gfins/scenarios, the plot scripts in P/share/gfins/scripts and the documentation in
-# P/share/doc/gfins. Built with CMAKE_INSTALL_PREFIX=/usr (the `deb` presets) the board files
+# P/share/gfins/scenarios (and P/share/gfins-fw/scenarios, the firmware's copy), the plot scripts
+# in P/share/gfins/scripts, example inputs in P/share/gfins/examples and the documentation in
+# P/share/doc/gfins-*. The programs find them relative to their own location (docs/install.md). Built with CMAKE_INSTALL_PREFIX=/usr (the `deb` presets) the board files
 # go to their Debian places instead: /etc/gfins/gfins-fw.toml, /var/lib/gfins,
 # /lib/systemd/system/gfins-fw.service, /lib/udev/rules.d/60-gfins-fw.rules.
 #
@@ -33,6 +34,25 @@ else()
 endif()
 set(GFINS_DOC_DIR ${CMAKE_INSTALL_FULL_DATADIR}/doc/gfins-fw)
 
+# --- data: the same layout in the build tree ---------------------------------------------------
+# The programs find their data relative to their own executable (host_sim/include/gfins/host_sim/
+# data_paths.hpp): PREFIX/share/gfins/<scenarios|scripts|examples> for PREFIX one to three levels
+# above the program's folder. An installed program in P/bin finds P/share/gfins; a program of the
+# build tree (build/<preset>/<folder>/<program>) finds build/<preset>/share/gfins, which holds
+# links to the sources made here. No path of the source or build tree is compiled into a program.
+# The example inputs (a calibration CSV, a candump log) are the tests' golden files.
+set(gfins_examples
+    ${PROJECT_SOURCE_DIR}/tests/golden/paper_tables_4_5.csv  # gfins-calibrate --means (Tables 4/5)
+    ${PROJECT_SOURCE_DIR}/tests/golden/can/clean.log)        # gfins-can decode / plot
+set(gfins_build_share ${PROJECT_BINARY_DIR}/share/gfins)
+file(MAKE_DIRECTORY ${gfins_build_share}/examples)
+file(CREATE_LINK ${PROJECT_SOURCE_DIR}/host_sim/scenarios ${gfins_build_share}/scenarios SYMBOLIC)
+file(CREATE_LINK ${PROJECT_SOURCE_DIR}/scripts ${gfins_build_share}/scripts SYMBOLIC)
+foreach(f IN LISTS gfins_examples)
+  get_filename_component(n ${f} NAME)
+  file(CREATE_LINK ${f} ${gfins_build_share}/examples/${n} SYMBOLIC)
+endforeach()
+
 # --- board: the firmware ---------------------------------------------------------------------
 set(gfins_components "")
 if(TARGET gfins-fw)
@@ -50,11 +70,16 @@ if(TARGET gfins-fw)
           COMPONENT board)
   install(FILES ${GFINS_PKG_DIR}/60-gfins-fw.rules DESTINATION ${gfins_udev_dest} COMPONENT board)
   install(FILES docs/deploy.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-fw COMPONENT board)
+  # gfins-fw --sim NAME needs the scenarios without the host tools: the package carries its own
+  # copy in share/gfins-fw/scenarios (gfins-tools has share/gfins/scenarios; two folders, so the
+  # two packages never own the same file). The program looks in share/gfins first.
+  install(DIRECTORY host_sim/scenarios/ DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins-fw/scenarios
+          COMPONENT board FILES_MATCHING PATTERN "*.toml")
 endif()
 
 # --- tools: host programs, scenarios, plot scripts, documentation ----------------------------
 set(gfins_tool_targets "")
-foreach(t IN ITEMS gfins-can gfins-sim gfins-calibrate gfins-replay)
+foreach(t IN ITEMS gfins-can gfins-can-gen gfins-sim gfins-calibrate gfins-replay)
   if(TARGET ${t})
     list(APPEND gfins_tool_targets ${t})
   endif()
@@ -67,6 +92,8 @@ if(gfins_tool_targets)
           COMPONENT tools FILES_MATCHING PATTERN "*.toml")
   file(GLOB gfins_plot_scripts CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/scripts/*.py)
   install(PROGRAMS ${gfins_plot_scripts} DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scripts
+          COMPONENT tools)
+  install(FILES ${gfins_examples} DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/examples
           COMPONENT tools)
   install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-tools COMPONENT tools
           FILES_MATCHING PATTERN "*.md" PATTERN "*.png")

@@ -14,6 +14,9 @@ cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 cmake --preset host-release
 cmake --build --preset host-release
+# The programs by name for the README's rows: installed in out/gfins (bin/ and their data in
+# share/gfins; docs/install.md). `export PATH="$PWD/out/gfins/bin:$PATH"` puts them on PATH.
+cmake --install build/host-release --prefix "$PWD/out/gfins" >/dev/null
 
 scenario="${1:-rest}"
 if [[ $# -gt 0 ]]; then shift; fi
@@ -28,3 +31,4 @@ if [[ -x "$bin/host_sim/can_tool/gfins-can" ]]; then
 else
   echo "note: gfins-can is not in this build; the summary above is gfins-fw's own."
 fi
+echo "programs installed in out/gfins/bin: export PATH=\"\$PWD/out/gfins/bin:\$PATH\" (README, Running things)"

@@ -32,7 +32,7 @@ cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
-  can_publisher_no_malloc_check gfins-can gfins_can_decode_bench
+  can_publisher_no_malloc_check gfins-can gfins_can_decode_bench gfins_package_programs
 
 step "host-release: hour-long runs (label long) and heap checks (label heap)"
 ctest --preset host-release -j "$jobs" -L 'long|heap' | tee "$log_dir/ctest-release.log"
@@ -47,6 +47,15 @@ fw_log="$log_dir/fw-rest.log"
 ./build/host-release/firmware/app/gfins-fw --sim rest --calibration "" --duration 2 \
   --can-log "$fw_log" >/dev/null
 ./build/host-release/host_sim/can_tool/gfins-can decode --view none "$fw_log"
+
+# Every installed program and subcommand from a temporary prefix, the checkout renamed away
+# while they run (docs/install.md); about 20 s.
+step "host-release: installed programs away from the trees (tests/install/install_test.sh)"
+./tests/install/install_test.sh build/host-release
+# The README rows and docs blocks marked <!-- runnable -->, as written, after what bootstrap.sh
+# leaves (out/gfins installed); about 20 s.
+step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
+./tests/install/runnable_docs.py --build build/host-release
 
 step "cortex-m4f: bare-metal build of the navigation core and the soft-double check"
 cmake --preset cortex-m4f >/dev/null

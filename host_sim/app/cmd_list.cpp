@@ -5,7 +5,9 @@
 namespace gfins::sim::app {
 
 int cmd_list() {
-  for (const auto& n : builtin_scenarios(GFINS_SCENARIO_DIR)) {
+  const auto dir = builtin_scenario_dir();
+  if (!dir.is_ok()) return fail(dir.error(), kExitError);
+  for (const auto& n : builtin_scenarios(dir.value())) {
     const auto p = load(n);
     std::printf("%-24s %s\n", n.c_str(),
                 p.is_ok() ? p.value().description.c_str() : p.error().message.c_str());

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/host_sim/data_paths.hpp"
 
 namespace gfins::sim::app {
 
@@ -16,9 +17,7 @@ int fail(const HostError& e, int exit_code) {
   return exit_code;
 }
 
-HostResult<Scenario> load(const std::string& file_or_name) {
-  return load_scenario(file_or_name, GFINS_SCENARIO_DIR);
-}
+HostResult<Scenario> load(const std::string& file_or_name) { return load_scenario(file_or_name); }
 
 HostStatus make_dir(const std::string& dir) {
   std::error_code ec;
@@ -42,7 +41,17 @@ HostStatus plot(const std::string& script, const std::vector<std::string>& args)
   const std::string python = env != nullptr && env[0] != '\0'                  ? env
                              : std::filesystem::exists("/usr/bin/python3", ec) ? "/usr/bin/python3"
                                                                                : "python3";
-  const std::string path = std::string(GFINS_SCRIPTS_DIR) + "/" + script;
+  const paths::DataLookup dir = paths::scripts_dir();
+  if (!dir.found()) {
+    return HostError{ErrorCode::kUnavailable,
+                     "plotting failed: " +
+                         dir.explain("plot script",
+                                     "the plot scripts are installed with gfins-tools "
+                                     "(share/gfins/scripts); set GFINS_SCRIPTS_DIR, or pass "
+                                     "--no-plot") +
+                         "; the CSV files are written"};
+  }
+  const std::string path = (dir.dir / script).string();
   std::vector<std::string> argv = {python, path};
   argv.insert(argv.end(), args.begin(), args.end());
   // The summary first, then the script's own output (both go to the same terminal or log).

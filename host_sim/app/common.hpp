@@ -20,7 +20,8 @@ inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures a
 /// Prints "gfins-sim: <message>" on stderr and returns `exit_code`.
 int fail(const HostError& e, int exit_code);
 
-/// A scenario file, or a built-in scenario by name (host_sim/scenarios: the one registry).
+/// A scenario file (a path: contains '/' or ends in .toml), or a built-in scenario by name,
+/// found relative to the program (sim::load_scenario; $GFINS_SCENARIO_DIR overrides).
 HostResult<Scenario> load(const std::string& file_or_name);
 
 /// Creates the output folder (and its parents).
@@ -31,10 +32,11 @@ HostStatus make_dir(const std::string& dir);
 /// only the last flush (glibc returns 0 after an earlier ENOSPC).
 HostStatus close_output(std::FILE* f, const std::string& path);
 
-/// Runs scripts/<script> with `args` through the Python interpreter ($GFINS_PYTHON, else
-/// Debian's /usr/bin/python3, which has python3-matplotlib; a python3 first on PATH often lacks
-/// it), without a shell: the arguments reach the script as they are, whatever they contain.
-/// Fails with a message naming the script and its exit status (or why it could not start).
+/// Runs the plot script <script> (found by paths::scripts_dir(): $GFINS_SCRIPTS_DIR, else
+/// PREFIX/share/gfins/scripts next to the program) with `args` through the Python interpreter
+/// ($GFINS_PYTHON, else Debian's /usr/bin/python3, which has python3-matplotlib; a python3 first on
+/// PATH often lacks it), without a shell: the arguments reach the script as they are, whatever they
+/// contain. Fails with a message naming the script and its exit status (or why it could not start).
 HostStatus plot(const std::string& script, const std::vector<std::string>& args);
 
 /// Progress on a TTY only (a log file gets no \r lines).

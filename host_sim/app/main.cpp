@@ -6,10 +6,11 @@
 //   gfins-sim paper63              cmd_paper63.cpp: the paper's §6.3 (Figs. 7-10), four configs
 //   gfins-sim montecarlo [NAME]    cmd_montecarlo.cpp: N seeds, statistics and growth slopes
 //   gfins-sim covariance [NAME]    cmd_covariance.cpp: predicted 1σ envelopes, error budget
-//   gfins-sim list                 cmd_list.cpp: the scenarios of host_sim/scenarios
+//   gfins-sim list                 cmd_list.cpp: the built-in scenarios
 //
 // Every run goes through the one sample source and navigation loop of host_sim; scenarios come
-// from the one registry, host_sim/scenarios/*.toml.
+// from the one registry, host_sim/scenarios/*.toml, installed as share/gfins/scenarios and found
+// relative to this program (gfins/host_sim/data_paths.hpp), never through a build-tree path.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -18,6 +19,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "gfins/host_sim/version.hpp"
 
 namespace {
 
@@ -27,10 +29,20 @@ int sim_main(int argc, char** argv) {
   app::DefaultOptions o;
   o.scalar = GFINS_NAV_SCALAR_DEFAULT;
   CLI::App cli{"gfins-sim: scenarios through the gyro-free navigation core"};
-  cli.footer(
+  const std::string footer =
       "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
-      "scenario rejected; 3 CSV written but plotting failed (PNG asked for).");
-  const std::vector<std::string> names = gfins::sim::builtin_scenarios(GFINS_SCENARIO_DIR);
+      "scenario rejected; 3 CSV written but plotting failed (PNG asked for).\n"
+      "A scenario argument with a '/' or ending in .toml is a file (./drive), otherwise a "
+      "built-in name (gfins-sim list).\n"
+      "Environment: GFINS_SCENARIO_DIR (built-in scenarios), GFINS_SCRIPTS_DIR (plot scripts; "
+      "both default to ../share/gfins/ next to this program), GFINS_PYTHON (python3 with "
+      "matplotlib).";
+  cli.footer(footer);
+  cli.set_version_flag("--version", gfins::version::version_line("gfins-sim"));
+  const auto scenario_dir = gfins::sim::builtin_scenario_dir();
+  const std::vector<std::string> names = scenario_dir.is_ok()
+                                             ? gfins::sim::builtin_scenarios(scenario_dir.value())
+                                             : std::vector<std::string>{};
   cli.add_option("-s,--scenario", o.scenario, "trajectory of a built-in scenario")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
@@ -59,7 +71,8 @@ int sim_main(int argc, char** argv) {
   std::size_t mc_runs = 50;
   std::uint64_t mc_seed = 1;
   auto* run_cmd = cli.add_subcommand("run", "run a scenario file or built-in scenario");
-  run_cmd->add_option("scenario", scenario_name, "file, or built-in name (host_sim/scenarios)")
+  run_cmd
+      ->add_option("scenario", scenario_name, "file (has a '/' or ends in .toml) or built-in name")
       ->required();
   auto* p63 = cli.add_subcommand("paper63", "the paper's §6.3 experiment, Figs. 7-10");
   auto* mc = cli.add_subcommand("montecarlo", "N seeds: error statistics and growth slopes");
@@ -92,6 +105,7 @@ int sim_main(int argc, char** argv) {
         ->check(CLI::Range(1, 1024));
   }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
+  for (auto* c : {run_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
   cli.require_subcommand(0, 1);
   try {
     cli.parse(argc, argv);

@@ -30,19 +30,6 @@ namespace {
 // within a minute.
 constexpr int kDevWatchdogTimeoutS = 10;
 
-// Named scenarios: next to the installed program (../share/gfins/scenarios), else the source
-// tree's (a build that was not installed).
-std::string scenario_dir(const FwConfig& c) {
-  if (!c.sim_scenario_dir.empty()) return c.sim_scenario_dir;
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const auto installed = exe.parent_path().parent_path() / "share" / "gfins" / "scenarios";
-    if (std::filesystem::is_directory(installed, ec)) return installed.string();
-  }
-  return GFINS_SCENARIO_DIR;
-}
-
 std::string enter_realtime(const FwConfig& c) {
   std::string warn;
   if (c.rt_priority > 0) {
@@ -109,7 +96,12 @@ struct SimParts {
 
 BoardResult make_sim_board(const FwConfig& c) {
   BoardResult out;
-  const auto parsed = sim::load_scenario(c.sim_scenario, scenario_dir(c));
+  // Named scenarios: sim.scenario_dir when set, else found relative to this program
+  // ($GFINS_SCENARIO_DIR, PREFIX/share/gfins/scenarios, PREFIX/share/gfins-fw/scenarios: the
+  // gfins-fw package carries its own copy; gfins/host_sim/data_paths.hpp).
+  const auto parsed = c.sim_scenario_dir.empty()
+                          ? sim::load_scenario(c.sim_scenario)
+                          : sim::load_scenario(c.sim_scenario, c.sim_scenario_dir);
   if (!parsed.is_ok()) {
     out.error = parsed.error().message;
     return out;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "gfins/app/config.hpp"
+#include "gfins/host_sim/version.hpp"
 
 namespace gfins::app {
 namespace {
@@ -87,11 +88,19 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                  "benchmark: write the data-ready → CAN latency histogram (us,count) here");
   app.add_flag("--print-default-config", print_default, "print the commented default and exit");
 
+  app.footer(
+      "Exit codes: 0 stopped normally (end of a --sim run, SIGINT/SIGTERM), or --help, --version, "
+      "--print-default-config, --check-config done; 1 the board could not be set up or the run "
+      "failed; 2 command line or configuration rejected.\n"
+      "Environment: GFINS_SCENARIO_DIR (the built-in scenarios of --sim; default "
+      "../share/gfins/scenarios, then ../share/gfins-fw/scenarios next to this program).");
+  app.set_version_flag("--version", version::version_line("gfins-fw"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     std::ostringstream o, err;
-    out.exit_code = app.exit(e, o, err);
+    // CLI11's own codes (100+) become the documented 2; --help and --version stay 0.
+    out.exit_code = app.exit(e, o, err) == 0 ? 0 : 2;
     out.message = o.str() + err.str();
     return out;
   }

@@ -3,6 +3,7 @@
 //   gfins-can-gen icd          the signal tables of docs/can-interface.md
 //   gfins-can-gen budget       the bus budget table of docs/can-interface.md
 //   gfins-can-gen log SECONDS  a candump log of a synthetic moving board (tests, benchmarks)
+//   gfins-can-gen --version    version and git revision; --help the usage and exit codes
 // The tests regenerate the same text and fail when the committed files differ.
 #include <cstdio>
 #include <cstdlib>
@@ -11,12 +12,33 @@
 
 #include "generate.hpp"
 #include "gfins/can/message_table.hpp"
+#include "gfins/host_sim/version.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: gfins-can-gen dbc [node] | icd | budget | log SECONDS | --help | --version\n"
+    "  dbc [node]    the DBC of the CAN interface for node id 0..15 (default 0)\n"
+    "  icd           the signal tables of docs/can-interface.md\n"
+    "  budget        the bus budget table of docs/can-interface.md\n"
+    "  log SECONDS   a candump log of a synthetic moving board, (0, 86400] s\n"
+    "Exit codes: 0 written to stdout; 1 command line rejected; 2 stdout could not be "
+    "written.\n";
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace gfins::can_tool;
   if (argc < 2) {
-    std::fprintf(stderr, "usage: gfins-can-gen dbc [node] | icd | budget | log SECONDS\n");
+    (void)std::fputs(kUsage, stderr);  // the exit code says it either way
     return 1;
+  }
+  if (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+    return std::fputs(kUsage, stdout) < 0 ? 2 : 0;
+  }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    const std::string v = gfins::version::version_line("gfins-can-gen") + "\n";
+    return std::fputs(v.c_str(), stdout) < 0 ? 2 : 0;
   }
   std::string text;
   if (std::strcmp(argv[1], "dbc") == 0) {
@@ -43,7 +65,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   } else {
-    std::fprintf(stderr, "gfins-can-gen: unknown output '%s'\n", argv[1]);
+    std::fprintf(stderr, "gfins-can-gen: unknown output '%s'\n%s", argv[1], kUsage);
     return 1;
   }
   if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0) {

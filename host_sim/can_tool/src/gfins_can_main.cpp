@@ -18,16 +18,13 @@
 #include "command_client.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
+#include "gfins/host_sim/version.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL
 #include <iostream>
 
 #include "hil.hpp"
-#endif
-
-#ifndef GFINS_VERSION
-#define GFINS_VERSION "0.0.0"
 #endif
 
 namespace {
@@ -274,7 +271,7 @@ int run_cmd(const CmdOptions& o, can::Command c) {
 int main_impl(int argc, char** argv) {
   CLI::App app{"gfins-can: decode, check and plot gfins CAN traffic; send commands to a board"};
   app.footer(kExitCodes);
-  app.set_version_flag("--version", std::string("gfins-can ") + GFINS_VERSION);
+  app.set_version_flag("--version", gfins::version::version_line("gfins-can"));
   app.require_subcommand(1);
 
   DecodeOptions d;

@@ -48,8 +48,9 @@ struct Input {
 // register-level chip model and the real driver, as on the simulated board; sample k has
 // seq = k and t_ns = round(k · 1e9 / rate).
 bool scenario_samples(const HilOptions& o, Input& in, std::ostream& err) {
-  const std::string dir = o.scenario_dir.empty() ? GFINS_SCENARIO_DIR : o.scenario_dir;
-  const auto parsed = sim::load_scenario(o.scenario, dir);
+  // Built-in names are found relative to the program unless a folder is given.
+  const auto parsed = o.scenario_dir.empty() ? sim::load_scenario(o.scenario)
+                                             : sim::load_scenario(o.scenario, o.scenario_dir);
   if (!parsed.is_ok()) {
     err << "gfins-can hil: " << parsed.error().message << "\n";
     return false;

@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "gfins/host_sim/data_paths.hpp"
+
 #if GFINS_CAN_HAVE_SOCKETCAN
 #include "gfins/drivers/lnx/socket_can.hpp"
 #endif
@@ -79,18 +81,11 @@ void for_each_line(std::FILE* f, const std::function<void(std::uint64_t, std::st
 }
 
 std::filesystem::path find_script(const std::string& name) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    fs::path installed = exe.parent_path() / ".." / "share" / "gfins" / "scripts" / name;
-    if (fs::exists(installed, ec)) return installed;
-  }
-#ifdef GFINS_SCRIPTS_DIR
-  fs::path source = fs::path(GFINS_SCRIPTS_DIR) / name;
-  if (fs::exists(source, ec)) return source;
-#endif
-  return fs::path(name);
+  // $GFINS_SCRIPTS_DIR, else PREFIX/share/gfins/scripts next to the program (an install, or the
+  // build tree's share/gfins, which links to the sources): no build path is compiled in.
+  const paths::DataLookup dir = paths::scripts_dir();
+  if (!dir.found()) return std::filesystem::path(name);
+  return dir.dir / name;
 }
 
 }  // namespace gfins::can_tool

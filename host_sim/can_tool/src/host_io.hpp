@@ -30,8 +30,8 @@ Status run_without_shell(const std::vector<std::string>& argv, std::string* deta
 void for_each_line(std::FILE* f, const std::function<void(std::uint64_t, std::string_view)>& fn,
                    std::size_t max_line = 4096);
 
-/// Where the plot script is: next to the installed program (../share/gfins/scripts), else the
-/// source tree's scripts/ (build tree runs).
+/// Where the plot script is: $GFINS_SCRIPTS_DIR, else PREFIX/share/gfins/scripts next to the
+/// program (installed, or the build tree's share/gfins link); the bare name if neither exists.
 std::filesystem::path find_script(const std::string& name);
 
 }  // namespace gfins::can_tool

@@ -376,36 +376,6 @@ HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::strin
   }
 }
 
-HostResult<Scenario> load_scenario(const std::string& file_or_name,
-                                   const std::string& builtin_dir) {
-  std::filesystem::path path(file_or_name);
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) {
-    const auto builtin = std::filesystem::path(builtin_dir) / (file_or_name + ".toml");
-    if (!std::filesystem::exists(builtin, ec)) {
-      return HostError{
-          ErrorCode::kInvalidArgument,
-          file_or_name + ": no such file, and no built-in scenario of that name in " + builtin_dir};
-    }
-    path = builtin;
-  }
-  std::ifstream in(path);
-  if (!in) return HostError{ErrorCode::kIoError, path.string() + ": cannot read the file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scenario(text.str(), path.string());
-}
-
-std::vector<std::string> builtin_scenarios(const std::string& builtin_dir) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(builtin_dir, ec)) {
-    if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, double period_s) {
   return std::make_unique<DriveTrajectory>(speed_mps, amplitude_m, period_s);
 }

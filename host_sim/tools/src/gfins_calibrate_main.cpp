@@ -18,6 +18,7 @@
 #include "calibrate.hpp"
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/host_sim/version.hpp"
 #include "gfins/nav_core/gravity.hpp"
 
 namespace {
@@ -407,6 +408,11 @@ int calibrate_main(int argc, char** argv) {
                  "check verification poses (--means, --poses) against this installed calibration "
                  "file: residuals and z per pose and sensor; exit 3 beyond 5 sigma")
       ->check(CLI::ExistingFile);
+  app.footer(
+      "Exit codes: 0 file written (or --dry-run / --verify done); 1 bad usage or input; 2 the "
+      "solver failed; 3 the verdict is not good and --force was not given (nothing written), or "
+      "--verify found a pose beyond 5 sigma; 4 the file could not be written.");
+  app.set_version_flag("--version", gfins::version::version_line("gfins-calibrate"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -112,12 +112,36 @@ struct Scenario {
 /// Parses TOML text; `source` names it in messages. Errors name the file, the key and the line.
 HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source);
 
-/// Loads a file, or a built-in scenario by name from `builtin_dir` (NAME.toml): the one
-/// scenario registry of the host is that folder (host_sim/scenarios).
+/// A scenario argument is a file path when it contains a '/' or ends in ".toml" (`./drive`,
+/// `my.toml`), otherwise the name of a built-in scenario (`drive`). A file or folder named like a
+/// built-in scenario in the current directory never shadows it (docs/install.md).
+bool is_scenario_path(std::string_view arg);
+
+/// Loads a file (is_scenario_path), or a built-in scenario by name from `builtin_dir`
+/// (NAME.toml): the one scenario registry of the host is that folder (host_sim/scenarios,
+/// installed as share/gfins/scenarios). An unknown name is an error naming the closest built-in
+/// names and `gfins-sim list`.
 HostResult<Scenario> load_scenario(const std::string& file_or_name, const std::string& builtin_dir);
+
+/// Same, with the built-in folder found relative to the running program
+/// (gfins::paths::scenario_dir(): $GFINS_SCENARIO_DIR, PREFIX/share/gfins/scenarios,
+/// PREFIX/share/gfins-fw/scenarios). A file path needs no folder; a name without a folder found
+/// is an error saying where it looked.
+HostResult<Scenario> load_scenario(const std::string& file_or_name);
 
 /// Names of the built-in scenarios in a folder (file stems of *.toml), sorted.
 std::vector<std::string> builtin_scenarios(const std::string& builtin_dir);
+
+/// The folder of the built-in scenarios found relative to the running program, or an error
+/// saying where it looked and which package holds them.
+HostResult<std::string> builtin_scenario_dir();
+
+/// The names among `names` closest to `name` by edit distance (Levenshtein: insertions,
+/// deletions, substitutions), best first, at most `max_count`; a name further than
+/// max(2, |name| / 3) edits is not suggested, except that a name containing `name` (or contained
+/// in it) always is.
+std::vector<std::string> closest_names(std::string_view name, const std::vector<std::string>& names,
+                                       std::size_t max_count = 3);
 
 /// The trajectory of a scenario; kInvalidArgument for a kind it does not know (parse_scenario
 /// rejects those first).
