@@ -54,8 +54,8 @@ void BM_MonteCarlo(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(r.value().rms_norm[0].back());
   }
-  state.counters["runs_per_s"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * kRuns, benchmark::Counter::kIsRate);
+  state.counters["runs_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()) * kRuns,
+                                                    benchmark::Counter::kIsRate);
 }
 
 // gfins-sim covariance on the manoeuvre with every error source: 2 s at 1 kHz, seven
