@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -245,6 +246,45 @@ TEST(RecordingTest, DamagedFilesOnDiskGiveTheSameErrorsAsInMemory) {
   EXPECT_FALSE(reader.value().next_block(block).is_ok());
   std::filesystem::remove(cut_path);
   std::filesystem::remove(bad_path);
+}
+
+TEST(RecordingTest, AReaderMovedInTheMiddleOfAFileContinuesWhereItWas) {
+  // Given a file of several blocks and a reader that has returned two of them (the stream reads
+  // through a buffer the reader owns, which must move with it),
+  const std::string path = temp_path("moved.gfr");
+  const std::string other_path = temp_path("moved_other.gfr");
+  const auto samples = test_samples();
+  ASSERT_TRUE(write_recording(path, test_header(), samples).is_ok());
+  ASSERT_TRUE(write_recording(other_path, test_header(), samples).is_ok());
+  std::vector<RawSample> got;
+  std::vector<RawSample> block;
+  std::optional<RecordingReader> second;
+  {
+    auto first = RecordingReader::open(path);
+    ASSERT_TRUE(first.is_ok()) << first.error().message;
+    for (int b = 0; b < 2; ++b) {
+      ASSERT_TRUE(first.value().next_block(block).value());
+      got.insert(got.end(), block.begin(), block.end());
+    }
+    // when it is moved into a new reader and the old one is destroyed,
+    second.emplace(std::move(first.value()));
+  }
+  // and that one is moved over a reader of another open file, then destroyed too,
+  auto third = RecordingReader::open(other_path);
+  ASSERT_TRUE(third.is_ok());
+  third.value() = std::move(*second);
+  second.reset();
+  for (;;) {
+    const auto more = third.value().next_block(block);
+    ASSERT_TRUE(more.is_ok()) << more.error().message;
+    if (!more.value()) break;
+    got.insert(got.end(), block.begin(), block.end());
+  }
+  // then the samples read are those of the file, in order, each once.
+  expect_same(got, samples);
+  EXPECT_EQ(third.value().records_read(), samples.size());
+  std::filesystem::remove(path);
+  std::filesystem::remove(other_path);
 }
 
 TEST(RecordingTest, CorruptHeaderFailsItsCrc) {
