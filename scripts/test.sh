@@ -48,12 +48,12 @@ fw_log="$log_dir/fw-rest.log"
   --can-log "$fw_log" >/dev/null
 ./build/host-release/host_sim/can_tool/gfins-can decode --view none "$fw_log"
 
-# Every installed program and subcommand from a temporary prefix, the checkout renamed away
-# while they run (docs/install.md); about 20 s.
+# Every installed program and subcommand from a temporary prefix, the source and build trees
+# hidden from them by a private mount namespace (docs/install.md); about 15 s.
 step "host-release: installed programs away from the trees (tests/install/install_test.sh)"
 ./tests/install/install_test.sh build/host-release
 # The README rows and docs blocks marked <!-- runnable -->, as written, after what bootstrap.sh
-# leaves (out/gfins installed); about 20 s.
+# leaves (out/gfins installed); about 30 s.
 step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
 ./tests/install/runnable_docs.py --build build/host-release
 
