@@ -29,7 +29,8 @@ class ScenarioNameCli : public ::testing::Test {
  protected:
   void SetUp() override {
     std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("gfins-names-" + std::to_string(rd()) + std::to_string(rd()));
+    dir_ =
+        fs::temp_directory_path() / ("gfins-names-" + std::to_string(rd()) + std::to_string(rd()));
     fs::create_directories(dir_ / "logs");
   }
   void TearDown() override {
