@@ -15,7 +15,8 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
   if (out_dir.empty()) out_dir = "sim-out/montecarlo-" + s.name;
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim montecarlo: %zu runs of %s\n", runs, describe(s).c_str());
-  const auto result = run_montecarlo(s, runs, seed0, tty_progress("montecarlo"), jobs);
+  const auto result =
+      run_montecarlo(s, runs, seed0, tty_progress("montecarlo"), NavScalar::kDouble, jobs);
   if (!result.is_ok()) return fail(result.error(), kExitError);
   const MonteCarloResult& r = result.value();
   if (auto w = write_montecarlo_csv(r, out_dir + "/montecarlo.csv"); !w.is_ok()) {

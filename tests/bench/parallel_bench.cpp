@@ -47,7 +47,7 @@ void BM_MonteCarlo(benchmark::State& state) {
     return;
   }
   for (auto _ : state) {
-    const auto r = run_montecarlo(s.value(), kRuns, 1, {}, jobs);
+    const auto r = run_montecarlo(s.value(), kRuns, 1, {}, NavScalar::kDouble, jobs);
     if (!r.is_ok()) {
       state.SkipWithError(r.error().message.c_str());
       break;

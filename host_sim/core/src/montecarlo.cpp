@@ -23,11 +23,12 @@ struct RunErrors {
 
 /// Run k of the Monte-Carlo: its seeds come from (seed0, k) only, so the run is the same on any
 /// thread and in any order (parallel.hpp).
-HostResult<RunErrors> one_run(const Scenario& base, std::uint64_t seed0, std::size_t k) {
+HostResult<RunErrors> one_run(const Scenario& base, std::uint64_t seed0, std::size_t k,
+                              NavScalar scalar) {
   Scenario s = base;
   s.seed = seed0 + k;
   s.calibration.seed = seed0 + 100003 * k;
-  GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false));
+  GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false, scalar));
   RunErrors r;
   r.calibration_angle_error_rad = o.calibration.rms_angle_error_rad;
   const auto& smp = o.compensated.samples;
@@ -50,7 +51,7 @@ HostResult<RunErrors> one_run(const Scenario& base, std::uint64_t seed0, std::si
 
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
                                             std::uint64_t seed0, const ProgressFn& progress,
-                                            std::size_t jobs) {
+                                            NavScalar scalar, std::size_t jobs) {
   if (runs < 2) {
     return HostError{ErrorCode::kInvalidArgument, "montecarlo: at least two runs are needed"};
   }
@@ -100,7 +101,7 @@ HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t ru
     return true;
   };
   ordered_parallel_for(
-      runs, jobs, [&](std::size_t k) { return one_run(base, seed0, k); }, fold);
+      runs, jobs, [&](std::size_t k) { return one_run(base, seed0, k, scalar); }, fold);
   if (failed) return *failed;
   const auto nr = static_cast<double>(runs);
   const std::size_t n = r.t_s.size();
