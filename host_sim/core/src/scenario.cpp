@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gfins/host_sim/pose_sequence.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "gfins/nav_core/paper_table6.hpp"
 
@@ -186,6 +187,35 @@ class Reader {
 
 Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
 
+/// The [trajectory] keys each kind reads (docs/simulation.md, "Scenario format"). A key of
+/// another kind would be silently ignored, so it is an error naming the kind and its keys.
+std::vector<std::string> trajectory_keys_of(const std::string& kind) {
+  if (kind == "rest") return {"kind", "euler_deg"};
+  if (kind == "constant_acceleration") return {"kind", "euler_deg", "accel_mps2"};
+  if (kind == "spin" || kind == "rate_table") return {"kind", "euler_deg", "axis_b", "rate_dps"};
+  if (kind == "coning") return {"kind", "euler_deg", "half_angle_deg", "cone_rate_hz"};
+  if (kind == "maneuver") return {"kind", "scale"};
+  if (kind == "drive") return {"kind", "speed_mps", "turn_amplitude_m", "turn_period_s"};
+  if (kind == "calibration_poses") return {"kind", "poses", "dwell_s"};
+  return {"kind"};
+}
+
+void check_trajectory_keys(const toml::table& tr, const Reader& rd, const std::string& kind) {
+  const std::vector<std::string> keys = trajectory_keys_of(kind);
+  for (const auto& [k, v] : tr) {
+    const std::string key(k.str());
+    if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    std::string list;
+    for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
+    std::string what = "does not apply to trajectory kind \"";
+    what += kind;
+    what += "\" (its keys: ";
+    what += list;
+    what += ")";
+    rd.fail(&v, "trajectory." + key, what);
+  }
+}
+
 constexpr double kBig = 1e9;
 
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
@@ -228,6 +258,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   t.kind = rd.string(tr, p, "kind", std::nullopt,
                      {"rest", "constant_acceleration", "spin", "rate_table", "coning", "maneuver",
                       "drive", "calibration_poses"});
+  check_trajectory_keys(tr, rd, t.kind);
   if (const auto e = rd.numbers(tr, p, "euler_deg", 3, -360.0, 360.0, false); !e.empty()) {
     t.euler0_rad = vec3(e) * kDegToRad;
   }
@@ -382,7 +413,11 @@ std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, dou
 
 HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& t) {
   const Quatd q0 = nav::quat_from_euler(t.euler0_rad.x(), t.euler0_rad.y(), t.euler0_rad.z());
-  if (t.kind == "rest" || t.kind == "calibration_poses") return make_rest(q0);
+  if (t.kind == "rest") return make_rest(q0);
+  if (t.kind == "calibration_poses") {
+    GFINS_TRY(const auto poses, calibration_pose_list(t.poses));
+    return make_pose_sequence(poses, t.dwell_s);
+  }
   if (t.kind == "constant_acceleration") return make_constant_acceleration(t.accel_n_mps2, q0);
   if (t.kind == "spin" || t.kind == "rate_table") return make_spin(t.axis_b, t.rate_rps, q0);
   if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);

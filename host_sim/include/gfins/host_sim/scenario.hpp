@@ -211,6 +211,12 @@ struct ScenarioOutcome {
   RunSeries compensated;
   CalibrationOutcome calibration;
   nav::Misalignment<double> compensator_misalignment{};
+  // The samples the runs navigated, as the ADC delivered them (empty for the paper's §6.3
+  // m/s² scenarios, which have no converter): sample 0 is the start (start_at), then every sample
+  // offered to the navigation loop. A calibration_poses scenario fills them too (its motion,
+  // pose_sequence.hpp), so that it can be recorded. write_run_recording() stores them.
+  std::vector<RawSample> raw;
+  double volts_per_count = 0.0;  // of the converter, V at the sensor output
 };
 
 /// Called with the fraction done (0..1) now and then; may be empty.
@@ -227,6 +233,19 @@ ArrayErrors array_errors(const Scenario& s);
 
 /// Scalar of the navigation core a run uses: float is the board's, double the host reference.
 enum class NavScalar : std::uint8_t { kFloat, kDouble };
+
+/// Memory a run of `s` holds (bytes): per sample the truth, the converter's output and one
+/// SampleRecord per run (two with the uncompensated run), times duration × rate + 1 samples.
+std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated = true);
+
+/// The largest run accepted (bytes of run_memory_bytes): 2 GiB, half of the 4 GiB of a small
+/// development machine or CI runner, so a run never ends in std::bad_alloc after minutes of work.
+inline constexpr std::uint64_t kMaxRunMemoryBytes = std::uint64_t{2} << 30;
+
+/// Checks before any work: at least two samples (duration × rate ≥ 1 sample period), and the
+/// memory estimate within kMaxRunMemoryBytes. The message names the scenario, the figures and
+/// the limit. run_scenario() calls it first.
+HostStatus check_run_size(const Scenario& s, bool with_uncompensated = true);
 
 /// Runs a navigation scenario twice with the same samples (one SampleSource stream, computed
 /// once): without compensation and with the scenario's compensator, both through the one
@@ -245,7 +264,15 @@ struct Bounds {
 Bounds linear_accel_bounds(const RunSeries& r);   // a_err_n, m/s²
 Bounds angular_accel_bounds(const RunSeries& r);  // wdot_err_b, rad/s²
 
-/// Writes a run as CSV: t, truth, estimate and errors.
-HostStatus write_series_csv(const RunSeries& r, const std::string& path);
+/// Writes a run as CSV: t, truth, estimate and errors, with units and frames in every column
+/// name (docs/simulation.md, "Output files"). `decimate` N keeps every N-th sample (and the
+/// last): 1 keeps all.
+HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate = 1);
+
+/// The recording header of a run of `s` (rate, the converter's LSB, the nominal Table 1
+/// geometry at the scenario's ρ) and the file: exactly the samples the run navigated
+/// (ScenarioOutcome::raw). kFailedPrecondition for a run without a converter (§6.3, m/s²).
+HostStatus write_run_recording(const Scenario& s, const ScenarioOutcome& o,
+                               const std::string& path);
 
 }  // namespace gfins::sim
