@@ -83,7 +83,10 @@ struct Rig {
 
 /// The codes of conversions 0..n-1 of the scenario, index-paced (the fast board's path).
 std::vector<RawSample> reference_samples(const sim::Scenario& s, std::uint32_t n) {
-  auto stream = sim_board::make_scenario_stream(s);
+  auto made = sim_board::make_scenario_stream(s);
+  EXPECT_TRUE(made.is_ok()) << made.error().message;
+  if (!made.is_ok()) return {};
+  auto stream = std::move(made).value();
   sim_board::ChipAdc adc(s.rate_hz);
   EXPECT_TRUE(adc.start().is_ok());
   sim_board::SampleClock clock;
@@ -114,7 +117,9 @@ TEST(SimGpioPacing, EachConversionTakesItsEdgesKernelTimeAndSequenceAndMissedEdg
   kernel.batches = {{t[0]}, {t[1], t[2]}, {t[3], t[4]}};
   const std::vector<std::uint32_t> expected_seq = {0, 1, 2, 4, 5};
 
-  auto stream = sim_board::make_scenario_stream(rig.scenario);
+  auto made = sim_board::make_scenario_stream(rig.scenario);
+  ASSERT_TRUE(made.is_ok()) << made.error().message;
+  auto stream = std::move(made).value();
   sim_board::ChipAdc adc(rig.scenario.rate_hz);
   ASSERT_TRUE(adc.start().is_ok());
   sim_board::SteadyClock clock;
@@ -150,7 +155,9 @@ TEST(SimGpioPacing, TheRunEndsAfterItsSamplesEvenWhenEdgesWereMissed) {
   dc.nominal_period_ns = kPeriodNs;
   auto line = lnx::GpiodDataReady::open(dc, kernel);
   ASSERT_TRUE(line.is_ok());
-  auto stream = sim_board::make_scenario_stream(rig.scenario);
+  auto made = sim_board::make_scenario_stream(rig.scenario);
+  ASSERT_TRUE(made.is_ok()) << made.error().message;
+  auto stream = std::move(made).value();
   sim_board::ChipAdc adc(rig.scenario.rate_hz);
   ASSERT_TRUE(adc.start().is_ok());
   sim_board::SteadyClock clock;

@@ -130,11 +130,12 @@ BoardResult make_sim_board(const FwConfig& c) {
   }
   const double duration = c.sim_duration_s > 0 ? c.sim_duration_s : s.duration_s;
   auto parts = std::make_shared<SimParts>();
-  parts->stream = sim_board::make_scenario_stream(s);
-  if (!parts->stream) {
-    out.error = "scenario " + s.name + ": its trajectory cannot be built";
+  auto stream = sim_board::make_scenario_stream(s);
+  if (!stream.is_ok()) {
+    out.error = stream.error().message;
     return out;
   }
+  parts->stream = std::move(stream).value();
   parts->adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
   if (const Status st = parts->adc->start(); !st.is_ok()) {
     out.error = std::string("simulated ADC start: ") + st.message();

@@ -216,12 +216,9 @@ namespace {
 // injection) behind them, so the source runs without one.
 class ScenarioStream final : public SensorStream {
  public:
-  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj)
-      : traj_(std::move(traj)),
-        source_(*traj_,
-                sim::SensorArrayModel(nav::table1_geometry<double>(s.rho_m), errors(s),
-                                      sim::gravity_model(s), s.rate_hz, s.seed),
-                nullptr, s.rate_hz) {
+  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj,
+                 sim::SensorArrayModel sensors)
+      : traj_(std::move(traj)), source_(*traj_, std::move(sensors), nullptr, s.rate_hz) {
     if (s.noise_uniform) source_.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   }
 
@@ -260,10 +257,21 @@ std::string device_id_for(const std::string& name) {
 
 }  // namespace
 
-std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s) {
+sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::Scenario& s) {
+  // Values, not exceptions: this runs inside gfins-fw (docs/architecture.md, errors).
   auto traj = sim::make_trajectory(s.trajectory);
-  if (!traj.is_ok()) return nullptr;
-  return std::make_unique<ScenarioStream>(s, std::move(traj).value());
+  if (!traj.is_ok()) {
+    return sim::HostError{traj.error().code, "scenario " + s.name + ": " + traj.error().message};
+  }
+  auto sensors =
+      sim::SensorArrayModel::make(nav::table1_geometry<double>(s.rho_m), ScenarioStream::errors(s),
+                                  sim::gravity_model(s), s.rate_hz, s.seed);
+  if (!sensors.is_ok()) {
+    return sim::HostError{sensors.error().code,
+                          "scenario " + s.name + ": " + sensors.error().message};
+  }
+  return std::unique_ptr<SensorStream>(
+      std::make_unique<ScenarioStream>(s, std::move(traj).value(), std::move(sensors).value()));
 }
 
 // ---- The chip -----------------------------------------------------------------------------

@@ -10,7 +10,6 @@
 
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
-#include "gfins/host_sim/pose_sequence.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/scenario.hpp"
@@ -170,7 +169,7 @@ ArrayErrors array_errors(const Scenario& s) {
     // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
     // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
     // out).
-    if (s.adc) e.scale_v_per_g = qa1100_sf;
+    if (s.adc) e.scale_v_per_g = s.scale_v_per_g[j] > 0 ? s.scale_v_per_g[j] : qa1100_sf;
     e.bias_g += s.bias_mps2[j] / g;
     // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
     if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
@@ -272,10 +271,8 @@ HostResult<ScenarioOutcome> run_scenario(const Scenario& s, const ProgressFn& pr
   if (s.trajectory.kind == "calibration_poses") {
     // No navigation run (the array turns between poses; the calibration is the product), but the
     // samples of the pose sequence, so that the calibration can be recorded and replayed.
-    GFINS_TRY(const auto poses, calibration_pose_list(s.trajectory.poses));
-    const auto traj = make_pose_sequence(
-        poses, s.trajectory.dwell_s, kPoseSlewS,
-        s.gravity == GravityChoice::kUp ? Vec3d(0.0, 0.0, 1.0) : Vec3d(0.0, 0.0, -1.0));
+    // The same motion as the simulated board's (make_trajectory, make_pose_sequence).
+    GFINS_TRY(const auto traj, make_trajectory(s.trajectory));
     GFINS_TRY(Stream st, make_stream(s, *traj));
     out.raw = std::move(st.raw);
     out.volts_per_count = st.volts_per_count;

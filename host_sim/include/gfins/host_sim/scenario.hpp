@@ -43,6 +43,9 @@ struct TrajectorySpec {
   double turn_period_s = 20.0;         // drive: period of one left-right weave
   std::string poses = "both";          // calibration_poses: "table2" | "table3" | "both"
   double dwell_s = 10.0;               // calibration_poses: time at rest in each pose
+  double transition_s = 2.0;           // calibration_poses: time to turn to the next pose
+  std::vector<Vec3d> extra_poses_g;    // calibration_poses: more poses after the tables' (e.g.
+                                       // verification poses), specific force in g, body axes
 };
 
 /// Where the compensator's misalignment comes from.
@@ -92,6 +95,10 @@ struct Scenario {
   CalibrationSpec calibration;
 
   bool noise_uniform = false;  // uniform noise of the same σ instead of Gaussian
+
+  // Per-sensor scale factor (V/g) behind the converter; 0 = the QA-1100's nominal 1.33 V/g.
+  // Known scale-factor errors of a simulated board to be calibrated ([sensors] scale_v_per_g).
+  std::array<double, 6> scale_v_per_g{};
 
   // The sensor model behind the outputs (SensorArrayModel, sensor_model.hpp): "paper" = unit-gain
   // sensors with only the errors above (the paper's §6.3); "qa1100" = AccelErrors::qa1100_typical
@@ -146,6 +153,12 @@ std::vector<std::string> closest_names(std::string_view name, const std::vector<
 /// The trajectory of a scenario; kInvalidArgument for a kind it does not know (parse_scenario
 /// rejects those first).
 HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& spec);
+
+/// The poses of a calibration_poses trajectory in order: Table 2's six, Table 3's six (or one
+/// table, trajectory.poses), then extra_poses_g; specific force sensed, body axes, g. Pose k
+/// (0-based) is held over [k·(dwell + transition), k·(dwell + transition) + dwell]
+/// (make_pose_sequence).
+std::vector<Vec3d> calibration_pose_vectors(const TrajectorySpec& spec);
 
 /// A vehicle drive with turns: forward at speed v along north, weaving east
 /// y(t) = A (1 − cos Ωt), Ω = 2π/period, heading along the velocity ψ = atan(ẏ/v), with a bank
@@ -214,7 +227,7 @@ struct ScenarioOutcome {
   // The samples the runs navigated, as the ADC delivered them (empty for the paper's §6.3
   // m/s² scenarios, which have no converter): sample 0 is the start (start_at), then every sample
   // offered to the navigation loop. A calibration_poses scenario fills them too (its motion,
-  // pose_sequence.hpp), so that it can be recorded. write_run_recording() stores them.
+  // make_pose_sequence), so that it can be recorded. write_run_recording() stores them.
   std::vector<RawSample> raw;
   double volts_per_count = 0.0;  // of the converter, V at the sensor output
 };

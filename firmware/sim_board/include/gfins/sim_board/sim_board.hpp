@@ -165,6 +165,9 @@ class MemoryCanBus final : public hal::CanBus {
 
   void refuse(bool on) { refuse_ = on; }
   void bus_off(bool on);
+  /// `n` received frames lost before the board read them, as SocketCAN reports a full socket
+  /// receive queue (SO_RXQ_OVFL: hal::CanCounters::rx_kernel_dropped).
+  void lose_received(std::uint32_t n) { counters_.rx_kernel_dropped += n; }
   /// Host → board frame (commands); false when the receive queue is full.
   bool inject_rx(const hal::CanFrame& f);
   /// Frames sent, oldest first (at most `capacity`); total() counts all ever sent.
@@ -189,8 +192,8 @@ class MemoryCanBus final : public hal::CanBus {
 };
 
 /// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
-/// null when the scenario's trajectory cannot be built.
-std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
+/// a HostError naming what cannot be built (trajectory, sensor model). Never throws.
+sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::Scenario& s);
 
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.
