@@ -87,11 +87,12 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   std::printf(
       "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
       describe(s).c_str(), noise, c.bias_ug, rw);
-  const CovarianceResult r = propagate_covariance(spec);
+  const CovarianceReport report = covariance_report(spec, times, c.jobs);
+  const CovarianceResult& r = report.envelopes;
   if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }
-  const ErrorBudget b = error_budget(spec, times);
+  const ErrorBudget& b = report.budget;
   if (auto w = write_budget_csv(b, out_dir + "/budget.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }

@@ -8,7 +8,7 @@
 
 namespace gfins::sim::app {
 
-int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0, std::size_t jobs,
                    const OutputOptions& out) {
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
@@ -28,7 +28,8 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim montecarlo: %zu runs of %s\n  navigation: %s\n", runs, describe(s).c_str(),
               scalar_text(scalar.value()));
-  const auto result = run_montecarlo(s, runs, seed0, tty_progress("montecarlo"), scalar.value());
+  const auto result =
+      run_montecarlo(s, runs, seed0, tty_progress("montecarlo"), scalar.value(), jobs);
   if (!result.is_ok()) return fail(result.error(), kExitError);
   const MonteCarloResult& r = result.value();
   if (auto w = write_montecarlo_csv(r, out_dir + "/montecarlo.csv"); !w.is_ok()) {

@@ -39,13 +39,14 @@ int cmd_run(const std::string& name, const OutputOptions& out);
 int cmd_paper63(const OutputOptions& out);
 
 /// gfins-sim montecarlo [NAME]: N seeds, envelopes and growth slopes.
-int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0, std::size_t jobs,
                    const OutputOptions& out);
 
 /// gfins-sim covariance [NAME]: predicted 1σ envelopes and error budget (docs/error-model.md).
 struct CovarianceOptions {
   double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;
   std::vector<double> times_s;
+  std::size_t jobs = 0;  // threads, 0: the hardware's (the output does not depend on it)
 };
 int cmd_covariance(const std::string& name, const CovarianceOptions& c, const OutputOptions& out);
 

@@ -111,6 +111,12 @@ int sim_main(int argc, char** argv) {
         ->check(CLI::IsMember({"float", "double"}))
         ->capture_default_str();
   }
+  std::size_t jobs = 0;  // 0: one thread per hardware thread (host_sim/parallel.hpp)
+  for (auto* c : {mc, cov}) {
+    c->add_option("-j,--jobs", jobs,
+                  "threads (default: the hardware's); the output does not depend on it")
+        ->check(CLI::Range(1, 1024));
+  }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
   for (auto* c : {run_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
   cli.require_subcommand(0, 1);
@@ -124,7 +130,8 @@ int sim_main(int argc, char** argv) {
   for (const auto* opt : out_opts) out.dir_given = out.dir_given || opt->count() > 0;
   if (*run_cmd) return app::cmd_run(scenario_name, out);
   if (*p63) return app::cmd_paper63(out);
-  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, out);
+  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out);
+  cov_opts.jobs = jobs;
   if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out);
   if (*list_cmd) return app::cmd_list();
   return app::cmd_default(o);
