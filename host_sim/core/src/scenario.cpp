@@ -195,7 +195,8 @@ std::vector<std::string> trajectory_keys_of(const std::string& kind) {
   if (kind == "coning") return {"kind", "euler_deg", "half_angle_deg", "cone_rate_hz"};
   if (kind == "maneuver") return {"kind", "scale"};
   if (kind == "drive") return {"kind", "speed_mps", "turn_amplitude_m", "turn_period_s"};
-  if (kind == "calibration_poses") return {"kind", "poses", "dwell_s"};
+  if (kind == "calibration_poses")
+    return {"kind", "poses", "dwell_s", "transition_s", "extra_poses_g"};
   return {"kind"};
 }
 
