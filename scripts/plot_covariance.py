@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """Figures of `gfins-sim covariance`: predicted 1-sigma envelopes and the error budget.
 
-Usage: plot_covariance.py OUT_DIR
-Reads OUT_DIR/covariance.csv (t_s, sigma_<state> for the twelve navigation errors) and
-OUT_DIR/budget.csv (source, t_s, sigma_<state>); writes OUT_DIR/covariance.png (envelopes,
-linear and log-log) and OUT_DIR/budget.png (each source's sigma at the last budget time).
+Usage: plot_covariance.py OUT_DIR [TITLE]
+Reads OUT_DIR/covariance.csv (t_s, sigma_<state> for the twelve navigation errors),
+OUT_DIR/budget.csv (source, t_s, sigma_<state>) and, when present, OUT_DIR/reference_run.csv
+(one run of the scenario through the navigation core, gfins-sim run's columns); writes
+OUT_DIR/covariance.png (envelopes, linear and log-log, with the run's errors) and
+OUT_DIR/budget.png (each non-zero source's sigma at every budget time). TITLE (the scenario and
+the core) heads both figures.
 Run it with /usr/bin/python3 (Debian's python3-matplotlib).
 """
 import csv
@@ -46,67 +49,92 @@ def state_columns(header, prefix):
     return [h for h in header if h.startswith("sigma_" + prefix)]
 
 
-def plot_envelopes(out_dir):
+# The reference run's error columns for the blocks whose frame matches (the run's attitude error
+# is in the body frame, the covariance's phi in the navigation frame: not overlaid).
+RUN_COLUMNS = {"dr_n": ("err_r_n", "m"), "dv_n": ("err_v_n", "mps"), "dw_b": ("err_w_b", "rps")}
+
+
+def plot_envelopes(out_dir, fig_title):
     rows = read_csv(os.path.join(out_dir, "covariance.csv"))
     t = column(rows, "t_s")
     header = list(rows[0].keys())
+    run_path = os.path.join(out_dir, "reference_run.csv")
+    run = read_csv(run_path) if os.path.exists(run_path) else None
     fig, axes = plt.subplots(4, 2, figsize=(12, 13))
+    colors = ["tab:red", "tab:green", "tab:blue"]
     for i, (title, prefix, unit, scale) in enumerate(BLOCKS):
-        for name in state_columns(header, prefix):
+        for k, name in enumerate(state_columns(header, prefix)):
             y = [v * scale for v in column(rows, name)]
             # The column names carry the CSV's unit (rad, m, ...); the axis states the plotted one.
             label = name.replace("sigma_", "").rsplit("_", 1)[0]
-            axes[i][0].plot(t, y, label=label)
+            axes[i][0].plot(t, y, color=colors[k], label="1σ " + label)
             pos = [(a, b) for a, b in zip(t, y) if a > 0 and b > 0]
             if pos:
-                axes[i][1].loglog([p[0] for p in pos], [p[1] for p in pos], label=label)
-        axes[i][0].set_title(f"{title}: predicted 1 sigma")
+                axes[i][1].loglog([p[0] for p in pos], [p[1] for p in pos], color=colors[k],
+                                  label="1σ " + label)
+            if run is not None and prefix in RUN_COLUMNS:
+                pre, u = RUN_COLUMNS[prefix]
+                axis = "xyz"[k]
+                tr = column(run, "t_s")
+                er = [abs(v) * scale for v in column(run, f"{pre}_{axis}_{u}")]
+                axes[i][0].plot(tr, er, color=colors[k], ls=":", lw=1, label=f"|one run| {axis}")
+        axes[i][0].set_title(f"{title}: predicted 1 sigma", fontsize=9)
         axes[i][0].set_ylabel(unit)
+        axes[i][1].set_ylabel(unit)
         axes[i][1].set_title("log-log (slope = growth exponent)")
         for ax in axes[i]:
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
     for ax in axes[-1]:
         ax.set_xlabel("t, s")
+    fig.suptitle(f"predicted error envelopes: {fig_title}", fontsize=11)
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "covariance.png"), dpi=110)
     plt.close(fig)
 
 
-def plot_budget(out_dir):
+def plot_budget(out_dir, fig_title):
     path = os.path.join(out_dir, "budget.csv")
     if not os.path.exists(path):
         return
-    rows = read_csv(path)
-    t_last = max(float(r["t_s"]) for r in rows)
-    rows = [r for r in rows if float(r["t_s"]) == t_last]
-    header = [h for h in rows[0].keys() if h.startswith("sigma_")]
-    sources = [r["source"] for r in rows]
-    fig, axes = plt.subplots(2, 2, figsize=(12, 8))
-    for ax, (title, prefix, unit, scale) in zip(axes.flat, BLOCKS):
-        names = [h for h in header if h.startswith("sigma_" + prefix)]
-        width = 0.8 / max(1, len(sources))
-        for k, r in enumerate(rows):
-            xs = [i + k * width for i in range(len(names))]
-            ys = [float(r[n]) * scale for n in names]
-            ax.bar(xs, ys, width, label=sources[k])
-        ax.set_xticks([i + 0.4 - width / 2 for i in range(len(names))])
-        ax.set_xticklabels([n.replace("sigma_", "") for n in names], fontsize=8)
-        ax.set_yscale("log")
-        ax.set_ylabel(unit)
-        ax.set_title(f"{title}: 1 sigma by source at t = {t_last:g} s")
-        ax.grid(True, axis="y", which="both", alpha=0.3)
-    axes.flat[0].legend(fontsize=7)
+    all_rows = read_csv(path)
+    times = sorted({float(r["t_s"]) for r in all_rows})
+    header = [h for h in all_rows[0].keys() if h.startswith("sigma_")]
+    # Sources that contribute nothing (σ = 0 everywhere) are left out: they would be empty bars
+    # on a log axis.
+    sources = [src for src in dict.fromkeys(r["source"] for r in all_rows)
+               if any(float(r[h]) > 0 for r in all_rows if r["source"] == src for h in header)]
+    fig, axes = plt.subplots(len(times), 4, figsize=(18, 3.6 * len(times)), squeeze=False)
+    for row, t_b in enumerate(times):
+        rows = [r for r in all_rows if float(r["t_s"]) == t_b and r["source"] in sources]
+        for ax, (title, prefix, unit, scale) in zip(axes[row], BLOCKS):
+            names = [h for h in header if h.startswith("sigma_" + prefix)]
+            width = 0.8 / max(1, len(rows))
+            for k, r in enumerate(rows):
+                xs = [i + k * width for i in range(len(names))]
+                ys = [float(r[n]) * scale for n in names]
+                ax.bar(xs, ys, width, label=r["source"])
+            ax.set_xticks([i + 0.4 - width / 2 for i in range(len(names))])
+            # Tick labels name the state and axis; the unit is the axis label's (the plotted one).
+            ax.set_xticklabels([n.replace("sigma_", "").rsplit("_", 1)[0] for n in names],
+                               fontsize=8)
+            ax.set_yscale("log")
+            ax.set_ylabel(f"1σ ({unit})")
+            ax.set_title(f"{title} at t = {t_b:g} s", fontsize=9)
+            ax.grid(True, axis="y", which="both", alpha=0.3)
+            ax.legend(fontsize=6)
+    fig.suptitle(f"error budget by source: {fig_title}", fontsize=11)
     fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, "budget.png"), dpi=110)
+    fig.savefig(os.path.join(out_dir, "budget.png"), dpi=90)
     plt.close(fig)
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
-    plot_envelopes(sys.argv[1])
-    plot_budget(sys.argv[1])
+    title = sys.argv[2] if len(sys.argv) == 3 else os.path.basename(sys.argv[1].rstrip("/"))
+    plot_envelopes(sys.argv[1], title)
+    plot_budget(sys.argv[1], title)
     print(f"figures: {sys.argv[1]}/covariance.png, {sys.argv[1]}/budget.png")
 
 

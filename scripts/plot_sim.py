@@ -1,9 +1,14 @@
 #!/usr/bin/env python3
 """Figures of gfins-sim (docs/simulation.md). Called by gfins-sim itself:
 
-    plot_sim.py run DIR          DIR/{uncompensated,compensated}.csv → DIR/*.png
-    plot_sim.py paper63 DIR      DIR/<config>_{before,after}.csv → Figs. 7-10 and navigation errors
-    plot_sim.py montecarlo DIR   DIR/montecarlo.csv → envelopes and log-log growth
+    plot_sim.py run DIR [TITLE]         DIR/{uncompensated,compensated}.csv → DIR/*.png
+    plot_sim.py paper63 DIR [CORE]      DIR/<config>_{before,after}.csv → Figs. 7-10, nav errors
+    plot_sim.py montecarlo DIR [TITLE]  DIR/montecarlo.csv → envelopes and log-log growth
+    plot_sim.py replay DIR [TITLE]      DIR/navigation.csv (gfins-replay) → DIR/replay.png
+
+TITLE names the scenario (or recording), the compensator and the core; every figure carries it.
+Column names carry units and frames (docs/simulation.md, "Output files"): err_v_n_x_mps is the
+velocity error along north, m/s; err_att_b_x_rad the attitude error about body x, rad.
 
 Matplotlib with the Agg backend (no display needed); numpy comes with matplotlib.
 """
@@ -28,11 +33,35 @@ def load(path):
     return np.genfromtxt(path, delimiter=",", names=True)
 
 
-def plot_vec(ax, d, prefix, scale=1.0, label_prefix=""):
-    for i, a in enumerate(AXES):
-        ax.plot(d["t_s"], d[prefix + a] * scale, color=COLORS[i], lw=1, label=label_prefix + a)
+# Column prefix and unit suffix of each quantity in the CSV files, and the axis names of its
+# frame: body FRD (x forward, y right, z down) or NED (north, east, down).
+BODY = ["body x", "body y", "body z"]
+NED = ["north", "east", "down"]
+Q = {"err_a": ("err_a_n", "mps2", NED), "err_wdot": ("err_wdot_b", "rps2", BODY),
+     "err_att": ("err_att_b", "rad", BODY), "err_v": ("err_v_n", "mps", NED),
+     "err_r": ("err_r_n", "m", NED), "est_w": ("est_w_b", "rps", BODY),
+     "est_v": ("est_v_n", "mps", NED), "est_r": ("est_r_n", "m", NED),
+     "est_a": ("est_a_n", "mps2", NED)}
+
+
+def column(d, key, i):
+    pre, unit, _ = Q[key]
+    return d[f"{pre}_{AXES[i]}_{unit}"]
+
+
+# The paper's §6.3 navigation frame is not NED: gravity along its −z (docs/simulation.md).
+PAPER_NAV = ["nav x", "nav y", "nav z"]
+
+
+def plot_vec(ax, d, key, scale=1.0, label_prefix="", names=None):
+    if names is None or Q[key][2] is BODY:
+        names = Q[key][2]
+    for i in range(3):
+        ax.plot(d["t_s"], column(d, key, i) * scale, color=COLORS[i], lw=1,
+                label=label_prefix + names[i])
     ax.grid(True, alpha=0.3)
     ax.set_xlabel("t (s)")
+    ax.legend(loc="best", fontsize=7)
 
 
 def save(fig, path):
@@ -42,34 +71,59 @@ def save(fig, path):
     print("  " + path)
 
 
-def nav_errors(before, after, title, path):
+def nav_errors(before, after, title, path, nav_names=None):
     fig, axs = plt.subplots(3, 2, figsize=(10, 7), sharex=True)
-    rows = [("err_att", 180 / np.pi, "attitude error (deg)"), ("err_v", 1, "velocity error (m/s)"),
-            ("err_r", 1, "position error (m)")]
+    rows = [("err_att", 180 / np.pi, "attitude error, body (deg)"),
+            ("err_v", 1, "velocity error, NED (m/s)"), ("err_r", 1, "position error, NED (m)")]
     for r, (pre, k, lab) in enumerate(rows):
         for c, (d, which) in enumerate([(before, "before"), (after, "after")]):
-            plot_vec(axs[r][c], d, pre, k)
-            axs[r][c].set_ylabel(lab)
+            plot_vec(axs[r][c], d, pre, k, names=nav_names)
+            axs[r][c].set_ylabel(lab if nav_names is None else lab.replace("NED", "nav frame"),
+                                 fontsize=8)
             if r == 0:
                 axs[r][c].set_title(which + " compensation")
-    axs[0][0].legend(loc="best", fontsize=8)
     fig.suptitle(title, fontsize=10)
     save(fig, path)
 
 
-def cmd_run(d):
+def cmd_run(d, title):
     before = load(d + "/uncompensated.csv")
     after = load(d + "/compensated.csv")
     fig, axs = plt.subplots(2, 2, figsize=(10, 6), sharex=True)
     for c, (data, which) in enumerate([(before, "before"), (after, "after")]):
         plot_vec(axs[0][c], data, "err_a")
-        axs[0][c].set_ylabel("linear accel. error (m/s²)")
+        axs[0][c].set_ylabel("linear accel. error, NED (m/s²)")
         axs[0][c].set_title(which + " compensation")
         plot_vec(axs[1][c], data, "err_wdot")
-        axs[1][c].set_ylabel("angular accel. error (rad/s²)")
-    axs[0][0].legend(fontsize=8)
+        axs[1][c].set_ylabel("angular accel. error, body (rad/s²)")
+    fig.suptitle(f"acceleration errors: {title}", fontsize=10)
     save(fig, d + "/accel_errors.png")
-    nav_errors(before, after, d, d + "/nav_errors.png")
+    nav_errors(before, after, f"navigation errors: {title}", d + "/nav_errors.png")
+
+
+def cmd_replay(d, title):
+    n = load(d + "/navigation.csv")
+    q = np.stack([n["est_q_nb_" + c] for c in "wxyz"])
+    w, x, y, z = q
+    roll = np.degrees(np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y)))
+    pitch = np.degrees(np.arcsin(np.clip(2 * (w * y - z * x), -1, 1)))
+    yaw = np.degrees(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+    fig, axs = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
+    for v, lab, c in zip((roll, pitch, yaw), ("roll", "pitch", "yaw"), COLORS):
+        axs[0][0].plot(n["t_s"], v, color=c, lw=1, label=lab)
+    axs[0][0].set_ylabel("attitude, body to NED (deg)")
+    axs[0][0].grid(True, alpha=0.3)
+    axs[0][0].legend(loc="best", fontsize=7)
+    plot_vec(axs[0][1], n, "est_w")
+    axs[0][1].set_ylabel("angular rate, body (rad/s)")
+    plot_vec(axs[1][0], n, "est_v")
+    axs[1][0].set_ylabel("velocity, NED (m/s)")
+    plot_vec(axs[1][1], n, "est_r")
+    axs[1][1].set_ylabel("position from the alignment point, NED (m)")
+    for ax in axs[0]:
+        ax.set_xlabel("")
+    fig.suptitle(f"replay: {title}\n(t from the end of the alignment)", fontsize=10)
+    save(fig, d + "/replay.png")
 
 
 PAPER = {"before_lin": (-8, 2), "before_ang": (-0.1, 0.5), "after_lin": (-0.002, 0.003),
@@ -88,40 +142,50 @@ ASSUME = {"matching": "ρ=0.35 m, g along −z, 2 s at 100 Hz, σ=5e-4 m/s² Gau
           "1mg-calibrated": "as 1mg, compensator from a simulated calibration (1 mg per pose mean)"}
 
 
-def cmd_paper63(d):
+def cmd_paper63(d, core):
     for cfg, assume in ASSUME.items():
         data = {"before": load(f"{d}/{cfg}_before.csv"), "after": load(f"{d}/{cfg}_after.csv")}
         for fig_name, which, pre, title, key in FIGS:
             fig, ax = plt.subplots(figsize=(6.4, 3.6))
-            plot_vec(ax, data[which], pre)
+            plot_vec(ax, data[which], pre, names=PAPER_NAV)
             lo, hi = PAPER[key]
             ax.axhline(lo, color="k", ls="--", lw=0.8, label="paper's bounds")
             ax.axhline(hi, color="k", ls="--", lw=0.8)
-            ax.set_title(title, fontsize=9)
+            ax.set_title(f"§6.3 {cfg} ({core} core): {title}", fontsize=8)
+            unit = title[title.rindex("(") + 1:-1]
+            frame = "nav frame" if pre == "err_a" else "body"
+            ax.set_ylabel(f"{title.split(' error')[0]} error, {frame} ({unit})", fontsize=8)
             ax.legend(fontsize=7, loc="best")
             fig.text(0.01, 0.01, assume, fontsize=6)
             save(fig, f"{d}/{fig_name}_{cfg}.png")
-        nav_errors(data["before"], data["after"], f"§6.3 navigation errors, {cfg}: {assume}",
-                   f"{d}/nav_errors_{cfg}.png")
+        nav_errors(data["before"], data["after"],
+                   f"§6.3 navigation errors, {cfg} ({core} core): {assume}",
+                   f"{d}/nav_errors_{cfg}.png", nav_names=PAPER_NAV)
 
 
-def cmd_montecarlo(d):
+def cmd_montecarlo(d, title):
     m = load(d + "/montecarlo.csv")
     t = m["t_s"]
     qs = [("w_err_b_rps", 1, "ω error (rad/s)"), ("att_err_b_rad", 180 / np.pi, "attitude error (deg)"),
           ("v_err_n_mps", 1, "velocity error (m/s)"), ("r_err_n_m", 1, "position error (m)")]
-    fig, axs = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
-    for ax, (q, k, lab) in zip(axs.flat, qs):
-        mean = m[q + "_x_mean"] * k
-        sd = m[q + "_x_std"] * k
-        ax.fill_between(t, mean - 3 * sd, mean + 3 * sd, color="tab:blue", alpha=0.15, label="±3σ")
-        ax.fill_between(t, mean - sd, mean + sd, color="tab:blue", alpha=0.35, label="±1σ")
-        ax.plot(t, mean, color="k", lw=1, label="mean")
-        ax.set_ylabel(lab + ", x axis")
-        ax.grid(True, alpha=0.3)
-    axs[0][0].legend(fontsize=8)
-    for ax in axs[1]:
+    frames = [BODY, BODY, NED, NED]
+    fig, axs = plt.subplots(4, 3, figsize=(13, 11), sharex=True)
+    for r, ((q, k, lab), names) in enumerate(zip(qs, frames)):
+        for a in range(3):
+            ax = axs[r][a]
+            mean = m[f"{q}_{AXES[a]}_mean"] * k
+            sd = m[f"{q}_{AXES[a]}_std"] * k
+            ax.fill_between(t, mean - 3 * sd, mean + 3 * sd, color=COLORS[a], alpha=0.15,
+                            label="mean ± 3σ")
+            ax.fill_between(t, mean - sd, mean + sd, color=COLORS[a], alpha=0.35,
+                            label="mean ± 1σ")
+            ax.plot(t, mean, color="k", lw=1, label="mean")
+            ax.set_ylabel(f"{lab}, {names[a]}", fontsize=8)
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=6, loc="upper left")
+    for ax in axs[-1]:
         ax.set_xlabel("t (s)")
+    fig.suptitle(f"Monte-Carlo error envelopes over the runs: {title}", fontsize=10)
     save(fig, d + "/montecarlo_envelopes.png")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
@@ -131,18 +195,23 @@ def cmd_montecarlo(d):
         ax.loglog(t[sel], y, color=c, label="RMS |" + lab.split(" (")[0] + "|")
         i = np.searchsorted(t[sel], t[-1] / 10)
         ref = y[-1] * (t[sel] / t[-1]) ** p
-        ax.loglog(t[sel][i:], ref[i:], color=c, ls="--", lw=0.8, label=f"∝ t^{p} (kinematics)")
+        ax.loglog(t[sel][i:], ref[i:], color="k", ls="--", lw=1.5,
+                  label=f"∝ t^{p} (kinematics), last decade")
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("RMS over runs (rad/s, rad)")
+    ax.set_ylabel("RMS over runs (ω: rad/s, attitude: rad)")
+    ax.set_title(f"error growth: {title}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     save(fig, d + "/montecarlo_growth.png")
 
 
 def main():
-    if len(sys.argv) != 3 or sys.argv[1] not in ("run", "paper63", "montecarlo"):
+    cmds = {"run": cmd_run, "paper63": cmd_paper63, "montecarlo": cmd_montecarlo,
+            "replay": cmd_replay}
+    if len(sys.argv) not in (3, 4) or sys.argv[1] not in cmds:
         sys.exit(__doc__)
-    {"run": cmd_run, "paper63": cmd_paper63, "montecarlo": cmd_montecarlo}[sys.argv[1]](sys.argv[2])
+    default = "float32" if sys.argv[1] == "paper63" else sys.argv[2]
+    cmds[sys.argv[1]](sys.argv[2], sys.argv[3] if len(sys.argv) == 4 else default)
 
 
 if __name__ == "__main__":

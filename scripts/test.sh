@@ -48,12 +48,12 @@ fw_log="$log_dir/fw-rest.log"
   --can-log "$fw_log" >/dev/null
 ./build/host-release/host_sim/can_tool/gfins-can decode --view none "$fw_log"
 
-# Every installed program and subcommand from a temporary prefix, the checkout renamed away
-# while they run (docs/install.md); about 20 s.
+# Every installed program and subcommand from a temporary prefix, the source and build trees
+# hidden from them by a private mount namespace (docs/install.md); about 15 s.
 step "host-release: installed programs away from the trees (tests/install/install_test.sh)"
 ./tests/install/install_test.sh build/host-release
 # The README rows and docs blocks marked <!-- runnable -->, as written, after what bootstrap.sh
-# leaves (out/gfins installed); about 20 s.
+# leaves (out/gfins installed); about 30 s.
 step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
 ./tests/install/runnable_docs.py --build build/host-release
 
@@ -76,12 +76,16 @@ ctest --preset aarch64-linux -j "$jobs" | tee "$log_dir/ctest-aarch64-linux.log"
 step "Debian packages (amd64, arm64) and lintian"
 ./scripts/package.sh deb-amd64 aarch64-linux
 
-# infra (Debian's tools on vcan0 and the gpio-sim line), canlog (canplayer replays a firmware
-# candump log on vcan0, gfins-can decodes it live; needs the host-release build above) and
-# service (systemd's notify and watchdog in a debootstrap root) pass today; backend, fw and faults need programs that do not
-# pass or exist yet (docs/deploy.md, "What the VM test checks") and are added here as they do.
+# One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
+# backends' real-kernel checks), fw / cmd / faults (the unchanged gfins-fw paced by the gpio-sim
+# line, on vcan0: output within one quantisation step of a host-only run, every CAN command,
+# kernel-made faults) and canlog; a second boot runs service (systemd: the amd64 package above
+# installed in a clean root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in
+# docs/ci.md.
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
-./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,canlog,service}"
+fw_deb=$(ls out/deb/gfins-fw_*_amd64.deb | head -n 1)
+./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
+  --deb "$fw_deb"
 
 step "clang-tidy"
 ./scripts/check-tidy.sh build/host-release

@@ -34,8 +34,23 @@ endif()
 
 # Programs built for the board cannot run here unless qemu-user is installed (then CTest and
 # gtest_discover_tests can use it).
+#
+# The dynamic loader and libc.so.6 must come from the same glibc build: they share private
+# state (the loader's _rtld_global, which pthread_create uses for its stack cache). With
+# `-L /usr/<triple>` qemu-user takes the loader from the cross compiler's libc
+# (libc6-<arch>-cross), but that loader reads the host's /etc/ld.so.cache, which lists the
+# multiarch libc (libc6:<arch>, /lib/<triple>/libc.so.6) whenever it is installed; the two are
+# different Debian revisions (2.36-8 and 2.36-9+deb12uN on Debian 12), and the first
+# pthread_create then spins forever on aarch64 and crashes on armhf. So when the multiarch libc
+# is present (scripts/install-cross-deps.sh installs it, and the binfmt handlers use it for
+# programs the tests start), qemu-user runs without -L and takes loader and libc from there, as
+# the board does; the cross compiler's sysroot is only used when nothing else is installed.
 find_program(GFINS_CROSS_EMULATOR NAMES qemu-${CMAKE_SYSTEM_PROCESSOR}-static
                                         qemu-${CMAKE_SYSTEM_PROCESSOR})
 if(GFINS_CROSS_EMULATOR)
-  set(CMAKE_CROSSCOMPILING_EMULATOR ${GFINS_CROSS_EMULATOR} -L /usr/${GFINS_CROSS_TRIPLE})
+  if(EXISTS /lib/${GFINS_CROSS_TRIPLE}/libc.so.6)
+    set(CMAKE_CROSSCOMPILING_EMULATOR ${GFINS_CROSS_EMULATOR})
+  else()
+    set(CMAKE_CROSSCOMPILING_EMULATOR ${GFINS_CROSS_EMULATOR} -L /usr/${GFINS_CROSS_TRIPLE})
+  endif()
 endif()

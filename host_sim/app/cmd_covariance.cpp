@@ -9,16 +9,58 @@
 #include "common.hpp"
 #include "gfins/host_sim/covariance.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
+#include "run_options.hpp"
 
 namespace gfins::sim::app {
 
-int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::string out_dir,
-                   bool do_plot) {
+namespace {
+
+/// The options a user gives in physical units: a negative σ or a time outside the run is refused
+/// (not clamped), with the option, the value and what is allowed.
+HostStatus check_options(const Scenario& s, const CovarianceOptions& c) {
+  const std::pair<const char*, double> sigmas[] = {{"--bias-ug", c.bias_ug},
+                                                   {"--bias-rw", c.bias_rw_ug_sqrt_s},
+                                                   {"--scale-ppm", c.scale_ppm},
+                                                   {"--orientation-urad", c.orientation_urad},
+                                                   {"--location-mm", c.location_mm}};
+  char buf[256];
+  for (const auto& [opt, v] : sigmas) {
+    if (!std::isfinite(v) || v < 0) {
+      std::snprintf(buf, sizeof buf, "%s %g: a 1-sigma must be a number >= 0", opt, v);
+      return HostError{ErrorCode::kInvalidArgument, buf};
+    }
+  }
+  for (double t : c.times_s) {
+    if (!std::isfinite(t) || t <= 0 || t > s.duration_s) {
+      std::snprintf(buf, sizeof buf,
+                    "--at %g: outside the run of scenario %s: a budget time must be in (0, %g] s "
+                    "(its duration_s)",
+                    t, s.name.c_str(), s.duration_s);
+      return HostError{ErrorCode::kOutOfRange, buf};
+    }
+  }
+  return Done{};
+}
+
+}  // namespace
+
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, const OutputOptions& out) {
   namespace nav = gfins::nav;
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
   const Scenario& s = loaded.value();
-  if (out_dir.empty()) out_dir = "sim-out/covariance-" + s.name;
+  const auto dir = output_dir(out, "sim-out/covariance-" + s.name);
+  if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
+  const auto scalar = nav_scalar(out.scalar);
+  if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
+  if (auto k = check_options(s, c); !k.is_ok()) return fail(k.error(), kExitBadInput);
+  if (s.trajectory.kind == "calibration_poses") {
+    return fail({ErrorCode::kInvalidArgument,
+                 "scenario " + s.name + " is a calibration, not a navigation run"},
+                kExitBadInput);
+  }
+  if (auto k = check_run_size(s, false); !k.is_ok()) return fail(k.error(), kExitBadInput);
+  const std::string& out_dir = dir.value();
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   auto traj = make_trajectory(s.trajectory);
   if (!traj.is_ok()) return fail(traj.error(), kExitBadInput);
@@ -45,11 +87,12 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::str
   std::printf(
       "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
       describe(s).c_str(), noise, c.bias_ug, rw);
-  const CovarianceResult r = propagate_covariance(spec);
+  const CovarianceReport report = covariance_report(spec, times, c.jobs);
+  const CovarianceResult& r = report.envelopes;
   if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }
-  const ErrorBudget b = error_budget(spec, times);
+  const ErrorBudget& b = report.budget;
   if (auto w = write_budget_csv(b, out_dir + "/budget.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }
@@ -64,8 +107,24 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::str
       "|dw| %.4g rad/s\nwritten: %s/covariance.csv, %s/budget.csv\n",
       r.t_s[last], block(0) * 180.0 / M_PI, block(3), block(6), block(9), out_dir.c_str(),
       out_dir.c_str());
-  if (!do_plot) return kExitOk;
-  if (auto p = plot("plot_covariance.py", {out_dir}); !p.is_ok()) {
+  // One run of the scenario (its own sensor errors) through the navigation core in the chosen
+  // scalar: a sample of what the envelopes predict, written next to them. The propagation
+  // above is the linear error model in double whatever the core's scalar.
+  const auto ref = run_scenario(s, tty_progress("reference run"), false, scalar.value());
+  if (!ref.is_ok()) return fail(ref.error(), kExitError);
+  const std::string ref_path = out_dir + "/reference_run.csv";
+  if (auto w = write_series_csv(ref.value().compensated, ref_path, spec.decimation); !w.is_ok()) {
+    return fail(w.error(), kExitError);
+  }
+  const NavSummary ns = nav_summary(ref.value().compensated);
+  std::printf(
+      "one run through the %s: final |att| %.4g deg, |dr| %.4g m, |dv| %.4g m/s\nwritten: %s\n",
+      scalar_text(scalar.value()), ns.att_final_deg, ns.pos_final_m, ns.vel_final_mps,
+      ref_path.c_str());
+  if (!out.plot) return kExitOk;
+  const std::string title = s.name + ", reference run in the " +
+                            (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
+  if (auto p = plot("plot_covariance.py", {out_dir, title}); !p.is_ok()) {
     return fail(p.error(), kExitPlotFailed);
   }
   return kExitOk;

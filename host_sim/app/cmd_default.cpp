@@ -76,6 +76,7 @@ int cmd_default(const DefaultOptions& o) {
   s.noise_uniform = false;
   s.compensator = nav::CompensatorKind::kNone;
   s.misalignment_source = MisalignmentSource::kTrue;
+  if (auto c = check_run_size(s, false); !c.is_ok()) return fail(c.error(), kExitBadInput);
   const NavScalar scalar = o.scalar == "float" ? NavScalar::kFloat : NavScalar::kDouble;
   std::FILE* csv = nullptr;
   if (!o.csv_path.empty()) {

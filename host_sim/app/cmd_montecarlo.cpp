@@ -4,18 +4,32 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "gfins/host_sim/montecarlo.hpp"
+#include "run_options.hpp"
 
 namespace gfins::sim::app {
 
-int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
-                   std::string out_dir, bool do_plot) {
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0, std::size_t jobs,
+                   const OutputOptions& out) {
   auto loaded = load(name);
   if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
   const Scenario& s = loaded.value();
-  if (out_dir.empty()) out_dir = "sim-out/montecarlo-" + s.name;
+  const auto dir = output_dir(out, "sim-out/montecarlo-" + s.name);
+  if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
+  const auto scalar = nav_scalar(out.scalar);
+  if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
+  if (s.trajectory.kind == "calibration_poses") {
+    return fail({ErrorCode::kInvalidArgument,
+                 "scenario " + s.name + " is a calibration, not a navigation run"},
+                kExitBadInput);
+  }
+  // One run is in memory at a time (the statistics are running sums).
+  if (auto c = check_run_size(s, false); !c.is_ok()) return fail(c.error(), kExitBadInput);
+  const std::string& out_dir = dir.value();
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
-  std::printf("gfins-sim montecarlo: %zu runs of %s\n", runs, describe(s).c_str());
-  const auto result = run_montecarlo(s, runs, seed0, tty_progress("montecarlo"));
+  std::printf("gfins-sim montecarlo: %zu runs of %s\n  navigation: %s\n", runs, describe(s).c_str(),
+              scalar_text(scalar.value()));
+  const auto result =
+      run_montecarlo(s, runs, seed0, tty_progress("montecarlo"), scalar.value(), jobs);
   if (!result.is_ok()) return fail(result.error(), kExitError);
   const MonteCarloResult& r = result.value();
   if (auto w = write_montecarlo_csv(r, out_dir + "/montecarlo.csv"); !w.is_ok()) {
@@ -44,8 +58,11 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
                  r.rms_norm[3].back());
   }
   if (auto c = close_output(f, slopes_path); !c.is_ok()) return fail(c.error(), kExitError);
-  if (!do_plot) return kExitOk;
-  if (auto p = plot("plot_sim.py", {"montecarlo", out_dir}); !p.is_ok()) {
+  if (!out.plot) return kExitOk;
+  const std::string title = s.name + ", " + nav::to_string(s.compensator) + " compensator, " +
+                            std::to_string(runs) + " runs, " +
+                            (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
+  if (auto p = plot("plot_sim.py", {"montecarlo", out_dir, title}); !p.is_ok()) {
     return fail(p.error(), kExitPlotFailed);
   }
   return kExitOk;

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "run_options.hpp"
 
 namespace gfins::sim::app {
 namespace {
@@ -19,8 +20,12 @@ struct Paper63Config {
 
 }  // namespace
 
-int cmd_paper63(std::string out_dir, bool do_plot) {
-  if (out_dir.empty()) out_dir = "sim-out/paper63";
+int cmd_paper63(const OutputOptions& out) {
+  const auto dir = output_dir(out, "sim-out/paper63");
+  if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
+  const auto scalar = nav_scalar(out.scalar);
+  if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
+  const std::string& out_dir = dir.value();
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   // The paper's quoted bounds (§6.3, Figs. 7-10), docs/simulation.md.
   const double paper[8] = {-8, 2, -0.1, 0.5, -0.002, 0.003, -0.003, 0.003};
@@ -41,7 +46,8 @@ int cmd_paper63(std::string out_dir, bool do_plot) {
   std::fprintf(csv, "paper");
   for (double v : paper) std::fprintf(csv, ",%g", v);
   std::fprintf(csv, ",,,,,,,,\n");
-  std::printf("gfins-sim paper63: the paper's §6.3 (assumptions: docs/simulation.md)\n\n");
+  std::printf("gfins-sim paper63: the paper's §6.3 (assumptions: docs/simulation.md), %s\n\n",
+              scalar_text(scalar.value()));
   std::printf("%-16s %9s %9s %8s %8s | %9s %9s %9s %9s | %7s %7s\n", "config", "bef lin lo",
               "lin hi", "ang lo", "ang hi", "aft lin lo", "lin hi", "ang lo", "ang hi", "x lin",
               "x ang");
@@ -55,7 +61,7 @@ int cmd_paper63(std::string out_dir, bool do_plot) {
     }
     Scenario s = std::move(loaded).value();
     if (c.calibrated) s.misalignment_source = MisalignmentSource::kCalibrated;
-    const auto outcome = run_scenario(s, tty_progress(c.tag));
+    const auto outcome = run_scenario(s, tty_progress(c.tag), true, scalar.value());
     if (!outcome.is_ok()) {
       (void)close_output(csv, csv_path);
       return fail(outcome.error(), kExitError);
@@ -104,8 +110,10 @@ int cmd_paper63(std::string out_dir, bool do_plot) {
       "(rad/s^2),\nmin/max over the three components and the samples t > 0; x: improvement "
       "(largest |error| before / after).\nwritten: %s/bounds.csv and per-config CSV files\n",
       out_dir.c_str());
-  if (!do_plot) return kExitOk;
-  if (auto p = plot("plot_sim.py", {"paper63", out_dir}); !p.is_ok()) {
+  if (!out.plot) return kExitOk;
+  if (auto p = plot("plot_sim.py", {"paper63", out_dir,
+                                    scalar.value() == NavScalar::kFloat ? "float32" : "double"});
+      !p.is_ok()) {
     return fail(p.error(), kExitPlotFailed);
   }
   return kExitOk;

@@ -22,23 +22,33 @@ struct DefaultOptions {
 };
 int cmd_default(const DefaultOptions& o);
 
+/// What run, paper63, montecarlo and covariance share on their command line.
+struct OutputOptions {
+  std::string dir;               // -o/--out; empty and not given: sim-out/<name>
+  bool dir_given = false;        // -o was on the command line (then it must not be empty)
+  bool plot = true;              // !--no-plot
+  std::string scalar = "float";  // --scalar: the navigation core's scalar (float = the board's)
+  std::size_t decimate = 1;      // --decimate N (run): every N-th sample in the CSV files
+  std::string record;            // --record FILE (run): the raw-sample recording (.gfr)
+};
+
 /// gfins-sim run FILE|NAME: without and with compensation, CSV, summary, PNG.
-int cmd_run(const std::string& name, std::string out_dir, bool do_plot);
+int cmd_run(const std::string& name, const OutputOptions& out);
 
 /// gfins-sim paper63: the paper's §6.3 in four configurations.
-int cmd_paper63(std::string out_dir, bool do_plot);
+int cmd_paper63(const OutputOptions& out);
 
 /// gfins-sim montecarlo [NAME]: N seeds, envelopes and growth slopes.
-int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0,
-                   std::string out_dir, bool do_plot);
+int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0, std::size_t jobs,
+                   const OutputOptions& out);
 
 /// gfins-sim covariance [NAME]: predicted 1σ envelopes and error budget (docs/error-model.md).
 struct CovarianceOptions {
   double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;
   std::vector<double> times_s;
+  std::size_t jobs = 0;  // threads, 0: the hardware's (the output does not depend on it)
 };
-int cmd_covariance(const std::string& name, const CovarianceOptions& c, std::string out_dir,
-                   bool do_plot);
+int cmd_covariance(const std::string& name, const CovarianceOptions& c, const OutputOptions& out);
 
 /// gfins-sim list: the scenarios of host_sim/scenarios with their descriptions.
 int cmd_list();

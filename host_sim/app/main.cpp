@@ -66,7 +66,7 @@ int sim_main(int argc, char** argv) {
                  "write t, attitude/velocity/position errors of the ideal run");
 
   std::string scenario_name;
-  std::string out_dir;
+  app::OutputOptions out;
   bool no_plot = false;
   std::size_t mc_runs = 50;
   std::uint64_t mc_seed = 1;
@@ -94,9 +94,28 @@ int sim_main(int argc, char** argv) {
   cov->add_option("--location-mm", cov_opts.location_mm,
                   "residual location error 1 sigma per axis, mm");
   cov->add_option("--at", cov_opts.times_s, "budget times, s (default T/4, T/2, T)");
+  run_cmd->add_option("--record", out.record,
+                      "also write the raw-sample recording (.gfr, docs/recording-format.md) of "
+                      "the samples the run navigated");
+  run_cmd->add_option("--decimate", out.decimate, "write every N-th sample to the CSV files")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
+      ->capture_default_str();
+  std::vector<CLI::Option*> out_opts;
   for (auto* c : {run_cmd, p63, mc, cov}) {
-    c->add_option("-o,--out", out_dir, "output folder (default sim-out/<name>)");
+    out_opts.push_back(
+        c->add_option("-o,--out", out.dir, "output folder (default sim-out/<name>)"));
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
+    c->add_option("--scalar", out.scalar,
+                  "navigation core scalar: float (the board's float32 core) or double (host "
+                  "reference)")
+        ->check(CLI::IsMember({"float", "double"}))
+        ->capture_default_str();
+  }
+  std::size_t jobs = 0;  // 0: one thread per hardware thread (host_sim/parallel.hpp)
+  for (auto* c : {mc, cov}) {
+    c->add_option("-j,--jobs", jobs,
+                  "threads (default: the hardware's); the output does not depend on it")
+        ->check(CLI::Range(1, 1024));
   }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
   for (auto* c : {run_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
@@ -107,10 +126,13 @@ int sim_main(int argc, char** argv) {
     const int rc = cli.exit(e);
     return rc == 0 ? app::kExitOk : app::kExitBadInput;
   }
-  if (*run_cmd) return app::cmd_run(scenario_name, out_dir, !no_plot);
-  if (*p63) return app::cmd_paper63(out_dir, !no_plot);
-  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, out_dir, !no_plot);
-  if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out_dir, !no_plot);
+  out.plot = !no_plot;
+  for (const auto* opt : out_opts) out.dir_given = out.dir_given || opt->count() > 0;
+  if (*run_cmd) return app::cmd_run(scenario_name, out);
+  if (*p63) return app::cmd_paper63(out);
+  if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out);
+  cov_opts.jobs = jobs;
+  if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out);
   if (*list_cmd) return app::cmd_list();
   return app::cmd_default(o);
 }

@@ -5,16 +5,18 @@
  *
  * PULL_FILE is gpio-sim's /sys/devices/platform/<dev>/<chip>/sim_gpioN/pull; writing "pull-up"
  * raises the simulated input, "pull-down" lowers it, and the kernel delivers the edge to a
- * process holding the line (gpiomon, the firmware) with a CLOCK_MONOTONIC timestamp. One rising
- * edge per period 1/RATE_HZ at absolute deadlines (clock_nanosleep TIMER_ABSTIME, so the rate
- * does not drift with the time a write takes), the falling edge half a period later. RATE_HZ 0
- * toggles as fast as possible (to measure what the VM reaches). COUNT 0 or absent: until
- * SIGTERM/SIGINT.
+ * process holding the line (gpiomon, the firmware) with a CLOCK_MONOTONIC timestamp. The line
+ * behaves like the ADS131M06's DRDY output, which is active low (datasheet, DRDY pin: the
+ * high-to-low transition marks new data, falling edges are one data-rate period apart): it idles
+ * high, falls at each deadline (one per period 1/RATE_HZ, absolute deadlines with
+ * clock_nanosleep TIMER_ABSTIME so the rate does not drift with the time a write takes) and
+ * rises again half a period later. RATE_HZ 0 toggles as fast as possible (to measure what the VM
+ * reaches). COUNT 0 or absent: until SIGTERM/SIGINT.
  *
  * Like a real ADC whose host stalls, a deadline missed by more than one period is not caught up
  * in a burst: the schedule restarts from now and the skipped periods are counted (SIGSTOP then
  * SIGCONT therefore looks like data-ready edges stopped and restarted). On exit it prints one
- * line: "drdy-toggle: edges=N skipped=S late=L seconds=T rate_hz=R" (late: rising edges written
+ * line: "drdy-toggle: edges=N skipped=S late=L seconds=T rate_hz=R" (late: falling edges written
  * more than a quarter period after their deadline).
  */
 #define _GNU_SOURCE
@@ -87,7 +89,7 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, NULL);
 
   const int64_t period_ns = rate_hz > 0.0 ? (int64_t)(1e9 / rate_hz + 0.5) : 0;
-  if (write_pull(fd, "pull-down", path) != 0) return 1;
+  if (write_pull(fd, "pull-up", path) != 0) return 1; /* idle: DRDY high, no data */
   const int64_t t0 = now_ns();
   int64_t next = t0 + period_ns;
   long long edges = 0, skipped = 0, late = 0;
@@ -102,10 +104,10 @@ int main(int argc, char** argv) {
       }
       if (lag > period_ns / 4) ++late;
     }
-    if (write_pull(fd, "pull-up", path) != 0) return 1;
+    if (write_pull(fd, "pull-down", path) != 0) return 1; /* falling edge: new data */
     ++edges;
     if (period_ns > 0) sleep_until(next + period_ns / 2);
-    if (write_pull(fd, "pull-down", path) != 0) return 1;
+    if (write_pull(fd, "pull-up", path) != 0) return 1;
     next += period_ns;
   }
   const double seconds = (double)(now_ns() - t0) * 1e-9;

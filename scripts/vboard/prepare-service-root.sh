@@ -76,13 +76,23 @@ if [ -n "$deb" ]; then
   rm -f "$out/tmp/$(basename "$deb")"
   [ -L "$out/etc/systemd/system/multi-user.target.wants/gfins-fw.service" ] ||
     vb_die "the gfins-fw postinst did not enable gfins-fw.service"
-  if [ -n "$fw_config" ]; then
-    # The VM has no SPI controller: the firmware runs from a configuration for the virtual
-    # board (the ADC chip model on SPI, vcan0, the gpio-sim line) through a unit drop-in.
-    cp "$fw_config" "$out/etc/gfins/vboard.toml"
-    mkdir -p "$out/etc/systemd/system/gfins-fw.service.d"
-    printf '[Service]\nExecStart=\nExecStart=/usr/bin/gfins-fw --config /etc/gfins/vboard.toml\n' \
-      >"$out/etc/systemd/system/gfins-fw.service.d/vboard.conf"
+  # The VM has no SPI controller: the firmware runs from a configuration for the virtual board
+  # (the ADC chip model inside the process, paced by the gpio-sim line's falling edges, output
+  # on vcan0) through a unit drop-in. Default: gfins-fw-vboard.toml at this rate with the
+  # systemd watchdog, the chip found by its gpio-sim label. The scenario is not in the firmware
+  # package (scenarios ship with gfins-tools): it goes to /etc/gfins/vboard-scenarios, named
+  # with --scenario-dir.
+  if [ -z "$fw_config" ]; then
+    fw_config=$vboard_cache/service-fw.toml
+    sed -e "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/" -e 's/^gpio_chip = .*/gpio_chip = "gfins-vboard"/' \
+      -e '/^\[watchdog\]/,/^kind/ s/^kind = .*/kind = "systemd"/' "$here/gfins-fw-vboard.toml" >"$fw_config"
+    grep -q '^kind = "systemd"' "$fw_config" || vb_die "could not set [watchdog] kind = systemd in $fw_config"
   fi
+  cp "$fw_config" "$out/etc/gfins/vboard.toml"
+  mkdir -p "$out/etc/gfins/vboard-scenarios"
+  sed "s/^rate_hz = .*/rate_hz = $rate.0/" "$here/vboard-rest.toml" >"$out/etc/gfins/vboard-scenarios/vboard-rest.toml"
+  mkdir -p "$out/etc/systemd/system/gfins-fw.service.d"
+  printf '[Service]\nExecStart=\nExecStart=/usr/bin/gfins-fw --config /etc/gfins/vboard.toml --scenario-dir /etc/gfins/vboard-scenarios\n' \
+    >"$out/etc/systemd/system/gfins-fw.service.d/vboard.conf"
 fi
 vb_log "service root ready: $out"

@@ -3,8 +3,9 @@
 # data-ready line and the project's programs, runs the in-VM test (vm-test.sh) and turns the
 # console into a pass/fail and an exit status (0 = every check passed).
 #
-#   scripts/vboard/run.sh [--stages infra,backend,fw,faults,canlog,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
+#   scripts/vboard/run.sh [--stages infra,backend,fw,cmd,faults,canlog,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
 #                         [--build-dir DIR] [--smp N] [--icount SHIFT|off] [--service-icount SHIFT|off]
+#                         [--measure]   (infra also measures the toggler alone at 250-4000 Hz and at full speed)
 #
 # Every step is idempotent and cached under .cache/vboard (see common.sh): the first run
 # installs the host packages, downloads the kernel, headers and source (about 220 MB) and builds
@@ -13,7 +14,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 
-stages=infra,backend,fw,faults,canlog,service
+stages=infra,backend,fw,cmd,faults,canlog,service
 rate=500
 timeout_s=600
 build_dir=$vboard_repo/build/host-release
@@ -22,6 +23,7 @@ icount=0          # data-ready timing stages: guest time counts instructions (do
 service_icount=off  # systemd boot: icount's sleep=off would warp time over every 9p wait
 service_deb=""
 service_config=""
+measure=0
 while [ $# -gt 0 ]; do
   case $1 in
     --stages) stages=$2; shift 2 ;;
@@ -33,7 +35,8 @@ while [ $# -gt 0 ]; do
     --service-icount) service_icount=$2; shift 2 ;;
     --deb) service_deb=$2; shift 2 ;;
     --fw-config) service_config=$2; shift 2 ;;
-    -h | --help) sed -n '2,12p' "$0"; exit 0 ;;
+    --measure) measure=1; shift ;;
+    -h | --help) sed -n '2,13p' "$0"; exit 0 ;;
     *) vb_die "run.sh: unknown argument '$1' (try --help)" ;;
   esac
 done
@@ -59,7 +62,32 @@ if want canlog; then
     vb_die "stage canlog: gfins-fw --sim rest --can-log failed (see $vboard_cache/canlog/fw-rest.out)"
   [ -s "$vboard_cache/canlog/fw-rest.log" ] || vb_die "stage canlog: gfins-fw wrote no log"
 fi
-for s in backend fw faults canlog; do
+# Stages fw, cmd, faults run gfins-fw from gfins-fw-vboard.toml on the scenario vboard-rest.toml
+# at the VM's data-ready rate. Stage fw compares the VM's output epoch by epoch with a host-only
+# run: the same configuration and scenario through the same binary in fast pacing, its frames
+# written to a candump log by the file sink and decoded to CSV by gfins-can.
+if want fw || want cmd || want faults; then
+  fwc=$vboard_cache/fw
+  mkdir -p "$fwc/scenarios"
+  sed "s/^rate_hz = .*/rate_hz = $rate.0/" "$here/vboard-rest.toml" >"$fwc/scenarios/vboard-rest.toml"
+fi
+if want fw; then
+  fw=$build_dir/firmware/app/gfins-fw
+  can_tool=$build_dir/host_sim/can_tool/gfins-can
+  [ -x "$fw" ] || vb_die "stage fw: $fw not built (it writes the host-only reference)"
+  [ -x "$can_tool" ] || vb_die "stage fw: $can_tool not built (it decodes the host-only reference)"
+  sed "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/" "$here/gfins-fw-vboard.toml" >"$fwc/ref.toml"
+  rm -f "$fwc/ref.log" "$fwc/ref.csv"
+  # 12 s: the VM stage's 10 s of edges and a margin.
+  "$fw" --config "$fwc/ref.toml" --scenario-dir "$fwc/scenarios" --pacing fast --duration 12 \
+    --can-log "$fwc/ref.log" >"$fwc/ref.out" 2>&1 ||
+    vb_die "stage fw: the host-only reference run failed (see $fwc/ref.out)"
+  "$can_tool" decode "$fwc/ref.log" --view csv -o "$fwc/ref.csv" --quiet 2>"$fwc/ref-decode.out" ||
+    vb_die "stage fw: gfins-can decode of the host-only reference failed (see $fwc/ref-decode.out)"
+  # The reference's CPU (libm's ifunc variants follow it); the VM prints the guest's.
+  vb_log "stage fw: host CPU $(grep -m1 '^flags' /proc/cpuinfo | tr -s ' \t' ' ')"
+fi
+for s in backend fw cmd faults canlog; do
   want "$s" || continue
   stage_script=$here/stage-$s.sh
   [ -e "$stage_script" ] || vb_die "stage '$s' has no scripts/vboard/stage-$s.sh yet"
@@ -133,7 +161,7 @@ verdict() {
 
 vm_stages=$(echo ",$stages," | sed 's/,service,/,/g; s/^,//; s/,$//')
 if [ -n "$vm_stages" ]; then
-  boot vm "vboard.stages=$vm_stages vboard.rate=$rate"
+  boot vm "vboard.stages=$vm_stages vboard.rate=$rate vboard.measure=$measure"
   verdict "$log" || overall=1
 fi
 

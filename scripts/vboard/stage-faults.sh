@@ -1,52 +1,82 @@
 # shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets gpiochip, pull, rate
-# Stage "faults" of the in-VM test (sourced by vm-test.sh, after stage fw): faults made through
-# the kernel while gfins-fw runs from gfins-fw-vboard.toml; after each the firmware must still
-# run and frames must flow again on vcan0.
-#   vcan0 down for 1 s, then up      (SocketCAN: ENETDOWN on send, the backend counts and recovers)
-#   data-ready edges stopped 1 s      (SIGSTOP/SIGCONT of the toggler: timeouts, missed edges)
-#   the bus flooded 2 s with cangen   (cangen -g 0: frames as fast as the kernel takes them)
+# Stage "faults" of the in-VM test (sourced by vm-test.sh): faults made through the kernel while
+# gfins-fw runs from gfins-fw-vboard.toml; after each, what the firmware reported (health counters
+# and status bits decoded by gfins-can, docs/can-interface.md) and that it recovered (epochs flow
+# again with a continuous sample counter):
+#   vcan0 down for 1 s, then up   SocketCAN refuses sends (ENETDOWN): CanTxDropped grows, bit 11
+#   data-ready edges stopped 1 s   SIGSTOP/SIGCONT of the toggler: bit 15 "data-ready lost",
+#                                  MissedEdges grows by the edges the ADC would have given
+#   the bus flooded 2 s            cangen -g 0 on 0x7FF: the firmware keeps publishing
 # needs: build:firmware/app/gfins-fw
+# needs: build:host_sim/can_tool/gfins-can
+# needs: repo:scripts/vboard/fw-common.sh:/vboard/fw-common.sh
 # needs: repo:scripts/vboard/gfins-fw-vboard.toml:/opt/gfins/etc/vboard.toml
-cfg=/opt/gfins/etc/vboard.toml
-alive() { kill -0 $fw_pid 2>/dev/null && echo yes || echo no; }
-frames_within() { # frames_within SECONDS: how many frames of node 1 candump sees in that time
-  timeout "$1" candump -L vcan0 2>/dev/null | grep -vc ' vcan0 7FF#'
+# needs: cache:fw/scenarios/vboard-rest.toml:/opt/share/gfins/scenarios/vboard-rest.toml
+. /vboard/fw-common.sh
+# window NAME SECONDS: records vcan0 for SECONDS (the firmware's frames only) and decodes it to
+# /tmp/faults-NAME.csv; sets w_epochs, w_jumps (consecutive epochs whose sample counters are
+# not one divider apart), w_flags (OR of StatusFlags), w_missed / w_dropped (last MissedEdges /
+# CanTxDropped carried).
+window() {
+  w=/tmp/faults-$1
+  timeout "$2" candump -L vcan0 2>/dev/null | grep -v ' vcan0 7FF#' >$w.log
+  gfins-can decode $w.log --view csv -o $w.csv --quiet 2>/dev/null
+  w_epochs=$(($(wc -l <$w.csv) - 1))
+  sc=$(csv_col $w.csv SampleCount)
+  st=$(csv_col $w.csv StatusFlags)
+  # (busybox awk has no ^: the bits are taken by halving)
+  w_jumps=$(awk -F, -v c="$sc" 'NR > 2 && $c - prev != 10 { ++j } NR > 1 { prev = $c } END { print j + 0 }' $w.csv)
+  w_flags=$(awk -F, -v s="$st" 'NR > 1 { v = $s; p = 1; for (b = 0; b < 20; ++b) { if (v % 2 && !f[b]) { f[b] = 1; o += p }; v = int(v / 2); p *= 2 } }
+                                END { print o + 0 }' $w.csv)
+  w_missed=$(health_last $w.csv MissedEdges)
+  w_dropped=$(health_last $w.csv CanTxDropped)
 }
+bit() { [ $(($1 / (1 << $2) % 2)) -eq 1 ]; }
+
 drdy-toggle "$pull" "$rate" >/tmp/faults-toggle.log &
 toggle_pid=$!
-gfins-fw --config $cfg --scenario-dir /opt/share/gfins/scenarios >/tmp/faults-fw.log 2>&1 &
-fw_pid=$!
-sleep 3
-n=$(frames_within 1)
-check faults-baseline "$n frames in 1 s before any fault" [ "$n" -gt 0 ]
+fw_start /tmp/faults-fw.log
+check faults-fw-start "gfins-fw runs on vcan0 with data-ready edges" [ $? -eq 0 ]
+sleep 1
+window baseline 2
+check faults-baseline "$w_epochs epochs in 2 s, $w_jumps counter jumps, flags $w_flags, missed $w_missed, dropped $w_dropped" \
+  [ "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 -a "$w_missed" -eq 0 -a "$w_dropped" -eq 0 ]
 
 ip link set down vcan0
 sleep 1
 ip link set up vcan0
-sleep 1
-n=$(frames_within 1)
-check faults-vcan-down-up "firmware alive: $(alive); $n frames in 1 s after vcan0 came back" \
-  [ "$n" -gt 0 -a "$(alive)" = yes ]
+window vcan 2
+check faults-vcan-reported "after vcan0 down 1 s and up: CanTxDropped $w_dropped, status bit 11 (CAN frames dropped) $(bit $w_flags 11 && echo set || echo clear)" \
+  [ "$w_dropped" -gt 0 ] && bit $w_flags 11
+check faults-vcan-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $w_jumps counter jumps" \
+  [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
 
+missed_before=$w_missed
 kill -STOP $toggle_pid
 sleep 1
 kill -CONT $toggle_pid
-sleep 1
-n=$(frames_within 1)
-check faults-drdy-stop "firmware alive: $(alive); $n frames in 1 s after the edges resumed" \
-  [ "$n" -gt 0 -a "$(alive)" = yes ]
+window drdy 2
+# About rate x 1 s of edges lost; at least half of them (the stop lasts "sleep 1" of guest time).
+check faults-drdy-reported "after 1 s without edges: MissedEdges $missed_before -> $w_missed (>= $((rate / 2)) more), status bit 15 (data-ready lost) $(bit $w_flags 15 && echo set || echo clear)" \
+  [ "$w_missed" -ge $((missed_before + rate / 2)) ] && bit $w_flags 15
+window drdy-after 2
+check faults-drdy-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $w_jumps counter jumps" \
+  [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
 
 # 0x7FF: the lowest priority identifier, so the firmware's frames still win arbitration on a
 # real bus; on vcan it is the socket queues that fill.
-timeout 2 cangen vcan0 -g 0 -I 7FF -L 8 -i >/dev/null 2>&1
-sleep 1
-n=$(frames_within 1)
-check faults-flood "firmware alive: $(alive); $n frames in 1 s after a 2 s cangen flood" \
-  [ "$n" -gt 0 -a "$(alive)" = yes ]
+dropped_before=$w_dropped
+timeout 2 cangen vcan0 -g 0 -I 7FF -L 8 -i >/dev/null 2>&1 &
+flood_pid=$!
+window flood 2
+wait $flood_pid 2>/dev/null
+echo "VBOARD-INFO faults flood: $w_epochs epochs during the flood, CanTxDropped $dropped_before -> $w_dropped, flags $w_flags"
+window flood-after 2
+check faults-flood-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after a 2 s cangen flood, $w_jumps counter jumps" \
+  [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
 
-kill -TERM $fw_pid 2>/dev/null
-wait $fw_pid
+fw_stop
 kill -TERM $toggle_pid 2>/dev/null
 wait $toggle_pid 2>/dev/null
-# The firmware's log names each fault (docs/faults.md); show what it said.
-grep -iE 'bus|data-ready|drop|timeout|recover' /tmp/faults-fw.log | head -n 20 | sed 's/^/VBOARD-LOG faults: /'
+check faults-fw-exit "gfins-fw ended on SIGTERM with status $fw_rc after the faults" [ $fw_rc -eq 0 ]
+grep -iE 'bus|data-ready|drop|timeout|recover|missed|health' /tmp/faults-fw.log | head -n 16 | sed 's/^/VBOARD-LOG faults: /'

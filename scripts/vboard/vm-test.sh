@@ -4,7 +4,7 @@
 #   VBOARD-CHECK PASS|FAIL <name>: <what was measured>
 # and measurements print "VBOARD-MEASURE <name> <value>"; the last line is
 #   VBOARD-RESULT PASS|FAIL checks=N failed=F
-# Stages come from the kernel command line: vboard.stages=infra,backend,fw,faults,canlog (default all).
+# Stages come from the kernel command line: vboard.stages=infra,backend,fw,cmd,faults,canlog (default all).
 # A stage whose program is missing FAILS naming it: nothing is skipped silently.
 failed=0
 checks=0
@@ -19,7 +19,7 @@ measure() { echo "VBOARD-MEASURE $1 $2"; }
 param() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" /proc/cmdline; }
 
 stages=$(param vboard.stages)
-[ -n "$stages" ] || stages=infra,backend,fw,faults,canlog
+[ -n "$stages" ] || stages=infra,backend,fw,cmd,faults,canlog
 rate=$(param vboard.rate)
 [ -n "$rate" ] || rate=500
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
@@ -48,6 +48,7 @@ echo "VBOARD-INFO gpio-sim chip=$gpiochip pull=$pull"
 
 # --- stage infra: the infrastructure checked with Debian's own tools ---------------------------
 if want infra; then
+  infra_t0=$(cut -d' ' -f1 /proc/uptime)
   n=200
   candump -L -n $n vcan0 >/tmp/infra-candump.log &
   dump_pid=$!
@@ -67,9 +68,10 @@ if want infra; then
   check gpiodetect "gpiodetect lists $gpiochip" sh -c "gpiodetect | grep -q '^$gpiochip '"
   check gpioinfo-name "gpioinfo names line 0 adc-drdy" sh -c "gpioinfo $gpiochip | grep -q '\"adc-drdy\"'"
 
-  # Edges at the nominal rate: gpiomon must see every one, spaced one period apart.
+  # Data-ready edges (falling: the ADS131M06's DRDY is active low) at the nominal rate: gpiomon
+# must see every one, spaced one period apart.
   n=$((rate * 4))
-  gpiomon --rising-edge --num-events=$n --format='%s %n' $gpiochip 0 >/tmp/infra-gpiomon.log &
+  gpiomon --falling-edge --num-events=$n --format='%s %n' $gpiochip 0 >/tmp/infra-gpiomon.log &
   mon_pid=$!
   sleep 1
   drdy-toggle "$pull" "$rate" $n >/tmp/infra-toggle.log
@@ -90,28 +92,36 @@ if want infra; then
   measure gpiomon-max-gap-periods "$2"
   measure gpiomon-gaps-over-1.5-periods "$3"
   skipped=$(sed -n 's/.*skipped=\([0-9]*\).*/\1/p' /tmp/infra-toggle.log)
-  check gpiomon-edges "gpiomon saw $got of $n rising edges at $rate Hz (toggler skipped ${skipped:-?})" \
+  check gpiomon-edges "gpiomon saw $got of $n falling (data-ready) edges at $rate Hz (toggler skipped ${skipped:-?})" \
     [ "$got" -eq $n -a "${skipped:-1}" -eq 0 ]
 
   # The toggler alone at several rates: how often it is late (> 1/4 period) or stalls a period.
-  for r in 250 500 1000 2000 4000; do
+  # About 12 s of guest time: only with run.sh --measure (vboard.measure=1), not in CI.
+  [ "$(param vboard.measure)" = 1 ] && for r in 250 500 1000 2000 4000; do
     measure toggle-alone-$r "$(drdy-toggle "$pull" $r $((r * 2)) | sed 's/drdy-toggle: //')"
   done
 
   # What the VM reaches at most (as fast as the sysfs writes go, gpiomon reading).
-  gpiomon --rising-edge --silent $gpiochip 0 &
-  mon_pid=$!
-  sleep 1
-  drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
-  kill $mon_pid 2>/dev/null
-  wait $mon_pid 2>/dev/null
-  measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
+  if [ "$(param vboard.measure)" = 1 ]; then
+    gpiomon --falling-edge --silent $gpiochip 0 &
+    mon_pid=$!
+    sleep 1
+    drdy-toggle "$pull" 0 4000 >/tmp/infra-max.log
+    kill $mon_pid 2>/dev/null
+    wait $mon_pid 2>/dev/null
+    measure toggle-max-rate-hz "$(sed -n 's/.*rate_hz=\([0-9.]*\).*/\1/p' /tmp/infra-max.log)"
+  fi
+  measure stage-infra-guest-seconds "$(awk -v a="$infra_t0" -v b="$(cut -d' ' -f1 /proc/uptime)" 'BEGIN { printf "%.1f", b - a }')"
 fi
 
-for s in backend fw faults canlog; do
+uptime_s() { cut -d' ' -f1 /proc/uptime; }
+for s in backend fw cmd faults canlog; do
   want $s || continue
   if [ -e /vboard/stage-$s.sh ]; then
+    t0=$(uptime_s)
     . /vboard/stage-$s.sh
+    # Guest seconds per stage (icount: instructions / 1e9), for the CI cost figures.
+    measure stage-$s-guest-seconds "$(awk -v a="$t0" -v b="$(uptime_s)" 'BEGIN { printf "%.1f", b - a }')"
   else
     fail "stage-$s: its program is not in the image (see scripts/vboard/run.sh)"
   fi

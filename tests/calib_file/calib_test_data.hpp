@@ -10,6 +10,7 @@
 #include <string>
 
 #include "gfins/calib_file/calibration_data.hpp"
+#include "support/temp_dir.hpp"
 
 namespace gfins::calib_file::testing {
 
@@ -43,37 +44,13 @@ inline CalibrationData table6_data() {
   return d;
 }
 
-/// A fresh empty directory under the system temp dir, removed (recursively) on destruction.
-class TempDir {
+// The shared temporary folder and file helpers (tests/support/temp_dir.hpp).
+using gfins::testing::read_text;
+using gfins::testing::write_text;
+/// A temporary folder named for these tests.
+class TempDir : public gfins::testing::TempDir {
  public:
-  TempDir() {
-    std::string tmpl = (std::filesystem::temp_directory_path() / "gfins-calib-XXXXXX").string();
-    path_ = ::mkdtemp(tmpl.data());
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
-                                 std::filesystem::perm_options::add, ec);
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
+  TempDir() : gfins::testing::TempDir("gfins-calib") {}
 };
-
-inline std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-inline void write_text(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-}
 
 }  // namespace gfins::calib_file::testing

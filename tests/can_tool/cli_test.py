@@ -83,6 +83,21 @@ def main():
     check('does-not-exist.log' in err and 'No such file' in err, 'missing file not named')
     check(len(r.stdout.decode().splitlines()) == 20, 'files around the missing one not decoded')
 
+    # an empty log (and an empty stdin): readable, no problem, but no frame at all: exit 7, said
+    empty = os.path.join(a.workdir, 'empty.log')
+    open(empty, 'wb').close()
+    for argv, stdin in (([exe, 'decode', empty], None), ([exe, 'decode', '-'], b'')):
+        r = run(argv, stdin=stdin)
+        err = r.stderr.decode()
+        check(r.returncode == 7 and 'no CAN frame in the input' in err and 'summary: 0 lines' in err,
+              f'empty input {argv[2]}: exit {r.returncode}: {err}')
+    # ... and with one frame in it, it is no longer "no frames"
+    with open(empty, 'wb') as f:
+        f.write(data.splitlines(keepends=True)[0])
+    r = run([exe, 'decode', '--view', 'none', empty])
+    check(r.returncode != 7 and 'no CAN frame' not in r.stderr.decode(),
+          f'one-frame log: exit {r.returncode}')
+
     # hostile file name
     hostile = os.path.join(a.workdir, "-x; rm -rf ' \"$(id)\"\nlog.log")
     with open(hostile, 'wb') as f:
@@ -93,7 +108,8 @@ def main():
     # help, version, usage errors
     r = run([exe, '--help'])
     out = r.stdout.decode()
-    check(r.returncode == 0 and 'Exit codes' in out and '3  decoded' in out, '--help exit codes')
+    check(r.returncode == 0 and 'Exit codes' in out and '3  decoded' in out and
+          '7  decode, plot: no CAN frame' in out, '--help exit codes')
     r = run([exe, '--version'])
     check(r.returncode == 0 and r.stdout.decode().startswith('gfins-can '), '--version')
     r = run([exe, 'decode', '--view', 'nonsense', clean])

@@ -57,6 +57,12 @@ class BoardBus final : public hal::CanBus {
         for (const auto& fr : can::encode_capture_result(r, c.token, kNode)) rx_.push_back(fr);
         break;
       }
+      case can::Opcode::kReloadCalibration:
+        // The firmware answers a reload with the status frame, then the new calibration id
+        // (firmware/app can_adapters.cpp, docs/can-interface.md).
+        rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, 0}, kNode));
+        rx_.push_back(can::encode_calibration_id_response(c.token, 0x0BADCAFE, kNode));
+        break;
       default:
         rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, c.divider}, kNode));
     }

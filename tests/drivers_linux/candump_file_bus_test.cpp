@@ -19,6 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "support/fake_clock.hpp"
+#include "support/temp_dir.hpp"
+
 extern char** environ;
 
 namespace gfins::drivers::lnx {
@@ -26,42 +29,13 @@ namespace {
 
 using ::testing::HasSubstr;
 
-class SimClock : public hal::Clock {
+using SimClock = gfins::testing::FakeClock;
+/// A temporary folder named for these tests (tests/support/temp_dir.hpp).
+class TempDir : public gfins::testing::TempDir {
  public:
-  std::int64_t t_ns = 0;
-
- private:
-  std::int64_t do_now_ns() override { return t_ns; }
-  Status do_sleep_until_ns(std::int64_t t) override {
-    t_ns = t;
-    return Status::ok();
-  }
+  TempDir() : gfins::testing::TempDir("gfins-candump") {}
 };
-
-class TempDir {
- public:
-  TempDir() {
-    std::string t = (std::filesystem::temp_directory_path() / "gfins-candump-XXXXXX").string();
-    path_ = ::mkdtemp(t.data());
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using gfins::testing::read_text;
 
 hal::CanFrame make(std::uint32_t id, bool ext, std::vector<std::uint8_t> bytes) {
   hal::CanFrame f;

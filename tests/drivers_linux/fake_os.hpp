@@ -47,6 +47,9 @@ class FakeOs : public Os {
   };
   std::function<int(void*, unsigned long, const timespec*)> on_ppoll =
       [](void*, unsigned long, const timespec*) { return 0; };
+  std::function<long(int, void*, int)> on_recvmsg = [](int, void*, int) -> long {
+    return fail_with(ENOSYS);
+  };
   std::function<int(int, timespec*)> on_clock_gettime;  // nullptr: time stands at 1000 s
   std::function<int(int, int, const timespec*)> on_clock_nanosleep = [](int, int, const timespec*) {
     return ENOSYS;
@@ -93,6 +96,10 @@ class FakeOs : public Os {
   int ppoll(void* f, unsigned long n, const timespec* t) override {
     rec("ppoll");
     return on_ppoll(f, n, t);
+  }
+  long recvmsg(int fd, void* m, int f) override {
+    rec("recvmsg");
+    return on_recvmsg(fd, m, f);
   }
   int clock_gettime(int id, timespec* ts) override;
   int clock_nanosleep(int id, int f, const timespec* r) override {

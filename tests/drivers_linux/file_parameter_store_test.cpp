@@ -17,6 +17,7 @@
 
 #include "drivers_linux/failing_os.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
+#include "support/temp_dir.hpp"
 
 namespace gfins::drivers::lnx {
 namespace {
@@ -24,32 +25,12 @@ namespace {
 using testing::FailingOs;
 using ::testing::HasSubstr;
 
-class TempDir {
+/// A temporary folder named for these tests (tests/support/temp_dir.hpp).
+class TempDir : public gfins::testing::TempDir {
  public:
-  TempDir() {
-    std::string t = (std::filesystem::temp_directory_path() / "gfins-store-XXXXXX").string();
-    path_ = ::mkdtemp(t.data());
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
-                                 std::filesystem::perm_options::add, ec);
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
+  TempDir() : gfins::testing::TempDir("gfins-store") {}
 };
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using gfins::testing::read_text;
 
 std::size_t count_entries(const std::filesystem::path& dir) {
   std::size_t n = 0;

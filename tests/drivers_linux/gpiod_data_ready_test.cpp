@@ -1,4 +1,5 @@
-// GpiodDataReady against a fake libgpiod: line lookup, the rising-edge request, timeouts, the
+// GpiodDataReady against a fake libgpiod: line lookup, the edge request
+// (falling by default: the ADS131M06's DRDY is active low), timeouts, the
 // one preallocated event buffer, bursts read at once, and the sequence numbers inferred from
 // kernel timestamps; plus the real library's answer for a chip that does not exist.
 #include "gfins/drivers/lnx/gpiod_data_ready.hpp"
@@ -52,7 +53,15 @@ class FakeGpiod : public GpiodApi {
     }
     return kLine;
   }
-  int line_request_rising_edge_events(gpiod_line*, const char* c) override {
+  int line_request_rising_edge_events(gpiod_line* l, const char* c) override {
+    requested_edge = "rising";
+    return request(l, c);
+  }
+  int line_request_falling_edge_events(gpiod_line* l, const char* c) override {
+    requested_edge = "falling";
+    return request(l, c);
+  }
+  int request(gpiod_line*, const char* c) {
     consumer = c;
     if (request_errno != 0) {
       errno = request_errno;
@@ -79,7 +88,8 @@ class FakeGpiod : public GpiodApi {
     for (; i < batch.size() && i < n; ++i) {
       ev[i].ts.tv_sec = static_cast<time_t>(batch[i] / 1000000000);
       ev[i].ts.tv_nsec = static_cast<long>(batch[i] % 1000000000);
-      ev[i].event_type = GPIOD_LINE_EVENT_RISING_EDGE;
+      ev[i].event_type =
+          requested_edge == "rising" ? GPIOD_LINE_EVENT_RISING_EDGE : GPIOD_LINE_EVENT_FALLING_EDGE;
     }
     return static_cast<int>(i);
   }
@@ -88,7 +98,7 @@ class FakeGpiod : public GpiodApi {
   unsigned num_lines = 8;
   int request_errno = 0;
   int wait_errno = 0;
-  std::string opened, found_name, consumer;
+  std::string opened, found_name, consumer, requested_edge;
   int got_offset = -1;
   int chip_closes = 0, releases = 0, waits = 0;
   timespec last_timeout{};
@@ -105,16 +115,31 @@ GpiodDataReadyConfig by_offset(int offset) {
   return c;
 }
 
-TEST(GpiodDataReady, FindsTheLineByOffsetAndRequestsRisingEdgesUnderItsConsumerName) {
+TEST(GpiodDataReady, FindsTheLineByOffsetAndRequestsFallingEdgesUnderItsConsumerName) {
   FakeGpiod api;
   auto d = GpiodDataReady::open(by_offset(5), api);
   ASSERT_TRUE(d.is_ok()) << d.status().message();
   EXPECT_EQ(api.opened, "gpiochip3");
   EXPECT_EQ(api.got_offset, 5);
   EXPECT_EQ(api.consumer, "gfins-drdy");
+  // ADS131M06 datasheet, DRDY pin: active low, the high-to-low transition marks new data.
+  EXPECT_EQ(api.requested_edge, "falling");
   d.value().reset();
   EXPECT_EQ(api.releases, 1);
   EXPECT_EQ(api.chip_closes, 1);
+}
+
+TEST(GpiodDataReady, AnInvertedWiringAsksForRisingEdges) {
+  FakeGpiod api;
+  GpiodDataReadyConfig c = by_offset(2);
+  c.edge = DataReadyEdgeKind::kRising;
+  ASSERT_TRUE(GpiodDataReady::open(c, api).is_ok());
+  EXPECT_EQ(api.requested_edge, "rising");
+  api.request_errno = EBUSY;
+  c.edge = DataReadyEdgeKind::kFalling;
+  auto busy = GpiodDataReady::open(c, api);
+  EXPECT_EQ(busy.status().code(), ErrorCode::kIoError);
+  EXPECT_EQ(api.requested_edge, "falling");
 }
 
 TEST(GpiodDataReady, FindsTheLineByName) {

@@ -73,11 +73,35 @@ class FakeCanKernel : public FakeOs {
       written.push_back(f);
       return static_cast<long>(n);
     };
-    on_read = [this](int, void* b, std::size_t n) -> long {
+    // A raw CAN socket answers recvmsg with one struct can_frame in the first iovec, and, when
+    // SO_RXQ_OVFL is on and the socket has dropped frames, one control message: level
+    // SOL_SOCKET, type SO_RXQ_OVFL, a __u32 with the total dropped since the socket was made
+    // (socket(7); the layout is cmsg(3)'s, built here with its macros).
+    on_recvmsg = [this](int, void* m, int) -> long {
+      auto* msg = static_cast<msghdr*>(m);
       if (rx.empty()) return fail_with(read_errno);
-      std::memcpy(b, &rx.front(), sizeof(can_frame));
+      EXPECT_GE(msg->msg_iovlen, 1u);
+      EXPECT_GE(msg->msg_iov[0].iov_len, sizeof(can_frame));
+      std::memcpy(msg->msg_iov[0].iov_base, &rx.front(), sizeof(can_frame));
       rx.pop_front();
-      return static_cast<long>(n);
+      std::int64_t drops = -1;
+      if (!rx_drops.empty()) {
+        drops = rx_drops.front();
+        rx_drops.pop_front();
+      }
+      if (drops >= 0 && rxq_ovfl_enabled()) {
+        EXPECT_GE(msg->msg_controllen, CMSG_SPACE(sizeof(std::uint32_t)));
+        cmsghdr* c = CMSG_FIRSTHDR(msg);
+        c->cmsg_level = SOL_SOCKET;
+        c->cmsg_type = SO_RXQ_OVFL;
+        c->cmsg_len = CMSG_LEN(sizeof(std::uint32_t));
+        const auto total = static_cast<std::uint32_t>(drops);
+        std::memcpy(CMSG_DATA(c), &total, sizeof total);
+        msg->msg_controllen = CMSG_SPACE(sizeof(std::uint32_t));
+      } else {
+        msg->msg_controllen = 0;  // no ancillary data with this frame
+      }
+      return static_cast<long>(sizeof(can_frame));
     };
     on_ioctl = [this](int, unsigned long req, void* arg) {
       if (req != SIOCGIFFLAGS) return fail_with(ENOTTY);
@@ -99,7 +123,19 @@ class FakeCanKernel : public FakeOs {
   std::deque<int> write_errnos;  // one entry per write: 0 = accepted
   std::vector<can_frame> written;
   std::deque<can_frame> rx;
+  // Per frame read: the SO_RXQ_OVFL total the kernel attaches, -1 = none (no drop yet).
+  std::deque<std::int64_t> rx_drops;
   int read_errno = EAGAIN;
+  bool rxq_ovfl_enabled() const {
+    for (const auto& o : options) {
+      if (o.level == SOL_SOCKET && o.name == SO_RXQ_OVFL && o.bytes.size() == sizeof(int)) {
+        int v = 0;
+        std::memcpy(&v, o.bytes.data(), sizeof v);
+        return v != 0;
+      }
+    }
+    return false;
+  }
   bool up = true;
   std::string asked_flags_for;
 };
@@ -398,6 +434,58 @@ TEST(SocketCanReceive, ABurstLongerThanTheQueueArrivesWholeAndInOrder) {
   }
   EXPECT_EQ(bus->counters().rx_frames, kBurst);
   EXPECT_EQ(bus->counters().rx_dropped, 0u);
+}
+
+// SO_RXQ_OVFL (socket(7)): the kernel attaches its running total of frames dropped from the
+// socket's full receive queue; the backend counts the differences, and a new socket (the
+// interface re-created) starts again from zero.
+TEST(SocketCanReceive, TheKernelsDroppedFrameCountIsRequestedAndCounted) {
+  FakeCanKernel k;
+  auto bus = open_on(k);
+  ASSERT_NE(bus, nullptr);
+  ASSERT_TRUE(k.rxq_ovfl_enabled()) << "setsockopt(SOL_SOCKET, SO_RXQ_OVFL, 1) not made";
+  can_frame f{};
+  f.can_id = 0x123;
+  f.len = 1;
+  // Given: no drop yet (no cmsg), then totals 5, 5 (nothing new), 12, then a total that wrapped
+  // past 2^32 (0xFFFFFFFE -> 3: 5 more)
+  const std::int64_t totals[] = {-1, 5, 5, 12, 0xFFFFFFFE, 3};
+  const std::uint32_t expected_after[] = {0, 5, 5, 12, 0xFFFFFFFEu, 0xFFFFFFFEu + 5u};
+  for (std::size_t i = 0; i < std::size(totals); ++i) {
+    // When the kernel delivers the next frame with that total and the backend reads it
+    k.rx.push_back(f);
+    k.rx_drops.push_back(totals[i]);
+    ASSERT_TRUE(bus->receive(0).is_ok());
+    // Then the counter is the kernel's total (wrapping like it), never a frame lost here
+    EXPECT_EQ(bus->counters().rx_kernel_dropped, expected_after[i]) << "after frame " << i;
+  }
+  EXPECT_EQ(bus->counters().rx_frames, std::size(totals));
+  EXPECT_EQ(bus->counters().rx_dropped, 0u);  // the controller reported nothing
+}
+
+TEST(SocketCanReceive, ANewSocketCountsItsKernelDropsFromZero) {
+  FakeCanKernel k;
+  auto bus = open_on(k);
+  can_frame f{};
+  f.can_id = 0x321;
+  f.len = 1;
+  k.rx.push_back(f);
+  k.rx_drops.push_back(40);
+  ASSERT_TRUE(bus->receive(0).is_ok());
+  EXPECT_EQ(bus->counters().rx_kernel_dropped, 40u);
+  // The interface is deleted and re-created with a new index: the backend binds a new socket,
+  // whose kernel total starts at 0; its first report of 2 means 2 more, not 2 - 40.
+  k.read_errno = ENODEV;
+  bus->service();
+  ASSERT_EQ(bus->state(), hal::CanBusState::kDown);
+  k.read_errno = EAGAIN;
+  k.interfaces["can0"] = 11;
+  bus->service();
+  ASSERT_EQ(k.sockets, 2);
+  k.rx.push_back(f);
+  k.rx_drops.push_back(2);
+  ASSERT_TRUE(bus->receive(0).is_ok());
+  EXPECT_EQ(bus->counters().rx_kernel_dropped, 42u);
 }
 
 TEST(SocketCanReceive, ANoFrameWaitPollsWithTheRemainingTimeThenTimesOut) {

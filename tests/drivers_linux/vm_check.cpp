@@ -178,12 +178,12 @@ void sleep_ns(std::int64_t ns) {
   ::nanosleep(&t, nullptr);
 }
 
-TEST(VmGpiod, EachRisingEdgeArrivesWithAMonotonicKernelTimestampAndTheNextSequence) {
+TEST(VmGpiod, EachFallingEdgeArrivesWithAMonotonicKernelTimestampAndTheNextSequence) {
   GFINS_NEEDS_VM("a gpio-sim line");
   GpioSim sim;
   ASSERT_TRUE(sim.usable()) << "needs GFINS_VM_GPIO_PULL (the gpio-sim line's sysfs pull file)";
   constexpr std::int64_t kPeriod = 50 * kMs;  // slow enough for an emulated guest
-  ASSERT_TRUE(sim.set(false)) << sim.path();
+  ASSERT_TRUE(sim.set(true)) << sim.path();
   auto line = open_line(kPeriod);
   ASSERT_TRUE(line);
   auto clock = MonotonicClock::open();
@@ -192,7 +192,7 @@ TEST(VmGpiod, EachRisingEdgeArrivesWithAMonotonicKernelTimestampAndTheNextSequen
   std::int64_t previous = 0;
   for (std::uint32_t i = 0; i < 10; ++i) {
     const std::int64_t before = clock.value()->now_ns();
-    ASSERT_TRUE(sim.set(true));
+    ASSERT_TRUE(sim.set(false));
     const auto e = line->wait_edge(kReceiveTimeoutNs);
     ASSERT_TRUE(e.is_ok()) << "edge " << i << ": " << describe("gpio", e.status());
     const std::int64_t after = clock.value()->now_ns();
@@ -201,8 +201,8 @@ TEST(VmGpiod, EachRisingEdgeArrivesWithAMonotonicKernelTimestampAndTheNextSequen
     EXPECT_LE(e->t_ns, after);
     EXPECT_GT(e->t_ns, previous);
     previous = e->t_ns;
-    ASSERT_TRUE(sim.set(false));
-    // Next rising edge one period after this one.
+    ASSERT_TRUE(sim.set(true));
+    // Next falling edge (new data, as the ADS131M06 signals it) one period after this one.
     const std::int64_t next = e->t_ns + kPeriod;
     const std::int64_t now = clock.value()->now_ns();
     if (next > now) sleep_ns(next - now);
@@ -215,14 +215,14 @@ TEST(VmGpiod, ABurstWhileTheReaderStallsIsCountedNotLost) {
   GpioSim sim;
   ASSERT_TRUE(sim.usable()) << "needs GFINS_VM_GPIO_PULL";
   constexpr std::int64_t kPeriod = 20 * kMs;
-  ASSERT_TRUE(sim.set(false));
+  ASSERT_TRUE(sim.set(true));
   auto line = open_line(kPeriod);
   ASSERT_TRUE(line);
-  // Five rising edges one period apart while nobody reads
+  // Five falling edges one period apart while nobody reads
   for (int i = 0; i < 5; ++i) {
-    ASSERT_TRUE(sim.set(true));
-    sleep_ns(kPeriod / 2);
     ASSERT_TRUE(sim.set(false));
+    sleep_ns(kPeriod / 2);
+    ASSERT_TRUE(sim.set(true));
     sleep_ns(kPeriod / 2);
   }
   std::vector<std::uint32_t> seqs;

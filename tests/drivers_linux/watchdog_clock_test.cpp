@@ -22,6 +22,7 @@
 #include "gfins/drivers/lnx/monotonic_clock.hpp"
 #include "gfins/drivers/lnx/realtime.hpp"
 #include "gfins/drivers/lnx/systemd_watchdog.hpp"
+#include "support/fake_clock.hpp"
 
 namespace gfins::drivers::lnx {
 namespace {
@@ -30,17 +31,7 @@ using testing::fail_with;
 using testing::FakeOs;
 using ::testing::HasSubstr;
 
-class SimClock : public hal::Clock {
- public:
-  std::int64_t t_ns = 0;
-
- private:
-  std::int64_t do_now_ns() override { return t_ns; }
-  Status do_sleep_until_ns(std::int64_t t) override {
-    t_ns = t;
-    return Status::ok();
-  }
-};
+using SimClock = gfins::testing::FakeClock;
 
 // Plays systemd: a datagram socket at $NOTIFY_SOCKET and the watchdog variables of a unit with
 // WatchdogSec=100ms, restored afterwards.

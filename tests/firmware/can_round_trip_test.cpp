@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <thread>
 
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
@@ -147,6 +146,11 @@ class CanCommands : public ::testing::Test {
   std::vector<can::ResponseFrame> round_trip(const hal::CanFrame& f, std::uint32_t cycles = 2) {
     rig_->bus->clear_sent();
     EXPECT_TRUE(rig_->bus->inject_rx(f));
+    return round_trip_cycles(cycles, false);
+  }
+  // Runs `cycles` cycles and returns the responses sent in them.
+  std::vector<can::ResponseFrame> round_trip_cycles(std::uint32_t cycles, bool clear = true) {
+    if (clear) rig_->bus->clear_sent();
     rig_->run_cycles(cycles);
     std::vector<can::ResponseFrame> out;
     for (const hal::CanFrame& r : rig_->bus->sent()) {
@@ -157,6 +161,16 @@ class CanCommands : public ::testing::Test {
   }
   std::vector<can::ResponseFrame> send(const can::Command& c, std::uint32_t cycles = 2) {
     return round_trip(can::encode_command(c, SimRig::kNode), cycles);
+  }
+  // A reload command: the cycle that reads it posts the request to the worker thread (the loop
+  // never waits for file I/O); the first cycle after the worker is done answers. Ordering, not
+  // timing: the test waits for the worker, whatever the machine's speed.
+  std::vector<can::ResponseFrame> reload(std::uint8_t token) {
+    auto r = send(cmd(can::Opcode::kReloadCalibration, token), 1);
+    worker_->wait_settled();
+    auto more = round_trip_cycles(1);
+    r.insert(r.end(), more.begin(), more.end());
+    return r;
   }
   static const can::ResponseFrame* part(const std::vector<can::ResponseFrame>& v, int p) {
     for (const auto& r : v) {
@@ -258,15 +272,7 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
   d.device_id = "reloaded-board";
   d.created_utc = "2026-01-01T00:00:00Z";
   ASSERT_TRUE(calib_file::save_calibration_file(path_, d).is_ok());
-  auto r = send(cmd(can::Opcode::kReloadCalibration, 17), 1);
-  for (int i = 0; i < 200 && part(r, 0) == nullptr; ++i) {  // the worker thread reads the file
-    rig_->bus->clear_sent();
-    rig_->run_cycles(1);
-    for (const hal::CanFrame& f : rig_->bus->sent()) {
-      if (auto x = can::decode_response(f); x.is_ok()) r.push_back(x.value());
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+  auto r = reload(17);
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
   ASSERT_NE(part(r, 1), nullptr);
@@ -278,15 +284,7 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
     std::fputs("[calibration\n", f);
     std::fclose(f);
   }
-  r = send(cmd(can::Opcode::kReloadCalibration, 18), 1);
-  for (int i = 0; i < 200 && part(r, 0) == nullptr; ++i) {
-    rig_->bus->clear_sent();
-    rig_->run_cycles(1);
-    for (const hal::CanFrame& f : rig_->bus->sent()) {
-      if (auto x = can::decode_response(f); x.is_ok()) r.push_back(x.value());
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+  r = reload(18);
   // Then the board answers "failed" and keeps the last good calibration
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);

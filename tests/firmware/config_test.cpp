@@ -118,6 +118,7 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[can]\nnodeid = 3\n", {"bad.toml:2", "unknown key 'can.nodeid'"}},
       {"[cann]\nnode_id = 3\n", {"unknown key 'cann'"}},
       {"[can\nnode_id = 3\n", {"bad.toml:1", "TOML syntax"}},
+      {"[sim]\npacing = \"edge\"\n", {"sim.pacing = \"edge\"", "\"gpio\""}},
   };
   for (const BadCase& c : cases) {
     const ConfigResult r = parse_config(c.text, "bad.toml");
@@ -151,6 +152,16 @@ TEST(Cli, OptionsOverrideTheFile) {
   EXPECT_EQ(r.config->dividers[static_cast<std::size_t>(message_index("euler"))], 40);
   EXPECT_EQ(r.config->position_m, (std::array<double, 3>{1.0, 2.0, 3.0}));
   EXPECT_EQ(r.config->pacing, Pacing::kRealTime);
+}
+
+TEST(Config, GpioPacingIsReadFromTheFileAndTheCommandLine) {
+  const ConfigResult r = parse_config("[sim]\npacing = \"gpio\"\n", "gpio.toml");
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.config->pacing, Pacing::kGpio);
+  EXPECT_STREQ(to_string(Pacing::kGpio), "gpio");
+  const CliResult c = cli({"--sim", "rest", "--pacing", "gpio"});
+  ASSERT_TRUE(c.config) << c.message;
+  EXPECT_EQ(c.config->pacing, Pacing::kGpio);
 }
 
 TEST(Cli, BadOptionsAreNamed) {

@@ -227,5 +227,26 @@ TEST(CanFaults, RefusingSinkAndBusOffAreCountedPublishedLoggedAndTheLoopKeepsRea
   EXPECT_GT(rig.bus->counters().tx_frames, 0u);
 }
 
+TEST(CanFaults, ReceivedFramesLostInTheKernelAreCountedFlaggedAndLogged) {
+  // Given a navigating board
+  SimRig rig("rest", 3.0);
+  rig.configure();
+  rig.run_cycles(2000);
+  // When the kernel reports 3 received frames dropped, then 4 more a little later
+  rig.bus->lose_received(3);
+  rig.run_cycles(10);
+  rig.bus->lose_received(4);
+  rig.run();
+  // Then the health counter has all 7, the status bit is set after the loss, one log line per
+  // report, and navigation is untouched
+  const auto lines = rig.drain_log();
+  EXPECT_EQ(rig.loop->health().can_rx_dropped, 7u);
+  EXPECT_EQ(epoch_at_seq(rig, 1990).status_bits & status_bits::kCanRxDrop, 0u);
+  EXPECT_NE(epoch_at_seq(rig, 2100).status_bits & status_bits::kCanRxDrop, 0u);
+  EXPECT_EQ(epoch_at_seq(rig, 2100).mode, Mode::kNavigating);
+  EXPECT_EQ(lines_with(lines, "received CAN frame(s) lost").size(), 2u);
+  EXPECT_FALSE(lines_with(lines, "(lost: 7)").empty());
+}
+
 }  // namespace
 }  // namespace gfins::app

@@ -49,7 +49,9 @@ struct SimRig {
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
-    stream = sim_board::make_scenario_stream(s);
+    auto made = sim_board::make_scenario_stream(s);
+    if (!made.is_ok()) throw std::runtime_error(made.error().message);
+    stream = std::move(made).value();
     adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
     if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
     source = std::make_unique<sim_board::SimSampleSource>(

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "gfins/host_sim/covariance.hpp"
@@ -110,6 +112,61 @@ TEST(CovarianceBudgetTest, SourceVariancesAddUpToTheTotal) {
       }
       const double total = b.sigma.back()[k][i];
       EXPECT_NEAR(sum / (total * total), 1.0, kAddRelTol) << kErrorStateNames[i];
+    }
+  }
+}
+
+TEST(CovarianceReport, SameBitsForAnyThreadCountAndTheSerialPropagation) {
+  // Given every source at once along a manoeuvre (so P and all 36 constant parameters move),
+  const auto traj = make_maneuver(1.0);
+  CovarianceSpec spec;
+  spec.trajectory = traj.get();
+  spec.geometry = nav::table1_geometry<double>(kRhoM);
+  spec.duration_s = 0.2;  // 20 steps: what matters is that every job has run (cheap under ASan)
+  spec.dt_s = 0.01;
+  spec.decimation = 5;
+  spec.noise.white_sigma_mps2.fill(1e-2);
+  spec.noise.bias_sigma_mps2.fill(1e-4);
+  spec.noise.bias_rw_mps2_sqrt_s.fill(1e-4);
+  spec.constants.scale_factor_sigma.fill(1e-4);
+  spec.constants.orientation_sigma_rad.fill(1e-3);
+  spec.constants.location_sigma_m.fill(1e-4);
+  const std::vector<double> times = {0.1, 0.2};
+  // when the report is computed on 1, 2 and 7 threads,
+  const CovarianceReport one = covariance_report(spec, times, 1);
+  const CovarianceResult serial = propagate_covariance(spec);
+  const auto bits_equal = [](const std::vector<double>& a, const std::vector<double>& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+  };
+  // then its envelopes are the one serial propagation of the whole spec,
+  ASSERT_TRUE(bits_equal(one.envelopes.t_s, serial.t_s));
+  for (std::size_t i = 0; i < kNav; ++i) {
+    EXPECT_TRUE(bits_equal(one.envelopes.sigma[i], serial.sigma[i])) << kErrorStateNames[i];
+  }
+  // the budget's total row is that propagation at the chosen times,
+  ASSERT_EQ(one.budget.sigma.size(), kBudgetSources.size() + 1);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const auto idx = static_cast<std::size_t>(std::llround(one.budget.t_s[k] / 0.05));
+    for (std::size_t i = 0; i < kNav; ++i) {
+      EXPECT_EQ(one.budget.sigma.back()[k][i], serial.sigma[i][idx]) << kErrorStateNames[i];
+    }
+  }
+  // and every thread count gives the same bits.
+  for (const std::size_t jobs : {2u, 7u}) {
+    SCOPED_TRACE("jobs " + std::to_string(jobs));
+    const CovarianceReport r = covariance_report(spec, times, jobs);
+    for (std::size_t i = 0; i < kNav; ++i) {
+      EXPECT_TRUE(bits_equal(r.envelopes.sigma[i], one.envelopes.sigma[i]));
+    }
+    ASSERT_EQ(r.budget.sigma.size(), one.budget.sigma.size());
+    for (std::size_t s = 0; s < r.budget.sigma.size(); ++s) {
+      for (std::size_t k = 0; k < times.size(); ++k) {
+        EXPECT_EQ(std::memcmp(r.budget.sigma[s][k].data(), one.budget.sigma[s][k].data(),
+                              sizeof(double) * kNav),
+                  0)
+            << "source " << s << " time " << k;
+      }
     }
   }
 }

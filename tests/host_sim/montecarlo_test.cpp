@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <vector>
 
 namespace gfins::sim {
 namespace {
@@ -87,6 +89,56 @@ TEST(MonteCarlo, NoiseOnlyEnvelopeMatchesTheRandomWalkOfTheTrapezoidRule) {
   // has probability 3 × 5e-4).
   constexpr double kMeanSe = 3.5;
   EXPECT_LT(worst_mean_in_se, kMeanSe);
+}
+
+/// Same doubles bit for bit (memcmp: also tells −0 from +0 and compares NaN payloads).
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+TEST(MonteCarlo, ResultIsBitIdenticalForAnyThreadCount) {
+  // Given the calibrated scenario, short (0.5 s at 100 Hz) so that 9 runs are cheap; every run
+  // draws both the sensor noise and the calibration error from its own seeds,
+  Scenario s = builtin("rest-calibrated");
+  s.duration_s = 0.5;
+  constexpr std::size_t kRuns = 9;
+  constexpr std::uint64_t kSeed0 = 3;
+  for (const NavScalar scalar : {NavScalar::kFloat, NavScalar::kDouble}) {
+    SCOPED_TRACE(scalar == NavScalar::kFloat ? "float core" : "double core");
+    // when the runs go to 1, 2 and 7 threads (7 > runs per thread: threads wait for their turn),
+    const MonteCarloResult one = run_montecarlo(s, kRuns, kSeed0, {}, scalar, 1).value();
+    for (const std::size_t jobs : {2u, 7u}) {
+      SCOPED_TRACE("jobs " + std::to_string(jobs));
+      const MonteCarloResult r = run_montecarlo(s, kRuns, kSeed0, {}, scalar, jobs).value();
+      // then every statistic is the single-threaded one, to the last bit: the runs' random streams
+      // depend on (seed0, k) only and the sums add the runs in index order. A generator shared
+      // between runs or a sum in completion order changes the last bits (in practice: the
+      // mutations tried are in docs/performance.md).
+      EXPECT_TRUE(same_bits(r.t_s, one.t_s));
+      for (std::size_t q = 0; q < kMcQuantities; ++q) {
+        for (std::size_t a = 0; a < 3; ++a) {
+          EXPECT_TRUE(same_bits(r.mean[q][a], one.mean[q][a])) << kMcQuantityNames[q] << ' ' << a;
+          EXPECT_TRUE(same_bits(r.std[q][a], one.std[q][a])) << kMcQuantityNames[q] << ' ' << a;
+        }
+        EXPECT_TRUE(same_bits(r.rms_norm[q], one.rms_norm[q])) << kMcQuantityNames[q];
+      }
+      EXPECT_EQ(std::memcmp(&r.rms_calibration_angle_error_rad,
+                            &one.rms_calibration_angle_error_rad, sizeof(double)),
+                0);
+    }
+    // and the runs do differ from each other (otherwise the check above could not fail): σ > 0.
+    EXPECT_GT(one.std[kRate][0].back(), 0.0);
+    EXPECT_GT(one.rms_calibration_angle_error_rad, 0.0);
+  }
+}
+
+TEST(MonteCarlo, FewerThanTwoRunsIsAnErrorNamingTheCount) {
+  const HostResult<MonteCarloResult> r =
+      run_montecarlo(builtin("rest"), 1, 1, {}, NavScalar::kDouble, 2);
+  ASSERT_FALSE(r.is_ok());
+  EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.error().message.find("two runs"), std::string::npos) << r.error().message;
 }
 
 }  // namespace

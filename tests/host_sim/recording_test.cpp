@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
+#include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -74,6 +77,33 @@ TEST(RecordingTest, Crc32MatchesTheStandardCheckValue) {
   const std::string digits = "123456789";
   const std::vector<std::uint8_t> b(digits.begin(), digits.end());
   EXPECT_EQ(crc32(b), 0xCBF43926u);
+}
+
+TEST(RecordingTest, Crc32EqualsTheBitwiseDefinitionForEveryLengthAndSplit) {
+  // The codec computes eight bytes per step with look-up tables (slicing by 8). Oracle: the
+  // definition itself, one bit at a time (reflected polynomial 0xEDB88320, init and final xor
+  // 0xFFFFFFFF), written here without tables.
+  const auto bitwise = [](const std::uint8_t* p, std::size_t n) {
+    std::uint32_t c = 0xFFFFFFFFu;
+    for (std::size_t i = 0; i < n; ++i) {
+      c ^= p[i];
+      for (int k = 0; k < 8; ++k) c = (c & 1u) != 0 ? (c >> 1) ^ 0xEDB88320u : c >> 1;
+    }
+    return ~c;
+  };
+  std::mt19937 rng(13);
+  std::vector<std::uint8_t> bytes(300);
+  for (auto& b : bytes) b = static_cast<std::uint8_t>(rng());
+  // Every length 0..299 from an odd start (unaligned words, every tail length 0..7),
+  for (std::size_t n = 0; n + 1 < bytes.size(); ++n) {
+    const std::span<const std::uint8_t> part(bytes.data() + 1, n);
+    ASSERT_EQ(crc32(part), bitwise(part.data(), n)) << "length " << n;
+  }
+  // and a CRC continued over two pieces split anywhere equals the CRC of the whole.
+  const std::span<const std::uint8_t> all(bytes);
+  for (std::size_t cut = 0; cut <= 40; ++cut) {
+    EXPECT_EQ(crc32(all.subspan(cut), crc32(all.first(cut))), crc32(all)) << "cut " << cut;
+  }
 }
 
 TEST(RecordingTest, InMemoryRoundTripIsExact) {
@@ -216,6 +246,45 @@ TEST(RecordingTest, DamagedFilesOnDiskGiveTheSameErrorsAsInMemory) {
   EXPECT_FALSE(reader.value().next_block(block).is_ok());
   std::filesystem::remove(cut_path);
   std::filesystem::remove(bad_path);
+}
+
+TEST(RecordingTest, AReaderMovedInTheMiddleOfAFileContinuesWhereItWas) {
+  // Given a file of several blocks and a reader that has returned two of them (the stream reads
+  // through a buffer the reader owns, which must move with it),
+  const std::string path = temp_path("moved.gfr");
+  const std::string other_path = temp_path("moved_other.gfr");
+  const auto samples = test_samples();
+  ASSERT_TRUE(write_recording(path, test_header(), samples).is_ok());
+  ASSERT_TRUE(write_recording(other_path, test_header(), samples).is_ok());
+  std::vector<RawSample> got;
+  std::vector<RawSample> block;
+  std::optional<RecordingReader> second;
+  {
+    auto first = RecordingReader::open(path);
+    ASSERT_TRUE(first.is_ok()) << first.error().message;
+    for (int b = 0; b < 2; ++b) {
+      ASSERT_TRUE(first.value().next_block(block).value());
+      got.insert(got.end(), block.begin(), block.end());
+    }
+    // when it is moved into a new reader and the old one is destroyed,
+    second.emplace(std::move(first.value()));
+  }
+  // and that one is moved over a reader of another open file, then destroyed too,
+  auto third = RecordingReader::open(other_path);
+  ASSERT_TRUE(third.is_ok());
+  third.value() = std::move(*second);
+  second.reset();
+  for (;;) {
+    const auto more = third.value().next_block(block);
+    ASSERT_TRUE(more.is_ok()) << more.error().message;
+    if (!more.value()) break;
+    got.insert(got.end(), block.begin(), block.end());
+  }
+  // then the samples read are those of the file, in order, each once.
+  expect_same(got, samples);
+  EXPECT_EQ(third.value().records_read(), samples.size());
+  std::filesystem::remove(path);
+  std::filesystem::remove(other_path);
 }
 
 TEST(RecordingTest, CorruptHeaderFailsItsCrc) {

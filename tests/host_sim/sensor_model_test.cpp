@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "gfins/nav_core/geometry.hpp"
@@ -273,6 +274,21 @@ TEST(SensorModelTest, NonPositiveSampleRateIsRefused) {
   EXPECT_THROW(SensorArrayModel(kNominal, ArrayErrors{}, kGravity,
                                 std::numeric_limits<double>::quiet_NaN(), 1),
                std::invalid_argument);
+}
+
+TEST(SensorModelTest, MakeRefusesTheSameRatesWithAValue) {
+  // The simulated board's way (it runs inside gfins-fw, where nothing may throw).
+  for (const double bad : {0.0, -1000.0, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()}) {
+    HostResult<SensorArrayModel> r = HostError{};
+    EXPECT_NO_THROW(r = SensorArrayModel::make(kNominal, ArrayErrors{}, kGravity, bad, 1));
+    ASSERT_FALSE(r.is_ok()) << bad;
+    EXPECT_EQ(r.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(r.error().message.find("sample rate"), std::string::npos) << r.error().message;
+  }
+  const auto good = SensorArrayModel::make(kNominal, ArrayErrors{}, kGravity, kRateHz, 1);
+  ASSERT_TRUE(good.is_ok());
+  EXPECT_EQ(good.value().sample_rate_hz(), kRateHz);
 }
 
 }  // namespace

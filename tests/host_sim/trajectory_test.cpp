@@ -1,5 +1,7 @@
 #include "gfins/host_sim/trajectory.hpp"
 
+#include "gfins/host_sim/scenario.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -171,6 +173,22 @@ TEST(TrajectoryTest, SpinHasConstantRateAboutTheGivenBodyAxis) {
 
 TEST(TrajectoryTest, SpinRejectsAZeroAxis) {
   EXPECT_THROW(make_spin(Vec3d::Zero(), 1.0, Quatd::Identity()), std::invalid_argument);
+}
+
+// The scenario path (make_trajectory, used by the simulated board inside gfins-fw) says so with a
+// value instead.
+TEST(TrajectoryTest, MakeTrajectoryRefusesAZeroOrNanSpinAxisWithAValue) {
+  for (const Vec3d& axis :
+       {Vec3d(Vec3d::Zero()), Vec3d(std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0)}) {
+    TrajectorySpec t;
+    t.kind = "spin";
+    t.axis_b = axis;
+    t.rate_rps = 1.0;
+    HostResult<std::unique_ptr<Trajectory>> r = HostError{};
+    EXPECT_NO_THROW(r = make_trajectory(t));
+    ASSERT_FALSE(r.is_ok());
+    EXPECT_NE(r.error().message.find("spin axis"), std::string::npos) << r.error().message;
+  }
 }
 
 TEST(TrajectoryTest, ConingRateHasTheTextbookForm) {

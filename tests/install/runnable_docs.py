@@ -11,7 +11,7 @@ Runs, from the repository root, in one bash shell and in order:
   3. every line of the ```sh blocks of docs/*.md whose preceding line is <!-- runnable -->.
 Fails (exit 1) when any of them exits non-zero, naming its file and line; 2 on bad usage or a
 marker that does not lead to a command. --list prints the commands without running them.
-Cost: about 20 s (the marked rows are the cheap ones).
+Cost: about 30 s (the marked rows and blocks are the cheap ones).
 """
 import argparse
 import os

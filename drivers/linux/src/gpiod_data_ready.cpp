@@ -21,6 +21,9 @@ gpiod_line* GpiodApi::chip_find_line(gpiod_chip* chip, const char* name) {
 int GpiodApi::line_request_rising_edge_events(gpiod_line* line, const char* consumer) {
   return ::gpiod_line_request_rising_edge_events(line, consumer);
 }
+int GpiodApi::line_request_falling_edge_events(gpiod_line* line, const char* consumer) {
+  return ::gpiod_line_request_falling_edge_events(line, consumer);
+}
 void GpiodApi::line_release(gpiod_line* line) { ::gpiod_line_release(line); }
 int GpiodApi::line_event_wait(gpiod_line* line, const timespec* timeout) {
   return ::gpiod_line_event_wait(line, timeout);
@@ -64,11 +67,16 @@ Result<std::unique_ptr<GpiodDataReady>> GpiodDataReady::open(const GpiodDataRead
                                           : "gpiod: no line of this name on the chip",
                   err);
   }
-  if (api.line_request_rising_edge_events(line, config.consumer.c_str()) < 0) {
+  const bool falling = config.edge == DataReadyEdgeKind::kFalling;
+  const int requested = falling
+                            ? api.line_request_falling_edge_events(line, config.consumer.c_str())
+                            : api.line_request_rising_edge_events(line, config.consumer.c_str());
+  if (requested < 0) {
     const int err = errno;
     api.chip_close(chip);
     return Status(ErrorCode::kIoError,
                   err == EBUSY ? "gpiod: line already requested by another consumer"
+                  : falling    ? "gpiod: requesting falling-edge events failed"
                                : "gpiod: requesting rising-edge events failed",
                   err);
   }

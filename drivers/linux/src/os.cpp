@@ -43,6 +43,9 @@ unsigned Os::if_nametoindex(const char* name) { return ::if_nametoindex(name); }
 int Os::ppoll(void* fds, unsigned long nfds, const timespec* timeout) {
   return ::ppoll(static_cast<pollfd*>(fds), nfds, timeout, nullptr);
 }
+long Os::recvmsg(int fd, void* msg, int flags) {
+  return ::recvmsg(fd, static_cast<msghdr*>(msg), flags);
+}
 
 int Os::clock_gettime(int clock_id, timespec* ts) { return ::clock_gettime(clock_id, ts); }
 int Os::clock_nanosleep(int clock_id, int flags, const timespec* request) {

@@ -7,6 +7,7 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <time.h>
 
 #include <cerrno>
@@ -92,6 +93,14 @@ Status SocketCan::open_socket() {
   if (os_.setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &mask, sizeof mask) != 0) {
     return Status(ErrorCode::kIoError, "socketcan: setsockopt(CAN_RAW_ERR_FILTER) failed", errno);
   }
+  // The kernel's count of frames it dropped because this socket's receive queue was full, sent
+  // as ancillary data (SOL_SOCKET, SO_RXQ_OVFL: a u32, total since the socket was created) with
+  // every frame read after the first drop (socket(7)). A new socket starts from zero.
+  const int one = 1;
+  if (os_.setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one) != 0) {
+    return Status(ErrorCode::kIoError, "socketcan: setsockopt(SO_RXQ_OVFL) failed", errno);
+  }
+  kernel_drops_seen_ = 0;
   Status s = apply_filters();
   if (!s.is_ok()) return s;
   sockaddr_can addr{};
@@ -266,18 +275,44 @@ void SocketCan::handle_error_frame(std::uint32_t can_id, const std::array<std::u
   }
 }
 
+void SocketCan::note_kernel_drops(const void* msg_header) {
+  const auto* msg = static_cast<const msghdr*>(msg_header);
+  for (const cmsghdr* c = CMSG_FIRSTHDR(msg); c != nullptr;
+       c = CMSG_NXTHDR(const_cast<msghdr*>(msg), const_cast<cmsghdr*>(c))) {
+    if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SO_RXQ_OVFL) continue;
+    if (c->cmsg_len < CMSG_LEN(sizeof(std::uint32_t))) continue;
+    std::uint32_t total = 0;
+    std::memcpy(&total, CMSG_DATA(c), sizeof total);
+    // A running total that wraps at 2^32: the unsigned difference is the drops since the last
+    // report, across a wrap too.
+    counters_.rx_kernel_dropped += total - kernel_drops_seen_;
+    kernel_drops_seen_ = total;
+  }
+}
+
 void SocketCan::drain_rx() {
   for (int i = 0; i < kMaxReadsPerDrain && state_ != hal::CanBusState::kDown; ++i) {
     // A full queue stops the drain: what is still in the socket stays in the kernel's buffer
     // (which is much larger) until the caller has collected, instead of being dropped here.
     if (rx_size_ == kRxQueue) return;
     can_frame raw{};
-    const long n = os_.read(fd_, &raw, sizeof raw);
+    iovec iov{&raw, sizeof raw};
+    // Room for the SO_RXQ_OVFL count (and a timestamp, should one ever be enabled).
+    alignas(cmsghdr)
+        std::array<unsigned char, CMSG_SPACE(sizeof(std::uint32_t)) + CMSG_SPACE(sizeof(timespec))>
+            control{};
+    msghdr msg{};
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control.data();
+    msg.msg_controllen = control.size();
+    const long n = os_.recvmsg(fd_, &msg, 0);
     if (n < 0) {
       const int err = errno;
       if (interface_gone(err)) go_down();
       return;  // EAGAIN: nothing more; other errors: reported by the next send
     }
+    note_kernel_drops(&msg);
     if (n != static_cast<long>(sizeof raw)) continue;  // not a classic frame
     if (raw.can_id & CAN_ERR_FLAG) {
       std::array<std::uint8_t, 8> d{};

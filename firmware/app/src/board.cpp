@@ -92,7 +92,23 @@ void add_can_protocol(const FwConfig& c, Board& b) {
 struct SimParts {
   std::unique_ptr<sim_board::SensorStream> stream;
   std::unique_ptr<sim_board::ChipAdc> adc;
+  std::unique_ptr<hal::DataReadyLine> drdy;  // pacing "gpio" only
 };
+
+/// The data-ready line of adc.gpio_chip / adc.drdy_line (an offset when all digits, else a name),
+/// as the Linux board opens it: falling edges (ADS131M06 DRDY is active low), sequence inferred
+/// from the kernel timestamps against the nominal period.
+Result<std::unique_ptr<lnx::GpiodDataReady>> open_drdy(const FwConfig& c) {
+  lnx::GpiodDataReadyConfig dr;
+  dr.chip = c.gpio_chip;
+  if (c.drdy_line.find_first_not_of("0123456789") == std::string::npos) {
+    dr.line_offset = std::stoi(c.drdy_line);
+  } else {
+    dr.line_name = c.drdy_line;
+  }
+  dr.nominal_period_ns = static_cast<std::int64_t>(std::llround(1e9 / c.sample_rate_hz));
+  return lnx::GpiodDataReady::open(dr);
+}
 
 BoardResult make_sim_board(const FwConfig& c) {
   BoardResult out;
@@ -114,11 +130,12 @@ BoardResult make_sim_board(const FwConfig& c) {
   }
   const double duration = c.sim_duration_s > 0 ? c.sim_duration_s : s.duration_s;
   auto parts = std::make_shared<SimParts>();
-  parts->stream = sim_board::make_scenario_stream(s);
-  if (!parts->stream) {
-    out.error = "scenario " + s.name + ": its trajectory cannot be built";
+  auto stream = sim_board::make_scenario_stream(s);
+  if (!stream.is_ok()) {
+    out.error = stream.error().message;
     return out;
   }
+  parts->stream = std::move(stream).value();
   parts->adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
   if (const Status st = parts->adc->start(); !st.is_ok()) {
     out.error = std::string("simulated ADC start: ") + st.message();
@@ -132,12 +149,25 @@ BoardResult make_sim_board(const FwConfig& c) {
     sample_clock = clock.get();
     b->clock = std::move(clock);
   } else {
+    // CLOCK_MONOTONIC: the clock of the kernel's GPIO edge timestamps too.
     b->clock = std::make_unique<sim_board::SteadyClock>();
   }
   const auto samples = static_cast<std::uint32_t>(std::llround(duration * s.rate_hz)) + 1;
-  auto source = std::make_unique<sim_board::SimSampleSource>(
-      *parts->stream, *parts->adc, *b->clock, sample_clock,
-      fast ? sim_board::Pacing::kFast : sim_board::Pacing::kRealTime, s.rate_hz, samples);
+  std::unique_ptr<sim_board::SimSampleSource> source;
+  if (c.pacing == Pacing::kGpio) {
+    auto drdy = open_drdy(c);
+    if (!drdy.is_ok()) {
+      out.error = lnx::describe(c.gpio_chip + " line " + c.drdy_line, drdy.status());
+      return out;
+    }
+    parts->drdy = std::move(drdy).value();
+    source = std::make_unique<sim_board::SimSampleSource>(*parts->stream, *parts->adc, *b->clock,
+                                                          *parts->drdy, samples);
+  } else {
+    source = std::make_unique<sim_board::SimSampleSource>(
+        *parts->stream, *parts->adc, *b->clock, sample_clock,
+        fast ? sim_board::Pacing::kFast : sim_board::Pacing::kRealTime, s.rate_hz, samples);
+  }
   const sim_board::SimSampleSource* src = source.get();
   b->finished = [src] { return src->finished(); };
   b->source = std::move(source);
@@ -157,8 +187,15 @@ BoardResult make_sim_board(const FwConfig& c) {
   b->defaults.beta = {};
   b->defaults.alpha = {};
   b->defaults.compensator = nav::CompensatorKind::kNone;
-  // Real-time pacing measures latency: give it the board's real-time set-up too.
-  if (!fast) b->enter_realtime = enter_realtime;
+  // Real-time and GPIO pacing run against the wall clock: give them the board's real-time
+  // set-up and its watchdog too (the service unit's WatchdogSec on the virtual board).
+  if (!fast) {
+    b->enter_realtime = enter_realtime;
+    if (std::string e = open_watchdog(c, *b->clock, *b); !e.empty()) {
+      out.error = e;
+      return out;
+    }
+  }
   b->close = [bus = b->bus.get()] { bus->service(); };
   b->keep_alive = parts;
   out.board = std::move(b);
@@ -230,15 +267,7 @@ BoardResult make_linux_board(const FwConfig& c) {
     out.error = lnx::describe(c.spi_device, spi.status());
     return out;
   }
-  lnx::GpiodDataReadyConfig dr;
-  dr.chip = c.gpio_chip;
-  if (c.drdy_line.find_first_not_of("0123456789") == std::string::npos) {
-    dr.line_offset = std::stoi(c.drdy_line);
-  } else {
-    dr.line_name = c.drdy_line;
-  }
-  dr.nominal_period_ns = static_cast<std::int64_t>(std::llround(1e9 / c.sample_rate_hz));
-  auto drdy = lnx::GpiodDataReady::open(dr);
+  auto drdy = open_drdy(c);
   if (!drdy.is_ok()) {
     out.error = lnx::describe(c.gpio_chip + " line " + c.drdy_line, drdy.status());
     return out;

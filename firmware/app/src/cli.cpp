@@ -79,8 +79,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                    ->check(CLI::IsMember({"none", "systemd", "device"}));
   auto* o_wdd = app.add_option("--watchdog-device", wd_device, "watchdog.device");
   auto* o_level = app.add_option("--log-level", level, "log.level");
-  auto* o_pacing =
-      app.add_option("--pacing", pacing, "sim.pacing")->check(CLI::IsMember({"fast", "realtime"}));
+  auto* o_pacing = app.add_option("--pacing", pacing, "sim.pacing")
+                       ->check(CLI::IsMember({"fast", "realtime", "gpio"}));
   auto* o_dur = app.add_option("--duration", duration, "sim.duration_s (0 = the scenario's)");
   auto* o_sdir = app.add_option("--scenario-dir", scenario_dir, "sim.scenario_dir");
   app.add_flag("--check-config", out.check_only, "validate the configuration and exit");
@@ -190,7 +190,11 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   }
   if (o_wdd->count()) c.watchdog_device = wd_device;
   if (o_level->count()) c.log_level = level;
-  if (o_pacing->count()) c.pacing = pacing == "realtime" ? Pacing::kRealTime : Pacing::kFast;
+  if (o_pacing->count()) {
+    c.pacing = pacing == "realtime" ? Pacing::kRealTime
+               : pacing == "gpio"   ? Pacing::kGpio
+                                    : Pacing::kFast;
+  }
   if (o_dur->count()) c.sim_duration_s = duration;
   if (o_sdir->count()) c.sim_scenario_dir = scenario_dir;
 

@@ -206,8 +206,9 @@ void read_all(Reader& r, FwConfig& c) {
   r.text("log.level", c.log_level);
   r.text("sim.scenario", c.sim_scenario);
   r.text("sim.scenario_dir", c.sim_scenario_dir);
-  r.choice("sim.pacing", c.pacing, std::array<const char*, 2>{"fast", "realtime"},
-           std::array<Pacing, 2>{Pacing::kFast, Pacing::kRealTime});
+  // gpio: each conversion waits for a data-ready edge on adc.gpio_chip / adc.drdy_line.
+  r.choice("sim.pacing", c.pacing, std::array<const char*, 3>{"fast", "realtime", "gpio"},
+           std::array<Pacing, 3>{Pacing::kFast, Pacing::kRealTime, Pacing::kGpio});
   r.number("sim.duration_s", c.sim_duration_s);
   r.text("hil.address", c.hil_address);
   r.integer("hil.port", c.hil_port, 0, 65535);
@@ -395,7 +396,17 @@ ConfigResult load_config(const std::string& path, FwConfig base) {
 const char* to_string(BoardKind b) {
   return b == BoardKind::kSim ? "sim" : (b == BoardKind::kHil ? "hil" : "linux");
 }
-const char* to_string(Pacing p) { return p == Pacing::kRealTime ? "realtime" : "fast"; }
+const char* to_string(Pacing p) {
+  switch (p) {
+    case Pacing::kRealTime:
+      return "realtime";
+    case Pacing::kGpio:
+      return "gpio";
+    case Pacing::kFast:
+      break;
+  }
+  return "fast";
+}
 const char* to_string(GravityChoice g) {
   switch (g) {
     case GravityChoice::kStandard:

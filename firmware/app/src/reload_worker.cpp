@@ -7,12 +7,15 @@ constexpr int kIdle = 0, kRequested = 1, kRunning = 2, kReady = 3, kFailed = 4;
 
 ReloadWorker::ReloadWorker(LoadFn load) : load_(std::move(load)), thread_([this] { run(); }) {}
 
+// The condition variables are notified with the mutex held: the state change and the wake-up
+// are then one step for every observer (valgrind's helgrind flags a notify without the mutex,
+// and a waiter cannot miss it either way since the state changes under the mutex).
 ReloadWorker::~ReloadWorker() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
+    wake_.notify_all();
   }
-  wake_.notify_all();
   thread_.join();
 }
 
@@ -21,22 +24,32 @@ bool ReloadWorker::request(const nav::PipelineConfig<float>& current) {
   if (state_.load() != kIdle || !mutex_.try_lock()) return false;
   request_config_ = current;
   state_.store(kRequested);
-  mutex_.unlock();
   wake_.notify_one();
+  mutex_.unlock();
   return true;
 }
 
 ReloadWorker::Poll ReloadWorker::poll(CalibrationSet& out) {
+  // The state is the hand-over: the worker writes result_ before it stores kReady (release,
+  // seq_cst here) and writes it again only after a new request, which only this side makes
+  // after it has stored kIdle. So reading result_ after loading kReady needs no lock.
   const int s = state_.load();
   if (s == kFailed) {
     state_.store(kIdle);
     return Poll::kFailed;
   }
-  if (s != kReady || !mutex_.try_lock()) return Poll::kNothing;
+  if (s != kReady) return Poll::kNothing;
   out = result_;
   state_.store(kIdle);
-  mutex_.unlock();
   return Poll::kReady;
+}
+
+void ReloadWorker::wait_settled() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  settled_.wait(lock, [this] {
+    const int s = state_.load();
+    return s != kRequested && s != kRunning;
+  });
 }
 
 void ReloadWorker::run() {
@@ -55,6 +68,7 @@ void ReloadWorker::run() {
     } else {
       state_.store(kFailed);
     }
+    settled_.notify_all();
   }
 }
 

@@ -144,6 +144,16 @@ void SampleLoop::update_can_counters(std::uint32_t sample, std::int64_t t_ns) {
           health_.can_tx_dropped);
     }
   }
+  // Commands arrive on the receive side: a lost frame may be a lost command (the host's cmd
+  // times out and says so), so the loss is flagged and counted, never silent.
+  const std::uint32_t rx_lost =
+      (c.rx_kernel_dropped - can_seen_.rx_kernel_dropped) + (c.rx_dropped - can_seen_.rx_dropped);
+  if (rx_lost != 0) {
+    health_.can_rx_dropped += rx_lost;
+    events_.set(status_bits::kCanRxDrop, sample);
+    log(LogLevel::kWarn, t_ns, "{} received CAN frame(s) lost before the loop read them (lost: {})",
+        rx_lost, health_.can_rx_dropped);
+  }
   if (c.bus_off_events != can_seen_.bus_off_events) {
     health_.bus_off_events += c.bus_off_events - can_seen_.bus_off_events;
     events_.set(status_bits::kBusOff, sample);

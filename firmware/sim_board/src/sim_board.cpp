@@ -42,6 +42,18 @@ SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock&
   if (pacing_ == Pacing::kRealTime) t0_ns_ = clock_.now_ns() + period_ns_;
 }
 
+SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock,
+                                 hal::DataReadyLine& drdy, std::uint32_t samples)
+    : stream_(stream),
+      adc_(adc),
+      clock_(clock),
+      sample_clock_(nullptr),
+      pacing_(Pacing::kGpio),
+      period_ns_(0),
+      period_s_(0.0),
+      remaining_(samples),
+      drdy_(&drdy) {}
+
 bool SimSampleSource::contains(const std::vector<std::uint32_t>& v, std::uint32_t x) {
   return std::find(v.begin(), v.end(), x) != v.end();
 }
@@ -52,8 +64,35 @@ std::int64_t SimSampleSource::edge_time(std::uint32_t seq) const {
   return t0_ns_ + static_cast<std::int64_t>(seq) * period_ns_;
 }
 
+Result<RawSample> SimSampleSource::read_gpio_paced(std::int64_t timeout_ns) {
+  // The edge first: no edge, no conversion (a silent line times out here as on the board).
+  const Result<hal::DataReadyEdge> edge = drdy_->wait_edge(timeout_ns);
+  if (!edge.is_ok()) return edge.status();
+  if (!have_first_edge_) {
+    have_first_edge_ = true;
+    first_edge_seq_ = edge.value().seq;
+  }
+  // Conversion index since the first edge (modulo 2^32, as the line's sequence).
+  const std::uint32_t seq = edge.value().seq - first_edge_seq_;
+  if (seq < next_seq_) {
+    return Status(ErrorCode::kOutOfRange, "sim: data-ready sequence went back");
+  }
+  // Conversions whose edges were missed happened all the same: their voltages are skipped.
+  while (next_seq_ < seq && remaining_ > 0) {
+    (void)stream_.volts(next_seq_++);
+    --remaining_;
+  }
+  if (remaining_ == 0) return Status(ErrorCode::kUnavailable, "sim: scenario finished");
+  ++next_seq_;
+  --remaining_;
+  // The conversion is stamped with the kernel's timestamp of its edge; the driver sees the
+  // edge's sequence, so a gap counts as missed edges exactly as on the Linux board.
+  return adc_.convert(stream_.volts(seq), seq, edge.value().t_ns);
+}
+
 Result<RawSample> SimSampleSource::do_read_sample(std::int64_t timeout_ns) {
   if (remaining_ == 0) return Status(ErrorCode::kUnavailable, "sim: scenario finished");
+  if (pacing_ == Pacing::kGpio) return read_gpio_paced(timeout_ns);
   // A silent data-ready line: no edge for the timeout; the conversions still happen (the sensor
   // stream advances) and are lost.
   if (faults_.silent_from != 0 && next_seq_ == faults_.silent_from && silent_left_ == 0) {
@@ -177,12 +216,9 @@ namespace {
 // injection) behind them, so the source runs without one.
 class ScenarioStream final : public SensorStream {
  public:
-  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj)
-      : traj_(std::move(traj)),
-        source_(*traj_,
-                sim::SensorArrayModel(nav::table1_geometry<double>(s.rho_m), errors(s),
-                                      sim::gravity_model(s), s.rate_hz, s.seed),
-                nullptr, s.rate_hz) {
+  ScenarioStream(const sim::Scenario& s, std::unique_ptr<sim::Trajectory> traj,
+                 sim::SensorArrayModel sensors)
+      : traj_(std::move(traj)), source_(*traj_, std::move(sensors), nullptr, s.rate_hz) {
     if (s.noise_uniform) source_.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   }
 
@@ -221,10 +257,21 @@ std::string device_id_for(const std::string& name) {
 
 }  // namespace
 
-std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s) {
+sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::Scenario& s) {
+  // Values, not exceptions: this runs inside gfins-fw (docs/architecture.md, errors).
   auto traj = sim::make_trajectory(s.trajectory);
-  if (!traj.is_ok()) return nullptr;
-  return std::make_unique<ScenarioStream>(s, std::move(traj).value());
+  if (!traj.is_ok()) {
+    return sim::HostError{traj.error().code, "scenario " + s.name + ": " + traj.error().message};
+  }
+  auto sensors =
+      sim::SensorArrayModel::make(nav::table1_geometry<double>(s.rho_m), ScenarioStream::errors(s),
+                                  sim::gravity_model(s), s.rate_hz, s.seed);
+  if (!sensors.is_ok()) {
+    return sim::HostError{sensors.error().code,
+                          "scenario " + s.name + ": " + sensors.error().message};
+  }
+  return std::unique_ptr<SensorStream>(
+      std::make_unique<ScenarioStream>(s, std::move(traj).value(), std::move(sensors).value()));
 }
 
 // ---- The chip -----------------------------------------------------------------------------

@@ -37,8 +37,13 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
         bus.receive(std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
     if (!rx.is_ok()) continue;  // timeout slices and transient errors: loop checks the deadline
     const Result<can::ResponseFrame> r = can::decode_response(*rx);
+    // The calibration id frame always carries the ReportCalibrationId opcode, also when it
+    // follows a reload (firmware/can command.cpp, encode_calibration_id_response).
+    const bool id_after_reload = r.is_ok() && c.opcode == can::Opcode::kReloadCalibration &&
+                                 r->part == can::kPartCalibrationId &&
+                                 r->opcode == can::kOpReportCalibrationId;
     if (!r.is_ok() || r->node_id != node_id || r->token != c.token ||
-        r->opcode != static_cast<std::uint8_t>(c.opcode)) {
+        (r->opcode != static_cast<std::uint8_t>(c.opcode) && !id_after_reload)) {
       continue;
     }
     if (r->part == can::kPartStatus) {
@@ -58,7 +63,10 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
         deadline = Clock::now() + capture_wait;
         continue;
       }
-      if (c.opcode != can::Opcode::kReportCalibrationId && c.opcode != can::Opcode::kStartCapture) {
+      // ReportCalibrationId and ReloadCalibration are answered with a status frame and then the
+      // calibration id frame (docs/can-interface.md): wait for the id.
+      if (c.opcode != can::Opcode::kReportCalibrationId &&
+          c.opcode != can::Opcode::kReloadCalibration && c.opcode != can::Opcode::kStartCapture) {
         out.kind = CommandOutcome::Kind::kOk;
         out.text = "ok: " + describe_status(c, *r);
         return out;
@@ -67,7 +75,8 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
       out.status = *r;
       out.kind = CommandOutcome::Kind::kOk;
       char buf[96];
-      std::snprintf(buf, sizeof buf, "ok: calibration id 0x%08X", r->cal_id);
+      std::snprintf(buf, sizeof buf, "ok: %scalibration id 0x%08X",
+                    c.opcode == can::Opcode::kReloadCalibration ? "reloaded, " : "", r->cal_id);
       out.text = buf;
       return out;
     } else {

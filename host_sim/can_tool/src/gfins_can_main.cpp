@@ -4,18 +4,24 @@
 #include <CLI/CLI.hpp>
 
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iostream>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "capture_sequence.hpp"
 #include "command_client.hpp"
+#include "csv.hpp"
+#include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
 #include "gfins/host_sim/version.hpp"
@@ -40,6 +46,7 @@ enum Exit : int {
   kExitRejected = 4,  // cmd: the board answered with an error result
   kExitTimeout = 5,   // cmd: no response in time, or the command could not be sent
   kExitPlot = 6,      // plot: the plot script could not be run or failed
+  kExitNoFrames = 7,  // decode, plot: readable, no problem, but not one frame arrived
 };
 
 constexpr const char* kExitCodes =
@@ -50,7 +57,8 @@ constexpr const char* kExitCodes =
     "  3  decoded to the end, but problems were found (malformed lines, bad CRCs, drops, ...)\n"
     "  4  cmd: the board rejected the command (error response)\n"
     "  5  cmd: no response before the timeout, or the command could not be sent\n"
-    "  6  plot: the plot script could not be started or failed\n";
+    "  6  plot: the plot script could not be started or failed\n"
+    "  7  decode, plot: no CAN frame at all (idle or wrong interface, empty log), no problem\n";
 
 struct DecodeOptions {
   std::vector<std::string> sources;
@@ -116,17 +124,17 @@ int decode(const DecodeOptions& o, View& view) {
     }
     current = o.iface;
     const auto start = std::chrono::steady_clock::now();
-    std::uint64_t n = 0;
-    while (o.duration_s <= 0 ||
-           std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o.duration_s)) {
-      (*bus)->service();
-      const auto f = (*bus)->receive(100'000'000);
-      if (!f.is_ok()) continue;
-      const auto t = std::chrono::duration_cast<std::chrono::microseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
-      dec.feed_frame(++n, t, *f);
-    }
+    const auto keep_going = [&] {
+      return o.duration_s <= 0 ||
+             std::chrono::steady_clock::now() - start < std::chrono::duration<double>(o.duration_s);
+    };
+    const auto now_us = [] {
+      return static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                           std::chrono::system_clock::now().time_since_epoch())
+                                           .count());
+    };
+    constexpr std::int64_t kPollNs = 100'000'000;  // --duration is honoured within 0.1 s
+    feed_live(**bus, dec, keep_going, now_us, kPollNs);
   }
   for (const std::string& src : o.sources) {
     current = src;
@@ -146,8 +154,19 @@ int decode(const DecodeOptions& o, View& view) {
   dec.finish();
   view.finish();
   print_summary(dec.summary(), stderr);
-  if (input_error) return kExitInput;
-  return dec.summary().total_issues() == 0 ? kExitOk : kExitIssues;
+  switch (decode_end(dec.summary(), input_error)) {
+    case DecodeEnd::kInputError:
+      return kExitInput;
+    case DecodeEnd::kProblems:
+      return kExitIssues;
+    case DecodeEnd::kNoFrames:
+      std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
+                   o.iface.empty() ? "in the input" : "arrived on the interface");
+      return kExitNoFrames;
+    case DecodeEnd::kOk:
+      break;
+  }
+  return kExitOk;
 }
 
 std::FILE* open_output(const std::string& path) {
@@ -200,7 +219,7 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   o.node = node;
   o.quiet = true;
   const int rc = run_decode(o);
-  if (rc == kExitInput || rc == kExitUsage) {
+  if (rc == kExitInput || rc == kExitUsage || rc == kExitNoFrames) {  // nothing to plot
     std::error_code ec;
     fs::remove(csv, ec);
     return rc;
@@ -257,6 +276,26 @@ int run_cmd(const CmdOptions& o, can::Command c) {
                   static_cast<double>(cc.std_counts), cc.count, cc.saturated ? 1 : 0,
                   cc.motion ? 1 : 0);
     }
+    // A pose that moved or saturated is not a measurement (docs/calibration.md, step 3).
+    std::string sat, moved;
+    for (std::size_t ch = 0; ch < 6; ++ch) {
+      const std::string name = "a" + std::to_string(ch + 1);
+      if (r.capture.channels[ch].saturated) sat += (sat.empty() ? "" : ", ") + name;
+      if (r.capture.channels[ch].motion) moved += (moved.empty() ? "" : ", ") + name;
+    }
+    if (!sat.empty() || !moved.empty()) {
+      std::fprintf(stderr, "gfins-can cmd: pose %u refused:%s%s\n", r.capture.pose,
+                   sat.empty() ? ""
+                               : (" channel(s) " + sat +
+                                  " saturated (a code at full scale during the capture);")
+                                     .c_str(),
+                   moved.empty() ? ""
+                                 : (" channel(s) " + moved +
+                                    " moved (standard deviation above the firmware's still "
+                                    "limit, 2 mg of the scale factor)")
+                                       .c_str());
+      return kExitRejected;
+    }
   }
   switch (r.kind) {
     case CommandOutcome::Kind::kOk:
@@ -266,6 +305,124 @@ int run_cmd(const CmdOptions& o, can::Command c) {
     default:
       return kExitTimeout;
   }
+}
+
+struct SequenceCliOptions {
+  std::string iface;
+  int node = 0;
+  int samples = 2000;
+  double adc_lsb = 0.0;
+  double rate_hz = 1000.0;
+  std::vector<double> nominal_sf;
+  double tolerance_g = 0.2;
+  std::string poses;
+  std::string layout = "auto";
+  std::string output;
+  std::string poses_out;
+  bool auto_wait = false;
+  int probe_samples = 200;
+  double pose_timeout_s = 60.0;
+  int retries = 3;
+  int timeout_ms = 1000;
+};
+
+bool write_text(const std::string& path, const std::string& text) {
+  // Whole file under a temporary name, then renamed over the target: a reader (gfins-calibrate)
+  // never sees half a file, and a failed run leaves the previous one intact.
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    f.flush();
+    if (!f) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
+
+int run_calibrate_sequence(const SequenceCliOptions& o) {
+  std::vector<PlanPose> plan = tables23_plan();
+  if (!o.poses.empty()) {
+    const auto rows = tools::read_poses(o.poses);
+    if (!rows.is_ok()) {
+      std::fprintf(stderr, "gfins-can calibrate: %s\n", rows.status().message().c_str());
+      return kExitUsage;
+    }
+    std::vector<std::pair<int, std::array<double, 3>>> r;
+    for (const auto& p : rows.value()) r.emplace_back(p.attitude, p.f_b_g);
+    std::string error;
+    plan = plan_from_rows(r, error);
+    if (plan.empty()) {
+      std::fprintf(stderr, "gfins-can calibrate: %s: %s\n", o.poses.c_str(), error.c_str());
+      return kExitUsage;
+    }
+  }
+  const bool paper = o.layout == "paper" || (o.layout == "auto" && o.poses.empty());
+  if (paper && !o.poses.empty()) {
+    std::fprintf(stderr,
+                 "gfins-can calibrate: --layout paper is the Tables 2/3 plan's; with --poses the "
+                 "means are written for every sensor (--layout all)\n");
+    return kExitUsage;
+  }
+  SequenceOptions so;
+  so.node_id = static_cast<std::uint8_t>(o.node);
+  so.samples = static_cast<std::uint16_t>(o.samples);
+  so.sample_rate_hz = o.rate_hz;
+  so.adc_lsb_v = o.adc_lsb;
+  if (o.nominal_sf.size() == 1) so.nominal_sf_v_per_g.fill(o.nominal_sf[0]);
+  if (o.nominal_sf.size() == 6) std::copy_n(o.nominal_sf.begin(), 6, so.nominal_sf_v_per_g.begin());
+  if (!o.nominal_sf.empty() && o.nominal_sf.size() != 1 && o.nominal_sf.size() != 6) {
+    std::fprintf(stderr, "gfins-can calibrate: --nominal-sf takes 1 or 6 values (V/g)\n");
+    return kExitUsage;
+  }
+  so.pose_tolerance_g = o.tolerance_g;
+  so.wait = o.auto_wait ? WaitMode::kAuto : WaitMode::kHook;
+  so.probe_samples = static_cast<std::uint16_t>(o.probe_samples);
+  so.pose_timeout_s = o.pose_timeout_s;
+  so.retries = o.retries;
+  so.first_token = static_cast<std::uint8_t>(std::random_device{}() & 0xFFu);
+  so.timeouts.response = std::chrono::milliseconds(o.timeout_ms);
+
+  auto bus = open_live_bus(o.iface);
+  if (!bus.is_ok()) {
+    std::fprintf(stderr, "gfins-can calibrate: cannot open CAN interface '%s': %s\n",
+                 o.iface.c_str(), bus.status().message());
+    return kExitInput;
+  }
+  SequenceIo io;
+  io.note = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
+  io.await_pose = [](const PlanPose& p, std::size_t i, std::size_t n, bool repeat) {
+    std::fprintf(stderr,
+                 "%s pose %d (%s), %zu of %zu: turn the board so that it senses f = (%+.3f, "
+                 "%+.3f, %+.3f) g (body axes; at rest f points up), keep it still, then press "
+                 "Enter (q Enter stops)\n",
+                 repeat ? "REPEAT" : "next:", p.attitude, p.label.c_str(), i + 1, n, p.f_b_g[0],
+                 p.f_b_g[1], p.f_b_g[2]);
+    std::string line;
+    if (!std::getline(std::cin, line)) return false;
+    return line != "q";
+  };
+  const SequenceResult r = run_capture_sequence(**bus, plan, so, io);
+  if (!r.ok) {
+    std::fprintf(stderr, "gfins-can calibrate: %s\n", r.error.c_str());
+    return r.stop == SequenceResult::Stop::kRefused ? kExitRejected : kExitTimeout;
+  }
+  if (!write_text(o.output, means_csv(r.captures, o.adc_lsb, paper))) {
+    std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.output.c_str());
+    return kExitInput;
+  }
+  std::fprintf(
+      stderr, "gfins-can calibrate: wrote %s (%zu poses, %s layout, %d refused on the way)\n",
+      o.output.c_str(), r.captures.size(), paper ? "paper Tables 4/5" : "all sensors", r.refused);
+  if (!o.poses_out.empty()) {
+    if (!write_text(o.poses_out, poses_csv(plan))) {
+      std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.poses_out.c_str());
+      return kExitInput;
+    }
+    std::fprintf(stderr, "gfins-can calibrate: wrote %s\n", o.poses_out.c_str());
+  }
+  return kExitOk;
 }
 
 int main_impl(int argc, char** argv) {
@@ -331,6 +488,57 @@ int main_impl(int argc, char** argv) {
   capture->add_option("--samples", samples, "N samples")->required()->check(CLI::Range(1, 65535));
   auto* reload = cmd->add_subcommand("reload", "reload the calibration file");
 
+  SequenceCliOptions so;
+  auto* calibrate = app.add_subcommand(
+      "calibrate",
+      "orientation calibration through the firmware: capture every pose of a plan (Tables 2/3, "
+      "or --poses), refuse poses that moved, saturated or are not the expected one, write the "
+      "means CSV of gfins-calibrate (docs/calibration.md)");
+  calibrate->add_option("--iface", so.iface, "SocketCAN interface")->required();
+  calibrate->add_option("--node", so.node, "node id of the board")->check(CLI::Range(0, 15));
+  calibrate->add_option("--adc-lsb", so.adc_lsb, "ADC LSB at the sensor, V/count")
+      ->required()
+      ->check(CLI::Range(1e-12, 1.0));
+  calibrate->add_option("--samples", so.samples, "N samples per pose")
+      ->check(CLI::Range(2, 65535))
+      ->capture_default_str();
+  calibrate->add_option("--rate", so.rate_hz, "the board's sample rate, Hz")
+      ->check(CLI::Range(1.0, 100000.0))
+      ->capture_default_str();
+  calibrate->add_option("--nominal-sf", so.nominal_sf,
+                        "nominal scale factor(s), V/g, 1 or 6 values (default 1.33)");
+  calibrate
+      ->add_option("--tolerance-g", so.tolerance_g,
+                   "largest difference of a channel from the pose's expected output, g")
+      ->check(CLI::Range(0.01, 0.5))
+      ->capture_default_str();
+  calibrate
+      ->add_option("--poses", so.poses,
+                   "plan: CSV attitude,fx_g,fy_g,fz_g (default: the 12 poses of Tables 2/3)")
+      ->check(CLI::ExistingFile);
+  calibrate
+      ->add_option("--layout", so.layout,
+                   "paper (Tables 4/5: each sensor in its table's poses; default for the "
+                   "Tables 2/3 plan) or all (every sensor in every pose, with --poses-out)")
+      ->check(CLI::IsMember({"auto", "paper", "all"}));
+  calibrate->add_option("-o,--output", so.output, "means CSV to write")->required();
+  calibrate->add_option("--poses-out", so.poses_out, "also write the plan as a poses CSV");
+  calibrate->add_flag("--auto", so.auto_wait,
+                      "do not prompt: probe until the board is still in the expected pose "
+                      "(index table, simulated board)");
+  calibrate->add_option("--probe-samples", so.probe_samples, "--auto: samples per probe")
+      ->check(CLI::Range(2, 65535))
+      ->capture_default_str();
+  calibrate
+      ->add_option("--pose-timeout-s", so.pose_timeout_s,
+                   "--auto: give up on a pose after probing this long")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  calibrate->add_option("--retries", so.retries, "refused captures of a pose before giving up")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
+  calibrate->add_option("--timeout-ms", so.timeout_ms, "response timeout")->capture_default_str();
+
 #if GFINS_CAN_HAVE_HIL
   HilOptions ho;
   auto* hil = app.add_subcommand(
@@ -377,6 +585,7 @@ int main_impl(int argc, char** argv) {
   }
 
   if (dec->parsed()) return run_decode(d);
+  if (calibrate->parsed()) return run_calibrate_sequence(so);
 #if GFINS_CAN_HAVE_HIL
   if (hil->parsed()) return run_hil(ho, std::cout, std::cerr);
 #endif

@@ -56,11 +56,12 @@ bool scenario_samples(const HilOptions& o, Input& in, std::ostream& err) {
     return false;
   }
   const sim::Scenario& s = parsed.value();
-  auto stream = sim_board::make_scenario_stream(s);
-  if (!stream) {
-    err << "gfins-can hil: scenario " << s.name << ": its trajectory cannot be built\n";
+  auto made = sim_board::make_scenario_stream(s);
+  if (!made.is_ok()) {
+    err << "gfins-can hil: " << made.error().message << "\n";
     return false;
   }
+  auto stream = std::move(made).value();
   sim_board::ChipAdc adc(s.rate_hz);
   if (const Status st = adc.start(); !st.is_ok()) {
     err << "gfins-can hil: simulated ADC start: " << st.message() << "\n";

@@ -4,33 +4,76 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
+#include <string>
+
+#include "gfins/host_sim/parallel.hpp"
 
 namespace gfins::sim {
 
+namespace {
+
+/// What one run contributes to the statistics: per sample, the twelve error components and the
+/// four squared norms, in the order the sums take them.
+struct RunErrors {
+  double calibration_angle_error_rad = 0;
+  std::vector<double> t_s;
+  std::vector<std::array<double, kMcQuantities * 4>> e;  // [q * 4 + a] axis a, [q * 4 + 3] |.|²
+};
+
+/// Run k of the Monte-Carlo: its seeds come from (seed0, k) only, so the run is the same on any
+/// thread and in any order (parallel.hpp).
+HostResult<RunErrors> one_run(const Scenario& base, std::uint64_t seed0, std::size_t k,
+                              NavScalar scalar) {
+  Scenario s = base;
+  s.seed = seed0 + k;
+  s.calibration.seed = seed0 + 100003 * k;
+  GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false, scalar));
+  RunErrors r;
+  r.calibration_angle_error_rad = o.calibration.rms_angle_error_rad;
+  const auto& smp = o.compensated.samples;
+  r.t_s.reserve(smp.size());
+  r.e.reserve(smp.size());
+  for (const auto& x : smp) {
+    r.t_s.push_back(x.t_s);
+    const std::array<Vec3d, kMcQuantities> e = {x.w_err_b(), x.att_err_b(), x.v_err_n(),
+                                                x.r_err_n()};
+    auto& row = r.e.emplace_back();
+    for (std::size_t q = 0; q < kMcQuantities; ++q) {
+      for (std::size_t a = 0; a < 3; ++a) row[q * 4 + a] = e[q](static_cast<Eigen::Index>(a));
+      row[q * 4 + 3] = e[q].squaredNorm();
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
-                                            std::uint64_t seed0, const ProgressFn& progress) {
+                                            std::uint64_t seed0, const ProgressFn& progress,
+                                            NavScalar scalar, std::size_t jobs) {
   if (runs < 2) {
     return HostError{ErrorCode::kInvalidArgument, "montecarlo: at least two runs are needed"};
   }
   MonteCarloResult r;
   r.runs = runs;
   // Running sums per [quantity][axis][sample] (Welford would be overkill: errors are small and
-  // the sums are in double).
+  // the sums are in double), added in run order 0, 1, 2, ... whatever the thread count.
   std::array<std::array<std::vector<double>, 3>, kMcQuantities> sum;
   std::array<std::array<std::vector<double>, 3>, kMcQuantities> sum2;
   std::array<std::vector<double>, kMcQuantities> norm2;
   double cal2 = 0;
-  for (std::size_t k = 0; k < runs; ++k) {
-    Scenario s = base;
-    s.seed = seed0 + k;
-    s.calibration.seed = seed0 + 100003 * k;
-    GFINS_TRY(const ScenarioOutcome o, run_scenario(s, {}, /*with_uncompensated=*/false));
-    cal2 += o.calibration.rms_angle_error_rad * o.calibration.rms_angle_error_rad;
-    const auto& smp = o.compensated.samples;
-    const std::size_t n = smp.size();
+  std::optional<HostError> failed;
+  const auto fold = [&](std::size_t k, HostResult<RunErrors>&& run) {
+    if (!run.is_ok()) {
+      failed = std::move(run).take_error();
+      return false;
+    }
+    const RunErrors& o = run.value();
+    cal2 += o.calibration_angle_error_rad * o.calibration_angle_error_rad;
+    const std::size_t n = o.t_s.size();
     if (k == 0) {
-      r.t_s.resize(n);
-      for (std::size_t i = 0; i < n; ++i) r.t_s[i] = smp[i].t_s;
+      r.t_s = o.t_s;
       for (std::size_t q = 0; q < kMcQuantities; ++q) {
         for (std::size_t a = 0; a < 3; ++a) {
           sum[q][a].assign(n, 0.0);
@@ -38,21 +81,28 @@ HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t ru
         }
         norm2[q].assign(n, 0.0);
       }
+    } else if (n != r.t_s.size()) {
+      failed = HostError{ErrorCode::kFailedPrecondition,
+                         "montecarlo: run " + std::to_string(k) + " has " + std::to_string(n) +
+                             " samples, run 0 has " + std::to_string(r.t_s.size())};
+      return false;
     }
     for (std::size_t i = 0; i < n; ++i) {
-      const std::array<Vec3d, kMcQuantities> e = {smp[i].w_err_b(), smp[i].att_err_b(),
-                                                  smp[i].v_err_n(), smp[i].r_err_n()};
       for (std::size_t q = 0; q < kMcQuantities; ++q) {
         for (std::size_t a = 0; a < 3; ++a) {
-          const double v = e[q](static_cast<Eigen::Index>(a));
+          const double v = o.e[i][q * 4 + a];
           sum[q][a][i] += v;
           sum2[q][a][i] += v * v;
         }
-        norm2[q][i] += e[q].squaredNorm();
+        norm2[q][i] += o.e[i][q * 4 + 3];
       }
     }
     if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(runs));
-  }
+    return true;
+  };
+  ordered_parallel_for(
+      runs, jobs, [&](std::size_t k) { return one_run(base, seed0, k, scalar); }, fold);
+  if (failed) return *failed;
   const auto nr = static_cast<double>(runs);
   const std::size_t n = r.t_s.size();
   for (std::size_t q = 0; q < kMcQuantities; ++q) {

@@ -136,7 +136,7 @@ class Reader {
     }
     const auto* a = n->as_array();
     if (a == nullptr) fail(n, full, "expected an array of numbers, got " + type_name(*n));
-    if (a->size() != size) {
+    if (size != 0 && a->size() != size) {  // size 0: any length (the caller checks it)
       fail(n, full,
            "expected " + std::to_string(size) + " numbers, got " + std::to_string(a->size()));
     }
@@ -186,6 +186,36 @@ class Reader {
 
 Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
 
+/// The [trajectory] keys each kind reads (docs/simulation.md, "Scenario format"). A key of
+/// another kind would be silently ignored, so it is an error naming the kind and its keys.
+std::vector<std::string> trajectory_keys_of(const std::string& kind) {
+  if (kind == "rest") return {"kind", "euler_deg"};
+  if (kind == "constant_acceleration") return {"kind", "euler_deg", "accel_mps2"};
+  if (kind == "spin" || kind == "rate_table") return {"kind", "euler_deg", "axis_b", "rate_dps"};
+  if (kind == "coning") return {"kind", "euler_deg", "half_angle_deg", "cone_rate_hz"};
+  if (kind == "maneuver") return {"kind", "scale"};
+  if (kind == "drive") return {"kind", "speed_mps", "turn_amplitude_m", "turn_period_s"};
+  if (kind == "calibration_poses")
+    return {"kind", "poses", "dwell_s", "transition_s", "extra_poses_g"};
+  return {"kind"};
+}
+
+void check_trajectory_keys(const toml::table& tr, const Reader& rd, const std::string& kind) {
+  const std::vector<std::string> keys = trajectory_keys_of(kind);
+  for (const auto& [k, v] : tr) {
+    const std::string key(k.str());
+    if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    std::string list;
+    for (const auto& a : keys) list += (list.empty() ? "" : ", ") + a;
+    std::string what = "does not apply to trajectory kind \"";
+    what += kind;
+    what += "\" (its keys: ";
+    what += list;
+    what += ")";
+    rd.fail(&v, "trajectory." + key, what);
+  }
+}
+
 constexpr double kBig = 1e9;
 
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
@@ -220,14 +250,15 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   // [trajectory]
   const toml::table& tr = *rd.table(root, "trajectory", true);
   const std::string p = "trajectory.";
-  rd.only(
-      tr, p,
-      {"kind", "euler_deg", "accel_mps2", "axis_b", "rate_dps", "half_angle_deg", "cone_rate_hz",
-       "scale", "speed_mps", "turn_amplitude_m", "turn_period_s", "poses", "dwell_s"});
+  rd.only(tr, p,
+          {"kind", "euler_deg", "accel_mps2", "axis_b", "rate_dps", "half_angle_deg",
+           "cone_rate_hz", "scale", "speed_mps", "turn_amplitude_m", "turn_period_s", "poses",
+           "dwell_s", "transition_s", "extra_poses_g"});
   TrajectorySpec& t = s.trajectory;
   t.kind = rd.string(tr, p, "kind", std::nullopt,
                      {"rest", "constant_acceleration", "spin", "rate_table", "coning", "maneuver",
                       "drive", "calibration_poses"});
+  check_trajectory_keys(tr, rd, t.kind);
   if (const auto e = rd.numbers(tr, p, "euler_deg", 3, -360.0, 360.0, false); !e.empty()) {
     t.euler0_rad = vec3(e) * kDegToRad;
   }
@@ -254,6 +285,20 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   if (t.kind == "calibration_poses") {
     t.poses = rd.string(tr, p, "poses", std::string("both"), {"table2", "table3", "both"});
     t.dwell_s = rd.number(tr, p, "dwell_s", 10.0, 1e-2, 1e5);
+    t.transition_s = rd.number(tr, p, "transition_s", 2.0, 1e-2, 1e4);
+    const auto extra = rd.numbers(tr, p, "extra_poses_g", 0, -1.5, 1.5, false);
+    if (extra.size() % 3 != 0) {
+      rd.fail(tr.get("extra_poses_g"), p + "extra_poses_g",
+              "takes three numbers (fx, fy, fz in g) per pose");
+    }
+    for (std::size_t i = 0; i + 2 < extra.size(); i += 3) {
+      const Vec3d f(extra[i], extra[i + 1], extra[i + 2]);
+      if (!(f.norm() > 0.5)) {
+        rd.fail(tr.get("extra_poses_g"), p + "extra_poses_g",
+                "a pose's specific force must be about 1 g (at rest: minus gravity, body axes)");
+      }
+      t.extra_poses_g.push_back(f);
+    }
   }
 
   // [sensors]
@@ -261,7 +306,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     const std::string q = "sensors.";
     rd.only(*se, q,
             {"orientation", "beta_deg", "alpha_deg", "location_error_mm", "bias_mps2", "noise_mps2",
-             "noise_mg", "noise_distribution", "model", "temperature_c", "adc"});
+             "noise_mg", "noise_distribution", "model", "temperature_c", "adc", "scale_v_per_g"});
     const std::string orient =
         rd.string(*se, q, "orientation", std::string("none"), {"none", "paper_table6", "custom"});
     if (orient == "paper_table6") {
@@ -300,6 +345,10 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     s.noise_uniform = rd.string(*se, q, "noise_distribution", std::string("gaussian"),
                                 {"gaussian", "uniform"}) == "uniform";
     s.adc = rd.boolean(*se, q, "adc", true);
+    if (const auto sf = rd.numbers(*se, q, "scale_v_per_g", 6, 0.1, 10.0, false); !sf.empty()) {
+      std::copy(sf.begin(), sf.end(), s.scale_v_per_g.begin());
+      if (!s.adc) rd.fail(se->get("scale_v_per_g"), q + "scale_v_per_g", "needs adc = true");
+    }
     if (!s.adc && s.qa1100) {
       rd.fail(se->get("adc"), q + "adc",
               "false (the paper's §6.3 m/s² setting) needs model = \"paper\", not \"qa1100\"");
@@ -376,15 +425,39 @@ HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::strin
   }
 }
 
+std::vector<Vec3d> calibration_pose_vectors(const TrajectorySpec& spec) {
+  std::vector<Vec3d> out;
+  const auto add = [&out](const std::array<std::array<double, 3>, 6>& table) {
+    for (const auto& a : table) out.emplace_back(a[0], a[1], a[2]);
+  };
+  if (spec.poses != "table3") add(calib::table2_attitudes<double>());
+  if (spec.poses != "table2") add(calib::table3_attitudes<double>());
+  out.insert(out.end(), spec.extra_poses_g.begin(), spec.extra_poses_g.end());
+  return out;
+}
+
 std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, double period_s) {
   return std::make_unique<DriveTrajectory>(speed_mps, amplitude_m, period_s);
 }
 
 HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& t) {
   const Quatd q0 = nav::quat_from_euler(t.euler0_rad.x(), t.euler0_rad.y(), t.euler0_rad.z());
-  if (t.kind == "rest" || t.kind == "calibration_poses") return make_rest(q0);
+  if (t.kind == "rest") return make_rest(q0);
+  if (t.kind == "calibration_poses") {
+    return std::unique_ptr<Trajectory>(
+        make_pose_sequence(calibration_pose_vectors(t), t.dwell_s, t.transition_s));
+  }
   if (t.kind == "constant_acceleration") return make_constant_acceleration(t.accel_n_mps2, q0);
-  if (t.kind == "spin" || t.kind == "rate_table") return make_spin(t.axis_b, t.rate_rps, q0);
+  if (t.kind == "spin" || t.kind == "rate_table") {
+    // make_spin throws on a zero or non-finite axis (host code); here, on the simulated board's
+    // path, it is a value.
+    const double n = t.axis_b.norm();
+    if (!(n > 0.0) || !std::isfinite(n)) {
+      return HostError{ErrorCode::kInvalidArgument,
+                       "trajectory '" + t.kind + "': the spin axis must be finite and non-zero"};
+    }
+    return make_spin(t.axis_b, t.rate_rps, q0);
+  }
   if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);
   if (t.kind == "maneuver") return make_maneuver(t.scale);
   if (t.kind == "drive") return make_drive(t.speed_mps, t.turn_amplitude_m, t.turn_period_s);

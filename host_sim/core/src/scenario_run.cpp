@@ -10,6 +10,7 @@
 
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
+#include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
@@ -168,7 +169,7 @@ ArrayErrors array_errors(const Scenario& s) {
     // Through the converter the sensors have the QA-1100's scale factor (1.33 V/g into 1 kΩ), so
     // the counts carry the real LSB in g; the paper's §6.3 sensors are unit gain (m/s² in, m/s²
     // out).
-    if (s.adc) e.scale_v_per_g = qa1100_sf;
+    if (s.adc) e.scale_v_per_g = s.scale_v_per_g[j] > 0 ? s.scale_v_per_g[j] : qa1100_sf;
     e.bias_g += s.bias_mps2[j] / g;
     // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
     if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
@@ -227,14 +228,56 @@ HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s) {
   return c;
 }
 
+std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated) {
+  const double samples = std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0;
+  const std::uint64_t per_sample = sizeof(TruthState) +
+                                   (s.adc ? 2 * sizeof(RawSample) : sizeof(Vec6d)) +
+                                   (with_uncompensated ? 2u : 1u) * sizeof(SampleRecord);
+  const double bytes = samples * static_cast<double>(per_sample);
+  return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
+}
+
+HostStatus check_run_size(const Scenario& s, bool with_uncompensated) {
+  char buf[320];
+  const double periods = s.duration_s * s.rate_hz;
+  if (!(std::floor(periods + 0.5) >= 1.0)) {
+    std::snprintf(buf, sizeof buf,
+                  "scenario %s: duration_s %g x rate_hz %g = %.3g sample periods: a run needs at "
+                  "least 2 samples (duration_s >= %g s at this rate)",
+                  s.name.c_str(), s.duration_s, s.rate_hz, periods, 1.0 / s.rate_hz);
+    return HostError{ErrorCode::kInvalidArgument, buf};
+  }
+  const std::uint64_t bytes = run_memory_bytes(s, with_uncompensated);
+  if (bytes > kMaxRunMemoryBytes) {
+    std::snprintf(buf, sizeof buf,
+                  "scenario %s: duration_s %g x rate_hz %g = %.4g samples would need %.3g GiB "
+                  "of memory, above the limit of %.3g GiB: shorten the run or lower the rate",
+                  s.name.c_str(), s.duration_s, s.rate_hz, std::floor(periods + 0.5) + 1.0,
+                  static_cast<double>(bytes) / double(1u << 30),
+                  static_cast<double>(kMaxRunMemoryBytes) / double(1u << 30));
+    return HostError{ErrorCode::kOutOfRange, buf};
+  }
+  return Done{};
+}
+
 HostResult<ScenarioOutcome> run_scenario(const Scenario& s, const ProgressFn& progress,
                                          bool with_uncompensated, NavScalar scalar) {
+  GFINS_TRY_STATUS(check_run_size(s, with_uncompensated));
   ScenarioOutcome out;
   const bool calibrated = s.misalignment_source == MisalignmentSource::kCalibrated;
   if (calibrated || s.trajectory.kind == "calibration_poses") {
     GFINS_TRY(out.calibration, simulate_calibration(s));
   }
-  if (s.trajectory.kind == "calibration_poses") return out;
+  if (s.trajectory.kind == "calibration_poses") {
+    // No navigation run (the array turns between poses; the calibration is the product), but the
+    // samples of the pose sequence, so that the calibration can be recorded and replayed.
+    // The same motion as the simulated board's (make_trajectory, make_pose_sequence).
+    GFINS_TRY(const auto traj, make_trajectory(s.trajectory));
+    GFINS_TRY(Stream st, make_stream(s, *traj));
+    out.raw = std::move(st.raw);
+    out.volts_per_count = st.volts_per_count;
+    return out;
+  }
 
   // What the compensator is told: the truth, or the calibration's estimates (angles and biases;
   // the location errors are not estimated by the multi-attitude calibration and stay as given).
@@ -263,6 +306,8 @@ HostResult<ScenarioOutcome> run_scenario(const Scenario& s, const ProgressFn& pr
                                      ", " + source_name(s.misalignment_source) + ")",
                                  0.5));
   if (progress) progress(1.0);
+  out.volts_per_count = st.volts_per_count;
+  out.raw = st.raw;
   return out;
 }
 
@@ -287,22 +332,41 @@ Bounds angular_accel_bounds(const RunSeries& r) {
   return bounds_of(r, [](const SampleRecord& x) { return x.wdot_err_b(); });
 }
 
-HostStatus write_series_csv(const RunSeries& r, const std::string& path) {
+HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) return HostError{ErrorCode::kIoError, "cannot write " + path};
-  std::fprintf(f,
-               "t_s,"
-               "true_qw,true_qx,true_qy,true_qz,true_wx,true_wy,true_wz,"
-               "true_ax,true_ay,true_az,true_vx,true_vy,true_vz,true_rx,true_ry,true_rz,"
-               "est_qw,est_qx,est_qy,est_qz,est_wx,est_wy,est_wz,"
-               "est_ax,est_ay,est_az,est_vx,est_vy,est_vz,est_rx,est_ry,est_rz,"
-               "err_wdotx,err_wdoty,err_wdotz,err_ax,err_ay,err_az,err_wx,err_wy,err_wz,"
-               "err_attx,err_atty,err_attz,err_vx,err_vy,err_vz,err_rx,err_ry,err_rz\n");
+  // Units and frames in every name: q_nb (body to NED, unitless), w_b (rad/s, body FRD),
+  // a_n (m/s², NED), v_n (m/s, NED), r_n (m, NED), wdot_b (rad/s², body), att_b (small-angle
+  // attitude error, rad, body).
+  std::string head = "t_s";
+  const auto quat_cols = [&](const char* who) {
+    for (const char* c : {"w", "x", "y", "z"}) head += std::string(",") + who + "_q_nb_" + c;
+  };
+  const auto vec_cols = [&](const std::string& name, const char* unit) {
+    for (const char* c : {"x", "y", "z"}) head += "," + name + "_" + c + "_" + unit;
+  };
+  for (const char* who : {"true", "est"}) {
+    quat_cols(who);
+    vec_cols(std::string(who) + "_w_b", "rps");
+    vec_cols(std::string(who) + "_a_n", "mps2");
+    vec_cols(std::string(who) + "_v_n", "mps");
+    vec_cols(std::string(who) + "_r_n", "m");
+  }
+  vec_cols("err_wdot_b", "rps2");
+  vec_cols("err_a_n", "mps2");
+  vec_cols("err_w_b", "rps");
+  vec_cols("err_att_b", "rad");
+  vec_cols("err_v_n", "mps");
+  vec_cols("err_r_n", "m");
+  std::fprintf(f, "%s\n", head.c_str());
   const auto v3 = [f](const Vec3d& v) { std::fprintf(f, ",%.9g,%.9g,%.9g", v.x(), v.y(), v.z()); };
   const auto q4 = [f](const Quatd& q) {
     std::fprintf(f, ",%.9g,%.9g,%.9g,%.9g", q.w(), q.x(), q.y(), q.z());
   };
-  for (const auto& x : r.samples) {
+  const std::size_t every = std::max<std::size_t>(decimate, 1);
+  for (std::size_t k = 0; k < r.samples.size(); ++k) {
+    if (k % every != 0 && k + 1 != r.samples.size()) continue;
+    const SampleRecord& x = r.samples[k];
     std::fprintf(f, "%.6f", x.t_s);
     q4(x.truth.q_nb);
     v3(x.truth.w_b);
@@ -329,6 +393,21 @@ HostStatus write_series_csv(const RunSeries& r, const std::string& path) {
     return HostError{ErrorCode::kIoError, "error writing " + path};
   }
   return Done{};
+}
+
+HostStatus write_run_recording(const Scenario& s, const ScenarioOutcome& o,
+                               const std::string& path) {
+  if (o.raw.empty() || !(o.volts_per_count > 0.0)) {
+    return HostError{ErrorCode::kFailedPrecondition,
+                     "scenario " + s.name +
+                         ": nothing to record: its samples do not go through the ADC (sensors.adc "
+                         "= false, the paper's §6.3 in m/s²); a recording holds ADC counts"};
+  }
+  RecordingHeader h;
+  h.sample_rate_hz = s.rate_hz;
+  h.volts_per_count.fill(o.volts_per_count);
+  h.geometry = nav::table1_geometry<double>(s.rho_m);
+  return write_recording(path, h, o.raw);
 }
 
 }  // namespace gfins::sim

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace gfins::sim {
 namespace {
@@ -38,6 +39,24 @@ AccelErrors AccelErrors::qa1100_typical() {
   return e;
 }
 
+namespace {
+bool valid_rate(double sample_rate_hz) {
+  return sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz);
+}
+}  // namespace
+
+HostResult<SensorArrayModel> SensorArrayModel::make(const nav::ArrayGeometry<double, 6>& nominal,
+                                                    const ArrayErrors& errors,
+                                                    const nav::GravityModel<double>& gravity,
+                                                    double sample_rate_hz, std::uint64_t seed) {
+  if (!valid_rate(sample_rate_hz)) {
+    return HostError{ErrorCode::kInvalidArgument, "sensor model: sample rate " +
+                                                      std::to_string(sample_rate_hz) +
+                                                      " Hz must be positive and finite"};
+  }
+  return SensorArrayModel(nominal, errors, gravity, sample_rate_hz, seed);  // cannot throw now
+}
+
 SensorArrayModel::SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal,
                                    const ArrayErrors& errors,
                                    const nav::GravityModel<double>& gravity, double sample_rate_hz,
@@ -47,7 +66,7 @@ SensorArrayModel::SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal,
       real_(nav::misaligned_geometry(nominal, errors.misalignment), gravity),
       sample_rate_hz_(sample_rate_hz),
       sqrt_dt_s_(std::sqrt(1.0 / sample_rate_hz)) {
-  if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz)) {
+  if (!valid_rate(sample_rate_hz)) {
     throw std::invalid_argument("SensorArrayModel: sample rate must be positive and finite");
   }
   for (std::size_t j = 0; j < 6; ++j) {

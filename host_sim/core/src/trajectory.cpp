@@ -2,8 +2,10 @@
 // q̈). Each class writes its motion once, in pose(), over time jets.
 #include "gfins/host_sim/trajectory.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace gfins::sim {
 
@@ -188,6 +190,48 @@ class Maneuver final : public JetTrajectory {
   double scale_;
 };
 
+// Static poses joined by smooth rotations about the array centre (calibration_poses). Pose k is
+// held over [k·(D + T), k·(D + T) + D] (D dwell, T transition); the transition from q_k to
+// q_k+1 is q_k ⊗ exp(½ φ s(τ) u) with u, φ the axis and angle of q_k* ⊗ q_k+1 (shortest way,
+// body axes) and s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (minimum jerk), τ = (t − start)/T, so ω and ω̇ are zero
+// at both ends and the board is exactly still within each dwell.
+class PoseSequence final : public JetTrajectory {
+ public:
+  PoseSequence(std::vector<Quatd> q_nb, double dwell_s, double transition_s)
+      : q_(std::move(q_nb)), dwell_s_(dwell_s), transition_s_(transition_s) {
+    for (std::size_t k = 0; k + 1 < q_.size(); ++k) {
+      Quatd dq = q_[k].conjugate() * q_[k + 1];
+      if (dq.w() < 0) dq.coeffs() *= -1.0;
+      const double n = dq.vec().norm();
+      axis_.push_back(n > 0 ? Vec3d(dq.vec() / n) : Vec3d::UnitX());
+      angle_.push_back(2.0 * std::atan2(n, dq.w()));
+    }
+  }
+  void pose(const JetD& t, JetVec3& r_n, JetQuat& q_nb) const override {
+    r_n = JetVec3{};
+    const double period = dwell_s_ + transition_s_;
+    const double k_real = std::floor(std::max(t.val, 0.0) / period);
+    const auto k = static_cast<std::size_t>(std::min(k_real, static_cast<double>(q_.size() - 1)));
+    const double in_dwell_until = static_cast<double>(k) * period + dwell_s_;
+    if (k + 1 >= q_.size() || t.val <= in_dwell_until) {
+      q_nb = JetQuat::constant(q_[k]);
+      return;
+    }
+    const JetD tau = (t - in_dwell_until) / transition_s_;
+    const JetD tau3 = tau * tau * tau;
+    const JetD s = tau3 * (10.0 - 15.0 * tau + 6.0 * (tau * tau));
+    q_nb = JetQuat::constant(q_[k]) * jet_axis_angle(axis_[k], angle_[k] * s);
+  }
+  std::string name() const override { return "calibration_poses"; }
+
+ private:
+  std::vector<Quatd> q_;
+  std::vector<Vec3d> axis_;
+  std::vector<double> angle_;
+  double dwell_s_;
+  double transition_s_;
+};
+
 }  // namespace
 
 std::unique_ptr<Trajectory> make_rest(const Quatd& q_nb, const Vec3d& r_n) {
@@ -215,6 +259,28 @@ std::unique_ptr<Trajectory> make_coning(double half_angle_rad, double cone_rate_
 
 std::unique_ptr<Trajectory> make_maneuver(double scale) {
   return std::make_unique<Maneuver>(scale);
+}
+
+Quatd attitude_sensing(const Vec3d& f_b) {
+  // At rest the specific force is −g: along −z of NED ("up"). FromTwoVectors gives the rotation
+  // R with R·f̂_b = −ẑ_n, i.e. q_nb (heading: the shortest rotation's, arbitrary but fixed).
+  return Quatd::FromTwoVectors(f_b.normalized(), Vec3d(0.0, 0.0, -1.0));
+}
+
+std::unique_ptr<Trajectory> make_pose_sequence(const std::vector<Vec3d>& f_b, double dwell_s,
+                                               double transition_s) {
+  if (f_b.empty() || !(dwell_s > 0.0) || !(transition_s > 0.0)) {
+    throw std::invalid_argument(
+        "make_pose_sequence: needs at least one pose, a positive dwell and transition");
+  }
+  std::vector<Quatd> q;
+  for (const Vec3d& f : f_b) {
+    if (!(f.norm() > 0.0) || !std::isfinite(f.norm())) {
+      throw std::invalid_argument("make_pose_sequence: a pose's specific force must be non-zero");
+    }
+    q.push_back(attitude_sensing(f));
+  }
+  return std::make_unique<PoseSequence>(std::move(q), dwell_s, transition_s);
 }
 
 }  // namespace gfins::sim

@@ -52,13 +52,16 @@ constexpr const char* to_string(CanBusState s) {
 
 /// Counters only grow (they wrap at 2^32).
 struct CanCounters {
-  std::uint32_t tx_frames = 0;       // frames handed to the controller / sink
-  std::uint32_t tx_dropped = 0;      // frames dropped: queue full, bus-off, interface down
-  std::uint32_t tx_queued = 0;       // frames that had to wait in the backend's queue
-  std::uint32_t rx_frames = 0;       // data frames received
-  std::uint32_t rx_dropped = 0;      // frames the kernel or backend reported lost on receive
-  std::uint32_t error_frames = 0;    // error frames seen (SocketCAN CAN_ERR_FLAG)
-  std::uint32_t bus_off_events = 0;  // transitions into bus-off
+  std::uint32_t tx_frames = 0;          // frames handed to the controller / sink
+  std::uint32_t tx_dropped = 0;         // frames dropped: queue full, bus-off, interface down
+  std::uint32_t tx_queued = 0;          // frames that had to wait in the backend's queue
+  std::uint32_t rx_frames = 0;          // data frames received
+  std::uint32_t rx_dropped = 0;         // frames the controller or backend reported lost on receive
+                                        // (SocketCAN: CAN_ERR_CRTL_RX_OVERFLOW error frames)
+  std::uint32_t rx_kernel_dropped = 0;  // frames the kernel dropped from this socket's full
+                                        // receive queue before we read them (SO_RXQ_OVFL)
+  std::uint32_t error_frames = 0;       // error frames seen (SocketCAN CAN_ERR_FLAG)
+  std::uint32_t bus_off_events = 0;     // transitions into bus-off
   std::uint32_t error_passive_events = 0;
   std::uint32_t restarts = 0;  // recoveries from bus-off / interface down
 };

@@ -70,7 +70,19 @@ struct ErrorBudget {
 };
 
 /// Propagates each source group alone and all together; σ at the samples nearest `times_s`.
-ErrorBudget error_budget(const CovarianceSpec& spec, const std::vector<double>& times_s);
+/// The seven propagations run on `jobs` threads (0: one per hardware thread, parallel.hpp), with
+/// the same result for every `jobs`.
+ErrorBudget error_budget(const CovarianceSpec& spec, const std::vector<double>& times_s,
+                         std::size_t jobs = 0);
+
+/// What gfins-sim covariance writes: the envelopes of the whole spec and the budget, whose
+/// "total" is the same propagation (done once). Same threads and guarantee as error_budget.
+struct CovarianceReport {
+  CovarianceResult envelopes;
+  ErrorBudget budget;
+};
+CovarianceReport covariance_report(const CovarianceSpec& spec, const std::vector<double>& times_s,
+                                   std::size_t jobs = 0);
 
 /// CSV writers.
 HostStatus write_covariance_csv(const CovarianceResult& r, const std::string& path);

@@ -36,9 +36,15 @@ struct MonteCarloResult {
 };
 
 /// Runs the scenario `runs` times (compensated run only): run k uses noise seed seed0 + k and
-/// calibration seed seed0 + 100003 k. `progress` gets the fraction of runs done.
+/// calibration seed seed0 + 100003 k. `progress` gets the fraction of runs done (called on the
+/// calling thread). `scalar` is the navigation core's (gfins-sim: float, the board's, unless
+/// --scalar double). The runs go to `jobs` threads (0: one per hardware thread, parallel.hpp); the
+/// result is bit for bit the same for every `jobs`: each run's random streams come from (seed0, k)
+/// only and the statistics add the runs in the order k = 0, 1, 2, ...
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
-                                            std::uint64_t seed0, const ProgressFn& progress = {});
+                                            std::uint64_t seed0, const ProgressFn& progress = {},
+                                            NavScalar scalar = NavScalar::kDouble,
+                                            std::size_t jobs = 0);
 
 /// Least-squares slope of log y against log t over the samples with t in [t_lo, t_hi] and y > 0.
 /// Returns NaN with fewer than two such samples.

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -103,6 +104,10 @@ class RecordingReader {
   std::uint64_t pos_ = kRecordingHeaderBytes;
   std::uint64_t index_ = 0;
   std::uint64_t block_ = 0;
+  static constexpr std::uint64_t kUnknownPos = ~std::uint64_t{0};
+  static constexpr std::size_t kReadBufferBytes = std::size_t{256} * 1024;
+  std::uint64_t file_pos_ = kUnknownPos;  // where the next fread starts, when known
+  std::unique_ptr<char[]> stdio_buffer_;  // the stream's buffer (setvbuf), kReadBufferBytes
   std::vector<std::uint8_t> buffer_;
 };
 

@@ -43,6 +43,9 @@ struct TrajectorySpec {
   double turn_period_s = 20.0;         // drive: period of one left-right weave
   std::string poses = "both";          // calibration_poses: "table2" | "table3" | "both"
   double dwell_s = 10.0;               // calibration_poses: time at rest in each pose
+  double transition_s = 2.0;           // calibration_poses: time to turn to the next pose
+  std::vector<Vec3d> extra_poses_g;    // calibration_poses: more poses after the tables' (e.g.
+                                       // verification poses), specific force in g, body axes
 };
 
 /// Where the compensator's misalignment comes from.
@@ -92,6 +95,10 @@ struct Scenario {
   CalibrationSpec calibration;
 
   bool noise_uniform = false;  // uniform noise of the same σ instead of Gaussian
+
+  // Per-sensor scale factor (V/g) behind the converter; 0 = the QA-1100's nominal 1.33 V/g.
+  // Known scale-factor errors of a simulated board to be calibrated ([sensors] scale_v_per_g).
+  std::array<double, 6> scale_v_per_g{};
 
   // The sensor model behind the outputs (SensorArrayModel, sensor_model.hpp): "paper" = unit-gain
   // sensors with only the errors above (the paper's §6.3); "qa1100" = AccelErrors::qa1100_typical
@@ -146,6 +153,12 @@ std::vector<std::string> closest_names(std::string_view name, const std::vector<
 /// The trajectory of a scenario; kInvalidArgument for a kind it does not know (parse_scenario
 /// rejects those first).
 HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& spec);
+
+/// The poses of a calibration_poses trajectory in order: Table 2's six, Table 3's six (or one
+/// table, trajectory.poses), then extra_poses_g; specific force sensed, body axes, g. Pose k
+/// (0-based) is held over [k·(dwell + transition), k·(dwell + transition) + dwell]
+/// (make_pose_sequence).
+std::vector<Vec3d> calibration_pose_vectors(const TrajectorySpec& spec);
 
 /// A vehicle drive with turns: forward at speed v along north, weaving east
 /// y(t) = A (1 − cos Ωt), Ω = 2π/period, heading along the velocity ψ = atan(ẏ/v), with a bank
@@ -211,6 +224,12 @@ struct ScenarioOutcome {
   RunSeries compensated;
   CalibrationOutcome calibration;
   nav::Misalignment<double> compensator_misalignment{};
+  // The samples the runs navigated, as the ADC delivered them (empty for the paper's §6.3
+  // m/s² scenarios, which have no converter): sample 0 is the start (start_at), then every sample
+  // offered to the navigation loop. A calibration_poses scenario fills them too (its motion,
+  // make_pose_sequence), so that it can be recorded. write_run_recording() stores them.
+  std::vector<RawSample> raw;
+  double volts_per_count = 0.0;  // of the converter, V at the sensor output
 };
 
 /// Called with the fraction done (0..1) now and then; may be empty.
@@ -227,6 +246,19 @@ ArrayErrors array_errors(const Scenario& s);
 
 /// Scalar of the navigation core a run uses: float is the board's, double the host reference.
 enum class NavScalar : std::uint8_t { kFloat, kDouble };
+
+/// Memory a run of `s` holds (bytes): per sample the truth, the converter's output and one
+/// SampleRecord per run (two with the uncompensated run), times duration × rate + 1 samples.
+std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated = true);
+
+/// The largest run accepted (bytes of run_memory_bytes): 2 GiB, half of the 4 GiB of a small
+/// development machine or CI runner, so a run never ends in std::bad_alloc after minutes of work.
+inline constexpr std::uint64_t kMaxRunMemoryBytes = std::uint64_t{2} << 30;
+
+/// Checks before any work: at least two samples (duration × rate ≥ 1 sample period), and the
+/// memory estimate within kMaxRunMemoryBytes. The message names the scenario, the figures and
+/// the limit. run_scenario() calls it first.
+HostStatus check_run_size(const Scenario& s, bool with_uncompensated = true);
 
 /// Runs a navigation scenario twice with the same samples (one SampleSource stream, computed
 /// once): without compensation and with the scenario's compensator, both through the one
@@ -245,7 +277,15 @@ struct Bounds {
 Bounds linear_accel_bounds(const RunSeries& r);   // a_err_n, m/s²
 Bounds angular_accel_bounds(const RunSeries& r);  // wdot_err_b, rad/s²
 
-/// Writes a run as CSV: t, truth, estimate and errors.
-HostStatus write_series_csv(const RunSeries& r, const std::string& path);
+/// Writes a run as CSV: t, truth, estimate and errors, with units and frames in every column
+/// name (docs/simulation.md, "Output files"). `decimate` N keeps every N-th sample (and the
+/// last): 1 keeps all.
+HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate = 1);
+
+/// The recording header of a run of `s` (rate, the converter's LSB, the nominal Table 1
+/// geometry at the scenario's ρ) and the file: exactly the samples the run navigated
+/// (ScenarioOutcome::raw). kFailedPrecondition for a run without a converter (§6.3, m/s²).
+HostStatus write_run_recording(const Scenario& s, const ScenarioOutcome& o,
+                               const std::string& path);
 
 }  // namespace gfins::sim

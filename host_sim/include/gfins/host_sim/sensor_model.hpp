@@ -27,6 +27,7 @@
 #include <random>
 
 #include "gfins/host_sim/array_model.hpp"
+#include "gfins/host_sim/error.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/geometry.hpp"
 #include "gfins/nav_core/gravity.hpp"
@@ -63,10 +64,17 @@ class SensorArrayModel {
  public:
   using Volts = Eigen::Matrix<double, 6, 1>;
 
+  /// The checked way to build one, for code the firmware runs (the simulated board): a rate that
+  /// is not positive and finite is a HostError naming it, never an exception.
+  static HostResult<SensorArrayModel> make(const nav::ArrayGeometry<double, 6>& nominal,
+                                           const ArrayErrors& errors,
+                                           const nav::GravityModel<double>& gravity,
+                                           double sample_rate_hz, std::uint64_t seed);
+
   /// `nominal` is the design geometry (e.g. nav::table1_geometry); the sensors sense along
   /// nav::misaligned_geometry(nominal, errors.misalignment). `sample_rate_hz` sets the random-walk
-  /// step. Throws std::invalid_argument when it is not positive and finite (host code, like
-  /// make_spin: a simulation set up wrong should stop, not run on a made-up rate).
+  /// step. Throws std::invalid_argument when it is not positive and finite: host tools and tests
+  /// only (their main() catches it); the firmware's simulated board uses make().
   SensorArrayModel(const nav::ArrayGeometry<double, 6>& nominal, const ArrayErrors& errors,
                    const nav::GravityModel<double>& gravity, double sample_rate_hz,
                    std::uint64_t seed);

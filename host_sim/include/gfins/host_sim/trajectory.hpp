@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "gfins/host_sim/jet.hpp"
 #include "gfins/nav_core/nav_state.hpp"
@@ -145,5 +146,18 @@ std::unique_ptr<Trajectory> make_coning(double half_angle_rad, double cone_rate_
 /// Cost of at(), -O2 on the development machine: about 0.1 µs (constant acceleration), 0.3 µs
 /// (spin, coning) and 0.7 µs (manoeuvre: 17 sin/cos pairs and one exp).
 std::unique_ptr<Trajectory> make_maneuver(double scale = 1.0);
+
+/// The attitude q_nb of a board at rest that senses the specific force f_b (body axes, any
+/// length; at rest f = −g, i.e. "up": (0, 0, −1) g is the face "z down"). Heading: that of the
+/// shortest rotation taking f̂_b to −ẑ_n (fixed, otherwise arbitrary).
+Quatd attitude_sensing(const Vec3d& f_b);
+
+/// A calibration session on an index table: the board rests in each pose k (sensing f_b[k]) for
+/// dwell_s, then turns to the next about the array centre in transition_s along the shortest
+/// rotation with a minimum-jerk profile (ω = ω̇ = 0 at both ends). Pose k is held over
+/// [k·(dwell + transition), k·(dwell + transition) + dwell]; the last pose is held for ever.
+/// Throws std::invalid_argument for no poses, a zero vector or a non-positive time.
+std::unique_ptr<Trajectory> make_pose_sequence(const std::vector<Vec3d>& f_b, double dwell_s,
+                                               double transition_s);
 
 }  // namespace gfins::sim

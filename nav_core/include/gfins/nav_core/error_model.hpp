@@ -134,10 +134,17 @@ class ErrorModel {
                    const Outputs& ds1, StateVec& x) const {
     const Result<StateMat> phi = transition(x0, x1, dt_s);
     if (!phi.is_ok()) return phi.status();
+    propagate(phi.value(), x0, x1, dt_s, ds0, ds1, x);
+    return Status::ok();
+  }
+
+  /// The same step with Φ = transition(x0, x1, dt_s) computed by the caller, who shares one Φ
+  /// between the many error sources propagated along the same step (bit for bit the same x).
+  void propagate(const StateMat& phi, const NavState<T>& x0, const NavState<T>& x1, T dt_s,
+                 const Outputs& ds0, const Outputs& ds1, StateVec& x) const {
     const StateVec u0 = input_matrix(x0) * ds0;
     const StateVec u1 = input_matrix(x1) * ds1;
-    x = phi.value() * x + (dt_s / T(2)) * (phi.value() * u0 + u1);
-    return Status::ok();
+    x = phi * x + (dt_s / T(2)) * (phi * u0 + u1);
   }
 
   /// Q_c: white output noise as the PSD σ² h (per-sample σ at interval h) and bias random walk.
@@ -186,9 +193,15 @@ class ErrorModel {
                               const SensorNoiseSpec<T, N>& spec, T dt_s, StateMat& p) const {
     const Result<StateMat> phi = transition(x0, x1, dt_s);
     if (!phi.is_ok()) return phi.status();
+    return propagate_covariance(phi.value(), x0, x1, spec, dt_s, p);
+  }
+
+  /// The same step with Φ = transition(x0, x1, dt_s) computed by the caller.
+  Status propagate_covariance(const StateMat& phi, const NavState<T>& x0, const NavState<T>& x1,
+                              const SensorNoiseSpec<T, N>& spec, T dt_s, StateMat& p) const {
     const Result<StateMat> qd = process_noise(x0, x1, spec, dt_s);
     if (!qd.is_ok()) return qd.status();
-    p = phi.value() * p * phi.value().transpose() + qd.value();
+    p = phi * p * phi.transpose() + qd.value();
     p = (p + p.transpose()) / T(2);  // keep it symmetric against rounding
     return Status::ok();
   }

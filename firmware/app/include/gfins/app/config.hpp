@@ -15,8 +15,8 @@
 
 namespace gfins::app {
 
-enum class BoardKind : std::uint8_t { kLinux, kSim, kHil };  // kHil: docs/hil.md
-enum class Pacing : std::uint8_t { kFast, kRealTime };       // simulated board only
+enum class BoardKind : std::uint8_t { kLinux, kSim, kHil };    // kHil: docs/hil.md
+enum class Pacing : std::uint8_t { kFast, kRealTime, kGpio };  // simulated board only
 enum class GravityChoice : std::uint8_t { kStandard, kConstant, kNormal };
 enum class WatchdogKind : std::uint8_t { kNone, kSystemd, kDevice };
 /// "calibration" = the compensator the calibration file names.

@@ -23,6 +23,8 @@ struct HealthCounters {
   std::uint32_t stuck_events = 0;       // channels that became stuck
   std::uint32_t rejected_samples = 0;   // samples not integrated (CRC, saturation)
   std::uint32_t can_tx_dropped = 0;     // frames the CAN backend dropped or refused
+  std::uint32_t can_rx_dropped = 0;     // received frames lost: the kernel's socket queue was full
+                                        // (SO_RXQ_OVFL) or the controller overflowed
   std::uint32_t bus_off_events = 0;     // transitions into bus-off
   std::uint32_t loop_overruns = 0;      // a cycle finished after the next edge was due
   std::uint32_t log_dropped = 0;        // log records lost to a full queue
@@ -56,6 +58,7 @@ inline constexpr std::uint32_t kAdcRecovered = can::status_bits::kAdcRecovered; 
 inline constexpr std::uint32_t kDataReadyLost = can::status_bits::kDataReadyLost;  // *
 inline constexpr std::uint32_t kBusOff = can::status_bits::kBusOff;                // *
 inline constexpr std::uint32_t kExtraEdge = can::status_bits::kExtraEdge;          // *
+inline constexpr std::uint32_t kCanRxDrop = can::status_bits::kCanRxDropped;       // *
 }  // namespace status_bits
 
 /// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).

@@ -37,15 +37,21 @@ class ReloadWorker {
   bool request(const nav::PipelineConfig<float>& current);
 
   enum class Poll : std::uint8_t { kNothing, kReady, kFailed };
-  /// Loop side, non-blocking: kReady copies the new set into `out`.
+  /// Loop side, non-blocking: kReady copies the new set into `out`. The first poll after the
+  /// worker finished sees the outcome (it takes no lock that the worker could be holding).
   Poll poll(CalibrationSet& out);
+
+  /// Host side only (tests, shutdown), blocking: returns once no reload is requested or
+  /// running, so that the next poll() reports the outcome. Never call it from the loop.
+  void wait_settled();
 
  private:
   void run();
 
   LoadFn load_;
-  std::mutex mutex_;  // guards the hand-over slots; the loop only ever try_locks it
-  std::condition_variable wake_;
+  std::mutex mutex_;  // guards request_config_ and the wake-up; the loop only ever try_locks it
+  std::condition_variable wake_;     // worker: a request or stop arrived
+  std::condition_variable settled_;  // wait_settled(): the worker finished a request
   nav::PipelineConfig<float> request_config_{};
   CalibrationSet result_{};
   std::atomic<int> state_{0};  // 0 idle, 1 requested, 2 running, 3 ready, 4 failed

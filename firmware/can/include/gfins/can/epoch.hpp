@@ -41,7 +41,10 @@ inline constexpr std::uint32_t kHealthDegraded = 1u << 13;     // any health cou
 inline constexpr std::uint32_t kAdcRecovered = 1u << 14;       // the ADC was reset and reconfigured
 inline constexpr std::uint32_t kDataReadyLost = 1u << 15;      // no data-ready edge in time
 inline constexpr std::uint32_t kBusOff = 1u << 16;             // the CAN controller went bus-off
-inline constexpr std::uint32_t kExtraEdge = 1u << 17;      // a data-ready edge without a conversion
+inline constexpr std::uint32_t kExtraEdge = 1u << 17;  // a data-ready edge without a conversion
+inline constexpr std::uint32_t kCanRxDropped = 1u
+                                               << 18;  // received CAN frames were lost (the
+                                                       // kernel's socket queue or the controller)
 inline constexpr std::uint32_t kAllBits = (1u << 20) - 1;  // width of the bus field
 static_assert(kAligned == nav::nav_status::kAligned && kSampleGap == nav::nav_status::kSampleGap &&
                   kInputInvalid == nav::nav_status::kInputInvalid &&

@@ -304,7 +304,7 @@ inline constexpr std::array<SignalDef, 4> kStatusSignals{{
                  "available, 6 ADC CRC error, 7 ADC saturated, 8 ADC channel stuck, 9 nominal "
                  "calibration, 10 loop overrun, 11 CAN frames dropped, 12 capture active, 13 "
                  "health degraded, 14 ADC recovered from a reset, 15 data-ready lost, 16 CAN "
-                 "bus-off, 17 extra data-ready edge; 18-19 reserved"),
+                 "bus-off, 17 extra data-ready edge, 18 CAN frames lost on receive; 19 reserved"),
     unsigned_int("CalId", Field::kCalId, 0, 20, 32, 4294967295.0, kNotMultiplexed, {}, kAtSample,
                  "Identity of the calibration in use (0 = nominal parameters)"),
     counter_signal(),

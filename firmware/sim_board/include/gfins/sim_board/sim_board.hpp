@@ -7,7 +7,9 @@
 //
 // Pacing: kFast takes the next edge at once, stamped with its scenario time (driven by the
 // sample index, bit-exact run to run); kRealTime sleeps until each edge's time on the monotonic
-// clock and stamps it with that time (for latency figures).
+// clock and stamps it with that time (for latency figures); kGpio waits for each conversion's
+// data-ready edge on a real line (hal::DataReadyLine: lnx::GpiodDataReady on the virtual board's
+// gpio-sim line) and carries the edge's kernel timestamp and sequence into the conversion.
 //
 // Fault injection (tests, docs/faults.md) sits at the places the faults happen: the ADC chain
 // (CRC error, stuck or saturated channel, chip reset), the data-ready line (missing, extra and
@@ -24,6 +26,7 @@
 #include "gfins/calib_file/calibration_data.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
+#include "gfins/hal/data_ready.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
 namespace gfins::sim_board {
@@ -106,13 +109,21 @@ struct FaultPlan {
   std::uint32_t saturated_until = 0;  // ... until here (0 = for ever)
 };
 
-enum class Pacing : std::uint8_t { kFast, kRealTime };
+enum class Pacing : std::uint8_t { kFast, kRealTime, kGpio };
 
 /// The data-ready line and the ADC of the simulated board, as the loop sees them.
 class SimSampleSource final : public app::SampleSource {
  public:
   SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock, SampleClock* sample_clock,
                   Pacing pacing, double sample_rate_hz, std::uint32_t samples);
+  /// kGpio pacing: conversion k happens at the edge whose sequence is the first edge's + k, at
+  /// that edge's timestamp. Edges the line reports missing (a sequence step > 1) cost their
+  /// conversions, as on the board: the sensor stream advances over them and the ADC driver
+  /// counts them from the sequence gap (Ads131m06Counters::missed_edges, the Linux board's
+  /// counter). `clock` must be the line's time base (CLOCK_MONOTONIC for libgpiod). The fault
+  /// plan does not apply: the faults are made on the line and the bus.
+  SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock, hal::DataReadyLine& drdy,
+                  std::uint32_t samples);
 
   void set_faults(const FaultPlan& f) { faults_ = f; }
   /// True once every sample of the run was delivered.
@@ -121,6 +132,7 @@ class SimSampleSource final : public app::SampleSource {
 
  private:
   Result<RawSample> do_read_sample(std::int64_t timeout_ns) override;
+  Result<RawSample> read_gpio_paced(std::int64_t timeout_ns);
   app::AdcCounters do_counters() const override;
   double do_volts_per_count() const override { return adc_.volts_per_count(); }
   std::int64_t edge_time(std::uint32_t seq) const;
@@ -138,6 +150,9 @@ class SimSampleSource final : public app::SampleSource {
   std::uint32_t remaining_;
   FaultPlan faults_{};
   std::uint32_t silent_left_ = 0;
+  hal::DataReadyLine* drdy_ = nullptr;  // kGpio only
+  bool have_first_edge_ = false;
+  std::uint32_t first_edge_seq_ = 0;
 };
 
 /// An in-memory CAN bus: frames sent are kept (fixed capacity, the oldest overwritten), frames
@@ -150,6 +165,9 @@ class MemoryCanBus final : public hal::CanBus {
 
   void refuse(bool on) { refuse_ = on; }
   void bus_off(bool on);
+  /// `n` received frames lost before the board read them, as SocketCAN reports a full socket
+  /// receive queue (SO_RXQ_OVFL: hal::CanCounters::rx_kernel_dropped).
+  void lose_received(std::uint32_t n) { counters_.rx_kernel_dropped += n; }
   /// Host → board frame (commands); false when the receive queue is full.
   bool inject_rx(const hal::CanFrame& f);
   /// Frames sent, oldest first (at most `capacity`); total() counts all ever sent.
@@ -174,8 +192,8 @@ class MemoryCanBus final : public hal::CanBus {
 };
 
 /// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
-/// null when the scenario's trajectory cannot be built.
-std::unique_ptr<SensorStream> make_scenario_stream(const sim::Scenario& s);
+/// a HostError naming what cannot be built (trajectory, sensor model). Never throws.
+sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::Scenario& s);
 
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.

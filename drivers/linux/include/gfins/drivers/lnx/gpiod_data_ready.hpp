@@ -2,10 +2,13 @@
 //
 // The line is found by chip ("gpiochip0", "/dev/gpiochip0", a number or a label, as
 // gpiod_chip_open_lookup accepts) and either an offset or a line name, then requested for
-// rising-edge events. wait_edge() waits with gpiod_line_event_wait and reads every queued event
-// at once with gpiod_line_event_read_multiple into a buffer allocated once at open() and reused
-// forever; the events are then handed out one per call, so a burst queued during a stall is
-// counted, not lost.
+// events of the edge that marks a new conversion: the falling one by default, because the
+// ADS131M06's DRDY is an active-low output whose high-to-low transition says new data are ready
+// and whose falling edges are one data-rate period apart (ADS131M06 datasheet, DRDY pin
+// description, §8.5.1 "SPI interface", DRDY). wait_edge() waits with gpiod_line_event_wait and
+// reads every queued event at once with gpiod_line_event_read_multiple into a buffer allocated once
+// at open() and reused forever; the events are then handed out one per call, so a burst queued
+// during a stall is counted, not lost.
 //
 // Timestamps: the kernel stamps each edge in its interrupt handler; since Linux 5.7 the v1 uAPI
 // uses CLOCK_MONOTONIC (gpio-cdev "lineevent_irq_handler": ktime_get_ns), the clock of
@@ -43,11 +46,18 @@ class GpiodApi {
   virtual gpiod_line* chip_get_line(gpiod_chip* chip, unsigned offset);
   virtual gpiod_line* chip_find_line(gpiod_chip* chip, const char* name);
   virtual int line_request_rising_edge_events(gpiod_line* line, const char* consumer);
+  virtual int line_request_falling_edge_events(gpiod_line* line, const char* consumer);
   virtual void line_release(gpiod_line* line);
   virtual int line_event_wait(gpiod_line* line, const timespec* timeout);
   virtual int line_event_read_multiple(gpiod_line* line, gpiod_line_event* events, unsigned n);
 };
 GpiodApi& real_gpiod();
+
+/// Which transition of the line is the data-ready event.
+enum class DataReadyEdgeKind : std::uint8_t {
+  kFalling,  // ADS131M06 DRDY (active low): high-to-low = new data
+  kRising,   // an inverted wiring (e.g. through an inverting level shifter)
+};
 
 struct GpiodDataReadyConfig {
   std::string chip = "gpiochip0";  // anything gpiod_chip_open_lookup accepts
@@ -55,11 +65,12 @@ struct GpiodDataReadyConfig {
   std::string line_name;           // used when line_offset < 0 (e.g. "ADC_DRDY")
   std::string consumer = "gfins-drdy";
   std::int64_t nominal_period_ns = 1000000;  // 1 kHz sample clock
+  DataReadyEdgeKind edge = DataReadyEdgeKind::kFalling;
 };
 
 /// Counters only grow.
 struct DataReadyCounters {
-  std::uint32_t edges = 0;         // rising edges read from the kernel
+  std::uint32_t edges = 0;         // data-ready edges read from the kernel
   std::uint32_t missed_edges = 0;  // inferred from timestamp gaps (see the file comment)
   std::uint32_t early_edges = 0;   // closer than half a period to the previous one
   std::uint32_t full_reads = 0;    // reads that filled the whole buffer (more may have waited)
@@ -70,7 +81,7 @@ class GpiodDataReady final : public hal::DataReadyLine {
   /// Events read per gpiod_line_event_read_multiple call; the kernel's v1 FIFO holds 16.
   static constexpr unsigned kEventBufferSize = 16;
 
-  /// Opens the chip, finds the line, requests rising-edge events. Errors (os_error() = errno):
+  /// Opens the chip, finds the line, requests events of config.edge. Errors (os_error() = errno):
   /// kInvalidArgument (no offset and no name, non-positive period); kUnavailable (no such chip,
   /// no such line offset or name); kIoError (the request failed, e.g. EBUSY: line in use).
   static Result<std::unique_ptr<GpiodDataReady>> open(const GpiodDataReadyConfig& config,

@@ -39,6 +39,8 @@ class Os {
   virtual int setsockopt(int fd, int level, int name, const void* value, unsigned len);
   virtual unsigned if_nametoindex(const char* name);
   virtual int ppoll(void* fds, unsigned long nfds, const timespec* timeout);
+  // `msg` is a struct msghdr (iovecs and the ancillary-data buffer, socket(7), cmsg(3)).
+  virtual long recvmsg(int fd, void* msg, int flags);
 
   // Time (<time.h>). clock_nanosleep returns an error number instead of setting errno.
   virtual int clock_gettime(int clock_id, timespec* ts);

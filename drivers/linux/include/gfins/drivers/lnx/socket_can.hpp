@@ -13,6 +13,8 @@
 //   interface up again (SIOCGIFFLAGS), or re-created with a new index (re-binds), and counts a
 //   restart.
 // - Receive filters (CAN_RAW_FILTER) for the firmware's command identifiers.
+// - Frames the kernel dropped because the socket's receive queue was full are counted from the
+//   SO_RXQ_OVFL ancillary data of recvmsg (hal::CanCounters::rx_kernel_dropped).
 // No heap after open(): the queues are arrays inside the object.
 #pragma once
 
@@ -82,6 +84,7 @@ class SocketCan final : public hal::CanBus {
   Status apply_filters();
   Status write_frame(const hal::CanFrame& f);
   void drain_rx();
+  void note_kernel_drops(const void* msg_header);  // a struct msghdr just filled by recvmsg
   void handle_error_frame(std::uint32_t can_id, const std::array<std::uint8_t, 8>& data);
   void go_down();
   void try_recover();
@@ -100,6 +103,7 @@ class SocketCan final : public hal::CanBus {
   std::array<char, kNameMax> name_{};
   hal::CanBusState state_ = hal::CanBusState::kErrorActive;
   hal::CanCounters counters_;
+  std::uint32_t kernel_drops_seen_ = 0;  // last SO_RXQ_OVFL total of the current socket
   SocketCanErrorCounters errors_;
 
   std::array<CanFilter, kMaxFilters> filters_{};

@@ -1,0 +1,512 @@
+// gfins-replay: a raw-sample recording (.gfr, docs/recording-format.md) through the navigation
+// core, or printed (docs/replay.md).
+//
+//   gfins-replay FILE.gfr [--cal CAL.toml] [-o DIR]   navigate: the one host navigation loop
+//                                                     (NavLoop, float32 core by default), CSV,
+//                                                     summary with the gap and hash report, PNG
+//   gfins-replay dump FILE.gfr                        header and samples as CSV on stdout
+//
+// The recording is what a board (or `gfins-sim run --record`) delivered: counts, sequence
+// counter, data-ready time and flags. Navigation starts as on the board: static alignment over
+// the first --align-s seconds (roll and pitch from the mean specific force, heading given), then
+// strapdown navigation, driven by sample index (never wall-clock), bit-exact run to run.
+#include <CLI/CLI.hpp>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "common.hpp"
+#include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/host_sim/recording.hpp"
+#include "gfins/host_sim/replay.hpp"
+#include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/host_sim/version.hpp"
+#include "gfins/nav_core/pipeline.hpp"
+#include "run_options.hpp"
+
+namespace {
+
+namespace app = gfins::sim::app;
+namespace sim = gfins::sim;
+namespace nav = gfins::nav;
+using gfins::ErrorCode;
+using gfins::RawSample;
+
+int fail(const std::string& message, int exit_code) {
+  std::fprintf(stderr, "gfins-replay: %s\n", message.c_str());
+  return exit_code;
+}
+
+struct ReplayOptions {
+  std::string recording;
+  std::string cal;
+  app::OutputOptions out;
+  double align_s = 1.0;
+  double heading_deg = 0.0;
+  double gravity_mps2 = nav::kStandardGravity;
+};
+
+/// Relative difference above which the calibration file's ADC LSB and the recording's disagree:
+/// both are written from the same converter configuration (Vref/(gain 2^23)), so anything beyond
+/// the 1e-9 of a decimal round trip of a double means a file of another board or gain.
+constexpr double kLsbMismatchRel = 1e-6;
+
+// ---- dump -------------------------------------------------------------------------------------
+
+int dump(const std::string& path) {
+  auto reader = sim::RecordingReader::open(path);
+  if (!reader.is_ok()) return fail(reader.error().message, app::kExitBadInput);
+  const sim::RecordingHeader& h = reader.value().header();
+  std::printf("# gfins raw-sample recording %s (docs/recording-format.md)\n", path.c_str());
+  std::printf("# version %u, %u channels, %u records per block, record_count %s\n",
+              static_cast<unsigned>(h.version), static_cast<unsigned>(h.channel_count),
+              static_cast<unsigned>(h.records_per_block),
+              h.record_count == sim::kRecordCountUnknown ? "unknown (writer not closed)"
+                                                         : std::to_string(h.record_count).c_str());
+  std::printf("# sample_rate_hz %.9g\n", h.sample_rate_hz);
+  for (std::size_t j = 0; j < 6; ++j) {
+    const auto& r = h.geometry.rho_b[j];
+    const auto& t = h.geometry.theta_b[j];
+    std::printf(
+        "# sensor a%zu: volts_per_count %.9g V, rho_b [%.6g %.6g %.6g] m, theta_b [%.6g %.6g "
+        "%.6g] (body FRD)\n",
+        j + 1, h.volts_per_count[j], r.x(), r.y(), r.z(), t.x(), t.y(), t.z());
+  }
+  std::printf(
+      "# columns: seq (ADC counter), t_ns (data-ready time, ns), count_1..count_6 (24-bit ADC "
+      "codes), v_1_V..v_6_V (volts at the sensor output = count x volts_per_count), flags (bit 0 "
+      "CRC error, 1 saturated, 2 late read, 3 synthetic)\n");
+  std::printf(
+      "seq,t_ns,count_1,count_2,count_3,count_4,count_5,count_6,v_1_V,v_2_V,v_3_V,v_4_V,v_5_V,"
+      "v_6_V,flags\n");
+  std::vector<RawSample> block;
+  for (;;) {
+    auto more = reader.value().next_block(block);
+    if (!more.is_ok()) {
+      (void)std::fflush(stdout);
+      return fail(more.error().message, app::kExitBadInput);
+    }
+    if (!more.value()) break;
+    for (const RawSample& s : block) {
+      std::printf("%" PRIu32 ",%" PRId64, s.seq, s.t_ns);
+      for (const auto c : s.counts) std::printf(",%" PRId32, c);
+      for (std::size_t j = 0; j < 6; ++j) {
+        std::printf(",%.9g", static_cast<double>(s.counts[j]) * h.volts_per_count[j]);
+      }
+      std::printf(",%" PRIu32 "\n", s.flags);
+    }
+  }
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+    return fail("error writing the dump to stdout", app::kExitError);
+  }
+  return app::kExitOk;
+}
+
+// ---- means (rate-table runs for gfins-calibrate --location-runs) -----------------------------
+
+struct MeansOptions {
+  std::string recording;
+  int mounting = 0;
+  std::vector<double> up_b;
+  double rate_rad_s = 0.0;
+  bool header = false;
+};
+
+/// One row of gfins-calibrate's --location-runs input (docs/calibration.md, §5): the mean and
+/// per-sample standard deviation of each sensor's output (V) over the whole revolutions of a
+/// rate-table recording, with the mounting, the body axis pointing up and the table rate.
+int means(const MeansOptions& o) {
+  const double up_norm =
+      std::sqrt(o.up_b[0] * o.up_b[0] + o.up_b[1] * o.up_b[1] + o.up_b[2] * o.up_b[2]);
+  if (!(up_norm > 0.0) || !std::isfinite(up_norm)) {
+    return fail("--up: the body axis pointing up must be a non-zero vector", app::kExitBadInput);
+  }
+  auto rec = sim::read_recording(o.recording);
+  if (!rec.is_ok()) return fail(rec.error().message, app::kExitBadInput);
+  const sim::RecordingHeader& h = rec.value().header;
+  const auto& smp = rec.value().samples;
+  // Whole revolutions: a real table wobbles once per turn, and whole turns average it out.
+  const double per_rev = 2.0 * M_PI / o.rate_rad_s * h.sample_rate_hz;  // samples
+  const double revs = std::floor(static_cast<double>(smp.size()) / per_rev);
+  if (revs < 1.0) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "%s: %zu samples at %g Hz are less than one revolution at %g rad/s (%.0f "
+                  "samples)",
+                  o.recording.c_str(), smp.size(), h.sample_rate_hz, o.rate_rad_s, per_rev);
+    return fail(buf, app::kExitBadInput);
+  }
+  const auto n = static_cast<std::size_t>(std::llround(revs * per_rev));
+  std::array<double, 6> sum{};
+  std::array<double, 6> sum2{};
+  std::size_t flagged = 0;
+  for (std::size_t k = 0; k < n && k < smp.size(); ++k) {
+    if ((smp[k].flags & (gfins::sample_flags::kCrcError | gfins::sample_flags::kSaturated)) != 0) {
+      ++flagged;
+      continue;
+    }
+    for (std::size_t j = 0; j < 6; ++j) {
+      const double v = static_cast<double>(smp[k].counts[j]) * h.volts_per_count[j];
+      sum[j] += v;
+      sum2[j] += v * v;
+    }
+  }
+  if (flagged > 0) {
+    return fail(o.recording + ": " + std::to_string(flagged) +
+                    " samples flagged with a CRC error or saturation inside the revolutions: "
+                    "their means are not the sensors'",
+                app::kExitBadInput);
+  }
+  const auto count = static_cast<double>(std::min(n, smp.size()));
+  if (o.header) {
+    std::printf(
+        "mounting,axis_x,axis_y,axis_z,rate_rad_s,mean_v1,mean_v2,mean_v3,mean_v4,mean_v5,"
+        "mean_v6,std_v1,std_v2,std_v3,std_v4,std_v5,std_v6,count\n");
+  }
+  std::printf("%d,%.9g,%.9g,%.9g,%.9g", o.mounting, o.up_b[0] / up_norm, o.up_b[1] / up_norm,
+              o.up_b[2] / up_norm, o.rate_rad_s);
+  for (std::size_t j = 0; j < 6; ++j) std::printf(",%.12g", sum[j] / count);
+  for (std::size_t j = 0; j < 6; ++j) {
+    const double m = sum[j] / count;
+    // Sample standard deviation; a noise-free recording can round to a tiny negative variance.
+    const double var = std::max(0.0, (sum2[j] - count * m * m) / (count - 1.0));
+    std::printf(",%.6g", std::sqrt(var));
+  }
+  std::printf(",%.0f\n", count);
+  return std::fflush(stdout) == 0 ? app::kExitOk : app::kExitError;
+}
+
+// ---- navigate ---------------------------------------------------------------------------------
+
+/// The pipeline configuration: the recording's LSB and geometry, the QA-1100's nominal scale
+/// factor, no compensation; a calibration file replaces the front end, geometry, misalignment
+/// and compensator (as on the board, calib_file::apply_to).
+gfins::sim::HostResult<nav::PipelineConfig<double>> config_of(const ReplayOptions& o,
+                                                              const sim::RecordingHeader& h,
+                                                              std::string& what) {
+  nav::PipelineConfig<double> c;
+  c.nominal = h.geometry;
+  const double sf = sim::AccelErrors::qa1100_typical().scale_v_per_g;
+  for (std::size_t j = 0; j < 6; ++j) {
+    c.front_end.volts_per_count[j] = h.volts_per_count[j];
+    c.front_end.scale_v_per_g[j] = sf;
+    c.front_end.bias_g[j] = 0.0;
+  }
+  c.compensator = nav::CompensatorKind::kNone;
+  what = "no calibration: nominal QA-1100 scale factor, no bias, no compensation";
+  if (!o.cal.empty()) {
+    const auto cal = gfins::calib_file::load_calibration_file(o.cal);
+    if (!cal.is_ok()) return sim::HostError{ErrorCode::kInvalidArgument, cal.status().message()};
+    const auto& d = cal.value();
+    for (std::size_t j = 0; j < 6; ++j) {
+      const double a = d.sensors[j].adc_lsb_v_per_count;
+      const double b = h.volts_per_count[j];
+      if (!(std::fabs(a - b) <= kLsbMismatchRel * std::fabs(b))) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "%s: sensor a%zu has an ADC LSB of %.9g V/count, the recording %.9g: the "
+                      "calibration is of another converter setting",
+                      o.cal.c_str(), j + 1, a, b);
+        return sim::HostError{ErrorCode::kInvalidArgument, buf};
+      }
+    }
+    gfins::calib_file::apply_to(d, c);
+    what = "calibration " + o.cal + " (device " + d.device_id + ", compensator " +
+           nav::to_string(d.compensator) + ")";
+  }
+  c.gravity = nav::GravityModel<double>::constant(o.gravity_mps2);
+  c.sample_rate_hz = h.sample_rate_hz;
+  c.alignment_samples =
+      static_cast<std::uint32_t>(std::max(1.0, std::round(o.align_s * h.sample_rate_hz)));
+  c.heading_rad = o.heading_deg * M_PI / 180.0;
+  return c;
+}
+
+template <typename T>
+nav::PipelineConfig<T> cast_config(const nav::PipelineConfig<double>& c) {
+  nav::PipelineConfig<T> o;
+  o.nominal = c.nominal.template cast<T>();
+  o.front_end = c.front_end.template cast<T>();
+  for (std::size_t i = 0; i < 6; ++i) {
+    o.misalignment.orientation.beta[i] = static_cast<T>(c.misalignment.orientation.beta[i]);
+    o.misalignment.orientation.alpha[i] = static_cast<T>(c.misalignment.orientation.alpha[i]);
+    o.misalignment.drho_b[i] = c.misalignment.drho_b[i].template cast<T>();
+  }
+  o.compensator = c.compensator;
+  o.gravity = nav::GravityModel<T>::constant(static_cast<T>(c.gravity.magnitude_at_origin()));
+  o.max_condition = c.max_condition;
+  o.sample_rate_hz = c.sample_rate_hz;
+  o.alignment_samples = c.alignment_samples;
+  o.heading_rad = static_cast<T>(c.heading_rad);
+  o.r0_n = c.r0_n.template cast<T>();
+  return o;
+}
+
+/// CSV columns: the estimate columns of `gfins-sim run` (same names and units) and the sample's
+/// counter and status bits.
+void write_header(std::FILE* f) {
+  std::string h = "t_s,seq,status";
+  for (const char* c : {"w", "x", "y", "z"}) h += std::string(",est_q_nb_") + c;
+  const auto v = [&h](const char* name, const char* unit) {
+    for (const char* c : {"x", "y", "z"}) h += std::string(",") + name + "_" + c + "_" + unit;
+  };
+  v("est_w_b", "rps");
+  v("est_wdot_b", "rps2");
+  v("est_f_b", "mps2");
+  v("est_a_n", "mps2");
+  v("est_v_n", "mps");
+  v("est_r_n", "m");
+  std::fprintf(f, "%s\n", h.c_str());
+}
+
+template <typename T>
+void write_row(std::FILE* f, double t_s, const nav::NavState<T>& s) {
+  std::fprintf(f, "%.6f,%" PRIu32 ",%" PRIu32 ",%.9g,%.9g,%.9g,%.9g", t_s, s.seq, s.status,
+               static_cast<double>(s.q_nb.w()), static_cast<double>(s.q_nb.x()),
+               static_cast<double>(s.q_nb.y()), static_cast<double>(s.q_nb.z()));
+  for (const auto* v : {&s.w_b, &s.wdot_b, &s.f_b, &s.a_n, &s.v_n, &s.r_n}) {
+    std::fprintf(f, ",%.9g,%.9g,%.9g", static_cast<double>(v->x()), static_cast<double>(v->y()),
+                 static_cast<double>(v->z()));
+  }
+  std::fprintf(f, "\n");
+}
+
+void print_report(std::FILE* f, const sim::NavReport& r, double rate_hz) {
+  std::fprintf(f,
+               "samples offered %" PRIu64 ", navigating %" PRIu64 " (alignment: the first %" PRIu64
+               "), rejected %" PRIu64 " (CRC error %" PRIu64 ", saturated %" PRIu64 ")\n",
+               r.samples, r.navigating, r.samples - r.navigating - r.rejected, r.rejected,
+               r.invalid, r.flagged_saturated);
+  std::fprintf(f, "gaps in the sample counter: %zu, samples missing: %" PRIu64 "\n", r.gaps.size(),
+               r.missed_samples);
+  constexpr std::size_t kListed = 20;
+  for (std::size_t i = 0; i < r.gaps.size() && i < kListed; ++i) {
+    const sim::NavGap& g = r.gaps[i];
+    std::fprintf(f,
+                 "  gap at sample %" PRIu64 " (t = %.6f s): expected seq %" PRIu32 ", saw %" PRIu32
+                 ", %" PRIu32 " missing\n",
+                 g.index, static_cast<double>(g.index) / rate_hz, g.expected_seq, g.seq, g.missing);
+  }
+  if (r.gaps.size() > kListed) std::fprintf(f, "  ... %zu more\n", r.gaps.size() - kListed);
+  std::fprintf(f, "output hash (FNV-1a-64 of every navigation state): %016" PRIx64 "\n",
+               r.output_hash);
+}
+
+template <typename T>
+int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
+             const nav::PipelineConfig<double>& cfg, const std::string& cal_text,
+             const std::string& out_dir) {
+  auto pipeline = std::make_unique<nav::NavPipeline<T>>();
+  if (const auto st = pipeline->configure(cast_config<T>(cfg)); !st.is_ok()) {
+    return fail(std::string("the navigation core rejected the configuration: ") + st.message(),
+                app::kExitBadInput);
+  }
+  const std::string csv_path = out_dir + "/navigation.csv";
+  std::FILE* csv = std::fopen(csv_path.c_str(), "w");
+  if (csv == nullptr) return fail("cannot write " + csv_path, app::kExitError);
+  write_header(csv);
+  const std::size_t every = std::max<std::size_t>(o.out.decimate, 1);
+  bool have_t0 = false;
+  std::int64_t t0_ns = 0;
+  std::uint64_t written = 0;
+  nav::NavState<T> last{};
+  std::uint64_t since = every;  // write the first state
+  // Progress on a terminal, from the record count of a closed recording.
+  const sim::ProgressFn progress =
+      h.record_count != sim::kRecordCountUnknown ? app::tty_progress("replay") : sim::ProgressFn{};
+  const std::uint64_t step = std::max<std::uint64_t>(h.record_count / 100, 1);
+  const auto result = sim::replay_recording<T>(
+      o.recording, *pipeline, [&](std::uint64_t index, const nav::NavState<T>& s) {
+        if (progress && (index % step == 0 || index + 1 == h.record_count)) {
+          progress(static_cast<double>(index + 1) / static_cast<double>(h.record_count));
+        }
+        if (!have_t0) {
+          have_t0 = true;
+          t0_ns = s.t_ns;
+        }
+        last = s;
+        if (since++ % every != 0) return;
+        write_row(csv, static_cast<double>(s.t_ns - t0_ns) * 1e-9, s);
+        ++written;
+      });
+  // The last state always ends the file (decimated or not), so the CSV reaches the end.
+  if (result.is_ok() && have_t0 && (since - 1) % every != 0) {
+    write_row(csv, static_cast<double>(last.t_ns - t0_ns) * 1e-9, last);
+    ++written;
+  }
+  if (auto c = app::close_output(csv, csv_path); !c.is_ok()) {
+    return fail(c.error().message, app::kExitError);
+  }
+  if (!result.is_ok()) {
+    return fail(result.error().message + " (navigation.csv holds the samples before it)",
+                app::kExitBadInput);
+  }
+  const sim::NavReport& r = result.value();
+  const std::string summary_path = out_dir + "/summary.txt";
+  std::FILE* summary = std::fopen(summary_path.c_str(), "w");
+  if (summary == nullptr) return fail("cannot write " + summary_path, app::kExitError);
+  for (std::FILE* f : {stdout, summary}) {
+    std::fprintf(f, "gfins-replay %s: %g Hz, %s, %s\n", o.recording.c_str(), h.sample_rate_hz,
+                 cal_text.c_str(),
+                 app::scalar_text(std::is_same_v<T, float> ? sim::NavScalar::kFloat
+                                                           : sim::NavScalar::kDouble));
+    print_report(f, r, h.sample_rate_hz);
+    if (r.navigating > 0) {
+      const auto& v = last.v_n;
+      const auto& p = last.r_n;
+      std::fprintf(f, "final state (t = %.3f s after alignment): |v_n| %.6g m/s, |r_n| %.6g m\n",
+                   static_cast<double>(last.t_ns - t0_ns) * 1e-9, static_cast<double>(v.norm()),
+                   static_cast<double>(p.norm()));
+    }
+  }
+  if (auto c = app::close_output(summary, summary_path); !c.is_ok()) {
+    return fail(c.error().message, app::kExitError);
+  }
+  std::printf("written: %s (%" PRIu64 " states%s), %s\n", csv_path.c_str(), written,
+              every > 1 ? (", every " + std::to_string(every) + "th state").c_str() : "",
+              summary_path.c_str());
+  if (r.navigating == 0) {
+    return fail("no navigation state: the recording (" + std::to_string(r.samples) +
+                    " samples) ends within the alignment of " +
+                    std::to_string(cfg.alignment_samples) + " samples (--align-s)",
+                app::kExitBadInput);
+  }
+  if (!o.out.plot) return app::kExitOk;
+  std::string title = std::filesystem::path(o.recording).filename().string() + ", " +
+                      (o.cal.empty() ? std::string("no calibration")
+                                     : std::filesystem::path(o.cal).filename().string()) +
+                      ", compensator " + nav::to_string(cfg.compensator) + ", " +
+                      (std::is_same_v<T, float> ? "float32" : "double") + " core";
+  if (auto p = app::plot("plot_sim.py", {"replay", out_dir, title}); !p.is_ok()) {
+    std::fprintf(stderr, "gfins-replay: %s\n", p.error().message.c_str());
+    return app::kExitPlotFailed;
+  }
+  std::printf("figures: %s/replay.png\n", out_dir.c_str());
+  return app::kExitOk;
+}
+
+int run_navigate(ReplayOptions& o) {
+  if (!(o.align_s > 0.0) || !std::isfinite(o.align_s)) {
+    return fail("--align-s " + std::to_string(o.align_s) + ": must be a positive number of seconds",
+                app::kExitBadInput);
+  }
+  auto reader = sim::RecordingReader::open(o.recording);
+  if (!reader.is_ok()) return fail(reader.error().message, app::kExitBadInput);
+  const sim::RecordingHeader h = reader.value().header();
+  // (record_count of an unclosed recording is kRecordCountUnknown, the largest value.)
+  if (h.record_count < 2) {
+    return fail(o.recording + ": " + std::to_string(h.record_count) +
+                    " samples: navigation needs at least 2",
+                app::kExitBadInput);
+  }
+  const auto scalar = app::nav_scalar(o.out.scalar);
+  if (!scalar.is_ok()) return fail(scalar.error().message, app::kExitBadInput);
+  const std::string stem = std::filesystem::path(o.recording).stem().string();
+  const auto dir = app::output_dir(o.out, "replay-out/" + stem);
+  if (!dir.is_ok()) return fail(dir.error().message, app::kExitBadInput);
+  std::string cal_text;
+  const auto cfg = config_of(o, h, cal_text);
+  if (!cfg.is_ok()) return fail(cfg.error().message, app::kExitBadInput);
+  if (auto d = app::make_dir(dir.value()); !d.is_ok()) {
+    return fail(d.error().message, app::kExitError);
+  }
+  return scalar.value() == sim::NavScalar::kFloat
+             ? navigate<float>(o, h, cfg.value(), cal_text, dir.value())
+             : navigate<double>(o, h, cfg.value(), cal_text, dir.value());
+}
+
+int replay_main(int argc, char** argv) {
+  const char* footer =
+      "Exit codes: 0 ok; 1 an output could not be written; 2 command line, recording or "
+      "calibration file rejected; 3 CSV written but plotting failed (PNG asked for).";
+  if (argc >= 2 && std::string(argv[1]) == "dump") {
+    CLI::App cli{"gfins-replay dump: a recording's header and samples as CSV on stdout",
+                 "gfins-replay dump"};
+    cli.footer(footer);
+    std::string path;
+    cli.add_option("recording", path, "raw-sample recording (.gfr)")->required();
+    try {
+      cli.parse(argc - 1, argv + 1);
+    } catch (const CLI::ParseError& e) {
+      return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
+    }
+    return dump(path);
+  }
+  if (argc >= 2 && std::string(argv[1]) == "means") {
+    CLI::App cli{
+        "gfins-replay means: one row of gfins-calibrate --location-runs (docs/calibration.md "
+        "§5) from a rate-table recording: per-sensor mean and standard deviation (V) over its "
+        "whole revolutions",
+        "gfins-replay means"};
+    cli.footer(footer);
+    MeansOptions m;
+    cli.add_option("recording", m.recording, "rate-table recording (.gfr)")->required();
+    cli.add_option("--mounting", m.mounting, "fixture pose of the run (0..7)")
+        ->check(CLI::Range(0, 7))
+        ->required();
+    cli.add_option("--up", m.up_b, "body axis pointing up (x y z)")->expected(3)->required();
+    cli.add_option("--rate-rad-s", m.rate_rad_s, "table rate, rad/s")
+        ->check(CLI::Range(0.1, 100.0))
+        ->required();
+    cli.add_flag("--header", m.header, "print the CSV header line first");
+    try {
+      cli.parse(argc - 1, argv + 1);
+    } catch (const CLI::ParseError& e) {
+      return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
+    }
+    return means(m);
+  }
+  CLI::App cli{
+      "gfins-replay: navigate a raw-sample recording (.gfr) through the navigation core, or "
+      "print it (gfins-replay dump FILE.gfr), or average a rate-table run (gfins-replay means)",
+      "gfins-replay"};
+  cli.footer(footer);
+  cli.set_version_flag("--version", gfins::version::version_line("gfins-replay"));
+  ReplayOptions o;
+  bool no_plot = false;
+  cli.add_option("recording", o.recording, "raw-sample recording (.gfr)")->required();
+  cli.add_option("--cal", o.cal,
+                 "calibration file (docs/calibration-file.md); without it: nominal scale "
+                 "factor, no compensation");
+  auto* out_opt =
+      cli.add_option("-o,--out", o.out.dir, "output folder (default replay-out/<stem>)");
+  cli.add_flag("--no-plot", no_plot, "write CSV only, no PNG");
+  cli.add_option("--scalar", o.out.scalar,
+                 "navigation core scalar: float (the board's float32 core) or double")
+      ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
+  cli.add_option("--decimate", o.out.decimate, "write every N-th state to navigation.csv")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
+      ->capture_default_str();
+  cli.add_option("--align-s", o.align_s, "static alignment at the start, s")->capture_default_str();
+  cli.add_option("--heading-deg", o.heading_deg,
+                 "initial heading (nothing on board senses it), deg")
+      ->check(CLI::Range(-360.0, 360.0))
+      ->capture_default_str();
+  cli.add_option("--gravity", o.gravity_mps2, "local gravity of the navigation model, m/s^2")
+      ->check(CLI::Range(9.7, 9.9))
+      ->capture_default_str();
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
+  }
+  o.out.plot = !no_plot;
+  o.out.dir_given = out_opt->count() > 0;
+  return run_navigate(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return replay_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gfins-replay: %s\n", e.what());
+    return app::kExitError;
+  }
+}

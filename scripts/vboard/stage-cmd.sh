@@ -1,0 +1,74 @@
+# shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets gpiochip, pull, rate
+# Stage "cmd" of the in-VM test (sourced by vm-test.sh): every command of the CAN protocol
+# (docs/can-interface.md, "Commands and responses") sent by `gfins-can cmd` over vcan0 to the
+# running gfins-fw (node 1), each response checked through gfins-can's exit status and what it
+# prints; then malformed command frames sent with Debian's cansend, each answered with the
+# Result the protocol gives for it (2 length not 8, 3 CRC mismatch, 5 unused bits set... as the
+# frame is built), read back with candump.
+# needs: build:firmware/app/gfins-fw
+# needs: build:host_sim/can_tool/gfins-can
+# needs: repo:scripts/vboard/fw-common.sh:/vboard/fw-common.sh
+# needs: repo:scripts/vboard/gfins-fw-vboard.toml:/opt/gfins/etc/vboard.toml
+# needs: cache:fw/scenarios/vboard-rest.toml:/opt/share/gfins/scenarios/vboard-rest.toml
+. /vboard/fw-common.sh
+drdy-toggle "$pull" "$rate" >/tmp/cmd-toggle.log &
+toggle_pid=$!
+fw_start /tmp/cmd-fw.log
+check cmd-fw-start "gfins-fw runs on vcan0 with data-ready edges" [ $? -eq 0 ]
+# Past the 1 s alignment (navigation.alignment_s): commands like realign need the navigating mode.
+sleep 2
+
+# cmd_ok NAME ARGS...: gfins-can cmd must exit 0 (the board answered Ok with the same token).
+cmd_ok() {
+  name=$1
+  shift
+  gfins-can cmd --iface vcan0 --node 1 --timeout-ms 2000 "$@" >/tmp/cmd-$name.out 2>&1
+  rc=$?
+  check "cmd-$name" "gfins-can cmd $* exit $rc ($(tr '\n' ' ' </tmp/cmd-$name.out | head -c 160))" [ $rc -eq 0 ]
+}
+cmd_ok realign realign --heading-deg 30
+cmd_ok reset reset
+cmd_ok compensator-exact compensator exact
+cmd_ok compensator-paper compensator paper
+cmd_ok divider divider GfinsEuler 20
+cmd_ok cal-id cal-id
+# The calibration id the board reports must be the one it publishes in its epochs.
+cal=$(tr 'A-F' 'a-f' </tmp/cmd-cal-id.out | sed -n 's/.*\(0x\)\{0,1\}\([0-9a-f]\{8\}\).*/\2/p' | head -n 1)
+cmd_ok capture capture --pose 0 --samples 50
+# No calibration file is configured (the factory calibration is in use): a reload must be
+# refused with Result 7 failed, which gfins-can reports as exit 4 (the board rejected it).
+gfins-can cmd --iface vcan0 --node 1 --timeout-ms 2000 reload >/tmp/cmd-reload.out 2>&1
+rc=$?
+check cmd-reload "gfins-can cmd reload exit $rc, expected 4 with no calibration file ($(tr '\n' ' ' </tmp/cmd-reload.out | head -c 160))" \
+  [ $rc -eq 4 ]
+# A node that does not exist: no answer, exit 5.
+gfins-can cmd --iface vcan0 --node 9 --timeout-ms 300 reset >/tmp/cmd-none.out 2>&1
+rc=$?
+check cmd-no-such-node "gfins-can cmd --node 9 exit $rc, expected 5 (no response)" [ $rc -eq 5 ]
+
+# raw_cmd NAME FRAME EXPECTED_RESULT: cansend a frame on 601, the response on 681 must be a status
+# part (byte 2 = 0) with byte 3 = EXPECTED_RESULT.
+raw_cmd() {
+  candump -L -n 1 vcan0,681:7FF >/tmp/cmd-raw-$1.log &
+  pid=$!
+  sleep 0.3
+  cansend vcan0 "601#$2"
+  i=0
+  while [ $i -lt 30 ] && kill -0 $pid 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
+  kill $pid 2>/dev/null
+  wait $pid 2>/dev/null
+  data=$(sed -n 's/.* vcan0 681#\([0-9A-F]*\).*/\1/p' /tmp/cmd-raw-$1.log)
+  part=$(echo "$data" | cut -c5-6)
+  result=$(echo "$data" | cut -c7-8)
+  check "cmd-malformed-$1" "cansend 601#$2 answered 681#${data:-nothing}: part ${part:-?}, result ${result:-?}, expected 00/$3" \
+    [ "$part" = 00 -a "$result" = "$3" ]
+}
+raw_cmd short-frame 0142 02         # 2 bytes: length not 8
+raw_cmd bad-crc 0242000000000000 03  # ResetNavigation with a wrong CRC byte
+
+fw_stop
+kill -TERM $toggle_pid 2>/dev/null
+wait $toggle_pid 2>/dev/null
+check cmd-fw-exit "gfins-fw ended on SIGTERM with status $fw_rc after the commands" [ $fw_rc -eq 0 ]
+grep -iE 'command' /tmp/cmd-fw.log | head -n 12 | sed 's/^/VBOARD-LOG cmd: /'
+echo "VBOARD-INFO cmd cal-id reported: ${cal:-?}"
