@@ -58,8 +58,8 @@ Reference<N> reference(const ArrayGeometry<double, N>& g) {
         th.y() * rho.z() + th.z() * rho.y(), th.x() * rho.z() + th.z() * rho.x(),
         th.x() * rho.y() + th.y() * rho.x();
   }
-  const Eigen::JacobiSVD<Eigen::Matrix<double, N, 6>> svd(h_scaled,
-                                                          Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::Matrix<double, N, 6>> svd(
+      h_scaled, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const auto& sv = svd.singularValues();
   Reference<N> r;
   r.cond = sv(0) / sv(5);
@@ -140,7 +140,7 @@ TYPED_TEST(SolverSetupAccuracyTest, Table6GeometryOfTheExactCompensator) {
 }
 
 TYPED_TEST(SolverSetupAccuracyTest, RandomArraysUpToTheConditionLimit) {
-  std::mt19937_64 rng(13);  // fixed seed: reproducible geometries
+  std::mt19937_64 rng(13);   // fixed seed: reproducible geometries
   double worst_ratio = 0.0;  // error / (κ u): how much of the bound is used
   double max_kappa = 0.0;
   for (int i = 0; i < 200; ++i) {
@@ -152,7 +152,8 @@ TYPED_TEST(SolverSetupAccuracyTest, RandomArraysUpToTheConditionLimit) {
     expect_within_bound<TypeParam>(e8);
     for (const Errors& e : {e6, e8}) {
       max_kappa = std::max(max_kappa, e.kappa);
-      worst_ratio = std::max(worst_ratio, std::max(e.m, e.k) / (e.kappa * kUnitRoundoff<TypeParam>));
+      worst_ratio =
+          std::max(worst_ratio, std::max(e.m, e.k) / (e.kappa * kUnitRoundoff<TypeParam>));
     }
   }
   std::printf("[ stats    ] largest kappa %.1f, worst error %.1f kappa*u (bound %.0f)\n", max_kappa,
