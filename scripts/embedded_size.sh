@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Flash/RAM footprint of the float32 navigation core on a bare-metal Cortex-M4F, and the proof
-# that its per-sample step calls no soft-float double routine.
+# that the image holds no soft-float double routine (set-up included) and that the per-sample
+# step reaches none. Enforces the limits of issue 13: flash (text + data) <= 24 KiB, static RAM
+# (data + bss) <= 4 KiB, no soft-double symbol anywhere in the program.
 #
 # Usage: scripts/embedded_size.sh [build-dir]      (default: build/cortex-m4f)
 #   Build first:  cmake --preset cortex-m4f && cmake --build --preset cortex-m4f
@@ -11,9 +13,12 @@
 #      instantiations; the program links only the float one, with --gc-sections);
 #   2. the largest symbols of the program;
 #   3. every soft-float double routine (__aeabi_d*, __*df2/3, __aeabi_f2d, ...) and double libm
-#      function the program contains, with the call path that reaches it from main, and then the
-#      same walk from the per-sample step gfins_nav_step(): it must reach none.
-# Exit status: 0 when the step is free of double arithmetic, 1 when it is not, 2 on usage errors.
+#      function the program contains (there must be none), with the call path that reaches it
+#      from main, and then the same walk from the per-sample step gfins_nav_step();
+#   4. the limits check.
+# Exit status: 0 within the limits and free of double arithmetic, 1 when a limit is exceeded or a
+# soft-double routine is present, 2 on usage errors. Limits: GFINS_FLASH_LIMIT / GFINS_RAM_LIMIT
+# (bytes) override the defaults.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -29,7 +34,10 @@ for f in "${elf}" "${lib}"; do
   fi
 done
 
-echo "== Probe program (float32 pipeline, paper compensator, static storage) =="
+flash_limit="${GFINS_FLASH_LIMIT:-24576}"  # 24 KiB
+ram_limit="${GFINS_RAM_LIMIT:-4096}"       # 4 KiB
+
+echo "== Probe program (float32 pipeline, exact compensator, one geometry, static storage) =="
 "${prefix}size" "${elf}"
 echo
 echo "== Navigation core library objects (float + double instantiations) =="
@@ -119,10 +127,10 @@ def demangle_all(names):
     return out.stdout.split("\n")
 
 present = sorted(f for f in graph if soft_double.match(f))
-print("== Soft-float double routines in the program ==")
+print("== Soft-float double routines in the program (there must be none, set-up included) ==")
 print("  " + (" ".join(present) if present else "(none)"))
 print()
-print("== Reached from main (one-time configuration may use double) ==")
+print("== Functions that call them, reached from main ==")
 from_main = walk("main")
 users = sorted(f for f in from_main
                if not soft_double.match(f) and any(soft_double.match(g) for g in graph[f]))
@@ -144,6 +152,31 @@ if bad:
         print("  SOFT DOUBLE: " + path(from_step, f))
     sys.exit(1)
 print("  no soft-float double routine is reachable: the step runs on the FPU in single precision")
+if present:
+    sys.exit(1)
 PY
+status=0
 "${prefix}objdump" -d --no-show-raw-insn "${elf}" |
-  python3 -c "${callgraph_py}" ${GFINS_SIZE_VERBOSE:+-v}
+  python3 -c "${callgraph_py}" ${GFINS_SIZE_VERBOSE:+-v} || status=1
+
+# Limits: flash holds text and the initial values of data; static RAM holds data and bss.
+read -r text data bss _ < <("${prefix}size" "${elf}" | awk 'NR == 2')
+flash=$((text + data))
+ram=$((data + bss))
+echo
+echo "== Limits =="
+printf '  flash (text + data) %6d B, limit %6d B\n' "${flash}" "${flash_limit}"
+printf '  RAM   (data + bss)  %6d B, limit %6d B\n' "${ram}" "${ram_limit}"
+if (( flash > flash_limit )); then
+  echo "  FAIL: flash above the limit" >&2
+  status=1
+fi
+if (( ram > ram_limit )); then
+  echo "  FAIL: static RAM above the limit" >&2
+  status=1
+fi
+if (( status != 0 )); then
+  echo "  FAIL: see above (limits or soft-float double)" >&2
+  exit 1
+fi
+echo "  OK: within the limits, no soft-float double routine in the image"

@@ -12,6 +12,7 @@ packages=(
   python3 python3-matplotlib python3-numpy python3-can nodejs
   clang-format clang-tidy valgrind
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
+  qemu-system-arm  # scripts/m4f_step_cycles.sh: the Cortex-M4F step traced on mps2-an386
 )
 
 # npm installs the CAN test's third-party DBC reader (tests/can/independent): Debian's package,

@@ -238,8 +238,8 @@ nav::PipelineConfig<T> cast_config(const nav::PipelineConfig<double>& c) {
   }
   o.compensator = c.compensator;
   o.gravity = nav::GravityModel<T>::constant(static_cast<T>(c.gravity.magnitude_at_origin()));
-  o.max_condition = c.max_condition;
-  o.sample_rate_hz = c.sample_rate_hz;
+  o.max_condition = static_cast<T>(c.max_condition);
+  o.sample_rate_hz = static_cast<T>(c.sample_rate_hz);
   o.alignment_samples = c.alignment_samples;
   o.heading_rad = static_cast<T>(c.heading_rad);
   o.r0_n = c.r0_n.template cast<T>();

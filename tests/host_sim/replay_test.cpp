@@ -54,7 +54,7 @@ struct Fixture {
     nav::PipelineConfig<T> out;
     out.nominal = c.nominal.template cast<T>();
     out.front_end = c.front_end.template cast<T>();
-    out.sample_rate_hz = c.sample_rate_hz;
+    out.sample_rate_hz = static_cast<T>(c.sample_rate_hz);
     out.alignment_samples = c.alignment_samples;
     return out;
   }

@@ -36,7 +36,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
     return Status(ErrorCode::kInvalidArgument, "sample loop: sample rate must be positive");
   }
   nav::PipelineConfig<float> cfg = cal.config;
-  cfg.sample_rate_hz = options.sample_rate_hz;
+  cfg.sample_rate_hz = static_cast<float>(options.sample_rate_hz);
   cfg.heading_rad = options.initial_heading_rad;
   cfg.r0_n = options.initial_position_n;
   if (const Status s = pipeline_.configure(cfg); !s.is_ok()) return s;

@@ -32,7 +32,7 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
       p.gravity = nav::GravityModel<float>::normal(c.latitude_deg * kRadPerDeg, c.height_m);
       break;
   }
-  p.sample_rate_hz = c.sample_rate_hz;
+  p.sample_rate_hz = static_cast<float>(c.sample_rate_hz);
   p.alignment_samples =
       static_cast<std::uint32_t>(std::llround(std::max(1.0, c.alignment_s * c.sample_rate_hz)));
   p.heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);

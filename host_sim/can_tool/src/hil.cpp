@@ -206,7 +206,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       app::load_calibration(fc, app::nominal_calibration(chain_volts_per_count(fc.sample_rate_hz)));
   const app::LoopOptions lo = app::loop_options(fc);
   nav::PipelineConfig<float> cfg = cal.set.config;  // as SampleLoop::configure
-  cfg.sample_rate_hz = lo.sample_rate_hz;
+  cfg.sample_rate_hz = static_cast<float>(lo.sample_rate_hz);
   cfg.heading_rad = lo.initial_heading_rad;
   cfg.r0_n = lo.initial_position_n;
   auto pipe = std::make_unique<nav::NavPipeline<float>>();

@@ -106,7 +106,7 @@ HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::Compens
   cfg_t.misalignment = cast_misalignment<T>(m);
   cfg_t.compensator = kind;
   cfg_t.gravity = gravity_model<T>(s);
-  cfg_t.sample_rate_hz = cfg.sample_rate_hz;
+  cfg_t.sample_rate_hz = static_cast<T>(cfg.sample_rate_hz);
   // Heap-allocated: the pipeline is a large object (on the board it lives in static storage).
   auto pipeline = std::make_unique<nav::NavPipeline<T>>();
   if (const auto status = pipeline->configure(cfg_t); !status.is_ok()) {

@@ -61,10 +61,12 @@ ArrayGeometry<T, 6> table1_geometry(T rho_m) {
 }
 
 /// Monomials m(ω) = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy] of the centripetal term.
-template <typename T>
-Vec6<T> centripetal_monomials(const Vec3<T>& w) {
+/// m(ω) of a padded 3-vector (ArraySolver::PaddedVec3: 3 or 4 lanes, the 4th ignored).
+template <typename T, int P>
+Vec6<T> centripetal_monomials(const Eigen::Matrix<T, P, 1>& w) {
+  static_assert(P == 3 || P == 4, "a 3-vector, padded or not");
   Vec6<T> m;
-  m << w.x() * w.x(), w.y() * w.y(), w.z() * w.z(), w.y() * w.z(), w.x() * w.z(), w.x() * w.y();
+  m << w(0) * w(0), w(1) * w(1), w(2) * w(2), w(1) * w(2), w(0) * w(2), w(0) * w(1);
   return m;
 }
 
@@ -78,61 +80,84 @@ class ArraySolver {
  public:
   using Outputs = Eigen::Matrix<T, N, 1>;
   using MapMatrix = Eigen::Matrix<T, 6, N>;
-  /// Rows of the stored M and K, and of u = M s: six, rounded up to whole SIMD packets of T
-  /// (padded_rows); the extra rows are zero.
-  static constexpr int kRows = padded_rows<T>(6);
-  /// Rows of the stored bottom (specific-force) rows of K: three, rounded up the same way.
-  static constexpr int kForceRows = padded_rows<T>(3);
+  /// A 3-vector padded to one SIMD packet of T when a packet holds four (floats with SSE or
+  /// NEON), plain otherwise (doubles on SSE, where a 4-vector is two packets and measured slower;
+  /// no SIMD on the Cortex-M4F); the extra lane is zero. The integrator keeps its per-sample
+  /// 3-vectors in this form so that each operation is one packet.
+  static constexpr int kHalfRows = Eigen::internal::packet_traits<T>::size == 4 ? 4 : 3;
+  using PaddedVec3 = Eigen::Matrix<T, kHalfRows, 1>;
+  /// Rows of the stored M and K, and of u = M s: the three ω̇ rows at 0..2 and the three f rows
+  /// at kHalfRows..kHalfRows+2, each group padded with zero rows to kHalfRows, so that
+  /// u.head<kHalfRows>() is ω̇ and u.tail<kHalfRows>() is f, both as PaddedVec3.
+  static constexpr int kRows = 2 * kHalfRows;
+  /// Rows of the stored bottom (specific-force) rows of K: three, padded the same way.
+  static constexpr int kForceRows = kHalfRows;
   using PaddedVec = Eigen::Matrix<T, kRows, 1>;
   using PaddedMap = Eigen::Matrix<T, kRows, N>;
   using PaddedK = Eigen::Matrix<T, kRows, 6>;
   using PaddedKForce = Eigen::Matrix<T, kForceRows, 6>;
 
-  /// Builds M and K from a geometry, computing in double whatever T is. Fails with kSingular
+  /// Builds M and K from a geometry, in T (single precision on the target: no double arithmetic
+  /// anywhere in the float core; geometry_impl.hpp states the accuracy). Fails with kSingular
   /// when the design is singular or its condition number exceeds max_condition; fails with
   /// kInvalidArgument when an axis is not near unit length (|‖θ‖−1| > 0.1: the calibrated
   /// axes θ* of eq. (23) carry gains of a few percent, so they are not exactly unit) or the array
   /// has no size. The condition number is that of H with its ω̇ columns scaled by the mean lever
   /// arm, so it does not depend on the unit of length.
   static Result<ArraySolver> create(const ArrayGeometry<T, N>& geometry,
-                                    double max_condition = kDefaultMaxCondition);
+                                    T max_condition = T(kDefaultMaxCondition));
 
   /// Angular acceleration ω̇ (rad/s², body) and specific force f (m/s², body, at o_b) from the
   /// outputs s (m/s², along each axis) and the current angular rate ω (rad/s, body).
   void solve(const Outputs& s, const Vec3<T>& w, Vec3<T>& wdot_b, Vec3<T>& f_b) const {
     const PaddedVec u = m_.lazyProduct(s) - k_.lazyProduct(centripetal_monomials(w));
     wdot_b = u.template head<3>();
-    f_b = u.template segment<3>(3);
+    f_b = u.template segment<3>(kHalfRows);
   }
 
-  /// The linear part M s (ω-independent); the integrator reuses it across predictor/corrector.
-  Vec6<T> linear_part(const Outputs& s) const { return padded_linear_part(s).template head<6>(); }
+  /// The linear part M s (ω-independent), [ω̇; f] order.
+  Vec6<T> linear_part(const Outputs& s) const { return unpad(padded_linear_part(s)); }
   /// M s in the padded layout the integrator takes (Strapdown::step_linear).
   PaddedVec padded_linear_part(const Outputs& s) const { return m_.lazyProduct(s); }
-  /// The centripetal correction K m(ω) that solve() subtracts.
+  /// The centripetal correction K m(ω) that solve() subtracts, [ω̇; f] order.
   Vec6<T> centripetal_part(const Vec3<T>& w) const {
-    return k_.lazyProduct(centripetal_monomials(w)).template head<6>();
+    return unpad(k_.lazyProduct(centripetal_monomials(w)));
   }
 
-  /// M (6×N) and K (6×6), views of the padded storage.
-  auto m() const { return m_.template topRows<6>(); }
-  auto k() const { return k_.template topRows<6>(); }
+  /// M (6×N) and K (6×6), gathered from the padded storage.
+  MapMatrix m() const { return unpad_rows(m_); }
+  Mat6<T> k() const { return unpad_rows(k_); }
   /// The padded storage itself, for the per-sample products.
   const PaddedMap& padded_m() const { return m_; }
   const PaddedK& padded_k() const { return k_; }
   /// Rows 3..5 of K (the specific-force rows), padded.
   const PaddedKForce& padded_k_force() const { return k_force_; }
-  double condition_number() const { return condition_; }
+  /// Condition number of the column-scaled design (computed in T).
+  double condition_number() const { return static_cast<double>(condition_); }
   const ArrayGeometry<T, N>& geometry() const { return geometry_; }
+
+  /// [ω̇; f] (6 values) from the padded layout.
+  static Vec6<T> unpad(const PaddedVec& u) {
+    Vec6<T> r;
+    r << u.template head<3>(), u.template segment<3>(kHalfRows);
+    return r;
+  }
 
   /// Forward model: the outputs an ideal array with this geometry gives for (ω̇, f, ω).
   Outputs predict(const Vec3<T>& wdot_b, const Vec3<T>& f_b, const Vec3<T>& w) const;
 
  private:
+  template <int C>
+  static Eigen::Matrix<T, 6, C> unpad_rows(const Eigen::Matrix<T, kRows, C>& p) {
+    Eigen::Matrix<T, 6, C> r;
+    r << p.template topRows<3>(), p.template middleRows<3>(kHalfRows);
+    return r;
+  }
+
   PaddedMap m_ = PaddedMap::Zero();
   PaddedK k_ = PaddedK::Zero();
   PaddedKForce k_force_ = PaddedKForce::Zero();
-  double condition_ = 0.0;
+  T condition_ = T(0);
   ArrayGeometry<T, N> geometry_{};
 };
 

@@ -48,7 +48,9 @@ class GravityModel {
   }
 
   /// g_n (m/s², NED) at navigation position r_n (m, NED from the alignment point).
-  Vec3<T> g_n(const Vec3<T>& r_n) const { return Vec3<T>(T(0), T(0), g0_ - dg_dh_ * r_n.z()); }
+  Vec3<T> g_n(const Vec3<T>& r_n) const { return Vec3<T>(T(0), T(0), g_down(r_n.z())); }
+  /// The down component of g_n (the others are zero) at the NED down coordinate r_down_m (m).
+  T g_down(T r_down_m) const { return g0_ - dg_dh_ * r_down_m; }
 
   GravityKind kind() const { return kind_; }
   T magnitude_at_origin() const { return g0_; }

@@ -24,19 +24,20 @@
 namespace gfins::nav {
 
 /// Vector sum with Kahan compensation: the rounding error of each addition is carried into the
-/// next one. Requires IEEE arithmetic as written (never build nav_core with -ffast-math).
-template <typename T>
+/// next one. Requires IEEE arithmetic as written (never build nav_core with -ffast-math). V is a
+/// 3-vector, plain or padded (ArraySolver::PaddedVec3).
+template <typename T, typename V = Vec3<T>>
 struct CompensatedVec3 {
-  Vec3<T> sum = Vec3<T>::Zero();
-  Vec3<T> carry = Vec3<T>::Zero();
+  V sum = V::Zero();
+  V carry = V::Zero();
 
-  void reset(const Vec3<T>& v) {
+  void reset(const V& v) {
     sum = v;
     carry.setZero();
   }
-  void add(const Vec3<T>& delta) {
-    const Vec3<T> y = delta - carry;
-    const Vec3<T> t = sum + y;
+  void add(const V& delta) {
+    const V y = delta - carry;
+    const V t = sum + y;
     carry = (t - sum) - y;
     sum = t;
   }
@@ -47,6 +48,9 @@ class Strapdown {
  public:
   using Solver = ArraySolver<T, N>;
   using Outputs = typename Solver::Outputs;
+  /// The per-sample 3-vectors, padded to whole SIMD packets (lane 3 zero with SSE).
+  using PVec = typename Solver::PaddedVec3;
+  static constexpr int kP = Solver::kHalfRows;
 
   Strapdown() = default;
   Strapdown(const Solver& solver, const GravityModel<T>& gravity)
@@ -68,8 +72,12 @@ class Strapdown {
     state_.q_nb.normalize();
     solver_.solve(s0, state_.w_b, state_.wdot_b, state_.f_b);
     state_.a_n = state_.q_nb * state_.f_b + gravity_.g_n(state_.r_n);
-    v_.reset(state_.v_n);
-    r_.reset(state_.r_n);
+    q_ = state_.q_nb;
+    w_ = pad(state_.w_b);
+    wdot_ = pad(state_.wdot_b);
+    a_ = pad(state_.a_n);
+    v_.reset(pad(state_.v_n));
+    r_.reset(pad(state_.r_n));
   }
 
   /// Advances to the sample s_k taken dt_s after the previous one.
@@ -77,58 +85,69 @@ class Strapdown {
     step_linear(solver_.padded_linear_part(s_k), dt_s, t_ns, seq);
   }
 
-  /// step() with u_k = M s_k already formed (padded layout of ArraySolver::kRows): the pipeline
-  /// folds the paper compensator into this product (Compensator::padded_linear_part).
+  /// step() with u_k = M s_k already formed (padded layout of ArraySolver::kRows: ω̇ rows in the
+  /// first kP, f rows in the last kP): the pipeline folds the paper compensator into this
+  /// product (Compensator::padded_linear_part). The arithmetic runs on padded 3-vectors (PVec),
+  /// element by element the same operations as on plain ones; the state is kept in that form
+  /// (q_, w_, wdot_, a_, v_, r_) and copied to the NavState once per step.
   void step_linear(const typename Solver::PaddedVec& u, T dt_s, std::int64_t t_ns,
                    std::uint32_t seq) {
     const T h = dt_s;
-    const Vec3<T> w0 = state_.w_b;
-    const Vec3<T> wdot0 = state_.wdot_b;
-    const Vec3<T> a0 = state_.a_n;
-    const Vec3<T> v0 = v_.sum;
+    const PVec w0 = w_;
+    const PVec wdot0 = wdot_;
+    const PVec a0 = a_;
+    const PVec v0 = v_.sum;
 
     // When K's top rows are zero (a symmetric array such as Table 1, where ω̇ = S s/(2ρ) of
     // eq. (4)/(6) has no centripetal term) the predictor is exact and ω̇ needs no product: same
     // values as the general case, which would subtract exact zeros, for a third fewer operations.
-    Vec3<T> wdot_pred = u.template head<3>();
+    PVec wdot_pred = u.template head<kP>();
     if (!wdot_free_of_w_) {
-      const Vec3<T> w_pred = w0 + h * wdot0;
+      const PVec w_pred = w0 + h * wdot0;
       // The whole padded product (whole SIMD packets) is cheaper than its three top rows.
-      wdot_pred -= solver_.padded_k().lazyProduct(centripetal_monomials(w_pred)).template head<3>();
+      wdot_pred -=
+          solver_.padded_k().lazyProduct(centripetal_monomials(w_pred)).template head<kP>();
     }
-    const Vec3<T> w1 = w0 + (h / T(2)) * (wdot0 + wdot_pred);
+    const PVec w1 = w0 + (h / T(2)) * (wdot0 + wdot_pred);
     const Vec6<T> m1 = centripetal_monomials(w1);
-    Vec3<T> wdot1;
-    Vec3<T> f1;
+    PVec wdot1;
+    PVec f1;
     if (wdot_free_of_w_) {
-      wdot1 = u.template head<3>();
-      f1 = u.template segment<3>(3) - solver_.padded_k_force().lazyProduct(m1).template head<3>();
+      wdot1 = u.template head<kP>();
+      f1 = u.template tail<kP>() - solver_.padded_k_force().lazyProduct(m1);
     } else {
       const typename Solver::PaddedVec full = u - solver_.padded_k().lazyProduct(m1);
-      wdot1 = full.template head<3>();
-      f1 = full.template segment<3>(3);
+      wdot1 = full.template head<kP>();
+      f1 = full.template tail<kP>();
     }
 
-    const Vec3<T> phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * w0.cross(w1);
-    Quat<T> q1 = state_.q_nb * quat_from_rotation_vector(phi);
+    const PVec phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * cross_padded(w0, w1);
+    Quat<T> q1 = q_ * quat_from_rotation_vector_padded(phi);
     q1.normalize();
 
-    const Vec3<T> a1 = q1 * f1 + gravity_.g_n(r_.sum);
+    PVec a1 = rotate_padded(q1, f1);
+    a1(2) += gravity_.g_down(r_.sum(2));  // + g_n(r_{k-1}), which has only a down component
     v_.add((h / T(2)) * (a0 + a1));
     r_.add(h * v0 + (h * h / T(6)) * (T(2) * a0 + a1));
 
+    q_ = q1;
+    w_ = w1;
+    wdot_ = wdot1;
+    a_ = a1;
     state_.t_ns = t_ns;
     state_.seq = seq;
     state_.q_nb = q1;
-    state_.w_b = w1;
-    state_.wdot_b = wdot1;
-    state_.f_b = f1;
-    state_.a_n = a1;
-    state_.v_n = v_.sum;
-    state_.r_n = r_.sum;
+    state_.w_b = w1.template head<3>();
+    state_.wdot_b = wdot1.template head<3>();
+    state_.f_b = f1.template head<3>();
+    state_.a_n = a1.template head<3>();
+    state_.v_n = v_.sum.template head<3>();
+    state_.r_n = r_.sum.template head<3>();
   }
 
   const NavState<T>& state() const { return state_; }
+  /// For the status bits only: the integration state lives in the padded copies above (set by
+  /// initialize()); changing q_nb, w_b, ... here would not change the next step.
   NavState<T>& mutable_state() { return state_; }
 
  private:
@@ -137,12 +156,22 @@ class Strapdown {
     return (solver.padded_k().template topRows<3>().array() == T(0)).all();
   }
 
+  static PVec pad(const Vec3<T>& v) {
+    PVec p = PVec::Zero();
+    p.template head<3>() = v;
+    return p;
+  }
+
   Solver solver_{};  // owned copy (a few hundred bytes), so the integrator can be copied
   GravityModel<T> gravity_{};
   bool wdot_free_of_w_ = false;
   NavState<T> state_{};
-  CompensatedVec3<T> v_{};
-  CompensatedVec3<T> r_{};
+  Quat<T> q_ = Quat<T>::Identity();
+  PVec w_ = PVec::Zero();
+  PVec wdot_ = PVec::Zero();
+  PVec a_ = PVec::Zero();
+  CompensatedVec3<T, PVec> v_{};
+  CompensatedVec3<T, PVec> r_{};
 };
 
 }  // namespace gfins::nav

@@ -23,8 +23,8 @@ using Mat6 = Eigen::Matrix<T, 6, 6>;
 template <typename T>
 using Quat = Eigen::Quaternion<T>;
 
-/// `rows` rounded up to whole SIMD packets of T: 8 for six floats with SSE (packets of 4), 6 for
-/// six doubles (packets of 2), `rows` itself without SIMD (Cortex-M4F). The per-sample products
+/// `rows` rounded up to whole SIMD packets of T: 4 for three floats with SSE (packets of 4), 4 for
+/// three doubles (packets of 2), `rows` itself without SIMD (Cortex-M4F). The per-sample products
 /// keep their matrices with zero rows up to this count, so that Eigen evaluates every column as
 /// whole packets instead of one packet plus scalar leftovers (docs/performance.md).
 template <typename T>
@@ -53,15 +53,13 @@ Mat3<T> skew(const Vec3<T>& v) {
   return m;
 }
 
-/// Quaternion of the rotation vector `phi` (rad): exp(phi/2). Below 0.1 rad a Taylor series is
-/// used; its truncation error (|phi|^6/46080 in the scalar part) is below the float and double
-/// rounding of the terms kept, and it avoids sin/cos on the per-sample path (a 1 kHz step rotates
-/// by far less than 0.1 rad for any rate below 100 rad/s).
+/// cos(|phi|/2) and sin(|phi|/2)/|phi| from a2 = |phi|² (rad²), the two factors of
+/// exp(phi/2) = (c, s·phi). Below |phi| = 0.1 rad a Taylor series is used; its truncation error
+/// (|phi|^6/46080 in the scalar part) is below the float and double rounding of the terms kept,
+/// and it avoids sin/cos on the per-sample path (a 1 kHz step rotates by far less than 0.1 rad
+/// for any rate below 100 rad/s).
 template <typename T>
-Quat<T> quat_from_rotation_vector(const Vec3<T>& phi) {
-  const T a2 = phi.squaredNorm();
-  T c;  // cos(|phi|/2)
-  T s;  // sin(|phi|/2)/|phi|
+void half_angle_factors(T a2, T& c, T& s) {
   if (a2 < T(0.01)) {
     // Horner form, constant reciprocals: cos y = 1 − y²/2 + y⁴/24 − y⁶/720 and
     // sin(y)/(2y) = 1/2 − y²/12 + y⁴/240 − y⁶/10080 with y = |phi|/2 (no division per sample).
@@ -73,7 +71,59 @@ Quat<T> quat_from_rotation_vector(const Vec3<T>& phi) {
     c = std::cos(a / T(2));
     s = std::sin(a / T(2)) / a;
   }
+}
+
+/// Quaternion of the rotation vector `phi` (rad): exp(phi/2) (half_angle_factors).
+template <typename T>
+Quat<T> quat_from_rotation_vector(const Vec3<T>& phi) {
+  T c;
+  T s;
+  half_angle_factors(phi.squaredNorm(), c, s);
   return Quat<T>(c, s * phi.x(), s * phi.y(), s * phi.z());
+}
+
+/// a × b of 3-vectors, plain (P = 3) or padded to four lanes (P = 4, lane 3 ignored on input and
+/// zero on output for finite inputs): Eigen's SIMD cross3, the same products and differences
+/// per lane as cross().
+template <typename T, int P>
+Eigen::Matrix<T, P, 1> cross_padded(const Eigen::Matrix<T, P, 1>& a,
+                                    const Eigen::Matrix<T, P, 1>& b) {
+  static_assert(P == 3 || P == 4, "a 3-vector, padded or not");
+  if constexpr (P == 4) {
+    return a.cross3(b);
+  } else {
+    return a.cross(b);
+  }
+}
+
+/// quat_from_rotation_vector for a padded 3-vector (lane 3, if any, zero): same arithmetic.
+template <typename T, int P>
+Quat<T> quat_from_rotation_vector_padded(const Eigen::Matrix<T, P, 1>& phi) {
+  T c;
+  T s;
+  half_angle_factors(phi.template head<3>().squaredNorm(), c, s);
+  if constexpr (P == 4) {
+    Eigen::Matrix<T, 4, 1> xyzw = s * phi;  // Eigen's coefficient order: x, y, z, w
+    xyzw(3) = c;
+    return Quat<T>(xyzw);
+  } else {
+    return Quat<T>(c, s * phi(0), s * phi(1), s * phi(2));
+  }
+}
+
+/// q v q* for a padded 3-vector v (lane 3 zero): Eigen's QuaternionBase::_transformVector,
+/// v + 2w (q_v × v) + q_v × (2 q_v × v), written on packets.
+template <typename T, int P>
+Eigen::Matrix<T, P, 1> rotate_padded(const Quat<T>& q, const Eigen::Matrix<T, P, 1>& v) {
+  Eigen::Matrix<T, P, 1> qv;
+  if constexpr (P == 4) {
+    qv = q.coeffs();  // x, y, z and w in lane 3, which cross3 ignores
+  } else {
+    qv = q.vec();
+  }
+  Eigen::Matrix<T, P, 1> uv = cross_padded(qv, v);
+  uv += uv;
+  return v + q.w() * uv + cross_padded(qv, uv);
 }
 
 /// Rotation vector of a unit quaternion (inverse of quat_from_rotation_vector), with the

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "gfins/nav_core/alignment.hpp"
@@ -25,8 +26,10 @@ struct PipelineConfig {
   Misalignment<T> misalignment{};
   CompensatorKind compensator = CompensatorKind::kNone;
   GravityModel<T> gravity = GravityModel<T>::constant(static_cast<T>(kStandardGravity));
-  double max_condition = kDefaultMaxCondition;
-  double sample_rate_hz = 1000.0;
+  // In T like everything else: on the Cortex-M4F any double here would need the soft-float
+  // routines at configure() (docs/performance.md, "no soft-float double anywhere").
+  T max_condition = T(kDefaultMaxCondition);
+  T sample_rate_hz = T(1000);
   std::uint32_t alignment_samples = 1000;  // samples at rest averaged before navigating
   T heading_rad = T(0);                    // given: nothing on board senses heading
   Vec3<T> r0_n = Vec3<T>::Zero();          // given initial position, m, NED
@@ -62,8 +65,9 @@ class NavPipeline {
         Compensator<T>::solver_geometry(config.compensator, config.nominal, config.misalignment),
         config.max_condition);
     if (!solver.is_ok()) return solver.status();
-    if (!(config.sample_rate_hz > 0.0)) {
-      return Status(ErrorCode::kInvalidArgument, "pipeline: sample rate must be positive");
+    if (!(config.sample_rate_hz > T(0)) || !std::isfinite(config.sample_rate_hz)) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "pipeline: sample rate must be positive and finite");
     }
     config_ = config;
     front_end_ = fe.value();
@@ -72,7 +76,7 @@ class NavPipeline {
     strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
     aligner_.reset();
     have_seen_ = false;
-    period_s_ = static_cast<T>(1.0 / config.sample_rate_hz);
+    period_s_ = T(1) / config.sample_rate_hz;
     phase_ = PipelinePhase::kAligning;
     configured_ = true;
     return Status::ok();

@@ -1,0 +1,186 @@
+#!/usr/bin/env bash
+# Instructions and estimated Cortex-M4F cycles of one navigation step (gfins_nav_step: read a
+# frame, NavPipeline<float>::process with the exact compensator, write the state out).
+#
+# Usage: scripts/m4f_step_cycles.sh [build-dir]        (default: build/cortex-m4f)
+#   Build first:  cmake --preset cortex-m4f && cmake --build --preset cortex-m4f
+#   Needs qemu-system-arm (Debian package qemu-system-arm, in scripts/install-deps.sh).
+#
+# Method. QEMU's mps2-an386 board (a Cortex-M4 with FPU) runs gfins_nav_qemu.elf, the size probe
+# with a start-up and 64 steps, one instruction per translation block, logging the address of
+# every executed instruction (-singlestep -d exec,nochain). QEMU does not model cycles (its
+# icount counts instructions), so the cycles are an estimate: each executed instruction is
+# looked up in the disassembly and costed with the Cortex-M4 Technical Reference Manual's timing
+# (ARM DDI 0439B, Table 3-1 for the integer instructions, Table 7-1 for the FPU), under the
+# assumptions printed with the result. Branch direction comes from the trace itself.
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${1:-${root}/build/cortex-m4f}"
+elf="${build}/nav_core/baremetal/gfins_nav_qemu.elf"
+prefix="${GFINS_ARM_PREFIX:-arm-none-eabi-}"
+if [[ ! -f "${elf}" ]]; then
+  echo "m4f_step_cycles.sh: ${elf} not found; build the cortex-m4f preset first" >&2
+  exit 2
+fi
+if ! command -v qemu-system-arm >/dev/null; then
+  echo "m4f_step_cycles.sh: qemu-system-arm not found (apt-get install qemu-system-arm)" >&2
+  exit 2
+fi
+
+work="$(mktemp -d)"
+trap 'rm -rf "${work}"' EXIT
+timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+  -semihosting-config enable=on,target=native -kernel "${elf}" \
+  -singlestep -d exec,nochain -D "${work}/trace.log"
+"${prefix}objdump" -d "${elf}" >"${work}/disasm.txt"
+"${prefix}nm" -S "${elf}" >"${work}/nm.txt"
+
+python3 - "${work}/trace.log" "${work}/disasm.txt" "${work}/nm.txt" <<'PY'
+import collections, re, sys
+
+trace_path, disasm_path, nm_path = sys.argv[1:4]
+P = 2  # pipeline refill after a taken branch: 1..3 cycles (TRM 3.3.1); 2 assumed
+
+insn = {}  # address -> (size in bytes, mnemonic, operands)
+line_re = re.compile(r"^\s*([0-9a-f]+):\s+((?:[0-9a-f]{4}\s)+)\s*(\S+)\s*([^;<]*)")
+for line in open(disasm_path):
+    m = line_re.match(line)
+    if m:
+        raw = m.group(2).split()
+        insn[int(m.group(1), 16)] = (2 * len(raw), m.group(3), m.group(4).strip())
+
+sym = {}
+for line in open(nm_path):
+    parts = line.split()
+    if len(parts) == 4:
+        sym[parts[3]] = (int(parts[0], 16), int(parts[1], 16))
+step_addr = sym["gfins_nav_step"][0]
+main_lo, main_size = sym["main"]
+
+pcs = []
+pc_re = re.compile(r"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
+for line in open(trace_path):
+    m = pc_re.match(line)
+    if m:
+        pcs.append(int(m.group(1), 16) & ~1)
+
+conds = ("eq", "ne", "cs", "cc", "hs", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt",
+         "le", "al")
+
+def base(mn):
+    mn = mn.split(".")[0]
+    for c in conds:  # condition suffix of an instruction in an IT block or a conditional branch
+        if mn.endswith(c) and len(mn) > len(c) and mn not in ("vcmpe", "bl", "teq", "vmls", "mls", "vnmls"):
+            stem = mn[: -len(c)]
+            if stem in ("b", "mov", "add", "sub", "ldr", "str", "vmov", "it", "bx", "vmul", "vadd",
+                        "vsub", "orr", "and", "cmp", "movs", "adds", "subs", "ldrb", "strb", "vstr",
+                        "vldr", "vneg", "vmla", "vdiv", "mvn", "rsb", "lsl", "lsr", "asr"):
+                return stem
+    return mn
+
+def reglist_count(ops):
+    m = re.search(r"\{([^}]*)\}", ops)
+    if not m:
+        return 1
+    n = 0
+    for part in m.group(1).split(","):
+        part = part.strip()
+        r = re.match(r"([rsd])(\d+)-[rsd](\d+)", part)
+        if r:
+            k = int(r.group(3)) - int(r.group(2)) + 1
+            n += 2 * k if r.group(1) == "d" else k
+        elif part:
+            n += 2 if part.startswith("d") else 1
+    return n
+
+def cost(mn, ops, taken, prev_mem):
+    b = base(mn)
+    if b in ("vldr", "vstr"):
+        return 2, "FPU load/store"
+    if b in ("vpush", "vpop") or b.startswith("vldm") or b.startswith("vstm"):
+        return 1 + reglist_count(ops), "FPU load/store"
+    if b in ("vdiv", "vsqrt"):
+        return 14, "FPU divide/sqrt"
+    if b in ("vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms"):
+        return 3, "FPU multiply-accumulate"
+    if b == "vmov":
+        return (2 if ops.count(",") >= 3 else 1), "FPU move"
+    if b.startswith("v"):
+        return 1, "FPU add/sub/mul/cmp/cvt"
+    if b in ("push", "pop") or b.startswith("ldm") or b.startswith("stm"):
+        n = reglist_count(ops)
+        return 1 + n + (P if "pc" in ops and b in ("pop", "ldm", "ldmia") else 0), "load/store multiple"
+    if b in ("ldrd", "strd"):
+        return 3, "load/store"
+    if b.startswith("ldr") or b.startswith("str"):
+        return (1 if prev_mem else 2), "load/store"
+    if b in ("b", "bl", "bx", "blx", "cbz", "cbnz"):
+        return (1 + P if taken else 1), "branch"
+    if b.startswith("it"):
+        return 1, "IT"
+    if b in ("sdiv", "udiv"):
+        return 12, "divide"
+    if b in ("mla", "mls"):
+        return 2, "multiply"
+    if b in ("mul", "muls", "smull", "umull", "smlal", "umlal"):
+        return 1, "multiply"
+    return 1, "integer"
+
+steps = []
+i = 0
+while i < len(pcs):
+    if pcs[i] != step_addr:
+        i += 1
+        continue
+    j = i
+    seq = []
+    while j < len(pcs) and not (main_lo <= pcs[j] < main_lo + main_size):
+        seq.append(j)
+        j += 1
+    steps.append(seq)
+    i = j
+
+if len(steps) < 10:
+    sys.exit("m4f_step_cycles.sh: fewer than 10 steps in the trace (%d)" % len(steps))
+
+def analyse(seq):
+    cyc, n = 0, 0
+    classes = collections.Counter()
+    ccount = collections.Counter()
+    prev_mem = False
+    for k in seq:
+        pc = pcs[k]
+        size, mn, ops = insn.get(pc, (2, "?", ""))
+        nxt = pcs[k + 1] if k + 1 < len(pcs) else None
+        taken = nxt is not None and nxt != pc + size
+        c, cls = cost(mn, ops, taken, prev_mem)
+        prev_mem = cls == "load/store"
+        cyc += c
+        n += 1
+        classes[cls] += c
+        ccount[cls] += 1
+    return n, cyc, classes, ccount
+
+# Steady state: the last step (the first ones include the first call's paths; all 64 follow the
+# same branches after the first, which the spread shows).
+results = [analyse(s) for s in steps[1:]]
+ns = sorted(r[0] for r in results)
+cs = sorted(r[1] for r in results)
+n, cyc, classes, ccount = results[-1]
+print("steps traced: %d; instructions per step min %d, max %d; estimated cycles min %d, max %d"
+      % (len(results), ns[0], ns[-1], cs[0], cs[-1]))
+print()
+print("one step (the last): %d instructions, %d estimated cycles (%.1f us at 168 MHz, %.2f %% of a"
+      " 1 kHz period)" % (n, cyc, cyc / 168.0, cyc / 168.0 / 10.0))
+print()
+print("%-28s %8s %8s" % ("class", "instr", "cycles"))
+for cls, c in sorted(classes.items(), key=lambda kv: -kv[1]):
+    print("%-28s %8d %8d" % (cls, ccount[cls], c))
+print()
+print("assumptions: zero-wait-state memory (code and data in SRAM, or flash behind a prefetch")
+print("accelerator that hits); taken branch 1+P with P = %d; LDR/STR 2 cycles, 1 when it follows" % P)
+print("another load/store (address/data phase pipelining); LDRD/STRD 3; LDM/STM/PUSH/POP 1+N;")
+print("VLDR/VSTR 2; VPUSH/VPOP/VLDM/VSTM 1+N; VADD/VSUB/VMUL/VCMP/VCVT 1; VMLA/VMLS/VFMA 3;")
+print("VDIV/VSQRT 14; IT 1 (not folded); SDIV/UDIV 12 (worst case); no FPU result stalls modelled.")
+PY
