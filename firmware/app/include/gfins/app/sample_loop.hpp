@@ -165,7 +165,8 @@ class SampleLoop {
 };
 
 constexpr std::uint64_t SampleLoop::layout_signature() {
-  const std::array<std::size_t, 2 * 20> sizes = {
+  const std::array<std::size_t, 40> sizes = {
+      // size and alignment of the class and of 15 members, then the sizes of 8 member types
       sizeof(SampleLoop),
       alignof(SampleLoop),
       sizeof(pipeline_),
