@@ -6,6 +6,7 @@
 #include "common.hpp"
 #include "run_options.hpp"
 
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 
@@ -38,16 +39,23 @@ class StopSignals {
 
 /// Refuses a run whose files would not fit on their file system (std::filesystem::space), with
 /// the numbers: better than a disk full after minutes of work.
-HostStatus check_disk_space(const std::string& dir, std::uint64_t need, const char* what) {
+HostStatus check_disk_space(const Scenario& s, const std::string& dir, std::uint64_t need,
+                            const char* what, const char* hint) {
+  // The folder may not exist yet (it is made after the checks): its nearest existing ancestor.
   std::error_code ec;
-  const auto sp = std::filesystem::space(dir, ec);
+  std::filesystem::path p = std::filesystem::absolute(dir, ec);
+  while (!ec && !std::filesystem::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) {
+    p = p.parent_path();
+  }
+  const auto sp = std::filesystem::space(p, ec);
   if (ec || need <= sp.available) return Done{};  // unknown free space: try, write errors report
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%s would need about %.3g MB in %s, which has %.3g MB free: free some space, use "
-                "--decimate N or a shorter run",
-                what, static_cast<double>(need) / 1e6, dir.c_str(),
-                static_cast<double>(sp.available) / 1e6);
+                "scenario %s: %.4g samples (duration_s %g x rate_hz %g): %s would need about "
+                "%.3g MB in %s, which has %.3g MB free: free some space, %s",
+                s.name.c_str(), std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0, s.duration_s,
+                s.rate_hz, what, static_cast<double>(need) / 1e6, dir.c_str(),
+                static_cast<double>(sp.available) / 1e6, hint);
   return HostError{ErrorCode::kResourceExhausted, buf};
 }
 
@@ -78,19 +86,22 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
                 kExitBadInput);
   }
   const std::string& out_dir = dir.value();
-  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   const bool navigation = s.trajectory.kind != "calibration_poses";
-  if (auto c = check_disk_space(out_dir, run_disk_bytes(s, out.decimate, false), "the CSV files");
+  if (auto c = check_disk_space(s, out_dir, run_disk_bytes(s, out.decimate, false), "the CSV files",
+                                "use --decimate N or a shorter run");
       !c.is_ok()) {
     return fail(c.error(), kExitBadInput);
   }
   if (!out.record.empty()) {
     const std::uint64_t need =
         run_disk_bytes(s, out.decimate, true) - run_disk_bytes(s, out.decimate, false);
-    if (auto c = check_disk_space(parent_dir(out.record), need, "the recording"); !c.is_ok()) {
+    if (auto c = check_disk_space(s, parent_dir(out.record), need, "the recording",
+                                  "record a shorter run");
+        !c.is_ok()) {
       return fail(c.error(), kExitBadInput);
     }
   }
+  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim run %s\n  navigation: %s\n", describe(s).c_str(),
               scalar_text(scalar.value()));
   std::fflush(stdout);

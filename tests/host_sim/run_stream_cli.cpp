@@ -59,9 +59,10 @@ std::string rest_scenario(double duration_s, double rate_hz) {
 class RunStreamCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("gfins_run_stream_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ =
+        fs::temp_directory_path() /
+        ("gfins_run_stream_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -113,7 +114,8 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
   // long scenario is refused under it.
   const auto s = load_scenario(long_toml.string());
   ASSERT_TRUE(s.is_ok()) << s.error().message;
-  const double per_sample = sizeof(TruthState) + 2.0 * sizeof(RawSample) + 2.0 * sizeof(SampleRecord);
+  const double per_sample =
+      sizeof(TruthState) + 2.0 * sizeof(RawSample) + 2.0 * sizeof(SampleRecord);
   const double in_memory_long = per_sample * (kLong * kRate + 1);
   EXPECT_EQ(static_cast<double>(run_memory_bytes(s.value())), in_memory_long);
   EXPECT_FALSE(check_run_size(s.value()).is_ok());
@@ -162,6 +164,23 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
   ASSERT_EQ(unsetenv("GFINS_MAX_RUN_MEMORY_BYTES"), 0);
 }
 
+// A run whose files cannot fit on the disk is refused before any work, with the figures, and
+// leaves no folder behind. 10^11 samples (10^6 s at 100 kHz, the largest a scenario allows)
+// make at least 2 × 10^11 CSV rows of > 100 bytes each: 2 × 10^13 bytes, more than any file
+// system this test runs on has free (checked below with std::filesystem::space).
+TEST_F(RunStreamCli, RunThatCannotFitOnTheDiskIsRefusedWithTheNumbers) {
+  constexpr double kMinBytesNeeded = 2e13;
+  ASSERT_LT(static_cast<double>(fs::space(dir_).available), kMinBytesNeeded);
+  const fs::path toml = write_scenario("huge", rest_scenario(1.0e6, 1.0e5));
+  const fs::path out = dir_ / "a" / "huge";
+  const CliResult r =
+      test::run_tool(GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"}, dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("1e+11 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("MB free"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "a")) << "a refused run left a folder";
+}
+
 // (2) SIGINT after the first progress line: exit 130, CSV rows a prefix of an uninterrupted
 // run's, a valid recording with as many samples as CSV rows, a summary saying where it stopped.
 TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
@@ -172,11 +191,9 @@ TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
   const fs::path gfr = dir_ / "cut.gfr";
   const fs::path log = dir_ / "log";
   fs::create_directories(log);
-  test::StartedTool t =
-      test::start_tool(GFINS_SIM_BIN,
-                       {"run", toml.string(), "-o", cut.string(), "--no-plot", "--record",
-                        gfr.string()},
-                       log);
+  test::StartedTool t = test::start_tool(
+      GFINS_SIM_BIN,
+      {"run", toml.string(), "-o", cut.string(), "--no-plot", "--record", gfr.string()}, log);
   ASSERT_GT(t.child.pid, 0);
   // Wait (bounded) for the first progress line on stderr, then interrupt.
   bool seen = false;
@@ -208,8 +225,8 @@ TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
   // The uninterrupted run of the same scenario: the cut files are prefixes of its files.
   unsetenv("GFINS_PROGRESS_INTERVAL_S");
   const fs::path full = dir_ / "full";
-  const CliResult f = test::run_tool(
-      GFINS_SIM_BIN, {"run", toml.string(), "-o", full.string(), "--no-plot"}, dir_);
+  const CliResult f =
+      test::run_tool(GFINS_SIM_BIN, {"run", toml.string(), "-o", full.string(), "--no-plot"}, dir_);
   ASSERT_EQ(f.exit_code, kExitOk) << f.output;
   for (const char* file : {"uncompensated.csv", "compensated.csv"}) {
     const std::string cut_text = test::slurp(cut / file);
