@@ -104,7 +104,7 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim run %s\n  navigation: %s\n", describe(s).c_str(),
               scalar_text(scalar.value()));
-  std::fflush(stdout);
+  static_cast<void>(std::fflush(stdout));  // the header before any progress line
   StreamTargets targets;
   if (navigation) {
     targets.uncompensated_csv = out_dir + "/uncompensated.csv";

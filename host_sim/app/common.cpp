@@ -102,7 +102,7 @@ ProgressFn run_progress(const std::string& what, double duration_s) {
     next = now + every;
     std::fprintf(stderr, "progress: %s: %.0f %% (t = %.3f of %.3f s)\n", what.c_str(), f * 100.0,
                  f * duration_s, duration_s);
-    std::fflush(stderr);
+    static_cast<void>(std::fflush(stderr));
   };
 }
 

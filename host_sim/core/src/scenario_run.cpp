@@ -369,7 +369,8 @@ SeriesCsvWriter::SeriesCsvWriter(SeriesCsvWriter&& other) noexcept
 
 SeriesCsvWriter& SeriesCsvWriter::operator=(SeriesCsvWriter&& other) noexcept {
   if (this != &other) {
-    if (file_ != nullptr) std::fclose(file_);
+    if (file_ != nullptr)
+      (void)std::fclose(file_);  // moved-over writer: errors are not reported (close() does)
     file_ = std::exchange(other.file_, nullptr);
     path_ = std::move(other.path_);
     every_ = other.every_;
@@ -381,7 +382,8 @@ SeriesCsvWriter& SeriesCsvWriter::operator=(SeriesCsvWriter&& other) noexcept {
 }
 
 SeriesCsvWriter::~SeriesCsvWriter() {
-  if (file_ != nullptr) std::fclose(file_);
+  if (file_ != nullptr)
+    (void)std::fclose(file_);  // unclosed: errors are not reported (close() does)
 }
 
 HostResult<SeriesCsvWriter> SeriesCsvWriter::open(const std::string& path, std::size_t decimate) {
@@ -550,11 +552,11 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
   const TruthState* current = nullptr;
   if (navigate_runs) {
     struct Spec {
-      nav::CompensatorKind kind;
-      nav::Misalignment<double> m;
-      std::array<double, 6> bias;
-      const std::string* csv;
-      SeriesStats* stats;
+      nav::CompensatorKind kind = nav::CompensatorKind::kNone;
+      nav::Misalignment<double> m{};
+      std::array<double, 6> bias{};
+      const std::string* csv = nullptr;
+      SeriesStats* stats = nullptr;
     };
     const Spec specs[] = {
         {nav::CompensatorKind::kNone, nav::Misalignment<double>{}, std::array<double, 6>{},
