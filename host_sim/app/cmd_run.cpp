@@ -6,14 +6,62 @@
 #include "common.hpp"
 #include "run_options.hpp"
 
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+
 namespace gfins::sim::app {
 namespace {
 
-int record(const Scenario& s, const ScenarioOutcome& o, const std::string& path) {
-  if (auto w = write_run_recording(s, o, path); !w.is_ok()) return fail(w.error(), kExitError);
-  std::printf("recorded: %s (%zu samples at %g Hz, %s)\n", path.c_str(), o.raw.size(), s.rate_hz,
-              s.trajectory.kind == "calibration_poses" ? "calibration poses" : "navigation run");
-  return kExitOk;
+// Set by the SIGINT/SIGTERM handler to the signal's number; the run polls it before each sample
+// and stops there with its files closed (run_scenario_streamed, StreamTargets::stop).
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+
+/// Handlers for the length of a run, the previous ones back on destruction.
+class StopSignals {
+ public:
+  StopSignals()
+      : old_int_(std::signal(SIGINT, on_stop_signal)),
+        old_term_(std::signal(SIGTERM, on_stop_signal)) {}
+  ~StopSignals() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  void (*old_int_)(int);
+  void (*old_term_)(int);
+};
+
+/// Refuses a run whose files would not fit on their file system (std::filesystem::space), with
+/// the numbers: better than a disk full after minutes of work.
+HostStatus check_disk_space(const Scenario& s, const std::string& dir, std::uint64_t need,
+                            const char* what, const char* hint) {
+  // The folder may not exist yet (it is made after the checks): its nearest existing ancestor.
+  std::error_code ec;
+  std::filesystem::path p = std::filesystem::absolute(dir, ec);
+  while (!ec && !std::filesystem::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) {
+    p = p.parent_path();
+  }
+  const auto sp = std::filesystem::space(p, ec);
+  if (ec || need <= sp.available) return Done{};  // unknown free space: try, write errors report
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "scenario %s: %.4g samples (duration_s %g x rate_hz %g): %s would need about "
+                "%.3g MB in %s, which has %.3g MB free: free some space, %s",
+                s.name.c_str(), std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0, s.duration_s,
+                s.rate_hz, what, static_cast<double>(need) / 1e6, dir.c_str(),
+                static_cast<double>(sp.available) / 1e6, hint);
+  return HostError{ErrorCode::kResourceExhausted, buf};
+}
+
+std::string parent_dir(const std::string& file) {
+  const std::filesystem::path p = std::filesystem::path(file).parent_path();
+  return p.empty() ? std::string(".") : p.string();
 }
 
 }  // namespace
@@ -26,7 +74,10 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
   if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
   const auto scalar = nav_scalar(out.scalar);
   if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
-  if (auto c = check_run_size(s); !c.is_ok()) return fail(c.error(), kExitBadInput);
+  // The series are streamed to the files, never held: only the sample count is checked.
+  if (auto c = check_run_size(s, true, /*in_memory=*/false); !c.is_ok()) {
+    return fail(c.error(), kExitBadInput);
+  }
   if (!out.record.empty() && !s.adc) {
     return fail({ErrorCode::kInvalidArgument,
                  "--record: scenario " + s.name +
@@ -35,14 +86,44 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
                 kExitBadInput);
   }
   const std::string& out_dir = dir.value();
+  const bool navigation = s.trajectory.kind != "calibration_poses";
+  if (auto c = check_disk_space(s, out_dir, run_disk_bytes(s, out.decimate, false), "the CSV files",
+                                "use --decimate N or a shorter run");
+      !c.is_ok()) {
+    return fail(c.error(), kExitBadInput);
+  }
+  if (!out.record.empty()) {
+    const std::uint64_t need =
+        run_disk_bytes(s, out.decimate, true) - run_disk_bytes(s, out.decimate, false);
+    if (auto c = check_disk_space(s, parent_dir(out.record), need, "the recording",
+                                  "record a shorter run");
+        !c.is_ok()) {
+      return fail(c.error(), kExitBadInput);
+    }
+  }
   if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
   std::printf("gfins-sim run %s\n  navigation: %s\n", describe(s).c_str(),
               scalar_text(scalar.value()));
-  const auto outcome = run_scenario(s, tty_progress(s.name), true, scalar.value());
+  static_cast<void>(std::fflush(stdout));  // the header before any progress line
+  StreamTargets targets;
+  if (navigation) {
+    targets.uncompensated_csv = out_dir + "/uncompensated.csv";
+    targets.compensated_csv = out_dir + "/compensated.csv";
+  }
+  targets.decimate = out.decimate;
+  targets.recording = out.record;
+  targets.stop = &g_stop_signal;
+  g_stop_signal = 0;
+  HostResult<StreamedOutcome> outcome = [&] {
+    const StopSignals handlers;
+    return run_scenario_streamed(s, targets, run_progress(s.name, s.duration_s), scalar.value());
+  }();
   if (!outcome.is_ok()) return fail(outcome.error(), kExitError);
-  const ScenarioOutcome& o = outcome.value();
+  const StreamedOutcome& o = outcome.value();
   if (!out.record.empty()) {
-    if (const int rc = record(s, o, out.record); rc != kExitOk) return rc;
+    std::printf("recorded: %s (%llu samples at %g Hz, %s)\n", out.record.c_str(),
+                static_cast<unsigned long long>(o.recorded), s.rate_hz,
+                navigation ? "navigation run" : "calibration poses");
   }
   const std::string summary_path = out_dir + "/summary.txt";
   std::FILE* summary = std::fopen(summary_path.c_str(), "w");
@@ -51,16 +132,23 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
     if (f == summary)
       std::fprintf(f, "%s\n  navigation: %s\n", describe(s).c_str(), scalar_text(scalar.value()));
     if (o.calibration.ran) print_calibration(f, s, o.calibration);
-    if (!o.compensated.samples.empty()) print_run_table(f, o);
-  }
-  if (auto c = close_output(summary, summary_path); !c.is_ok()) return fail(c.error(), kExitError);
-  if (o.compensated.samples.empty()) return kExitOk;
-  for (const auto& [series, file] : {std::pair{&o.uncompensated, "/uncompensated.csv"},
-                                     std::pair{&o.compensated, "/compensated.csv"}}) {
-    if (auto w = write_series_csv(*series, out_dir + file, out.decimate); !w.is_ok()) {
-      return fail(w.error(), kExitError);
+    if (o.compensated.samples != 0) print_run_table(f, o.uncompensated, o.compensated);
+    if (o.interrupted) {
+      std::fprintf(f,
+                   "interrupted (signal %d) at t = %.6f s, after %llu of %llu samples: the files "
+                   "hold the samples up to there\n",
+                   static_cast<int>(g_stop_signal), o.t_stop_s,
+                   static_cast<unsigned long long>(o.samples_done),
+                   static_cast<unsigned long long>(o.samples_planned));
     }
   }
+  if (auto c = close_output(summary, summary_path); !c.is_ok()) return fail(c.error(), kExitError);
+  if (o.interrupted) {
+    std::fprintf(stderr, "gfins-sim: interrupted at t = %.6f s (%s/summary.txt)\n", o.t_stop_s,
+                 out_dir.c_str());
+    return kExitInterrupted;
+  }
+  if (!navigation) return kExitOk;
   std::printf(
       "written: %s/{uncompensated,compensated}.csv, summary.txt%s\n", out_dir.c_str(),
       out.decimate > 1 ? (" (every " + std::to_string(out.decimate) + "th sample)").c_str() : "");

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -84,6 +85,27 @@ ProgressFn tty_progress(const std::string& what) {
   };
 }
 
+ProgressFn run_progress(const std::string& what, double duration_s) {
+  if (isatty(fileno(stderr)) != 0) return tty_progress(what);
+  double interval = kProgressIntervalS;
+  if (const char* v = std::getenv("GFINS_PROGRESS_INTERVAL_S"); v != nullptr && *v != '\0') {
+    char* end = nullptr;
+    const double x = std::strtod(v, &end);
+    if (*end == '\0' && x > 0) interval = x;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto every =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(interval));
+  return [what, duration_s, every, next = Clock::now() + every](double f) mutable {
+    const auto now = Clock::now();
+    if (now < next || f >= 1.0) return;
+    next = now + every;
+    std::fprintf(stderr, "progress: %s: %.0f %% (t = %.3f of %.3f s)\n", what.c_str(), f * 100.0,
+                 f * duration_s, duration_s);
+    static_cast<void>(std::fflush(stderr));
+  };
+}
+
 NavSummary nav_summary(const RunSeries& r) {
   NavSummary n;
   for (const auto& x : r.samples) {
@@ -131,21 +153,24 @@ void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome
 }
 
 void print_run_table(std::FILE* f, const ScenarioOutcome& o) {
+  print_run_table(f, series_stats(o.uncompensated), series_stats(o.compensated));
+}
+
+void print_run_table(std::FILE* f, const SeriesStats& uncompensated,
+                     const SeriesStats& compensated) {
   std::fprintf(f, "%-44s %11s %11s %11s %11s %11s %11s\n", "run", "lin lo", "lin hi", "ang lo",
                "ang hi", "att deg", "pos m");
-  for (const auto* r : {&o.uncompensated, &o.compensated}) {
-    if (r->samples.empty()) continue;
-    const auto lin = linear_accel_bounds(*r);
-    const auto ang = angular_accel_bounds(*r);
-    const NavSummary n = nav_summary(*r);
-    std::fprintf(f, "%-44s %11.4g %11.4g %11.4g %11.4g %11.4g %11.4g\n", r->label.c_str(), lin.lo,
-                 lin.hi, ang.lo, ang.hi, n.att_final_deg, n.pos_final_m);
+  for (const auto* r : {&uncompensated, &compensated}) {
+    if (r->samples == 0) continue;
+    std::fprintf(f, "%-44s %11.4g %11.4g %11.4g %11.4g %11.4g %11.4g\n", r->label.c_str(),
+                 r->linear.lo, r->linear.hi, r->angular.lo, r->angular.hi, r->att_final_deg,
+                 r->pos_final_m);
   }
   std::fprintf(
       f,
       "(lin: linear acceleration error, nav frame, m/s^2; ang: angular acceleration error, "
       "rad/s^2;\n min/max over components and samples t > 0; att, pos: final error)\n");
-  const NavReport& rep = o.compensated.report;
+  const NavReport& rep = compensated.report;
   if (rep.rejected != 0 || !rep.gaps.empty()) {
     std::fprintf(f, "samples rejected by the pipeline (saturated or CRC error): %llu, gaps: %zu\n",
                  static_cast<unsigned long long>(rep.rejected), rep.gaps.size());

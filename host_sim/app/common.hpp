@@ -16,6 +16,9 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;       // an output could not be written, a run failed
 inline constexpr int kExitBadInput = 2;    // command line or scenario file rejected
 inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures asked for are not
+// `run` stopped by SIGINT/SIGTERM (Ctrl-C): files closed and valid up to the last sample done
+// (128 + SIGINT, the shells' convention for a program ended by Ctrl-C).
+inline constexpr int kExitInterrupted = 130;
 
 /// Prints "gfins-sim: <message>" on stderr and returns `exit_code`.
 int fail(const HostError& e, int exit_code);
@@ -42,6 +45,14 @@ HostStatus plot(const std::string& script, const std::vector<std::string>& args)
 /// Progress on a TTY only (a log file gets no \r lines).
 ProgressFn tty_progress(const std::string& what);
 
+/// Progress of a long run on stderr: on a terminal the percentage (\r line, as tty_progress);
+/// otherwise (a log file, a pipe) one line "progress: NAME: P % (t = X of D s)" every
+/// kProgressIntervalS seconds of wall-clock time, none for a run that ends sooner.
+/// $GFINS_PROGRESS_INTERVAL_S (seconds, > 0) changes the interval: for tests, which wait for the
+/// first line before they interrupt a run.
+ProgressFn run_progress(const std::string& what, double duration_s);
+inline constexpr double kProgressIntervalS = 5.0;
+
 struct NavSummary {
   double att_final_deg = 0, att_max_deg = 0;
   double vel_final_mps = 0, vel_max_mps = 0;
@@ -53,5 +64,8 @@ NavSummary nav_summary(const RunSeries& r);
 std::string describe(const Scenario& s);
 void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c);
 void print_run_table(std::FILE* f, const ScenarioOutcome& o);
+/// The same table from statistics accumulated while streaming (run_scenario_streamed).
+void print_run_table(std::FILE* f, const SeriesStats& uncompensated,
+                     const SeriesStats& compensated);
 
 }  // namespace gfins::sim::app

@@ -31,7 +31,9 @@ int sim_main(int argc, char** argv) {
   CLI::App cli{"gfins-sim: scenarios through the gyro-free navigation core"};
   const std::string footer =
       "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
-      "scenario rejected; 3 CSV written but plotting failed (PNG asked for).\n"
+      "scenario rejected (also: a run whose files would not fit on the disk); 3 CSV written but "
+      "plotting failed (PNG asked for); 130 run stopped by Ctrl-C/SIGINT or SIGTERM, its files "
+      "closed and valid up to the time in summary.txt.\n"
       "A scenario argument with a '/' or ending in .toml is a file (./drive), otherwise a "
       "built-in name (gfins-sim list).\n"
       "Environment: GFINS_SCENARIO_DIR (built-in scenarios), GFINS_SCRIPTS_DIR (plot scripts; "

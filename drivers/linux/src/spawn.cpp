@@ -1,7 +1,9 @@
 #include "gfins/drivers/linux/spawn.hpp"
 
 #include <fcntl.h>
+#include <signal.h>  // kill
 #include <spawn.h>
+#include <sys/resource.h>  // rusage (wait4)
 #include <sys/wait.h>
 #include <unistd.h>  // environ (the caller's environment, handed to the child unchanged)
 
@@ -33,6 +35,12 @@ class FileActions {
 }  // namespace
 
 Result<ProcessExit> run_program(std::span<const std::string> argv, const SpawnOptions& options) {
+  Result<ChildProcess> child = start_program(argv, options);
+  if (!child.is_ok()) return child.status();
+  return wait_program(child.value());
+}
+
+Result<ChildProcess> start_program(std::span<const std::string> argv, const SpawnOptions& options) {
   if (argv.empty() || argv[0].empty()) {
     return Status(ErrorCode::kInvalidArgument, "spawn: no program given");
   }
@@ -68,14 +76,28 @@ Result<ProcessExit> run_program(std::span<const std::string> argv, const SpawnOp
                      : posix_spawn(&pid, args[0], fa.get(), nullptr, args.data(), environ);
   if (rc != 0) return Status(ErrorCode::kUnavailable, "spawn: cannot start the program", rc);
 
+  return ChildProcess{pid};
+}
+
+Status signal_program(const ChildProcess& child, int signal) {
+  if (child.pid <= 0) return Status(ErrorCode::kInvalidArgument, "spawn: no child to signal");
+  if (kill(child.pid, signal) != 0) return Status(ErrorCode::kIoError, "spawn: kill failed", errno);
+  return Status::ok();
+}
+
+Result<ProcessExit> wait_program(ChildProcess& child) {
+  if (child.pid <= 0) return Status(ErrorCode::kInvalidArgument, "spawn: no child to wait for");
   int wstatus = 0;
+  rusage usage{};
   for (;;) {
-    const pid_t w = waitpid(pid, &wstatus, 0);
-    if (w == pid) break;
+    const pid_t w = wait4(child.pid, &wstatus, 0, &usage);
+    if (w == child.pid) break;
     if (w < 0 && errno == EINTR) continue;  // a signal handler ran; the child is still there
     return Status(ErrorCode::kIoError, "spawn: waitpid failed", errno);
   }
+  child.pid = -1;
   ProcessExit e;
+  e.max_rss_kib = usage.ru_maxrss;  // Linux: kilobytes (getrusage(2))
   if (WIFEXITED(wstatus)) {
     e.exited = true;
     e.code = WEXITSTATUS(wstatus);

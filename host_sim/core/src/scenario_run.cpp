@@ -5,8 +5,11 @@
 // request.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <optional>
 #include <random>
+#include <utility>
 
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
@@ -85,18 +88,19 @@ SampleRecord record_of(const TruthState& truth, const nav::NavState<double>& e) 
   return rec;
 }
 
+/// The navigation core of one run, configured: the real front end (the converter's LSB, the
+/// sensors' scale factors, the biases the compensator is told, true or calibrated; unused by the
+/// §6.3 m/s² entry), the compensator and its misalignment, gravity, the rate.
 template <typename T>
-HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::CompensatorKind kind,
-                               const nav::Misalignment<double>& m,
-                               const std::array<double, 6>& bias_mps2, const std::string& label,
-                               const ProgressFn& progress, double progress_base) {
+HostResult<std::unique_ptr<nav::NavPipeline<T>>> make_pipeline(
+    const Scenario& s, double volts_per_count, const std::array<double, 6>& scale_v_per_g,
+    nav::CompensatorKind kind, const nav::Misalignment<double>& m,
+    const std::array<double, 6>& bias_mps2) {
   nav::PipelineConfig<double> cfg;
   cfg.nominal = nav::table1_geometry<double>(s.rho_m);
-  // The real front end: the converter's LSB, the sensors' scale factors, the biases the
-  // compensator is told (true or calibrated). Unused by the §6.3 m/s² entry.
   for (std::size_t j = 0; j < 6; ++j) {
-    cfg.front_end.volts_per_count[j] = s.adc ? st.volts_per_count : 1.0;
-    cfg.front_end.scale_v_per_g[j] = st.scale_v_per_g[j];
+    cfg.front_end.volts_per_count[j] = s.adc ? volts_per_count : 1.0;
+    cfg.front_end.scale_v_per_g[j] = scale_v_per_g[j];
     cfg.front_end.bias_g[j] = bias_mps2[j] / nav::kStandardGravity;
   }
   cfg.sample_rate_hz = s.rate_hz;
@@ -113,6 +117,16 @@ HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::Compens
     return host_error(status,
                       "scenario " + s.name + ": navigation core rejected the configuration: ");
   }
+  return pipeline;
+}
+
+template <typename T>
+HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::CompensatorKind kind,
+                               const nav::Misalignment<double>& m,
+                               const std::array<double, 6>& bias_mps2, const std::string& label,
+                               const ProgressFn& progress, double progress_base) {
+  GFINS_TRY(auto pipeline,
+            make_pipeline<T>(s, st.volts_per_count, st.scale_v_per_g, kind, m, bias_mps2));
   RunSeries r;
   r.label = label;
   r.samples.reserve(st.truth.size());
@@ -237,7 +251,15 @@ std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated) {
   return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
 }
 
-HostStatus check_run_size(const Scenario& s, bool with_uncompensated) {
+std::uint64_t max_run_memory_bytes() {
+  const char* v = std::getenv("GFINS_MAX_RUN_MEMORY_BYTES");
+  if (v == nullptr || *v == '\0') return kMaxRunMemoryBytes;
+  char* end = nullptr;
+  const unsigned long long n = std::strtoull(v, &end, 10);
+  return (*end == '\0' && n > 0) ? static_cast<std::uint64_t>(n) : kMaxRunMemoryBytes;
+}
+
+HostStatus check_run_size(const Scenario& s, bool with_uncompensated, bool in_memory) {
   char buf[320];
   const double periods = s.duration_s * s.rate_hz;
   if (!(std::floor(periods + 0.5) >= 1.0)) {
@@ -247,14 +269,16 @@ HostStatus check_run_size(const Scenario& s, bool with_uncompensated) {
                   s.name.c_str(), s.duration_s, s.rate_hz, periods, 1.0 / s.rate_hz);
     return HostError{ErrorCode::kInvalidArgument, buf};
   }
+  if (!in_memory) return Done{};  // a streamed run holds no series
   const std::uint64_t bytes = run_memory_bytes(s, with_uncompensated);
-  if (bytes > kMaxRunMemoryBytes) {
+  const std::uint64_t limit = max_run_memory_bytes();
+  if (bytes > limit) {
     std::snprintf(buf, sizeof buf,
                   "scenario %s: duration_s %g x rate_hz %g = %.4g samples would need %.3g GiB "
                   "of memory, above the limit of %.3g GiB: shorten the run or lower the rate",
                   s.name.c_str(), s.duration_s, s.rate_hz, std::floor(periods + 0.5) + 1.0,
                   static_cast<double>(bytes) / double(1u << 30),
-                  static_cast<double>(kMaxRunMemoryBytes) / double(1u << 30));
+                  static_cast<double>(limit) / double(1u << 30));
     return HostError{ErrorCode::kOutOfRange, buf};
   }
   return Done{};
@@ -332,7 +356,37 @@ Bounds angular_accel_bounds(const RunSeries& r) {
   return bounds_of(r, [](const SampleRecord& x) { return x.wdot_err_b(); });
 }
 
-HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate) {
+SeriesCsvWriter::SeriesCsvWriter(std::FILE* f, std::string path, std::size_t every)
+    : file_(f), path_(std::move(path)), every_(std::max<std::size_t>(every, 1)) {}
+
+SeriesCsvWriter::SeriesCsvWriter(SeriesCsvWriter&& other) noexcept
+    : file_(std::exchange(other.file_, nullptr)),
+      path_(std::move(other.path_)),
+      every_(other.every_),
+      seen_(other.seen_),
+      written_(other.written_),
+      pending_(std::move(other.pending_)) {}
+
+SeriesCsvWriter& SeriesCsvWriter::operator=(SeriesCsvWriter&& other) noexcept {
+  if (this != &other) {
+    if (file_ != nullptr)
+      (void)std::fclose(file_);  // moved-over writer: errors are not reported (close() does)
+    file_ = std::exchange(other.file_, nullptr);
+    path_ = std::move(other.path_);
+    every_ = other.every_;
+    seen_ = other.seen_;
+    written_ = other.written_;
+    pending_ = std::move(other.pending_);
+  }
+  return *this;
+}
+
+SeriesCsvWriter::~SeriesCsvWriter() {
+  if (file_ != nullptr)
+    (void)std::fclose(file_);  // unclosed: errors are not reported (close() does)
+}
+
+HostResult<SeriesCsvWriter> SeriesCsvWriter::open(const std::string& path, std::size_t decimate) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) return HostError{ErrorCode::kIoError, "cannot write " + path};
   // Units and frames in every name: q_nb (body to NED, unitless), w_b (rad/s, body FRD),
@@ -359,40 +413,95 @@ HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::si
   vec_cols("err_v_n", "mps");
   vec_cols("err_r_n", "m");
   std::fprintf(f, "%s\n", head.c_str());
+  return SeriesCsvWriter(f, path, decimate);
+}
+
+void SeriesCsvWriter::write_row(const SampleRecord& x) {
+  std::FILE* f = file_;
   const auto v3 = [f](const Vec3d& v) { std::fprintf(f, ",%.9g,%.9g,%.9g", v.x(), v.y(), v.z()); };
   const auto q4 = [f](const Quatd& q) {
     std::fprintf(f, ",%.9g,%.9g,%.9g,%.9g", q.w(), q.x(), q.y(), q.z());
   };
-  const std::size_t every = std::max<std::size_t>(decimate, 1);
-  for (std::size_t k = 0; k < r.samples.size(); ++k) {
-    if (k % every != 0 && k + 1 != r.samples.size()) continue;
-    const SampleRecord& x = r.samples[k];
-    std::fprintf(f, "%.6f", x.t_s);
-    q4(x.truth.q_nb);
-    v3(x.truth.w_b);
-    v3(x.truth.a_n);
-    v3(x.truth.v_n);
-    v3(x.truth.r_n);
-    q4(x.q_nb_est);
-    v3(x.w_b_est);
-    v3(x.a_n_est);
-    v3(x.v_n_est);
-    v3(x.r_n_est);
-    v3(x.wdot_err_b());
-    v3(x.a_err_n());
-    v3(x.w_err_b());
-    v3(x.att_err_b());
-    v3(x.v_err_n());
-    v3(x.r_err_n());
-    std::fprintf(f, "\n");
+  std::fprintf(f, "%.6f", x.t_s);
+  q4(x.truth.q_nb);
+  v3(x.truth.w_b);
+  v3(x.truth.a_n);
+  v3(x.truth.v_n);
+  v3(x.truth.r_n);
+  q4(x.q_nb_est);
+  v3(x.w_b_est);
+  v3(x.a_n_est);
+  v3(x.v_n_est);
+  v3(x.r_n_est);
+  v3(x.wdot_err_b());
+  v3(x.a_err_n());
+  v3(x.w_err_b());
+  v3(x.att_err_b());
+  v3(x.v_err_n());
+  v3(x.r_err_n());
+  std::fprintf(f, "\n");
+  ++written_;
+}
+
+HostStatus SeriesCsvWriter::add(const SampleRecord& x) {
+  if (file_ == nullptr) return HostError{ErrorCode::kFailedPrecondition, path_ + ": closed"};
+  // Row k is written when k is a multiple of the decimation; otherwise it waits, in case it is
+  // the last one (write_series_csv keeps every N-th sample and the last).
+  if (seen_ % every_ == 0) {
+    write_row(x);
+    pending_.reset();
+  } else {
+    pending_ = x;
   }
-  // The fprintf results above are not checked one by one: a failed write sets the error flag,
-  // and fclose alone reports only the last flush (glibc returns 0 after an earlier ENOSPC).
-  const bool write_failed = std::ferror(f) != 0;
-  if (std::fclose(f) != 0 || write_failed) {
-    return HostError{ErrorCode::kIoError, "error writing " + path};
-  }
+  ++seen_;
+  // The fprintf results are not checked one by one: a failed write sets the error flag.
+  if (std::ferror(file_) != 0) return HostError{ErrorCode::kIoError, "error writing " + path_};
   return Done{};
+}
+
+HostStatus SeriesCsvWriter::close() {
+  if (file_ == nullptr) return Done{};
+  if (pending_) write_row(*pending_);
+  pending_.reset();
+  // fclose alone reports only the last flush (glibc returns 0 after an earlier ENOSPC).
+  const bool write_failed = std::ferror(file_) != 0;
+  const int rc = std::fclose(std::exchange(file_, nullptr));
+  if (rc != 0 || write_failed) return HostError{ErrorCode::kIoError, "error writing " + path_};
+  return Done{};
+}
+
+HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate) {
+  GFINS_TRY(auto w, SeriesCsvWriter::open(path, decimate));
+  for (const SampleRecord& x : r.samples) GFINS_TRY_STATUS(w.add(x));
+  return w.close();
+}
+
+void SeriesStats::add(const SampleRecord& x) {
+  ++samples;
+  t_last_s = x.t_s;
+  if (x.t_s > 0) {  // t = 0 is the given initial state (bounds_of)
+    const Vec3d a = x.a_err_n();
+    const Vec3d w = x.wdot_err_b();
+    linear.lo = std::min(linear.lo, a.minCoeff());
+    linear.hi = std::max(linear.hi, a.maxCoeff());
+    angular.lo = std::min(angular.lo, w.minCoeff());
+    angular.hi = std::max(angular.hi, w.maxCoeff());
+  }
+  const double att = x.att_err_b().norm() * 180.0 / M_PI;
+  att_max_deg = std::max(att_max_deg, att);
+  vel_max_mps = std::max(vel_max_mps, x.v_err_n().norm());
+  pos_max_m = std::max(pos_max_m, x.r_err_n().norm());
+  att_final_deg = att;
+  vel_final_mps = x.v_err_n().norm();
+  pos_final_m = x.r_err_n().norm();
+}
+
+SeriesStats series_stats(const RunSeries& r) {
+  SeriesStats st;
+  st.label = r.label;
+  st.report = r.report;
+  for (const SampleRecord& x : r.samples) st.add(x);
+  return st;
 }
 
 HostStatus write_run_recording(const Scenario& s, const ScenarioOutcome& o,
@@ -408,6 +517,205 @@ HostStatus write_run_recording(const Scenario& s, const ScenarioOutcome& o,
   h.volts_per_count.fill(o.volts_per_count);
   h.geometry = nav::table1_geometry<double>(s.rho_m);
   return write_recording(path, h, o.raw);
+}
+
+namespace {
+
+/// One run of a streamed scenario: its pipeline, loop, CSV and statistics.
+template <typename T>
+struct StreamedSeries {
+  std::unique_ptr<nav::NavPipeline<T>> pipeline;
+  std::unique_ptr<NavLoop<T>> loop;
+  std::optional<SeriesCsvWriter> csv;
+  SeriesStats* stats = nullptr;
+  std::array<double, 6> bias_mps2{};
+  HostStatus sink_status = Done{};
+
+  HostStatus take(const SampleRecord& rec) {
+    stats->add(rec);
+    if (csv) return csv->add(rec);
+    return Done{};
+  }
+};
+
+template <typename T>
+HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTargets& targets,
+                       const ProgressFn& progress,
+                       const nav::Misalignment<double>& comp_misalignment,
+                       const std::array<double, 6>& bias_comp, const std::array<double, 6>& sf,
+                       std::optional<RecordingWriter>& rec, StreamedOutcome& out) {
+  const bool navigate_runs = s.trajectory.kind != "calibration_poses";
+  const auto steps = static_cast<std::uint64_t>(std::llround(s.duration_s * s.rate_hz));
+  out.samples_planned = steps + 1;
+  const double vpc = source.volts_per_count();
+  std::vector<std::unique_ptr<StreamedSeries<T>>> runs;
+  const TruthState* current = nullptr;
+  if (navigate_runs) {
+    struct Spec {
+      nav::CompensatorKind kind = nav::CompensatorKind::kNone;
+      nav::Misalignment<double> m{};
+      std::array<double, 6> bias{};
+      const std::string* csv = nullptr;
+      SeriesStats* stats = nullptr;
+    };
+    const Spec specs[] = {
+        {nav::CompensatorKind::kNone, nav::Misalignment<double>{}, std::array<double, 6>{},
+         &targets.uncompensated_csv, &out.uncompensated},
+        {s.compensator, comp_misalignment, bias_comp, &targets.compensated_csv, &out.compensated}};
+    for (const Spec& sp : specs) {
+      auto r = std::make_unique<StreamedSeries<T>>();
+      GFINS_TRY(auto p, make_pipeline<T>(s, vpc, sf, sp.kind, sp.m, sp.bias));
+      r->pipeline = std::move(p);
+      r->stats = sp.stats;
+      r->bias_mps2 = sp.bias;
+      if (!sp.csv->empty()) {
+        GFINS_TRY(auto w, SeriesCsvWriter::open(*sp.csv, targets.decimate));
+        r->csv.emplace(std::move(w));
+      }
+      StreamedSeries<T>* self = r.get();
+      r->loop = std::make_unique<NavLoop<T>>(
+          *r->pipeline, [self, &current](std::uint64_t, const nav::NavState<T>& e) {
+            // The sink runs inside step(), for the sample just offered: its truth is `current`.
+            if (!self->sink_status.is_ok()) return;
+            self->sink_status = self->take(record_of(*current, e.template cast<double>()));
+          });
+      runs.push_back(std::move(r));
+    }
+  }
+  const auto specific_force = [&](const SourceSample& x, const std::array<double, 6>& bias) {
+    // The paper's §6.3: m/s² after the front end, bias removed here (NavPipeline says why).
+    Vec6d o;
+    for (int j = 0; j < 6; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      o(j) = x.volts(j) / sf[ju] * nav::kStandardGravity - bias[ju];
+    }
+    return o;
+  };
+  const std::uint64_t every = std::max<std::uint64_t>(out.samples_planned / 1000, 1);
+  for (std::uint64_t k = 0; k <= steps; ++k) {
+    if (k > 0 && targets.stop != nullptr && *targets.stop != 0) {
+      out.interrupted = true;
+      break;
+    }
+    const Result<SourceSample> x = source.next();
+    if (!x.is_ok()) return host_error(x.status(), "scenario " + s.name + ": converter: ");
+    current = &x->truth;
+    if (rec) GFINS_TRY_STATUS(rec->append(x->raw));
+    for (auto& r : runs) {
+      if (k == 0) {
+        // The truth is given at the first sample (no alignment), as run_scenario does.
+        const nav::NavState<T> init = to_nav_state<T>(x->truth, 0);
+        if (s.adc) {
+          r->pipeline->start_at(init, x->raw);
+        } else {
+          r->pipeline->start_at_specific_force(init,
+                                               specific_force(*x, r->bias_mps2).template cast<T>());
+        }
+        GFINS_TRY_STATUS(
+            r->take(record_of(x->truth, r->pipeline->state().template cast<double>())));
+        continue;
+      }
+      if (s.adc) {
+        r->loop->step(x->raw);
+      } else {
+        r->loop->step_specific_force(specific_force(*x, r->bias_mps2).template cast<T>(),
+                                     static_cast<std::int64_t>(std::llround(x->truth.t_s * 1e9)),
+                                     static_cast<std::uint32_t>(k));
+      }
+      GFINS_TRY_STATUS(r->sink_status);
+    }
+    out.samples_done = k + 1;
+    out.t_stop_s = x->truth.t_s;
+    if (progress && k % every == 0) {
+      progress(static_cast<double>(k) / static_cast<double>(out.samples_planned));
+    }
+  }
+  for (auto& r : runs) {
+    r->stats->report = r->loop->report();
+    if (r->csv) GFINS_TRY_STATUS(r->csv->close());
+  }
+  if (progress && !out.interrupted) progress(1.0);
+  return Done{};
+}
+
+}  // namespace
+
+HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const StreamTargets& targets,
+                                                  const ProgressFn& progress, NavScalar scalar) {
+  GFINS_TRY_STATUS(check_run_size(s, true, /*in_memory=*/false));
+  StreamedOutcome out;
+  const bool calibrated = s.misalignment_source == MisalignmentSource::kCalibrated;
+  if (calibrated || s.trajectory.kind == "calibration_poses") {
+    GFINS_TRY(out.calibration, simulate_calibration(s));
+  }
+  std::array<double, 6> bias_comp = s.bias_mps2;
+  nav::Misalignment<double> comp_m = s.misalignment;
+  if (calibrated) {
+    comp_m.orientation = out.calibration.estimated;
+    for (std::size_t j = 0; j < 6; ++j) {
+      bias_comp[j] = out.calibration.bias_est_g[j] * nav::kStandardGravity;
+    }
+  }
+  out.uncompensated.label = "uncompensated";
+  out.compensated.label = std::string("compensated (") + nav::to_string(s.compensator) + ", " +
+                          source_name(s.misalignment_source) + ")";
+  GFINS_TRY(const auto traj, make_trajectory(s.trajectory));
+  // The same source as make_stream: the same samples, the same noise.
+  const ArrayErrors errors = array_errors(s);
+  SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
+                         s.seed);
+  AdcConfig adc_config;
+  adc_config.sample_rate_hz = s.rate_hz;
+  SampleSource source(*traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
+                      s.rate_hz);
+  if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
+  std::array<double, 6> sf{};
+  for (std::size_t j = 0; j < 6; ++j) sf[j] = errors.sensors[j].scale_v_per_g;
+  std::optional<RecordingWriter> rec;
+  if (!targets.recording.empty()) {
+    if (!s.adc || !(source.volts_per_count() > 0.0)) {
+      return HostError{ErrorCode::kFailedPrecondition,
+                       "scenario " + s.name +
+                           ": nothing to record: its samples do not go through the ADC "
+                           "(sensors.adc = false, the paper's §6.3 in m/s²); a recording holds "
+                           "ADC counts"};
+    }
+    RecordingHeader h;  // as write_run_recording
+    h.sample_rate_hz = s.rate_hz;
+    h.volts_per_count.fill(source.volts_per_count());
+    h.geometry = nav::table1_geometry<double>(s.rho_m);
+    GFINS_TRY(auto w, RecordingWriter::open(targets.recording, h));
+    rec.emplace(std::move(w));
+  }
+  const HostStatus st =
+      scalar == NavScalar::kFloat
+          ? stream_runs<float>(s, source, targets, progress, comp_m, bias_comp, sf, rec, out)
+          : stream_runs<double>(s, source, targets, progress, comp_m, bias_comp, sf, rec, out);
+  if (rec) {
+    out.recorded = rec->records_written();
+    // Closed even after an error, so that what was written stays a valid recording.
+    const HostStatus c = rec->close();
+    GFINS_TRY_STATUS(st);
+    GFINS_TRY_STATUS(c);
+  }
+  GFINS_TRY_STATUS(st);
+  return out;
+}
+
+std::uint64_t run_disk_bytes(const Scenario& s, std::size_t decimate, bool with_recording) {
+  const double samples = std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0;
+  const double rows = std::ceil(samples / static_cast<double>(std::max<std::size_t>(decimate, 1)));
+  double bytes = 0;
+  if (s.trajectory.kind != "calibration_poses") {
+    bytes += 2.0 * rows * static_cast<double>(kCsvRowBytesEstimate);
+  }
+  if (with_recording) {
+    // docs/recording-format.md: the header, 32 bytes per record, a CRC-32 per block.
+    bytes += static_cast<double>(kRecordingHeaderBytes) +
+             samples * static_cast<double>(kRecordingRecordBytes) +
+             std::ceil(samples / kDefaultRecordsPerBlock) * static_cast<double>(kRecordingCrcBytes);
+  }
+  return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
 }
 
 }  // namespace gfins::sim

@@ -8,7 +8,9 @@
 #pragma once
 
 #include <array>
+#include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -255,10 +257,16 @@ std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated = true
 /// development machine or CI runner, so a run never ends in std::bad_alloc after minutes of work.
 inline constexpr std::uint64_t kMaxRunMemoryBytes = std::uint64_t{2} << 30;
 
+/// The memory limit in force: kMaxRunMemoryBytes, or $GFINS_MAX_RUN_MEMORY_BYTES (bytes, a
+/// positive integer) when set. The variable is for tests, which show with a small limit that a
+/// streamed run (run_scenario_streamed) does not depend on it.
+std::uint64_t max_run_memory_bytes();
+
 /// Checks before any work: at least two samples (duration × rate ≥ 1 sample period), and the
-/// memory estimate within kMaxRunMemoryBytes. The message names the scenario, the figures and
+/// memory estimate within max_run_memory_bytes(). The message names the scenario, the figures and
 /// the limit. run_scenario() calls it first.
-HostStatus check_run_size(const Scenario& s, bool with_uncompensated = true);
+/// With `in_memory` false (a streamed run, run_scenario_streamed) only the first check applies.
+HostStatus check_run_size(const Scenario& s, bool with_uncompensated = true, bool in_memory = true);
 
 /// Runs a navigation scenario twice with the same samples (one SampleSource stream, computed
 /// once): without compensation and with the scenario's compensator, both through the one
@@ -281,6 +289,93 @@ Bounds angular_accel_bounds(const RunSeries& r);  // wdot_err_b, rad/s²
 /// name (docs/simulation.md, "Output files"). `decimate` N keeps every N-th sample (and the
 /// last): 1 keeps all.
 HostStatus write_series_csv(const RunSeries& r, const std::string& path, std::size_t decimate = 1);
+
+/// Writes the rows of write_series_csv one at a time, as a run produces them: the same header,
+/// the same row format and the same decimation (every N-th row and the last), so a streamed run
+/// and a run kept in memory give the same bytes. Memory use is one pending row.
+class SeriesCsvWriter {
+ public:
+  static HostResult<SeriesCsvWriter> open(const std::string& path, std::size_t decimate = 1);
+  SeriesCsvWriter(SeriesCsvWriter&& other) noexcept;
+  SeriesCsvWriter& operator=(SeriesCsvWriter&& other) noexcept;
+  SeriesCsvWriter(const SeriesCsvWriter&) = delete;
+  SeriesCsvWriter& operator=(const SeriesCsvWriter&) = delete;
+  ~SeriesCsvWriter();
+
+  /// Row `rows_seen()` of the series: written now when it falls on the decimation, else kept
+  /// until the next one (it is written by close() if it is the last). Fails on a write error.
+  HostStatus add(const SampleRecord& x);
+  /// Writes the pending last row, closes the file; reports any write error.
+  HostStatus close();
+  std::uint64_t rows_seen() const { return seen_; }
+  std::uint64_t rows_written() const { return written_; }
+
+ private:
+  SeriesCsvWriter(std::FILE* f, std::string path, std::size_t every);
+  void write_row(const SampleRecord& x);
+
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::size_t every_ = 1;
+  std::uint64_t seen_ = 0;
+  std::uint64_t written_ = 0;
+  std::optional<SampleRecord> pending_;
+};
+
+/// What the summary table of a run needs, accumulated sample by sample (bounds over t > 0, the
+/// final errors, the loop's report), so that a streamed run needs no series in memory.
+struct SeriesStats {
+  std::string label;
+  std::uint64_t samples = 0;      // SampleRecords seen (the start included)
+  Bounds linear{1e300, -1e300};   // a_err_n, m/s² (linear_accel_bounds)
+  Bounds angular{1e300, -1e300};  // wdot_err_b, rad/s² (angular_accel_bounds)
+  double att_max_deg = 0, vel_max_mps = 0, pos_max_m = 0;
+  double att_final_deg = 0, vel_final_mps = 0, pos_final_m = 0;
+  double t_last_s = 0;
+  NavReport report;
+  void add(const SampleRecord& x);
+};
+/// The statistics of a series kept in memory (the same numbers as the streamed ones).
+SeriesStats series_stats(const RunSeries& r);
+
+/// Where a streamed run writes while it navigates, and how it can be stopped.
+struct StreamTargets {
+  std::string uncompensated_csv;  // empty: not written
+  std::string compensated_csv;    // empty: not written
+  std::size_t decimate = 1;       // of both CSV files (write_series_csv)
+  std::string recording;          // empty: none; else the .gfr of every sample offered
+  /// Polled before each sample: when it reads non-zero the run stops there, closes its files
+  /// (the recording's last block and record_count written: a valid file) and reports it.
+  /// Set by a signal handler (SIGINT/SIGTERM), hence volatile sig_atomic_t.
+  const volatile std::sig_atomic_t* stop = nullptr;
+};
+
+struct StreamedOutcome {
+  SeriesStats uncompensated;
+  SeriesStats compensated;
+  CalibrationOutcome calibration;
+  std::uint64_t samples_planned = 0;  // duration × rate + 1
+  std::uint64_t samples_done = 0;     // offered to the navigation (the start included)
+  std::uint64_t recorded = 0;         // records in the recording
+  bool interrupted = false;           // *stop was set: the files hold samples_done samples
+  double t_stop_s = 0;                // time of the last sample done
+};
+
+/// run_scenario() without keeping the series: the samples are made one at a time, both runs
+/// (uncompensated and compensated) navigate each in turn (lockstep; the pipelines are separate,
+/// so each gives what it gives alone), and every row goes to the CSV files and the recording as
+/// it is produced. Memory does not grow with the duration. For a calibration_poses scenario only
+/// the recording (if asked) and `calibration` are produced. The files are byte-identical to
+/// write_series_csv / write_run_recording of run_scenario's outcome.
+HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const StreamTargets& targets,
+                                                  const ProgressFn& progress = {},
+                                                  NavScalar scalar = NavScalar::kDouble);
+
+/// Bytes a streamed run of `s` is expected to write: CSV rows (kCsvRowBytesEstimate each, both
+/// files, after decimation) plus the recording when asked.
+std::uint64_t run_disk_bytes(const Scenario& s, std::size_t decimate, bool with_recording);
+/// Typical bytes of one CSV row: measured 615 on `drive` (94 columns of %.9g), rounded up.
+inline constexpr std::uint64_t kCsvRowBytesEstimate = 700;
 
 /// The recording header of a run of `s` (rate, the converter's LSB, the nominal Table 1
 /// geometry at the scenario's ρ) and the file: exactly the samples the run navigated

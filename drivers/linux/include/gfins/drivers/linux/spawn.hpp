@@ -16,9 +16,10 @@ namespace gfins::drivers::lnx {
 
 /// How a child ended.
 struct ProcessExit {
-  bool exited = false;  // true: it returned from main / called exit(); false: killed by a signal
-  int code = 0;         // exit code when exited
-  int signal = 0;       // signal number when killed
+  bool exited = false;   // true: it returned from main / called exit(); false: killed by a signal
+  int code = 0;          // exit code when exited
+  int signal = 0;        // signal number when killed
+  long max_rss_kib = 0;  // the child's peak resident set (getrusage ru_maxrss of wait4), KiB
   bool ok() const { return exited && code == 0; }
 };
 
@@ -38,6 +39,21 @@ struct SpawnOptions {
 /// child that runs and fails is not an error of this call: look at ProcessExit.
 Result<ProcessExit> run_program(std::span<const std::string> argv,
                                 const SpawnOptions& options = {});
+
+/// A child started by start_program and not yet waited for.
+struct ChildProcess {
+  int pid = -1;
+};
+
+/// start_program + wait_program in one: the child is started as run_program does, but the
+/// caller gets control back at once, e.g. to send it a signal (signal_program) before waiting.
+/// The same errors as run_program for starting.
+Result<ChildProcess> start_program(std::span<const std::string> argv,
+                                   const SpawnOptions& options = {});
+/// Sends `signal` (SIGINT, SIGTERM, ...) to a started child. kIoError (os_error) when kill fails.
+Status signal_program(const ChildProcess& child, int signal);
+/// Waits for a started child and reaps it (its pid is then -1). kIoError when waiting fails.
+Result<ProcessExit> wait_program(ChildProcess& child);
 
 /// "exit status 3" / "killed by signal 9 (Killed)": for messages.
 std::string describe(const ProcessExit& e);
