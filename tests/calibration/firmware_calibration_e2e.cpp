@@ -27,6 +27,7 @@
 #include <fstream>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "capture_sequence.hpp"
@@ -152,8 +153,9 @@ class TraceSource final : public app::SampleSource {
 };
 
 struct Board {
-  explicit Board(const std::filesystem::path& cal_file, const sim_board::FaultPlan& faults = {}) {
-    const auto p = sim::load_scenario("calibration-board", GFINS_SCENARIO_DIR);
+  explicit Board(const std::filesystem::path& cal_file, const sim_board::FaultPlan& faults = {},
+                 const std::string& scenario = "calibration-board") {
+    const auto p = sim::load_scenario(scenario, GFINS_SCENARIO_DIR);
     if (!p.is_ok()) throw std::runtime_error(p.error().message);
     s = p.value();
     config.board = app::BoardKind::kSim;
@@ -693,6 +695,267 @@ TEST(FirmwareCalibration, ThePoseSequenceHoldsEachPoseStillAndTurnsSmoothly) {
   const sim::TruthState end = traj.value()->at(period);
   EXPECT_LT(end.w_b.norm(), 1e-9);
   EXPECT_LT(end.wdot_b.norm(), 1e-6);
+}
+
+// ---- Location calibration: rate-table runs captured through the firmware -------------------
+//
+// The five mountings of docs/calibration.md §5 (board axes x, y, z and the two face diagonals
+// pointing up, table axis vertical through the array centre) at 2, 6 and 10 rad/s: the set that
+// makes every component of Δρ observable. Each run is the simulated board (calibration-board's
+// sensors: SF, bias, orientation and location errors, its 24.8° site) spinning at a constant
+// rate; the host's StartCapture (capture_once, the code of gfins-can calibrate --rate-table)
+// averages whole revolutions through the firmware, and location_run_row writes the row
+// gfins-calibrate --location-runs reads. The base calibration is the scenario's truth for SF,
+// bias and orientation (the location solve takes them as known, §5).
+
+// Δρ recovered vs truth: |est − true| ≤ kLocationSigmas·σ, σ the file's stated 1σ. 18
+// components, Gaussian with honest σ: P(any beyond 5σ) = 18 · 5.7e-7 = 1e-5 (false failure).
+constexpr double kLocationSigmas = 5.0;
+// Samples per capture: whole revolutions totalling about 6 s at 1 kHz. σ of a 10 rad/s run's
+// mean is 0.5 mg/√6000 = 6.3e-5 m/s², i.e. 0.6 µm of Δρ at ω² = 100 s⁻²; the truth's Δρ
+// (0.1–1.2 mm) is hundreds of σ away from 0, so a solver writing Δρ = 0 fails.
+constexpr double kRunTargetSamples = 6000.0;
+constexpr std::array<double, 3> kRatesRadS{2.0, 6.0, 10.0};
+
+struct Mounting {
+  int number;
+  std::array<double, 3> up_b;  // body axis pointing up (unit)
+};
+const std::array<Mounting, 5> kMountings{{{0, {1, 0, 0}},
+                                          {1, {0, 1, 0}},
+                                          {2, {0, 0, 1}},
+                                          {3, {M_SQRT1_2, M_SQRT1_2, 0}},
+                                          {4, {M_SQRT1_2, 0, M_SQRT1_2}}}};
+
+/// The scenario of one run: calibration-board's sensors, the board spinning about `up_b` with
+/// `up_b` pointing up (−z of NED), for `duration_s`.
+std::string rate_table_scenario(const sim::Scenario& truth, const Mounting& m, double rate,
+                                double duration_s) {
+  // Euler angles (ZYX) of the attitude that points up_b up, checked against the core's own
+  // conversion below.
+  const Eigen::Vector3d up(m.up_b[0], m.up_b[1], m.up_b[2]);
+  const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d(0, 0, -1));
+  const Eigen::Matrix3d r = q.toRotationMatrix();
+  const double roll = std::atan2(r(2, 1), r(2, 2));
+  const double pitch = -std::asin(std::clamp(r(2, 0), -1.0, 1.0));
+  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  if ((nav::quat_from_euler(roll, pitch, yaw) * up - Eigen::Vector3d(0, 0, -1)).norm() > 1e-9) {
+    throw std::runtime_error("rate_table_scenario: Euler angles do not point the axis up");
+  }
+  constexpr double kDeg = 180.0 / M_PI;
+  std::string t;
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "[scenario]\nduration_s = %.6f\nrate_hz = %.1f\nseed = %d\n"
+                "[gravity]\nmodel = \"normal\"\nlatitude_deg = %.17g\nheight_m = %.17g\n"
+                "[trajectory]\nkind = \"rate_table\"\naxis_b = [%.17g, %.17g, %.17g]\n"
+                "rate_dps = %.17g\neuler_deg = [%.17g, %.17g, %.17g]\n",
+                duration_s, truth.rate_hz, 100 + 10 * m.number + static_cast<int>(rate),
+                truth.latitude_rad * kDeg, truth.height_m, up.x(), up.y(), up.z(), rate * kDeg,
+                roll * kDeg, pitch * kDeg, yaw * kDeg);
+  t += buf;
+  const auto list = [](const auto& get, std::size_t n) {
+    std::string l = "[";
+    for (std::size_t i = 0; i < n; ++i) {
+      char b[40];
+      std::snprintf(b, sizeof b, "%s%.17g", i ? ", " : "", get(i));
+      l += b;
+    }
+    return l + "]";
+  };
+  const auto& o = truth.misalignment.orientation;
+  t += "[sensors]\nmodel = \"paper\"\nnoise_mg = 0.5\norientation = \"custom\"\n";
+  t += "beta_deg = " + list([&](std::size_t i) { return o.beta[i] * kDeg; }, 6) + "\n";
+  t += "alpha_deg = " + list([&](std::size_t i) { return o.alpha[i] * kDeg; }, 6) + "\n";
+  t += "scale_v_per_g = " + list([&](std::size_t i) { return truth.scale_v_per_g[i]; }, 6) + "\n";
+  t += "bias_mps2 = " + list([&](std::size_t i) { return truth.bias_mps2[i]; }, 6) + "\n";
+  t += "location_error_mm = " +
+       list([&](std::size_t i) { return truth.misalignment.drho_b[i / 3](i % 3) * 1e3; }, 18) +
+       "\n[compensator]\nkind = \"exact\"\n";
+  return t;
+}
+
+/// The base calibration: the truth of SF, bias and orientation in the file's units (V per local
+/// g, local g, degrees), Δρ = 0, small stated σ.
+calib_file::CalibrationData truth_as_base(const sim::Scenario& s, double adc_lsb, double g_local) {
+  calib_file::CalibrationData d;
+  d.device_id = "sim-board-1";
+  d.created_utc = "2026-01-01T00:00:00Z";
+  d.source = "truth of calibration-board";
+  d.geometry.rho_m = s.rho_m;
+  d.gravity_mps2 = g_local;
+  d.gravity_source = "given";
+  for (std::size_t j = 0; j < 6; ++j) {
+    auto& e = d.sensors[j];
+    e.adc_lsb_v_per_count = adc_lsb;
+    // The sensor model's SF is V per standard g (sensor_model.hpp).
+    e.scale_v_per_g = s.scale_v_per_g[j] / nav::kStandardGravity * g_local;
+    e.scale_sigma_v_per_g = 1e-6;
+    e.bias_g = s.bias_mps2[j] / g_local;
+    e.bias_sigma_g = 1e-6;
+  }
+  for (std::size_t i = 0; i < 6; ++i) {
+    d.beta.angle_deg[i] = s.misalignment.orientation.beta[i] * 180.0 / M_PI;
+    d.alpha.angle_deg[i] = s.misalignment.orientation.alpha[i] * 180.0 / M_PI;
+    d.beta.angle_sigma_deg[i] = 1e-4;
+    d.alpha.angle_sigma_deg[i] = 1e-4;
+  }
+  return d;
+}
+
+/// Captures every run of `mountings` through the firmware; the --location-runs CSV (header +
+/// one row per run).
+std::string capture_location_runs(const std::filesystem::path& dir, const sim::Scenario& truth,
+                                  const std::vector<Mounting>& mountings, double& adc_lsb) {
+  std::string csv = can_tool::location_runs_header();
+  for (const Mounting& m : mountings) {
+    for (const double rate : kRatesRadS) {
+      const std::uint16_t n =
+          can_tool::whole_revolution_samples(rate, truth.rate_hz, kRunTargetSamples);
+      const double duration = static_cast<double>(n) / truth.rate_hz + 2.0;
+      const auto scen = dir / ("m" + std::to_string(m.number) + "-r" +
+                               std::to_string(static_cast<int>(rate)) + ".toml");
+      write(scen, rate_table_scenario(truth, m, rate, duration));
+      Board b(dir / "none.toml", {}, scen.string());
+      EXPECT_EQ(b.s.trajectory.kind, "rate_table");
+      SequenceOptions o = b.options();
+      adc_lsb = o.adc_lsb_v;
+      std::uint8_t token = 1;
+      const can_tool::CommandOutcome out =
+          can_tool::capture_once(*b.host_bus, static_cast<std::uint8_t>(m.number), n, o, token);
+      if (out.kind != can_tool::CommandOutcome::Kind::kOk || !out.capture_complete) {
+        ADD_FAILURE() << "mounting " << m.number << " at " << rate << " rad/s: " << out.text;
+        return {};
+      }
+      // A constant rotation about the vertical is constant specific force in body axes: the
+      // firmware's motion flag (static-pose threshold) must not fire, nor saturation.
+      std::string why;
+      std::string note;
+      if (!can_tool::check_rate_table_capture(out.capture, n, why, &note)) {
+        ADD_FAILURE() << "mounting " << m.number << " at " << rate << " rad/s: " << why;
+        return {};
+      }
+      EXPECT_EQ(note, "") << "mounting " << m.number << " at " << rate << " rad/s";
+      csv += can_tool::location_run_row(out.capture, m.number, m.up_b, rate, o.adc_lsb_v);
+    }
+  }
+  return csv;
+}
+
+struct LocationCheck {
+  double max_z = 0;
+  std::string worst;
+};
+LocationCheck compare_location(const calib_file::CalibrationData& d, const sim::Scenario& s) {
+  LocationCheck c;
+  for (std::size_t j = 0; j < 6; ++j) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double est = d.sensors[j].location_error_m[k];
+      const double truth = s.misalignment.drho_b[j](static_cast<Eigen::Index>(k));
+      const double sigma = d.sensors[j].location_error_sigma_m[k];
+      const double z = std::abs(est - truth) / sigma;
+      if (!(z <= c.max_z)) {
+        c.max_z = std::isfinite(z) ? z : 1e300;
+        c.worst = "a" + std::to_string(j + 1) + " axis " + std::to_string(k) + ": estimated " +
+                  std::to_string(est * 1e3) + " mm, true " + std::to_string(truth * 1e3) +
+                  " mm, 1σ " + std::to_string(sigma * 1e3) + " mm";
+      }
+    }
+  }
+  return c;
+}
+
+TEST(FirmwareCalibration, LocationErrorsFromRateTableRunsCapturedThroughTheFirmware) {
+  TempDir dir;
+  const auto loaded = sim::load_scenario("calibration-board", GFINS_SCENARIO_DIR);
+  ASSERT_TRUE(loaded.is_ok()) << loaded.error().message;
+  const sim::Scenario& truth = loaded.value();
+  const double g_local =
+      nav::GravityModel<double>::normal(truth.latitude_rad, truth.height_m).magnitude_at_origin();
+
+  // 1. The runs of all five mountings, through the firmware's capture command.
+  double adc_lsb = 0;
+  const std::vector<Mounting> all(kMountings.begin(), kMountings.end());
+  const std::string csv = capture_location_runs(dir.path, truth, all, adc_lsb);
+  ASSERT_FALSE(csv.empty());
+  write(dir.path / "runs.csv", csv);
+  ASSERT_EQ(calib_file::save_calibration_file(dir.path / "base.toml",
+                                              truth_as_base(truth, adc_lsb, g_local))
+                .message(),
+            "");
+
+  // 2. gfins-calibrate solves Δρ on top of the base calibration.
+  int rc = -1;
+  std::string out =
+      run_calibrate({"--location-runs", (dir.path / "runs.csv").string(), "--base",
+                     (dir.path / "base.toml").string(), "-o", (dir.path / "loc.toml").string()},
+                    dir.path, rc);
+  ASSERT_EQ(rc, 0) << out;
+  std::printf("%s", out.c_str());
+  const auto solved = calib_file::load_calibration_file(dir.path / "loc.toml");
+  ASSERT_TRUE(solved.is_ok()) << solved.status().message();
+  const LocationCheck c = compare_location(solved.value(), truth);
+  std::printf("location through the firmware: largest |est - true|/sigma %.2f (%s)\n", c.max_z,
+              c.worst.c_str());
+  EXPECT_LE(c.max_z, kLocationSigmas) << c.worst << "\n" << out;
+  // Every component observed: no sensor names an unobservable direction.
+  EXPECT_EQ(out.find("direction(s)"), std::string::npos) << out;
+
+  // 3. Runs about x, y and z only: each sensor's radial direction is named unobservable
+  // (docs/calibration.md §5: Table 1's axis has no component along its own position).
+  std::string xyz_csv;
+  {
+    std::istringstream in(csv);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.rfind("3,", 0) == 0 || line.rfind("4,", 0) == 0) continue;  // the diagonals
+      xyz_csv += line + "\n";
+    }
+  }
+  write(dir.path / "runs-xyz.csv", xyz_csv);
+  out =
+      run_calibrate({"--location-runs", (dir.path / "runs-xyz.csv").string(), "--base",
+                     (dir.path / "base.toml").string(), "-o", (dir.path / "loc-xyz.toml").string()},
+                    dir.path, rc);
+  ASSERT_EQ(rc, 0) << out;
+  for (int j = 1; j <= 6; ++j) {
+    const auto at = out.find("\na" + std::to_string(j) + " ");
+    ASSERT_NE(at, std::string::npos) << out;
+    const std::string row = out.substr(at + 1, out.find('\n', at + 1) - at - 1);
+    EXPECT_NE(row.find("1 direction(s)"), std::string::npos) << row;
+  }
+
+  // 4. A deliberate error: rows stating 5 % more rate than the table turned. The nominal
+  // centripetal term ω²ρ (0.1 m) then misfits by 10 % of up to 10 m/s², thousands of σ: the
+  // recovered Δρ is far from the truth.
+  std::string wrong;
+  {
+    std::istringstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    wrong = line + "\n";
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::stringstream ls(line);
+      std::string cell;
+      while (std::getline(ls, cell, ',')) f.push_back(cell);
+      f[4] = std::to_string(std::stod(f[4]) * 1.05);
+      for (std::size_t i = 0; i < f.size(); ++i) wrong += (i ? "," : "") + f[i];
+      wrong += "\n";
+    }
+  }
+  write(dir.path / "runs-wrong.csv", wrong);
+  out = run_calibrate(
+      {"--location-runs", (dir.path / "runs-wrong.csv").string(), "--base",
+       (dir.path / "base.toml").string(), "-o", (dir.path / "loc-wrong.toml").string()},
+      dir.path, rc);
+  ASSERT_EQ(rc, 0) << out;  // the tool cannot know the table's rate: the oracle must catch it
+  const auto bad = calib_file::load_calibration_file(dir.path / "loc-wrong.toml");
+  ASSERT_TRUE(bad.is_ok()) << bad.status().message();
+  const LocationCheck w = compare_location(bad.value(), truth);
+  std::printf("rows with a 5 %% rate error: largest |est - true|/sigma %.3g (%s)\n", w.max_z,
+              w.worst.c_str());
+  EXPECT_GT(w.max_z, kLocationSigmas) << out;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace gfins::can_tool {
 namespace {
@@ -334,6 +335,145 @@ std::string poses_csv(const std::vector<PlanPose>& plan) {
                   p.f_b_g[2]);
     s += line;
   }
+  return s;
+}
+
+// ---- Location runs ---------------------------------------------------------------------------
+
+namespace {
+
+constexpr double kMaxTableRateRadS = 100.0;  // beyond any rate table a board survives (955 rpm)
+
+std::string trim(const std::string& t) {
+  const auto b = t.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return {};
+  return t.substr(b, t.find_last_not_of(" \t\r") - b + 1);
+}
+
+}  // namespace
+
+std::vector<RateTableRun> rate_table_plan(const std::string& csv_text, std::string& error) {
+  std::vector<RateTableRun> plan;
+  std::size_t line_no = 0;
+  std::size_t pos = 0;
+  bool header = true;
+  while (pos <= csv_text.size()) {
+    const std::size_t end = std::min(csv_text.find('\n', pos), csv_text.size());
+    const std::string line = trim(csv_text.substr(pos, end - pos));
+    pos = end + 1;
+    ++line_no;
+    if (line.empty()) continue;
+    if (header) {  // the first non-empty line names the columns
+      header = false;
+      if (line != "mounting,axis_x,axis_y,axis_z,rate_rad_s") {
+        error = "line " + std::to_string(line_no) + ": header '" + line +
+                "': expected mounting,axis_x,axis_y,axis_z,rate_rad_s";
+        return {};
+      }
+      continue;
+    }
+    std::vector<std::string> f;
+    std::size_t a = 0;
+    while (true) {
+      const std::size_t c = line.find(',', a);
+      f.push_back(trim(line.substr(a, c == std::string::npos ? std::string::npos : c - a)));
+      if (c == std::string::npos) break;
+      a = c + 1;
+    }
+    const std::string where = "line " + std::to_string(line_no) + " ('" + line + "')";
+    if (f.size() != 5) {
+      error = where + ": " + std::to_string(f.size()) + " fields, expected 5";
+      return {};
+    }
+    std::array<double, 5> v{};
+    for (std::size_t i = 0; i < 5; ++i) {
+      char* e = nullptr;
+      v[i] = std::strtod(f[i].c_str(), &e);
+      if (f[i].empty() || e == nullptr || *e != '\0' || !std::isfinite(v[i])) {
+        error = where + ": field " + std::to_string(i + 1) + " '" + f[i] + "' is not a number";
+        return {};
+      }
+    }
+    RateTableRun r;
+    r.mounting = static_cast<int>(v[0]);
+    if (static_cast<double>(r.mounting) != v[0] || r.mounting < 0 || r.mounting > 255) {
+      error = where + ": mounting must be an integer 0..255";
+      return {};
+    }
+    const double n = std::sqrt(v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+    if (!(n > 1e-9)) {
+      error = where + ": the axis pointing up must be a non-zero vector";
+      return {};
+    }
+    r.up_b = {v[1] / n, v[2] / n, v[3] / n};
+    r.rate_rad_s = v[4];
+    if (!(r.rate_rad_s > 0.0 && r.rate_rad_s <= kMaxTableRateRadS)) {
+      error = where + ": rate_rad_s must be in (0, 100] rad/s";
+      return {};
+    }
+    plan.push_back(r);
+  }
+  if (plan.empty()) error = "no runs (expected rows mounting,axis_x,axis_y,axis_z,rate_rad_s)";
+  return plan;
+}
+
+std::uint16_t whole_revolution_samples(double rate_rad_s, double sample_rate_hz,
+                                       double target_samples) {
+  constexpr double kMaxSamples = 65535.0;  // the capture's sample count is 16 bits
+  const double per_rev = 2.0 * M_PI / rate_rad_s * sample_rate_hz;
+  double turns = std::max(1.0, std::round(target_samples / per_rev));
+  while (turns > 1.0 && std::round(turns * per_rev) > kMaxSamples) turns -= 1.0;
+  return static_cast<std::uint16_t>(std::min(kMaxSamples, std::round(turns * per_rev)));
+}
+
+bool check_rate_table_capture(const can::CaptureResult& r, std::uint16_t samples, std::string& why,
+                              std::string* note) {
+  std::string moved;
+  for (std::size_t j = 0; j < 6; ++j) {
+    const auto& ch = r.channels[j];
+    const std::string name = "channel " + std::to_string(j + 1);
+    if (ch.saturated) {
+      why = name + " saturated during the run: its mean is not the sensor's (lower the rate)";
+      return false;
+    }
+    if (ch.count != samples) {
+      why = name + " counted " + std::to_string(ch.count) + " of " + std::to_string(samples) +
+            " samples: repeat the run";
+      return false;
+    }
+    if (ch.motion) moved += (moved.empty() ? "" : ", ") + std::to_string(j + 1);
+  }
+  if (note != nullptr && !moved.empty()) {
+    *note = "channel(s) " + moved +
+            " vary more than a static pose allows: a table axis off the vertical, or a rate "
+            "that changed; the mean over whole turns is kept";
+  }
+  why.clear();
+  return true;
+}
+
+std::string location_runs_header() {
+  return "mounting,axis_x,axis_y,axis_z,rate_rad_s,mean_v1,mean_v2,mean_v3,mean_v4,mean_v5,"
+         "mean_v6,std_v1,std_v2,std_v3,std_v4,std_v5,std_v6,count\n";
+}
+
+std::string location_run_row(const can::CaptureResult& r, int mounting,
+                             const std::array<double, 3>& up_b, double rate_rad_s,
+                             double adc_lsb_v) {
+  const double n = std::sqrt(up_b[0] * up_b[0] + up_b[1] * up_b[1] + up_b[2] * up_b[2]);
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%d,%.9g,%.9g,%.9g,%.9g", mounting, up_b[0] / n, up_b[1] / n,
+                up_b[2] / n, rate_rad_s);
+  std::string s = buf;
+  for (const auto& ch : r.channels) {
+    std::snprintf(buf, sizeof buf, ",%.12g", static_cast<double>(ch.mean_counts) * adc_lsb_v);
+    s += buf;
+  }
+  for (const auto& ch : r.channels) {
+    std::snprintf(buf, sizeof buf, ",%.6g", static_cast<double>(ch.std_counts) * adc_lsb_v);
+    s += buf;
+  }
+  s += "," + std::to_string(r.channels[0].count) + "\n";
   return s;
 }
 

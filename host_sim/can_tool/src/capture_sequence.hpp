@@ -135,4 +135,43 @@ std::string means_csv(const std::vector<PoseCapture>& captures, double adc_lsb_v
 /// The poses file (attitude,fx_g,fy_g,fz_g) of a plan.
 std::string poses_csv(const std::vector<PlanPose>& plan);
 
+// ---- Location runs on a rate table (docs/calibration.md, "Location runs on a rate table") ----
+
+/// One run of a rate-table plan: the mounting number, the body axis pointing up (the table axis,
+/// normalised here) and the table rate.
+struct RateTableRun {
+  int mounting = 0;
+  std::array<double, 3> up_b{};
+  double rate_rad_s = 0.0;
+};
+
+/// A plan from a CSV with the rows mounting,axis_x,axis_y,axis_z,rate_rad_s (a header line
+/// first). Empty, with `error` naming the line and the value, for a malformed line, a zero or
+/// non-finite axis, a rate outside (0, 100] rad/s, or no rows.
+std::vector<RateTableRun> rate_table_plan(const std::string& csv_text, std::string& error);
+
+/// N for a capture of whole revolutions at rate_rad_s: the whole number of turns (at least one)
+/// whose samples come nearest to target_samples, capped to what one capture holds (65535).
+/// Whole turns average out what varies once per turn on a real table (axis tilt, wobble).
+std::uint16_t whole_revolution_samples(double rate_rad_s, double sample_rate_hz,
+                                       double target_samples);
+
+/// Whether a capture is usable as a rate-table run: complete (every channel counted `samples`)
+/// and no channel saturated; `why` names the channel otherwise. The firmware's motion flag is
+/// *not* a refusal here: it is the static-pose test (spread above 2 mg), and a rotation whose
+/// axis is a little off the vertical spreads gravity over the turn (0.16° gives 2 mg rms) while
+/// its mean over whole turns is what the location solve wants; a flagged channel is named in
+/// `note` so the operator can check the table.
+bool check_rate_table_capture(const can::CaptureResult& r, std::uint16_t samples, std::string& why,
+                              std::string* note = nullptr);
+
+/// The header of gfins-calibrate --location-runs (mounting,axis_x,...,count), newline-terminated.
+std::string location_runs_header();
+
+/// One row of gfins-calibrate --location-runs from a capture: volts from the codes by adc_lsb_v,
+/// the axis normalised, count = the samples of channel 1.
+std::string location_run_row(const can::CaptureResult& r, int mounting,
+                             const std::array<double, 3>& up_b, double rate_rad_s,
+                             double adc_lsb_v);
+
 }  // namespace gfins::can_tool
