@@ -657,6 +657,26 @@ TEST(GfinsCanCalibrate, BadInputIsNamedWithItsExitStatus) {
   r = run(with({"--nominal-sf", "1.3", "1.2"}));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("--nominal-sf takes 1 or 6 values"), std::string::npos) << r.output;
+  // A rate-table plan: a run with a zero rate, a zero axis, a short line are named by line;
+  // --poses with --rate-table is refused; a good plan reaches the (missing) interface.
+  const std::vector<std::pair<std::string, std::string>> bad_plans = {
+      {"0,1,0,0,0", "line 2 ('0,1,0,0,0'): rate_rad_s must be in (0, 100] rad/s"},
+      {"1,0,0,0,4", "line 2 ('1,0,0,0,4'): the axis pointing up must be a non-zero vector"},
+      {"2,0,1,4", "line 2 ('2,0,1,4'): 4 fields, expected 5"},
+      {"3,1,1,0,x", "line 2 ('3,1,1,0,x'): field 5 'x' is not a number"}};
+  for (const auto& [row, message] : bad_plans) {
+    write(dir.path / "plan.csv", "mounting,axis_x,axis_y,axis_z,rate_rad_s\n" + row + "\n");
+    r = run(with({"--rate-table", (dir.path / "plan.csv").string()}));
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("plan.csv: " + message), std::string::npos) << r.output;
+  }
+  write(dir.path / "plan.csv", "mounting,axis_x,axis_y,axis_z,rate_rad_s\n0,1,0,0,4\n");
+  r = run(with({"--rate-table", (dir.path / "plan.csv").string(), "--layout", "all"}));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("--rate-table captures location runs"), std::string::npos) << r.output;
+  r = run(with({"--rate-table", (dir.path / "plan.csv").string()}));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("cannot open CAN interface 'gfinsnone0'"), std::string::npos) << r.output;
   // No such interface: exit 2, the interface named; nothing written.
   r = run(base);
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -810,33 +830,35 @@ std::string capture_location_runs(const std::filesystem::path& dir, const sim::S
   std::string csv = can_tool::location_runs_header();
   for (const Mounting& m : mountings) {
     for (const double rate : kRatesRadS) {
-      const std::uint16_t n =
-          can_tool::whole_revolution_samples(rate, truth.rate_hz, kRunTargetSamples);
-      const double duration = static_cast<double>(n) / truth.rate_hz + 2.0;
+      // Whole revolutions nearest kRunTargetSamples (what capture_rate_table_run asks for).
+      const double n = static_cast<double>(
+          can_tool::whole_revolution_samples(rate, truth.rate_hz, kRunTargetSamples));
+      const double duration = n / truth.rate_hz + 2.0;
       const auto scen = dir / ("m" + std::to_string(m.number) + "-r" +
                                std::to_string(static_cast<int>(rate)) + ".toml");
       write(scen, rate_table_scenario(truth, m, rate, duration));
       Board b(dir / "none.toml", {}, scen.string());
       EXPECT_EQ(b.s.trajectory.kind, "rate_table");
       SequenceOptions o = b.options();
+      o.samples = static_cast<std::uint16_t>(kRunTargetSamples);
       adc_lsb = o.adc_lsb_v;
       std::uint8_t token = 1;
-      const can_tool::CommandOutcome out =
-          can_tool::capture_once(*b.host_bus, static_cast<std::uint8_t>(m.number), n, o, token);
-      if (out.kind != can_tool::CommandOutcome::Kind::kOk || !out.capture_complete) {
-        ADD_FAILURE() << "mounting " << m.number << " at " << rate << " rad/s: " << out.text;
+      const can_tool::RateTableCapture c = can_tool::capture_rate_table_run(
+          *b.host_bus, can_tool::RateTableRun{m.number, m.up_b, rate}, o, token);
+      if (!c.ok) {
+        ADD_FAILURE() << c.error;
         return {};
       }
-      // A constant rotation about the vertical is constant specific force in body axes: the
-      // firmware's motion flag (static-pose threshold) must not fire, nor saturation.
-      std::string why;
-      std::string note;
-      if (!can_tool::check_rate_table_capture(out.capture, n, why, &note)) {
-        ADD_FAILURE() << "mounting " << m.number << " at " << rate << " rad/s: " << why;
-        return {};
-      }
-      EXPECT_EQ(note, "") << "mounting " << m.number << " at " << rate << " rad/s";
-      csv += can_tool::location_run_row(out.capture, m.number, m.up_b, rate, o.adc_lsb_v);
+      // Whole turns: N·ω/(2π f_s) within half a sample's angle of a whole number (>= 1) of turns.
+      const double per_sample_turns = rate / (2.0 * M_PI * truth.rate_hz);
+      const double turns = static_cast<double>(c.samples) * per_sample_turns;
+      EXPECT_GE(turns, 1.0);
+      EXPECT_LE(std::abs(turns - std::round(turns)), 0.5 * per_sample_turns);
+      EXPECT_EQ(c.result.channels[0].count, c.samples);
+      // A constant rotation about the vertical is a constant specific force in body axes: the
+      // firmware's static-pose motion flag must not fire.
+      EXPECT_EQ(c.note, "");
+      csv += c.row;
     }
   }
   return csv;

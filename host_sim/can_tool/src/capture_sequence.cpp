@@ -477,4 +477,32 @@ std::string location_run_row(const can::CaptureResult& r, int mounting,
   return s;
 }
 
+RateTableCapture capture_rate_table_run(hal::CanBus& bus, const RateTableRun& run,
+                                        const SequenceOptions& o, std::uint8_t& token) {
+  RateTableCapture c;
+  char name[96];
+  std::snprintf(name, sizeof name, "mounting %d at %g rad/s", run.mounting, run.rate_rad_s);
+  c.samples = whole_revolution_samples(run.rate_rad_s, o.sample_rate_hz, o.samples);
+  const CommandOutcome r =
+      capture_once(bus, static_cast<std::uint8_t>(run.mounting), c.samples, o, token);
+  if (r.kind != CommandOutcome::Kind::kOk) {
+    c.error = std::string(name) + ": capture failed: " + r.text;
+    return c;
+  }
+  if (!r.capture_complete) {
+    c.error = std::string(name) + ": some result frames of the capture were lost: repeat the run";
+    return c;
+  }
+  c.result = r.capture;
+  std::string why;
+  if (!check_rate_table_capture(r.capture, c.samples, why, &c.note)) {
+    c.error = std::string(name) + " refused: " + why;
+    return c;
+  }
+  if (!c.note.empty()) c.note = std::string(name) + ": " + c.note;
+  c.row = location_run_row(r.capture, run.mounting, run.up_b, run.rate_rad_s, o.adc_lsb_v);
+  c.ok = true;
+  return c;
+}
+
 }  // namespace gfins::can_tool

@@ -174,4 +174,19 @@ std::string location_run_row(const can::CaptureResult& r, int mounting,
                              const std::array<double, 3>& up_b, double rate_rad_s,
                              double adc_lsb_v);
 
+/// The outcome of one rate-table run.
+struct RateTableCapture {
+  bool ok = false;
+  std::uint16_t samples = 0;  // N asked for (whole revolutions)
+  can::CaptureResult result;
+  std::string row;    // location_run_row, when ok
+  std::string error;  // why not ok (names the run, the channel and the reason)
+  std::string note;   // check_rate_table_capture's note (motion flags), may be empty
+};
+
+/// One rate-table run (the code of gfins-can calibrate --rate-table): StartCapture over whole
+/// revolutions nearest o.samples (pose number = the mounting), checked, as a --location-runs row.
+RateTableCapture capture_rate_table_run(hal::CanBus& bus, const RateTableRun& run,
+                                        const SequenceOptions& o, std::uint8_t& token);
+
 }  // namespace gfins::can_tool

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -319,6 +320,7 @@ struct SequenceCliOptions {
   std::string layout = "auto";
   std::string output;
   std::string poses_out;
+  std::string rate_table;  // a rate-table plan: location runs instead of poses
   bool auto_wait = false;
   int probe_samples = 200;
   double pose_timeout_s = 60.0;
@@ -339,6 +341,75 @@ bool write_text(const std::string& path, const std::string& text) {
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   return !ec;
+}
+
+/// gfins-can calibrate --rate-table: one capture of whole revolutions per run of the plan, the
+/// rows of gfins-calibrate --location-runs (docs/calibration.md, location runs).
+int run_rate_table_sequence(const SequenceCliOptions& o, const SequenceOptions& so) {
+  if (!o.poses.empty() || !o.poses_out.empty() || o.layout != "auto") {
+    std::fprintf(stderr,
+                 "gfins-can calibrate: --rate-table captures location runs; --poses, "
+                 "--poses-out and --layout are for the orientation poses\n");
+    return kExitUsage;
+  }
+  std::ifstream f(o.rate_table, std::ios::binary);
+  std::stringstream text;
+  text << f.rdbuf();
+  if (!f) {
+    std::fprintf(stderr, "gfins-can calibrate: cannot read '%s'\n", o.rate_table.c_str());
+    return kExitInput;
+  }
+  std::string error;
+  const std::vector<RateTableRun> plan = rate_table_plan(text.str(), error);
+  if (plan.empty()) {
+    std::fprintf(stderr, "gfins-can calibrate: %s: %s\n", o.rate_table.c_str(), error.c_str());
+    return kExitUsage;
+  }
+  auto bus = open_live_bus(o.iface);
+  if (!bus.is_ok()) {
+    std::fprintf(stderr, "gfins-can calibrate: cannot open CAN interface '%s': %s\n",
+                 o.iface.c_str(), bus.status().message());
+    return kExitInput;
+  }
+  std::string csv = location_runs_header();
+  std::uint8_t token = so.first_token;
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const RateTableRun& run = plan[i];
+    for (int attempt = 0;; ++attempt) {
+      if (!o.auto_wait) {
+        std::fprintf(stderr,
+                     "%s run %zu of %zu: mounting %d, body axis (%+.3f, %+.3f, %+.3f) up on the "
+                     "table, table at %g rad/s and steady, then press Enter (q Enter stops)\n",
+                     attempt > 0 ? "REPEAT" : "next:", i + 1, plan.size(), run.mounting,
+                     run.up_b[0], run.up_b[1], run.up_b[2], run.rate_rad_s);
+        std::string line;
+        if (!std::getline(std::cin, line) || line == "q") {
+          std::fprintf(stderr, "gfins-can calibrate: stopped before run %zu\n", i + 1);
+          return kExitTimeout;
+        }
+      }
+      const RateTableCapture c = capture_rate_table_run(**bus, run, so, token);
+      if (c.ok) {
+        if (!c.note.empty()) std::fprintf(stderr, "note: %s\n", c.note.c_str());
+        std::fprintf(stderr, "run %zu: captured %u samples (whole turns)\n", i + 1, c.samples);
+        csv += c.row;
+        break;
+      }
+      std::fprintf(stderr, "%s\n", c.error.c_str());
+      if (attempt >= o.retries) {
+        std::fprintf(stderr, "gfins-can calibrate: run %zu given up after %d attempts\n", i + 1,
+                     attempt + 1);
+        return kExitRejected;
+      }
+    }
+  }
+  if (!write_text(o.output, csv)) {
+    std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.output.c_str());
+    return kExitInput;
+  }
+  std::fprintf(stderr, "gfins-can calibrate: wrote %s (%zu rate-table runs)\n", o.output.c_str(),
+               plan.size());
+  return kExitOk;
 }
 
 int run_calibrate_sequence(const SequenceCliOptions& o) {
@@ -383,6 +454,7 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
   so.retries = o.retries;
   so.first_token = static_cast<std::uint8_t>(std::random_device{}() & 0xFFu);
   so.timeouts.response = std::chrono::milliseconds(o.timeout_ms);
+  if (!o.rate_table.empty()) return run_rate_table_sequence(o, so);
 
   auto bus = open_live_bus(o.iface);
   if (!bus.is_ok()) {
@@ -523,6 +595,12 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "paper", "all"}));
   calibrate->add_option("-o,--output", so.output, "means CSV to write")->required();
   calibrate->add_option("--poses-out", so.poses_out, "also write the plan as a poses CSV");
+  calibrate
+      ->add_option("--rate-table", so.rate_table,
+                   "location runs instead of poses: plan CSV mounting,axis_x,axis_y,axis_z,"
+                   "rate_rad_s (body axis up, table rate); -o gets the rows of gfins-calibrate "
+                   "--location-runs, each a capture of the whole turns nearest --samples")
+      ->check(CLI::ExistingFile);
   calibrate->add_flag("--auto", so.auto_wait,
                       "do not prompt: probe until the board is still in the expected pose "
                       "(index table, simulated board)");
