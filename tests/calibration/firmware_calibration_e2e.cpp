@@ -43,6 +43,7 @@
 #include "gfins/nav_core/gravity.hpp"
 #include "gfins/sim_board/sim_board.hpp"
 #include "support/run_cli.hpp"
+#include "support/sim_chain.hpp"
 
 namespace gfins {
 namespace {
@@ -162,14 +163,10 @@ struct Board {
     config.node_id = kNode;
     config.calibration_file = cal_file.string();
     samples = static_cast<std::uint32_t>(std::llround(s.duration_s * s.rate_hz)) + 1;
-    auto made = sim_board::make_scenario_stream(s);
-    if (!made.is_ok()) throw std::runtime_error(made.error().message);
-    stream = std::move(made).value();
-    adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
-    if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
-    source = std::make_unique<sim_board::SimSampleSource>(
-        *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
-    source->set_faults(faults);
+    test::SimChain chain = test::make_sim_chain(s, clock, samples, faults);
+    stream = std::move(chain.stream);
+    adc = std::move(chain.adc);
+    source = std::move(chain.source);
     tap = std::make_unique<TraceSource>(*source);
     tap->record = std::getenv("GFINS_CAL_E2E_OUT") != nullptr;
     period_ns = std::llround(1e9 / s.rate_hz);

@@ -15,6 +15,7 @@
 #include "gfins/app/startup.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/sim_board/sim_board.hpp"
+#include "support/sim_chain.hpp"
 
 namespace gfins::testing {
 
@@ -49,14 +50,10 @@ struct SimRig {
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
-    auto made = sim_board::make_scenario_stream(s);
-    if (!made.is_ok()) throw std::runtime_error(made.error().message);
-    stream = std::move(made).value();
-    adc = std::make_unique<sim_board::ChipAdc>(s.rate_hz);
-    if (const Status st = adc->start(); !st.is_ok()) throw std::runtime_error(st.message());
-    source = std::make_unique<sim_board::SimSampleSource>(
-        *stream, *adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
-    source->set_faults(faults);
+    test::SimChain chain = test::make_sim_chain(s, clock, samples, faults);
+    stream = std::move(chain.stream);
+    adc = std::move(chain.adc);
+    source = std::move(chain.source);
     tap = std::make_unique<TapSource>(*source, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
     publisher = std::make_unique<app::CanEpochSink>(*bus, kNode, app::to_can_dividers(config));

@@ -36,22 +36,6 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-inline CliResult run_tool(const std::string& exe, const std::vector<std::string>& args,
-                          const std::filesystem::path& log_dir) {
-  std::vector<std::string> argv{exe};
-  argv.insert(argv.end(), args.begin(), args.end());
-  drivers::lnx::SpawnOptions o;
-  o.search_path = false;
-  o.stdout_path = (log_dir / "cli.out").string();
-  o.stderr_path = (log_dir / "cli.err").string();
-  CliResult r;
-  const auto e = drivers::lnx::run_program(argv, o);
-  if (e.is_ok() && e->exited) r.exit_code = e->code;
-  if (e.is_ok()) r.max_rss_kib = e->max_rss_kib;
-  r.output = slurp(o.stdout_path) + slurp(o.stderr_path);
-  return r;
-}
-
 /// A tool started without waiting (start_tool), e.g. to be interrupted: its stdout and stderr go
 /// to log_dir/cli.out and log_dir/cli.err, which the test may read while it runs.
 struct StartedTool {
@@ -84,6 +68,13 @@ inline CliResult finish_tool(StartedTool& t) {
   }
   r.output = slurp(t.log_dir / "cli.out") + slurp(t.log_dir / "cli.err");
   return r;
+}
+
+/// Runs a tool to its end (start_tool + finish_tool): exit code and stdout + stderr.
+inline CliResult run_tool(const std::string& exe, const std::vector<std::string>& args,
+                          const std::filesystem::path& log_dir) {
+  StartedTool t = start_tool(exe, args, log_dir);
+  return finish_tool(t);
 }
 
 inline CliResult run_tool(const std::string& exe, const std::string& args,
