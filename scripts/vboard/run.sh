@@ -51,6 +51,29 @@ vb_log "kernel $kver ready (+$(elapsed)s)"
 # Programs and files per stage; a missing one fails here, naming it.
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
 args=()
+# The programs the stages need ("# needs: build:<path>", target = the file name) are brought up
+# to date in the build folder first, so a partial build (test.sh builds only what it runs)
+# cannot leave one missing or stale.
+targets=()
+for s in backend fw cmd faults canlog; do
+  want "$s" || continue
+  [ -e "$here/stage-$s.sh" ] || continue
+  while read -r need; do
+    case $need in build:*) targets+=("$(basename "${need#build:}")") ;; esac
+  done < <(sed -n 's/^# needs: //p' "$here/stage-$s.sh")
+done
+if want canlog || want fw; then targets+=(gfins-fw gfins-can); fi
+if [ ${#targets[@]} -gt 0 ]; then
+  [ -f "$build_dir/CMakeCache.txt" ] ||
+    vb_die "no configured build folder at $build_dir (cmake --preset host-release, or --build-dir)"
+  mapfile -t targets < <(printf '%s\n' "${targets[@]}" | sort -u)
+  mkdir -p "$vboard_cache"
+  vb_log "building ${targets[*]} in $build_dir"
+  cmake --build "$build_dir" --target "${targets[@]}" >"$vboard_cache/build.out" 2>&1 || {
+    tail -n 30 "$vboard_cache/build.out" >&2
+    vb_die "building ${targets[*]} in $build_dir failed (log: $vboard_cache/build.out)"
+  }
+fi
 # Stage canlog replays a candump log written by the firmware's file sink on the host.
 if want canlog; then
   fw=$build_dir/firmware/app/gfins-fw
