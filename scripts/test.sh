@@ -7,8 +7,34 @@ cd "$(dirname "$0")/.."
 jobs=${GFINS_JOBS:-$(nproc)}
 start=$(date +%s)
 log_dir=$(mktemp -d)
-trap 'rm -rf "$log_dir"' EXIT
-step() { printf '\n=== %s (%s, +%ds)\n' "$*" "$(date +%T)" "$(($(date +%s) - start))"; }
+# Per step: wall seconds and the CPU seconds (user + sys) of everything it started, which is
+# what the step costs on an idle machine whatever the load was (docs/ci.md); printed as a table
+# when the script ends, passing or failing.
+# `times` runs in this shell (in a pipe or $(...) it would see a subshell's children only).
+children_cpu() {
+  times >"$log_dir/times"
+  cpu_s=$(awk 'END { s = 0; for (i = 1; i <= 2; i++) { split($i, a, "m"); s += a[1] * 60 + a[2] } printf "%d", s }' "$log_dir/times")
+}
+step_rows=()
+step_close() {
+  [ -n "${step_name:-}" ] || return 0
+  children_cpu
+  step_rows+=("$(printf '%6d s %7d s   %s' $(($(date +%s) - step_t)) $((cpu_s - step_cpu)) "$step_name")")
+}
+step_table() {
+  step_close
+  step_name=""
+  printf '\n   wall  CPU (u+s)   step\n'
+  printf '%s\n' "${step_rows[@]}"
+  printf '%6d s             total\n' $(($(date +%s) - start))
+}
+trap 'rc=$?; step_table; rm -rf "$log_dir"; exit $rc' EXIT
+step() {
+  step_close
+  children_cpu
+  step_name="$*" step_t=$(date +%s) step_cpu=$cpu_s
+  printf '\n=== %s (%s, +%ds)\n' "$*" "$(date +%T)" "$((step_t - start))"
+}
 
 step "install packages"
 ./scripts/install-deps.sh
