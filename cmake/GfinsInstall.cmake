@@ -3,36 +3,24 @@
 # `cmake --install <build> [--prefix P]` puts the programs in P/bin, the scenarios in
 # P/share/gfins/scenarios (and P/share/gfins-fw/scenarios, the firmware's copy), the plot scripts
 # in P/share/gfins/scripts, example inputs in P/share/gfins/examples and the documentation in
-# P/share/doc/gfins-*. The programs find them relative to their own location (docs/install.md). Built with CMAKE_INSTALL_PREFIX=/usr (the `deb` presets) the board files
-# go to their Debian places instead: /etc/gfins/gfins-fw.toml, /var/lib/gfins,
-# /lib/systemd/system/gfins-fw.service, /lib/udev/rules.d/60-gfins-fw.rules.
+# P/share/doc/gfins-*. The programs find them relative to their own location (docs/install.md).
+# The firmware's board files (configuration, state folder, systemd unit, udev rule) are placed
+# when installing, by cmake/GfinsInstallBoardFiles.cmake, from the prefix of that installation:
+# with prefix /usr (what CPack uses for the packages) their Debian places, /etc/gfins/gfins-fw.toml,
+# /var/lib/gfins, /lib/systemd/system/gfins-fw.service, /lib/udev/rules.d/60-gfins-fw.rules;
+# with any other prefix P, under P (P/etc/gfins, ...). So the layout does not depend on the
+# CMAKE_INSTALL_PREFIX a tree was configured with: `cmake --install build/host-release --prefix P`
+# and the packages made from the same host-release tree both come out right.
 #
 # `cpack --config <build>/CPackConfig.cmake` then makes one .deb per component:
 #   gfins-fw     (component board): the firmware, its configuration, unit and udev rule
 #   gfins-tools  (component tools): gfins-can and the other host programs, scenarios, scripts
-# for the architecture of the build (amd64, arm64 or armhf).
+# for the architecture of the build (amd64, arm64 or armhf), always installed under /usr.
 include(GNUInstallDirs)
 
 set(GFINS_PKG_DIR ${PROJECT_SOURCE_DIR}/packaging)
-if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
-  # Debian layout (FHS): configuration and state outside /usr, units and rules in /lib.
-  set(gfins_conf_dest /etc/gfins)
-  set(gfins_state_dest /var/lib/gfins)
-  set(gfins_unit_dest /lib/systemd/system)
-  set(gfins_udev_dest /lib/udev/rules.d)
-else()
-  set(gfins_conf_dest ${CMAKE_INSTALL_SYSCONFDIR}/gfins)
-  set(gfins_state_dest ${CMAKE_INSTALL_LOCALSTATEDIR}/lib/gfins)
-  set(gfins_unit_dest ${CMAKE_INSTALL_LIBDIR}/systemd/system)
-  set(gfins_udev_dest ${CMAKE_INSTALL_LIBDIR}/udev/rules.d)
-endif()
-set(GFINS_FULL_BINDIR ${CMAKE_INSTALL_FULL_BINDIR})
-if(IS_ABSOLUTE "${gfins_conf_dest}")
-  set(GFINS_FULL_CONFDIR ${gfins_conf_dest})
-else()
-  set(GFINS_FULL_CONFDIR ${CMAKE_INSTALL_PREFIX}/${gfins_conf_dest})
-endif()
-set(GFINS_DOC_DIR ${CMAKE_INSTALL_FULL_DATADIR}/doc/gfins-fw)
+# The prefix of the Debian packages, whatever the build tree's CMAKE_INSTALL_PREFIX.
+set(gfins_deb_prefix /usr)
 
 # --- data: the same layout in the build tree ---------------------------------------------------
 # The programs find their data relative to their own executable (host_sim/include/gfins/host_sim/
@@ -61,14 +49,16 @@ if(TARGET gfins-fw)
   set(gfins_default_config ${PROJECT_SOURCE_DIR}/firmware/app/gfins-fw.toml)
   if(NOT EXISTS ${gfins_default_config})
     message(FATAL_ERROR "gfins-fw is built but ${gfins_default_config} (its default "
-                        "configuration, installed as ${GFINS_FULL_CONFDIR}/gfins-fw.toml) is missing")
+                        "configuration, installed as /etc/gfins/gfins-fw.toml) is missing")
   endif()
-  install(FILES ${gfins_default_config} DESTINATION ${gfins_conf_dest} COMPONENT board)
-  install(DIRECTORY DESTINATION ${gfins_state_dest} COMPONENT board)
-  configure_file(${GFINS_PKG_DIR}/gfins-fw.service.in ${PROJECT_BINARY_DIR}/gfins-fw.service @ONLY)
-  install(FILES ${PROJECT_BINARY_DIR}/gfins-fw.service DESTINATION ${gfins_unit_dest}
+  # Configuration, state folder, unit, udev rule: placed at install time from the install prefix
+  # (see the top of this file).
+  install(CODE "set(gfins_fw_config [[${gfins_default_config}]])
+set(gfins_service_in [[${GFINS_PKG_DIR}/gfins-fw.service.in]])
+set(gfins_udev_rules [[${GFINS_PKG_DIR}/60-gfins-fw.rules]])
+set(gfins_stage_dir [[${PROJECT_BINARY_DIR}/packaging/install]])
+include([[${PROJECT_SOURCE_DIR}/cmake/GfinsInstallBoardFiles.cmake]])"
           COMPONENT board)
-  install(FILES ${GFINS_PKG_DIR}/60-gfins-fw.rules DESTINATION ${gfins_udev_dest} COMPONENT board)
   install(FILES docs/deploy.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-fw COMPONENT board)
   # gfins-fw --sim NAME needs the scenarios without the host tools: the package carries its own
   # copy in share/gfins-fw/scenarios (gfins-tools has share/gfins/scenarios; two folders, so the
@@ -151,7 +141,13 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "")
 set(CPACK_PACKAGE_VENDOR "gfins")
 set(CPACK_PACKAGE_CONTACT "gfins maintainers <maintainers@users.noreply.h-seed-37f600bd.example>")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
-set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
+# DESTDIR staging: the install scripts run with CMAKE_INSTALL_PREFIX=/usr (the package's own
+# prefix; with CPACK_SET_DESTDIR, CPack takes it from CPACK_INSTALL_PREFIX, which would default to
+# the build tree's prefix, /usr/local for host-release), which is what puts the board files in
+# their Debian places (GfinsInstallBoardFiles.cmake).
+set(CPACK_SET_DESTDIR ON)
+set(CPACK_INSTALL_PREFIX ${gfins_deb_prefix})
+set(CPACK_PACKAGING_INSTALL_PREFIX ${gfins_deb_prefix})
 set(CPACK_COMPONENTS_ALL ${gfins_components})
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
@@ -174,7 +170,8 @@ gfins-fw (Type=notify, watchdog, restart on failure) under its own user;
 configuration in /etc/gfins, calibration in /var/lib/gfins.")
 set(CPACK_DEBIAN_BOARD_PACKAGE_DEPENDS "adduser, init-system-helpers (>= 1.52)")
 # The configuration is a conffile: dpkg keeps the administrator's edits over updates.
-file(WRITE ${PROJECT_BINARY_DIR}/packaging/gfins-fw/conffiles "${GFINS_FULL_CONFDIR}/gfins-fw.toml\n")
+# (/etc/gfins: the place GfinsInstallBoardFiles.cmake gives it under the package prefix /usr)
+file(WRITE ${PROJECT_BINARY_DIR}/packaging/gfins-fw/conffiles "/etc/gfins/gfins-fw.toml\n")
 set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_EXTRA
     "${GFINS_PKG_DIR}/deb/postinst;${GFINS_PKG_DIR}/deb/prerm;${GFINS_PKG_DIR}/deb/postrm;${PROJECT_BINARY_DIR}/packaging/gfins-fw/conffiles")
 set(CPACK_DEBIAN_BOARD_PACKAGE_CONTROL_STRICT_PERMISSION ON)

@@ -2,14 +2,17 @@
 # Debian packages per architecture (docs/deploy.md): configures and builds each preset, makes
 # its .deb files with CPack into out/deb/ and runs lintian on them; fails on any lintian error.
 #
-#   scripts/package.sh [preset...]      default: deb-amd64 aarch64-linux armhf-linux
+#   scripts/package.sh [preset...]      default: host-release aarch64-linux armhf-linux
 #
-# The cross presets need scripts/install-cross-deps.sh first. GFINS_JOBS sets the parallelism.
+# amd64 comes from host-release, the tree scripts/test.sh has already built (the packages' layout
+# is decided when installing, from the package prefix /usr: cmake/GfinsInstall.cmake), so making
+# the amd64 packages compiles nothing more. The cross presets need scripts/install-cross-deps.sh
+# first. GFINS_JOBS sets the parallelism.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${GFINS_JOBS:-$(nproc)}
 presets=("$@")
-[ ${#presets[@]} -gt 0 ] || presets=(deb-amd64 aarch64-linux armhf-linux)
+[ ${#presets[@]} -gt 0 ] || presets=(host-release aarch64-linux armhf-linux)
 out=out/deb
 mkdir -p "$out"
 command -v lintian >/dev/null || { echo "package.sh: lintian missing: apt install lintian" >&2; exit 1; }
