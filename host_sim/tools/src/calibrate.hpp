@@ -76,9 +76,12 @@ FileStatus check_settings(const FileSettings& settings);
 /// Location calibration (paper §4.2) from rate-table runs, given the orientation calibration
 /// (SF, bias, angles, nominal geometry and local gravity of `cal`): Δρ_j and its 1σ per body
 /// component, and which components the runs did not determine (held at 0; their σ is the
-/// mechanical prior `prior_sigma_m`).
+/// mechanical prior `prior_sigma_m`). sigma_m counts the runs' noise (solution.drho_cov_m2) and
+/// the uncertainty of `cal`'s SF, bias and angles (base_cov_m2, first order, with `cal`'s
+/// correlations; 0 correlation when cal.correlations_known is false).
 struct LocationReport {
   calib::LocationCalibration<double> solution;
+  std::array<nav::Mat3<double>, 6> base_cov_m2{};  // Δρ_j covariance from the base, m²
   std::array<std::array<double, 3>, 6> drho_m{};
   std::array<std::array<double, 3>, 6> sigma_m{};
   std::vector<std::string> lines;  // the report
