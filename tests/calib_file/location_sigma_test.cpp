@@ -35,8 +35,8 @@ constexpr std::array<double, 6> kScale{1.31, 1.35, 1.29, 1.37, 1.33, 1.30};  // 
 constexpr std::array<double, 6> kBiasG{0.002, -0.0015, 0.003, -0.0025, 0.001, -0.0005};
 constexpr std::array<double, 6> kBetaDeg{0.8, -1.2, 0.5, 1.5, -0.7, 0.9};
 constexpr std::array<double, 6> kAlphaDeg{-1.1, 0.6, 1.3, -0.4, 0.2, -1.6};
-constexpr std::array<double, 18> kDrhoMm{1.0,  -0.5, 0.3, -0.8, 0.6,  0.2, 0.4, 0.9,  -0.7,
-                                         -0.3, 0.5,  1.2, 0.7, -0.2, -0.6, 0.1, -0.9, 0.8};
+constexpr std::array<double, 18> kDrhoMm{1.0,  -0.5, 0.3, -0.8, 0.6,  0.2,  0.4, 0.9,  -0.7,
+                                         -0.3, 0.5,  1.2, 0.7,  -0.2, -0.6, 0.1, -0.9, 0.8};
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 // The runs of docs/calibration.md §5: five mountings (body axis up), 2, 6 and 10 rad/s, 6000
@@ -221,11 +221,11 @@ std::vector<LocationRunRow> draw_runs(std::mt19937_64& rng, const Truth& t) {
 }
 
 struct Tally {
-  double chi2_total = 0.0;  // against the stated covariance (runs + base)
-  double chi2_runs = 0.0;   // against the runs' part alone (the σ stated before)
+  double chi2_total = 0.0;         // against the stated covariance (runs + base)
+  double chi2_runs = 0.0;          // against the runs' part alone (the σ stated before)
   double chi2_uncorrelated = 0.0;  // base σ without the correlations (a format version 2 file)
-  double z2_sum = 0.0;      // per component against the file's σ
-  int beyond3 = 0;          // per components beyond 3σ
+  double z2_sum = 0.0;             // per component against the file's σ
+  int beyond3 = 0;                 // per components beyond 3σ
   int components = 0;
   int vectors = 0;
   double base_over_runs = 0.0;  // mean trace ratio, for the printout

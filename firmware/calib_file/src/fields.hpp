@@ -91,8 +91,11 @@ void visit_fields(D& d, V& v, std::int64_t version = kFormatVersion) {
       const SensorAngles a = sensor_angles(j);
       const std::string a1 = kAngleNames[a.angle[0]];
       const std::string a2 = kAngleNames[a.angle[1]];
+      std::string pair = a1;
+      pair += '_';
+      pair += a2;
       const std::array<std::string, kNumCorrelations> names = {
-          "scale_bias", "scale_" + a1, "scale_" + a2, "bias_" + a1, "bias_" + a2, a1 + "_" + a2};
+          "scale_bias", "scale_" + a1, "scale_" + a2, "bias_" + a1, "bias_" + a2, pair};
       for (std::size_t c = 0; c < kNumCorrelations; ++c) {
         v.number(p + "correlation." + names[c], s.correlation[c], Domain::kCorrelation);
       }
