@@ -975,6 +975,22 @@ TEST(FirmwareCalibration, LocationErrorsFromRateTableRunsCapturedThroughTheFirmw
       max_z_runs);
   EXPECT_GE(chi2, kChi2Low) << out;
   EXPECT_LE(chi2, kChi2High) << out;
+  // Optional data for docs/figures/location-sigma.png (scripts/plot_location_sigma.py).
+  if (const char* fig = std::getenv("GFINS_CAL_E2E_OUT"); fig != nullptr) {
+    std::ofstream f(std::filesystem::path(fig) / "location_z.csv");
+    f << "component,z_runs,z_total,chi2_runs,chi2_total\n";
+    for (std::size_t j = 0; j < 6; ++j) {
+      const Eigen::Matrix3d runs_cov = rep.value().solution.drho_cov_m2[j];
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto kk = static_cast<Eigen::Index>(k);
+        const double e =
+            solved.value().sensors[j].location_error_m[k] - truth.misalignment.drho_b[j](kk);
+        f << "a" << j + 1 << "xyz"[k] << "," << e / std::sqrt(runs_cov(kk, kk)) << ","
+          << e / solved.value().sensors[j].location_error_sigma_m[k] << "," << chi2_runs << ","
+          << chi2 << "\n";
+      }
+    }
+  }
   // Every component observed: no sensor names an unobservable direction.
   EXPECT_EQ(out.find("direction(s)"), std::string::npos) << out;
 
