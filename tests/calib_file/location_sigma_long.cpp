@@ -305,6 +305,27 @@ TEST(LocationSigma, ABaseFileWithoutCorrelationsIsUsedWithZeroCorrelationAndTheR
   EXPECT_NE(text.find("taken as 0"), std::string::npos) << text;
   // And the base part is there: the σ of SF, b and the angles alone give a nonzero covariance.
   for (const auto& c : rep.value().base_cov_m2) EXPECT_GT(c.trace(), 0.0);
+  EXPECT_EQ(text.find("states sigma = 0"), std::string::npos) << text;
+}
+
+TEST(LocationSigma, ABaseWithoutAnyStatedSigmaIsNamedInTheReport) {
+  // Given a base whose sensor 4 states σ = 0 for SF, b and both its angles (yx, yz of set α)
+  const Truth t = make_truth();
+  std::mt19937_64 rng(11);
+  calib_file::CalibrationData cal = draw_base(rng, Eigen::Matrix4d::Zero());
+  cal.sensors[3].scale_sigma_v_per_g = 0.0;
+  cal.sensors[3].bias_sigma_g = 0.0;
+  cal.alpha.angle_sigma_deg[2] = 0.0;
+  cal.alpha.angle_sigma_deg[3] = 0.0;
+  const auto rep = run_location_calibration(draw_runs(rng, t), cal, 1e-3, "runs.csv");
+  ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+  std::string text;
+  for (const auto& l : rep.value().lines) text += l + "\n";
+  // Then the report names it (and only it), and its base part is zero
+  EXPECT_NE(text.find("states sigma = 0 for SF, bias and angles of a4 ("), std::string::npos)
+      << text;
+  EXPECT_EQ(rep.value().base_cov_m2[3].trace(), 0.0);
+  EXPECT_GT(rep.value().base_cov_m2[0].trace(), 0.0);
 }
 
 }  // namespace

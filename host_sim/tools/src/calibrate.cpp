@@ -581,6 +581,15 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
            : "; its file predates format version 3 and states no correlations: taken as 0") +
       ", propagated to first order); the last column splits it as sigma_runs / sigma_base (mm, "
       "largest component)");
+  std::string no_sigma;  // sensors whose base states no uncertainty at all
+  for (std::size_t j = 0; j < 6; ++j) {
+    if (base_cov[j].isZero(0.0)) no_sigma += " a" + std::to_string(j + 1);
+  }
+  if (!no_sigma.empty()) {
+    rep.lines.push_back("  note: the base states sigma = 0 for SF, bias and angles of" + no_sigma +
+                        " (an exactly determined calibration without stated sigma): their "
+                        "uncertainty cannot be counted, the sigma below is the runs' alone");
+  }
   rep.lines.push_back(
       "sensor  drho_x (mm)          drho_y (mm)          drho_z (mm)          runs / base"
       "           not observable");
