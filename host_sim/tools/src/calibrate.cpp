@@ -477,7 +477,7 @@ namespace {
 // from the file's σ and correlations of its (SF, b, angle a1, angle a2) (docs/calibration.md,
 // location σ). With T = ∂(c, k, δθ)/∂(SF, b, a1, a2), first order in the errors of eq. (21)
 // s* = (P/SF − b)·g and of θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15)):
-//   SF → SF(1 + ε): s* → s* − ε(s* + b g), i.e. k = −ε, c = −ε b g  (∂/∂SF = ε/SF);
+//   SF → SF(1 + ε), ε = δSF/SF: s* → s* − ε(s* + b g), i.e. k = −ε, c = −ε b g;
 //   b → b + δb:     c = −g δb;
 //   angle a:        δθ = Σ_k ∂C_rk/∂a θ_k.
 // Returns T Σ Tᵀ with Σ = D R D (D the σ, R the correlations; R = I when the file predates them).
