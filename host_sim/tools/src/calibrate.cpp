@@ -473,43 +473,15 @@ FileStatus check_settings(const FileSettings& settings) {
 
 namespace {
 
-// Covariance of sensor j's generic base perturbations (calib::kBaseOffset, kBaseGain, kBaseAxis)
-// from the file's σ and correlations of its (SF, b, angle a1, angle a2) (docs/calibration.md,
-// location σ). With T = ∂(c, k, δθ)/∂(SF, b, a1, a2), first order in the errors of eq. (21)
-// s* = (P/SF − b)·g and of θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15)):
-//   SF → SF(1 + ε), ε = δSF/SF: s* → s* − ε(s* + b g), i.e. k = −ε, c = −ε b g;
-//   b → b + δb:     c = −g δb;
-//   angle a:        δθ = Σ_k ∂C_rk/∂a θ_k.
-// Returns T Σ Tᵀ with Σ = D R D (D the σ, R the correlations; R = I when the file predates them).
-Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams> base_perturbation_cov(
-    const calib_file::CalibrationData& cal, std::size_t j,
-    const nav::ArrayGeometry<double, 6>& nominal) {
+// The covariance the file states for sensor j's own parameters (SF [V/g], b [g], angle a1 [rad],
+// angle a2 [rad]; a1, a2 the row of C of eqs. (14)/(15) it owns, calib_file::sensor_angles()):
+// Σ_j = D R D, D the σ, R the correlations of SensorCalibration::correlation in the order
+// (SF,b) (SF,a1) (SF,a2) (b,a1) (b,a2) (a1,a2). A file older than format version 3 carries
+// zeros there (correlations_known false): R = I, "correlations unknown: taken as 0".
+Eigen::Matrix4d sensor_parameter_cov(const calib_file::CalibrationData& cal, std::size_t j) {
   const auto& s = cal.sensors[j];
-  const double g = cal.gravity_mps2;
   const calib_file::SensorAngles angles = calib_file::sensor_angles(j);
-  const auto& set = angles.alpha ? nav::kSetAlpha : nav::kSetBeta;
   const auto& angle_sigma = angles.alpha ? cal.alpha.angle_sigma_deg : cal.beta.angle_sigma_deg;
-  std::size_t row = 0;
-  for (std::size_t r = 0; r < 3; ++r) {
-    if (static_cast<std::size_t>(set[r]) == j) row = r;
-  }
-  Eigen::Matrix<double, calib::kNumBaseParams, 4> t =
-      Eigen::Matrix<double, calib::kNumBaseParams, 4>::Zero();
-  t(calib::kBaseOffset, 0) = -s.bias_g * g / s.scale_v_per_g;
-  t(calib::kBaseGain, 0) = -1.0 / s.scale_v_per_g;
-  t(calib::kBaseOffset, 1) = -g;
-  for (std::size_t m = 0; m < 2; ++m) {
-    std::array<double, 6> unit{};
-    unit[angles.angle[m]] = 1.0;
-    // C is affine in the angles: ∂C/∂a = C(e_a) − I.
-    const nav::Mat3<double> dc = nav::set_matrix(unit) - nav::Mat3<double>::Identity();
-    nav::Vec3<double> d = nav::Vec3<double>::Zero();
-    for (std::size_t k = 0; k < 3; ++k) {
-      d += dc(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(k)) *
-           nominal.theta_b[static_cast<std::size_t>(set[k])];
-    }
-    t.block<3, 1>(calib::kBaseAxis, static_cast<Eigen::Index>(2 + m)) = d;
-  }
   const Eigen::Vector4d sd(s.scale_sigma_v_per_g, s.bias_sigma_g,
                            angle_sigma[angles.angle[0]] * calib_file::kRadPerDeg,
                            angle_sigma[angles.angle[1]] * calib_file::kRadPerDeg);
@@ -520,8 +492,56 @@ Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams> base_perturb
     r(pairs[k][0], pairs[k][1]) = s.correlation[k];
     r(pairs[k][1], pairs[k][0]) = s.correlation[k];
   }
-  const Eigen::Matrix4d sigma = sd.asDiagonal() * r * sd.asDiagonal();
-  return t * sigma * t.transpose();
+  return sd.asDiagonal() * r * sd.asDiagonal();
+}
+
+// ∂θ*_j/∂a (per radian) for sensor j's two angles a1, a2: θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15),
+// r its row in its set) and C is affine in its angles, so ∂C/∂a = C(e_a) − I exactly.
+std::array<nav::Vec3<double>, 2> axis_derivatives(std::size_t j,
+                                                  const nav::ArrayGeometry<double, 6>& nominal) {
+  const calib_file::SensorAngles angles = calib_file::sensor_angles(j);
+  const auto& set = angles.alpha ? nav::kSetAlpha : nav::kSetBeta;
+  std::size_t row = 0;
+  for (std::size_t r = 0; r < 3; ++r) {
+    if (static_cast<std::size_t>(set[r]) == j) row = r;
+  }
+  std::array<nav::Vec3<double>, 2> out{};
+  for (std::size_t m = 0; m < 2; ++m) {
+    std::array<double, 6> unit{};
+    unit[angles.angle[m]] = 1.0;
+    const nav::Mat3<double> dc = nav::set_matrix(unit) - nav::Mat3<double>::Identity();
+    out[m].setZero();
+    for (std::size_t k = 0; k < 3; ++k) {
+      out[m] += dc(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(k)) *
+                nominal.theta_b[static_cast<std::size_t>(set[k])];
+    }
+  }
+  return out;
+}
+
+// Covariance of sensor j's generic base perturbations (calib::kBaseOffset, kBaseGain, kBaseAxis)
+// from the file's σ and correlations of its (SF, b, angle a1, angle a2) (docs/calibration.md,
+// location σ). With T = ∂(c, k, δθ)/∂(SF, b, a1, a2), first order in the errors of eq. (21)
+// s* = (P/SF − b)·g and of θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15)):
+//   SF → SF(1 + ε), ε = δSF/SF: s* → s* − ε(s* + b g), i.e. k = −ε, c = −ε b g;
+//   b → b + δb:     c = −g δb;
+//   angle a:        δθ = Σ_k ∂C_rk/∂a θ_k.
+// Returns T Σ Tᵀ with Σ = sensor_parameter_cov().
+Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams> base_perturbation_cov(
+    const calib_file::CalibrationData& cal, std::size_t j,
+    const nav::ArrayGeometry<double, 6>& nominal) {
+  const auto& s = cal.sensors[j];
+  const double g = cal.gravity_mps2;
+  Eigen::Matrix<double, calib::kNumBaseParams, 4> t =
+      Eigen::Matrix<double, calib::kNumBaseParams, 4>::Zero();
+  t(calib::kBaseOffset, 0) = -s.bias_g * g / s.scale_v_per_g;
+  t(calib::kBaseGain, 0) = -1.0 / s.scale_v_per_g;
+  t(calib::kBaseOffset, 1) = -g;
+  const auto d_theta = axis_derivatives(j, nominal);
+  for (std::size_t m = 0; m < 2; ++m) {
+    t.block<3, 1>(calib::kBaseAxis, static_cast<Eigen::Index>(2 + m)) = d_theta[m];
+  }
+  return t * sensor_parameter_cov(cal, j) * t.transpose();
 }
 
 }  // namespace
@@ -633,16 +653,26 @@ FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
   if (poses) {
     for (const Pose& p : *poses) pose_of[p.attitude] = p.f_b_g;
   }
-  const auto theta_of = [](const calib_file::CalibrationData& d) {
-    return nav::misaligned_geometry(calib_file::nominal_geometry<double>(d),
-                                    calib_file::misalignment<double>(d))
-        .theta_b;
-  };
-  const auto theta = theta_of(cal);
+  const auto nominal = calib_file::nominal_geometry<double>(cal);
+  const auto theta =
+      nav::misaligned_geometry(nominal, calib_file::misalignment<double>(cal)).theta_b;
   VerifyReport rep;
   rep.lines.push_back("verification against the calibration of device " + cal.device_id +
                       ": residual P - SF (b + theta*.a) per pose and sensor (mV), z = residual / "
-                      "predicted sigma (mean noise and the file's own uncertainties)");
+                      "predicted sigma");
+  rep.lines.push_back(
+      std::string("predicted sigma = the capture's noise (std_v/sqrt(count), where given) and the "
+                  "file's covariance of each sensor's SF, bias and two angles (their sigma") +
+      (cal.correlations_known
+           ? " and correlations"
+           : "; correlations unknown: taken as 0, the file predates format version 3") +
+      "), propagated to first order through eq. (16)");
+  std::array<Eigen::Matrix4d, 6> cov{};
+  std::array<std::array<nav::Vec3<double>, 2>, 6> d_theta{};
+  for (std::size_t j = 0; j < 6; ++j) {
+    cov[j] = sensor_parameter_cov(cal, j);
+    d_theta[j] = axis_derivatives(j, nominal);
+  }
   for (const MeanRow& m : means) {
     std::array<double, 3> a{};
     if (poses) {
@@ -667,22 +697,19 @@ FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
     const double proj = theta[j].dot(av);
     const double predicted = s.scale_v_per_g * (s.bias_g + proj);  // eq. (16), g = T = 1
     const double res = m.mean_v - predicted;
-    // Predicted σ: the mean's own, and the file's σ of SF, b and every angle of the sensor's set
-    // (first order; the angles by a one-σ perturbation of each).
-    double var = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
-    var += (s.bias_g + proj) * (s.bias_g + proj) * s.scale_sigma_v_per_g * s.scale_sigma_v_per_g;
-    var += s.scale_v_per_g * s.scale_v_per_g * s.bias_sigma_g * s.bias_sigma_g;
-    for (const bool alpha : {false, true}) {
-      for (std::size_t i = 0; i < 6; ++i) {
-        calib_file::CalibrationData e = cal;
-        auto& set = alpha ? e.alpha : e.beta;
-        set.angle_deg[i] += set.angle_sigma_deg[i];
-        const double d = s.scale_v_per_g * (theta_of(e)[j].dot(av) - proj);
-        var += d * d;
-      }
-    }
+    // Predicted σ, first order: h = SF (b + θ*(a1, a2)·a) (eq. (16), θ* of eqs. (14)/(15)) has
+    // ∂h/∂(SF, b, a1, a2) = (b + θ*·a, SF, SF ∂θ*/∂a1·a, SF ∂θ*/∂a2·a); the residual's variance
+    // is the mean's own plus J Σ_j Jᵀ with the file's whole 4×4 covariance Σ_j of the sensor.
+    // Sensors are independent, so no other sensor's parameters enter.
+    const Eigen::Vector4d jac(s.bias_g + proj, s.scale_v_per_g,
+                              s.scale_v_per_g * d_theta[j][0].dot(av),
+                              s.scale_v_per_g * d_theta[j][1].dot(av));
+    const double var_mean = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
+    // A valid file's Σ_j is positive semidefinite (checked on load); max() guards rounding.
+    const double var = var_mean + std::max(0.0, jac.dot(cov[j] * jac));
     const double sigma = std::sqrt(var);
     const double z = sigma > 0.0 ? res / sigma : 0.0;
+    rep.rows.push_back(VerifyRow{m.attitude, m.sensor, res, sigma, std::sqrt(var_mean)});
     if (std::abs(z) > rep.max_abs_z) {
       rep.max_abs_z = std::abs(z);
       rep.worst_sensor = m.sensor;

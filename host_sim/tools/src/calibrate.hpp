@@ -102,11 +102,21 @@ void print_report(std::ostream& out, const CalibrationRun& run);
 std::vector<std::string> verdict_warnings(const calib::MultiAttitudeResult<double>& r);
 
 /// Verification poses against an installed calibration: per pose and sensor the residual
-/// P − SF (b + θ*·a) (eq. (16), a in local g) and its z, the residual over its predicted σ (the
-/// stated σ of the mean and the file's own σ of SF, b and the angles, first order). Poses
+/// P − SF (b + θ*·a) (eqs. (16)/(21), a in local g) and its z, the residual over its predicted σ:
+/// the capture's noise (std_v/√count where given) and the file's covariance of the sensor's SF,
+/// b and two angles (its σ and correlations; correlations taken as 0 when
+/// cal.correlations_known is false), propagated to first order (docs/calibration.md §7). Poses
 /// without a poses file are numbered as in Tables 2/3.
+struct VerifyRow {
+  int attitude = 0;
+  int sensor = 0;             // 1-based
+  double residual_v = 0.0;    // P − SF (b + θ*·a), V
+  double sigma_v = 0.0;       // predicted 1σ of the residual, V
+  double sigma_mean_v = 0.0;  // the capture's part of it (std_v/√count), V
+};
 struct VerifyReport {
   std::vector<std::string> lines;
+  std::vector<VerifyRow> rows;  // one per row of the means, in their order
   double max_abs_z = 0.0;
   int worst_sensor = 0;  // 1-based
   int worst_pose = 0;
