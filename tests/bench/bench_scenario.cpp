@@ -37,8 +37,8 @@ double volts_per_count() {
 Workload make_workload() {
   const auto trajectory = sim::make_maneuver(1.0);
   sim::SensorArrayModel sensors(nav::table1_geometry<double>(kRhoM), array_errors(),
-                                nav::GravityModel<double>::constant(nav::kStandardGravity),
-                                kRateHz, /*seed=*/1);
+                                nav::GravityModel<double>::constant(nav::kStandardGravity), kRateHz,
+                                /*seed=*/1);
   sim::SampleSource source(*trajectory, std::move(sensors), sim::make_source_adc(adc_config()),
                            kRateHz);
   Workload w;
