@@ -33,6 +33,8 @@ inline CalibrationData table6_data() {
     s.bias_sigma_g = 2e-6;
     s.location_error_m = {1e-4 * static_cast<double>(j), -2e-4, 0.0};
     s.location_error_sigma_m = {5e-5, 5e-5, 5e-5};
+    // (SF,b) (SF,a1) (SF,a2) (b,a1) (b,a2) (a1,a2): made up, a valid correlation matrix.
+    s.correlation = {0.25, -0.125, 0.5, 0.0625, -0.375, 0.1875};
   }
   d.beta.angle_deg = {1.117319, -0.175730, -0.581196, -0.738742, 2.454457, 2.482135};
   d.alpha.angle_deg = {-2.654967, 2.596778, -0.838703, -0.737387, 0.119537, -1.451107};

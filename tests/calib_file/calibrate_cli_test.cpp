@@ -229,8 +229,9 @@ TEST(CalibrateCli, AVerificationPoseShowsTheResidualsAndCatchesAWrongOne) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("pose 1 sensor a2: residual"));
   EXPECT_THAT(r.output, HasSubstr("verification passed"));
-  // and a pose whose sensor 3 reads 50 mV off (a mis-seated jig: ~0.1 g on SF 0.5 V/g, 18x the
-  // predicted sigma of ~2.7 mV) fails, naming the sensor and the pose.
+  // and a pose whose sensor 3 reads 50 mV off (a mis-seated jig: ~0.1 g on SF 0.5 V/g, 175x the
+  // predicted sigma of 0.29 mV, the file's covariance through eq. (16)) fails,
+  // naming the sensor and the pose.
   std::string text = read_text(kGolden);
   const auto at = text.find("\n3,2,");
   ASSERT_NE(at, std::string::npos);

@@ -121,35 +121,93 @@ TEST_F(LoadErrors, BrokenSyntaxNamesTheLineAndColumn) {
 }
 
 TEST_F(LoadErrors, AnotherFormatVersionIsRefusedNamingBothVersions) {
-  const int line = line_of(good_, "format_version = 2");
-  const FileStatus s = load_text(replace_once(good_, "format_version = 2", "format_version = 3"));
+  const int line = line_of(good_, "format_version = 3");
+  const FileStatus s = load_text(replace_once(good_, "format_version = 3", "format_version = 4"));
   EXPECT_EQ(s.code(), ErrorCode::kUnimplemented);
   EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) +
-                                     ": format version 3 is "
-                                     "not supported (this build reads versions 1 to 2)"));
+                                     ": format version 4 is "
+                                     "not supported (this build reads versions 1 to 3)"));
 }
 
-// A version-1 file as the previous build wrote it: no [gravity] table, "format_version = 1",
-// and the checksum over the version-1 key list (written here from docs/calibration-file.md:
-// the canonical text without the two gravity lines).
-std::string version1_text(const CalibrationData& d) {
+// Removes every line of `text` that starts with `prefix` (canonical text: one key per line).
+std::string drop_lines(std::string text, const std::string& prefix) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const auto end = text.find('\n', at);
+    const std::string line = text.substr(at, end - at + 1);
+    if (line.rfind(prefix, 0) != 0) out += line;
+    at = end + 1;
+  }
+  return out;
+}
+
+// Removes the TOML table whose header line contains `header` (up to the next blank line).
+std::string drop_table(std::string text, const std::string& header) {
+  const auto h = text.find(header);
+  EXPECT_NE(h, std::string::npos) << header;
+  const auto line_start = text.rfind('\n', h) + 1;
+  const auto end = text.find("\n\n", h);
+  return text.erase(line_start, end + 2 - line_start);
+}
+
+// A file as an older build wrote it (written here from docs/calibration-file.md, versioning):
+// version 2 without the sensor.N.correlation tables and orientation.correlations, version 1
+// also without [gravity]; the checksum over that version's key list.
+std::string older_version_text(const CalibrationData& d, int version) {
   std::string text = to_toml_text(d);
-  const auto g0 = text.find("[gravity]\n");
-  const auto g1 = text.find("\n\n", g0);
-  text.erase(g0, g1 + 2 - g0);
-  text = replace_once(text, "format_version = 2", "format_version = 1");
   std::string canon = canonical_serialisation(d);
-  canon = replace_once(canon, "format_version=2\n", "format_version=1\n");
-  const auto c0 = canon.find("gravity.local_mps2=");
-  const auto c1 = canon.find("sensor.1.", c0);
-  canon.erase(c0, c1 - c0);
+  for (int j = 1; j <= 6; ++j) {
+    text = drop_table(text, "[sensor." + std::to_string(j) + ".correlation]\n");
+    canon = drop_lines(canon, "sensor." + std::to_string(j) + ".correlation.");
+  }
+  text = replace_once(text, "[orientation]\ncorrelations = 'stated'\n\n", "");
+  canon = drop_lines(canon, "orientation.correlations=");
+  if (version < 2) {
+    text = drop_table(text, "[gravity]\n");
+    canon = drop_lines(canon, "gravity.");
+  }
+  const std::string v = std::to_string(version);
+  text = replace_once(text, "format_version = 3", "format_version = " + v);
+  canon = replace_once(canon, "format_version=3\n", "format_version=" + v + "\n");
   char old_sum[40];
-  char v1_sum[40];
+  char new_sum[40];
   std::snprintf(old_sum, sizeof old_sum, "fnv1a64:%016llx",
                 static_cast<unsigned long long>(checksum(d)));
-  std::snprintf(v1_sum, sizeof v1_sum, "fnv1a64:%016llx",
+  std::snprintf(new_sum, sizeof new_sum, "fnv1a64:%016llx",
                 static_cast<unsigned long long>(fnv1a64(canon)));
-  return replace_once(text, old_sum, v1_sum);
+  return replace_once(text, old_sum, new_sum);
+}
+std::string version1_text(const CalibrationData& d) { return older_version_text(d, 1); }
+
+TEST(FormatVersion2, LoadsWithoutCorrelationsAndSaysSo) {
+  // Given a version-2 file (σ of SF, b and the angles, but not their correlations)
+  const CalibrationData d = table6_data();
+  const auto r = parse_calibration_text(older_version_text(d, 2), "v2.toml");
+  // Then every value reads back, the correlations are 0 and marked as not known
+  ASSERT_TRUE(r.is_ok()) << r.status().message();
+  CalibrationData expected = d;
+  for (auto& s : expected.sensors) s.correlation = {};
+  expected.correlations_known = false;
+  EXPECT_EQ(r.value(), expected);
+  // And re-saved as version 3 the file says that they are not known
+  const std::string text = to_toml_text(r.value());
+  EXPECT_NE(text.find("correlations = 'unknown: taken as 0'"), std::string::npos) << text;
+  const auto again = parse_calibration_text(text, "v3.toml");
+  ASSERT_TRUE(again.is_ok()) << again.status().message();
+  EXPECT_EQ(again.value(), expected);
+}
+
+TEST_F(LoadErrors, AVersion3FileWithoutCorrelationsIsRefused) {
+  const FileStatus s = load_text(replace_once(good_, "scale_bias = 0.25\n", ""));
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("missing key 'sensor.1.correlation.scale_bias'"));
+}
+
+TEST_F(LoadErrors, AnUnknownCorrelationsStateIsRefused) {
+  const FileStatus s =
+      load_text(replace_once(good_, "correlations = 'stated'", "correlations = 'x'"));
+  EXPECT_THAT(s.message(), HasSubstr("orientation.correlations is \"x\": expected \"stated\" or"));
 }
 
 TEST(FormatVersion1, LoadsWithStandardGravityAndSaysSo) {
@@ -163,9 +221,11 @@ TEST(FormatVersion1, LoadsWithStandardGravityAndSaysSo) {
   CalibrationData expected = d;
   expected.gravity_mps2 = nav::kStandardGravity;
   expected.gravity_source = kVersion1GravitySource;
+  for (auto& s : expected.sensors) s.correlation = {};  // not in version 1 either
+  expected.correlations_known = false;
   EXPECT_EQ(r.value(), expected);
-  // And re-saved it becomes a version-2 file that loads with the same values
-  const auto again = parse_calibration_text(to_toml_text(r.value()), "v2.toml");
+  // And re-saved it becomes a version-3 file that loads with the same values
+  const auto again = parse_calibration_text(to_toml_text(r.value()), "v3.toml");
   ASSERT_TRUE(again.is_ok()) << again.status().message();
   EXPECT_EQ(again.value(), expected);
 }
@@ -185,7 +245,7 @@ TEST_F(LoadErrors, AVersion2FileWithoutGravityIsRefused) {
 }
 
 TEST_F(LoadErrors, MissingVersionIsRefused) {
-  const FileStatus s = load_text(replace_once(good_, "format_version = 2", ""));
+  const FileStatus s = load_text(replace_once(good_, "format_version = 3", ""));
   EXPECT_THAT(s.message(), HasSubstr("missing key 'format_version'"));
 }
 
@@ -287,6 +347,25 @@ TEST_F(OutOfRange, GravityInGInsteadOfMetresPerSecondSquared) {
   CalibrationData d = table6_data();
   d.gravity_mps2 = 1.0;
   expect_refused(d, "gravity.local_mps2", "= 1: must be a local gravity in [9.7, 9.9] m/s²");
+}
+
+TEST_F(OutOfRange, CorrelationBeyondOne) {
+  CalibrationData d = table6_data();
+  d.sensors[1].correlation[0] = 1.5;
+  expect_refused(d, "sensor.2.correlation.scale_bias",
+                 "= 1.5: a correlation coefficient must be in [-1, 1]");
+}
+
+TEST_F(OutOfRange, CorrelationsThatAreNotACorrelationMatrix) {
+  // Given coefficients each within [-1, 1] whose matrix is not positive semidefinite: SF fully
+  // correlated with b and with angle 1, but b and angle 1 anti-correlated (eigenvalue −1)
+  CalibrationData d = table6_data();
+  d.sensors[3].correlation = {1.0, 1.0, 0.0, -1.0, 0.0, 0.0};
+  const FileStatus s = load_text(to_toml_text(d));
+  EXPECT_EQ(s.code(), ErrorCode::kOutOfRange) << s.message();
+  EXPECT_THAT(s.message(), HasSubstr("sensor.4.correlation is not a correlation matrix"));
+  const FileStatus saved = save_calibration_file(dir_.path() / "refused.toml", d);
+  EXPECT_EQ(saved.code(), ErrorCode::kOutOfRange);
 }
 
 TEST_F(OutOfRange, BadDeviceIdAndTimestamp) {

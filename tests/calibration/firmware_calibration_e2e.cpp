@@ -30,8 +30,10 @@
 #include <sstream>
 #include <string>
 
+#include "calibrate.hpp"
 #include "capture_sequence.hpp"
 #include "command_client.hpp"
+#include "csv.hpp"
 #include "gfins/app/can_adapters.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/epoch_sinks.hpp"
@@ -722,12 +724,20 @@ TEST(FirmwareCalibration, ThePoseSequenceHoldsEachPoseStillAndTurnsSmoothly) {
 // sensors: SF, bias, orientation and location errors, its 24.8° site) spinning at a constant
 // rate; the host's StartCapture (capture_once, the code of gfins-can calibrate --rate-table)
 // averages whole revolutions through the firmware, and location_run_row writes the row
-// gfins-calibrate --location-runs reads. The base calibration is the scenario's truth for SF,
-// bias and orientation (the location solve takes them as known, §5).
+// gfins-calibrate --location-runs reads. The base calibration is the one a user has: the twelve
+// poses captured through the firmware and solved by gfins-calibrate (base_through_firmware), so
+// its SF, biases and angles carry their own errors, which the stated σ of Δρ must include.
 
 // Δρ recovered vs truth: |est − true| ≤ kLocationSigmas·σ, σ the file's stated 1σ. 18
 // components, Gaussian with honest σ: P(any beyond 5σ) = 18 · 5.7e-7 = 1e-5 (false failure).
 constexpr double kLocationSigmas = 5.0;
+// Coverage of the truth by the stated covariance: χ² = Σ_j e_jᵀ C_j⁻¹ e_j over the six sensors
+// (e_j = Δρ_j estimated − true, C_j the stated 3×3 covariance, runs + base; sensors independent
+// with the axis through the centre) is χ² with 18 dof. Bounds: its 1e-4 and 1 − 1e-4 quantiles
+// (computed from the regularised incomplete gamma function), so a correct σ fails with
+// probability 2e-4; σ stated 3× too small (χ² ≈ 160) or 3× too large (χ² ≈ 2) fails.
+constexpr double kChi2Low = 3.555;
+constexpr double kChi2High = 49.19;
 // Samples per capture: whole revolutions totalling about 6 s at 1 kHz. σ of a 10 rad/s run's
 // mean is 0.5 mg/√6000 = 6.3e-5 m/s², i.e. 0.6 µm of Δρ at ω² = 100 s⁻²; the truth's Δρ
 // (0.1–1.2 mm) is hundreds of σ away from 0, so a solver writing Δρ = 0 fails.
@@ -792,32 +802,38 @@ std::string rate_table_scenario(const sim::Scenario& truth, const Mounting& m, d
   return t;
 }
 
-/// The base calibration: the truth of SF, bias and orientation in the file's units (V per local
-/// g, local g, degrees), Δρ = 0, small stated σ.
-calib_file::CalibrationData truth_as_base(const sim::Scenario& s, double adc_lsb, double g_local) {
-  calib_file::CalibrationData d;
-  d.device_id = "sim-board-1";
-  d.created_utc = "2026-01-01T00:00:00Z";
-  d.source = "truth of calibration-board";
-  d.geometry.rho_m = s.rho_m;
-  d.gravity_mps2 = g_local;
-  d.gravity_source = "given";
-  for (std::size_t j = 0; j < 6; ++j) {
-    auto& e = d.sensors[j];
-    e.adc_lsb_v_per_count = adc_lsb;
-    // The sensor model's SF is V per standard g (sensor_model.hpp).
-    e.scale_v_per_g = s.scale_v_per_g[j] / nav::kStandardGravity * g_local;
-    e.scale_sigma_v_per_g = 1e-6;
-    e.bias_g = s.bias_mps2[j] / g_local;
-    e.bias_sigma_g = 1e-6;
+/// The base calibration as a user makes it: the twelve poses of Tables 2/3 captured through the
+/// firmware (the board of `scenario`, auto wait) and solved by gfins-calibrate's general route
+/// at the scenario's site; returns the file's path.
+std::filesystem::path base_through_firmware(const std::filesystem::path& dir) {
+  Board b(dir / "none.toml");
+  const std::vector<PlanPose> plan = can_tool::tables23_plan();
+  SequenceOptions o = b.options();
+  o.wait = can_tool::WaitMode::kAuto;
+  const SequenceResult seq = can_tool::run_capture_sequence(*b.host_bus, plan, o, SequenceIo{});
+  if (!seq.ok || seq.captures.size() != plan.size()) {
+    ADD_FAILURE() << "base capture: " << seq.error;
+    return {};
   }
-  for (std::size_t i = 0; i < 6; ++i) {
-    d.beta.angle_deg[i] = s.misalignment.orientation.beta[i] * 180.0 / M_PI;
-    d.alpha.angle_deg[i] = s.misalignment.orientation.alpha[i] * 180.0 / M_PI;
-    d.beta.angle_sigma_deg[i] = 1e-4;
-    d.alpha.angle_sigma_deg[i] = 1e-4;
+  write(dir / "base-means.csv", can_tool::means_csv(seq.captures, o.adc_lsb_v, false));
+  write(dir / "base-poses.csv", can_tool::poses_csv(plan));
+  char lsb_text[40];
+  std::snprintf(lsb_text, sizeof lsb_text, "%.17g", o.adc_lsb_v);
+  char lat_text[40];
+  std::snprintf(lat_text, sizeof lat_text, "%.17g", b.s.latitude_rad * 180.0 / M_PI);
+  char height_text[40];
+  std::snprintf(height_text, sizeof height_text, "%.17g", b.s.height_m);
+  int rc = -1;
+  const std::string out = run_calibrate(
+      {"--means", (dir / "base-means.csv").string(), "--poses", (dir / "base-poses.csv").string(),
+       "--latitude", lat_text, "--height", height_text, "--device-id", "sim-board-1", "--adc-lsb",
+       lsb_text, "-o", (dir / "base.toml").string()},
+      dir, rc);
+  if (rc != 0) {
+    ADD_FAILURE() << "base calibration: exit " << rc << "\n" << out;
+    return {};
   }
-  return d;
+  return dir / "base.toml";
 }
 
 /// Captures every run of `mountings` through the firmware; the --location-runs CSV (header +
@@ -892,23 +908,26 @@ TEST(FirmwareCalibration, LocationErrorsFromRateTableRunsCapturedThroughTheFirmw
   const double g_local =
       nav::GravityModel<double>::normal(truth.latitude_rad, truth.height_m).magnitude_at_origin();
 
-  // 1. The runs of all five mountings, through the firmware's capture command.
+  // 1. The base (orientation) calibration through the firmware, then the runs of all five
+  // mountings through the firmware's capture command.
+  const std::filesystem::path base_file = base_through_firmware(dir.path);
+  ASSERT_FALSE(base_file.empty());
+  const auto base = calib_file::load_calibration_file(base_file);
+  ASSERT_TRUE(base.is_ok()) << base.status().message();
+  EXPECT_TRUE(base.value().correlations_known);
+  // The site the runs are simulated at (the same WGS-84 normal gravity, 17 digits on both sides).
+  EXPECT_NEAR(base.value().gravity_mps2, g_local, 1e-9);
   double adc_lsb = 0;
   const std::vector<Mounting> all(kMountings.begin(), kMountings.end());
   const std::string csv = capture_location_runs(dir.path, truth, all, adc_lsb);
   ASSERT_FALSE(csv.empty());
   write(dir.path / "runs.csv", csv);
-  ASSERT_EQ(calib_file::save_calibration_file(dir.path / "base.toml",
-                                              truth_as_base(truth, adc_lsb, g_local))
-                .message(),
-            "");
 
   // 2. gfins-calibrate solves Δρ on top of the base calibration.
   int rc = -1;
-  std::string out =
-      run_calibrate({"--location-runs", (dir.path / "runs.csv").string(), "--base",
-                     (dir.path / "base.toml").string(), "-o", (dir.path / "loc.toml").string()},
-                    dir.path, rc);
+  std::string out = run_calibrate({"--location-runs", (dir.path / "runs.csv").string(), "--base",
+                                   base_file.string(), "-o", (dir.path / "loc.toml").string()},
+                                  dir.path, rc);
   ASSERT_EQ(rc, 0) << out;
   std::printf("%s", out.c_str());
   const auto solved = calib_file::load_calibration_file(dir.path / "loc.toml");
@@ -917,6 +936,61 @@ TEST(FirmwareCalibration, LocationErrorsFromRateTableRunsCapturedThroughTheFirmw
   std::printf("location through the firmware: largest |est - true|/sigma %.2f (%s)\n", c.max_z,
               c.worst.c_str());
   EXPECT_LE(c.max_z, kLocationSigmas) << c.worst << "\n" << out;
+  EXPECT_NE(out.find("and the base calibration's uncertainty"), std::string::npos) << out;
+  // The full 3×3 covariance per sensor: the tool's own computation on the same inputs (the file
+  // keeps the diagonal, checked equal below), then χ² of the truth against it.
+  const auto rows = tools::read_location_runs(dir.path / "runs.csv");
+  ASSERT_TRUE(rows.is_ok()) << rows.status().message();
+  const auto rep = tools::run_location_calibration(rows.value(), base.value(), 1e-3, "runs.csv");
+  ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+  double chi2 = 0.0;
+  double chi2_runs = 0.0;
+  double max_z_runs = 0.0;
+  double z2_sum = 0.0;       // per component, against the file's σ
+  double z2_runs_sum = 0.0;  // per component, against the runs' σ alone
+  for (std::size_t j = 0; j < 6; ++j) {
+    const Eigen::Matrix3d runs_cov = rep.value().solution.drho_cov_m2[j];
+    const Eigen::Matrix3d total = runs_cov + rep.value().base_cov_m2[j];
+    Eigen::Vector3d e;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      e(kk) = solved.value().sensors[j].location_error_m[k] - truth.misalignment.drho_b[j](kk);
+      // The file's σ is the square root of this covariance's diagonal (the same computation).
+      EXPECT_NEAR(solved.value().sensors[j].location_error_sigma_m[k], std::sqrt(total(kk, kk)),
+                  1e-9 * std::sqrt(total(kk, kk)));
+      const double z_runs = e(kk) / std::sqrt(runs_cov(kk, kk));
+      const double z = e(kk) / solved.value().sensors[j].location_error_sigma_m[k];
+      max_z_runs = std::max(max_z_runs, std::abs(z_runs));
+      z2_runs_sum += z_runs * z_runs;
+      z2_sum += z * z;
+    }
+    chi2 += e.dot(total.ldlt().solve(e));
+    chi2_runs += e.dot(runs_cov.ldlt().solve(e));
+  }
+  std::printf(
+      "base through the firmware: chi2 of the 18 components %.2f (chi2/dof %.3f; mean z^2 per "
+      "component %.3f, worst |z| %.2f) against the stated covariance (runs + base); %.2f "
+      "(chi2/dof %.3f; mean z^2 %.3f, worst |z| %.2f) against the runs' noise alone\n",
+      chi2, chi2 / 18.0, z2_sum / 18.0, c.max_z, chi2_runs, chi2_runs / 18.0, z2_runs_sum / 18.0,
+      max_z_runs);
+  EXPECT_GE(chi2, kChi2Low) << out;
+  EXPECT_LE(chi2, kChi2High) << out;
+  // Optional data for docs/figures/location-sigma.png (scripts/plot_location_sigma.py).
+  if (const char* fig = std::getenv("GFINS_CAL_E2E_OUT"); fig != nullptr) {
+    std::ofstream f(std::filesystem::path(fig) / "location_z.csv");
+    f << "component,z_runs,z_total,chi2_runs,chi2_total\n";
+    for (std::size_t j = 0; j < 6; ++j) {
+      const Eigen::Matrix3d runs_cov = rep.value().solution.drho_cov_m2[j];
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto kk = static_cast<Eigen::Index>(k);
+        const double e =
+            solved.value().sensors[j].location_error_m[k] - truth.misalignment.drho_b[j](kk);
+        f << "a" << j + 1 << "xyz"[k] << "," << e / std::sqrt(runs_cov(kk, kk)) << ","
+          << e / solved.value().sensors[j].location_error_sigma_m[k] << "," << chi2_runs << ","
+          << chi2 << "\n";
+      }
+    }
+  }
   // Every component observed: no sensor names an unobservable direction.
   EXPECT_EQ(out.find("direction(s)"), std::string::npos) << out;
 

@@ -8,6 +8,8 @@
 #include <ctime>
 #include <string>
 
+#include <Eigen/Eigenvalues>
+
 #include "fields.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 
@@ -17,6 +19,11 @@ namespace gfins::calib_file {
 namespace {
 
 using detail::Domain;
+
+// Smallest eigenvalue a stored correlation matrix may have. Coefficients computed from a positive
+// semidefinite covariance and written with round-trip precision are PSD to rounding (~1e-16); an
+// exactly singular one (|ρ| = 1, an angle fixed by SF) may land a few ulps below zero.
+constexpr double kCorrelationPsdTolerance = 1e-9;
 
 // Shortest text that reads back to x (as the file prints it).
 std::string format_double(double x) {
@@ -77,6 +84,7 @@ class Validator {
       fail(key, "unknown geometry kind");
     }
   }
+  void correlations(const std::string&, bool) {}
   void compensator(const std::string& key, nav::CompensatorKind k) {
     if (!found() && k != nav::CompensatorKind::kNone && k != nav::CompensatorKind::kPaper &&
         k != nav::CompensatorKind::kExact) {
@@ -139,6 +147,9 @@ class Validator {
         return x >= kMinGravityMps2 && x <= kMaxGravityMps2
                    ? ""
                    : "must be a local gravity in [9.7, 9.9] m/s² (not g, not Gal)";
+      case Domain::kCorrelation:
+        return std::fabs(x) <= kMaxAbsCorrelation ? ""
+                                                  : "a correlation coefficient must be in [-1, 1]";
       default:
         return "";
     }
@@ -155,6 +166,9 @@ class Canonical {
   void unit(const std::string& key, const char* u) { line(key, u); }
   void geometry_kind(const std::string& key, GeometryKind k) { line(key, to_string(k)); }
   void compensator(const std::string& key, nav::CompensatorKind k) { line(key, nav::to_string(k)); }
+  void correlations(const std::string& key, bool known) {
+    line(key, known ? kCorrelationsStated : kCorrelationsUnknown);
+  }
   void number(const std::string& key, double x, Domain) { line(key, bits(x)); }
   void vec3(const std::string& key, const std::array<double, 3>& v, Domain) {
     line(key, bits(v[0]) + "," + bits(v[1]) + "," + bits(v[2]));
@@ -194,7 +208,28 @@ Problem validate(const CalibrationData& data) {
   // ρ first: the location bound depends on it.
   v.number("geometry.rho_m", data.geometry.rho_m, Domain::kRho);
   detail::visit_fields(data, v);
-  return v.problem();
+  if (v.problem().found()) return v.problem();
+  // Each sensor's correlations must form a correlation matrix (positive semidefinite), or the
+  // covariance they rebuild with the σ could give a negative variance to a derived quantity.
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    const auto& c = data.sensors[j].correlation;
+    Eigen::Matrix4d r = Eigen::Matrix4d::Identity();
+    const std::array<std::array<int, 2>, kNumCorrelations> at = {
+        {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+    for (std::size_t k = 0; k < kNumCorrelations; ++k) {
+      r(at[k][0], at[k][1]) = c[k];
+      r(at[k][1], at[k][0]) = c[k];
+    }
+    const double smallest =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(r, Eigen::EigenvaluesOnly).eigenvalues()(0);
+    if (!(smallest >= -kCorrelationPsdTolerance)) {
+      return Problem{"sensor." + std::to_string(j + 1) + ".correlation",
+                     "is not a correlation matrix (not positive semidefinite: smallest "
+                     "eigenvalue " +
+                         format_double(smallest) + ")"};
+    }
+  }
+  return Problem{};
 }
 
 std::string canonical_serialisation(const CalibrationData& data, std::int64_t version) {

@@ -15,19 +15,20 @@ namespace gfins::calib_file::detail {
 
 /// What a value must satisfy (validate()).
 enum class Domain : std::uint8_t {
-  kAdcLsb,    // finite, 0 < x ≤ kMaxAdcLsbV
-  kScale,     // finite, x > 0
-  kSigma,     // finite, x ≥ 0
-  kBias,      // finite, |x| ≤ kMaxAbsBiasG
-  kAngle,     // finite, |x| ≤ kMaxAngleDeg
-  kLocation,  // finite, |x| ≤ kMaxLocationErrorOfRho · ρ
-  kRho,       // finite, 0 < x ≤ kMaxRhoM
-  kPosition,  // finite, |x| ≤ kMaxPositionM
-  kAxis,      // finite, unit length within kAxisUnitTolerance
-  kDeviceId,  // [A-Za-z0-9._-]{1,64}
-  kUtc,       // YYYY-MM-DDTHH:MM:SSZ
-  kSource,    // printable ASCII, ≤ kMaxSourceLength
-  kGravity,   // finite, kMinGravityMps2 ≤ x ≤ kMaxGravityMps2
+  kAdcLsb,       // finite, 0 < x ≤ kMaxAdcLsbV
+  kScale,        // finite, x > 0
+  kSigma,        // finite, x ≥ 0
+  kBias,         // finite, |x| ≤ kMaxAbsBiasG
+  kAngle,        // finite, |x| ≤ kMaxAngleDeg
+  kLocation,     // finite, |x| ≤ kMaxLocationErrorOfRho · ρ
+  kRho,          // finite, 0 < x ≤ kMaxRhoM
+  kPosition,     // finite, |x| ≤ kMaxPositionM
+  kAxis,         // finite, unit length within kAxisUnitTolerance
+  kDeviceId,     // [A-Za-z0-9._-]{1,64}
+  kUtc,          // YYYY-MM-DDTHH:MM:SSZ
+  kSource,       // printable ASCII, ≤ kMaxSourceLength
+  kGravity,      // finite, kMinGravityMps2 ≤ x ≤ kMaxGravityMps2
+  kCorrelation,  // finite, |x| ≤ kMaxAbsCorrelation
 };
 
 /// Order of the angle keys: nav::AngleIndex (xy, xz, yx, yz, zx, zy).
@@ -51,6 +52,7 @@ inline const char* to_string_compensator(nav::CompensatorKind k) { return nav::t
 /// D is CalibrationData or const CalibrationData. V has the methods
 ///   text(key, std::string&, Domain), unit(key, const char* unit),
 ///   geometry_kind(key, GeometryKind&), compensator(key, nav::CompensatorKind&),
+///   correlations(key, bool& known),
 ///   number(key, double&, Domain), vec3(key, std::array<double, 3>&, Domain).
 /// Geometry's kind is visited before the keys that depend on it, so a reader sees it in time.
 /// `version` is the file's format version: the keys it defines (version 1 has no [gravity]).
@@ -83,6 +85,21 @@ void visit_fields(D& d, V& v, std::int64_t version = kFormatVersion) {
     v.number(p + "bias_sigma_g", s.bias_sigma_g, Domain::kSigma);
     v.vec3(p + "location_error_m", s.location_error_m, Domain::kLocation);
     v.vec3(p + "location_error_sigma_m", s.location_error_sigma_m, Domain::kSigma);
+    if (version >= 3) {
+      // sensor.N.correlation.scale_bias, scale_<a1>, scale_<a2>, bias_<a1>, bias_<a2>, <a1>_<a2>
+      // with <a1>, <a2> the Table 6 names of the sensor's two angles (sensor_angles()).
+      const SensorAngles a = sensor_angles(j);
+      const std::string a1 = kAngleNames[a.angle[0]];
+      const std::string a2 = kAngleNames[a.angle[1]];
+      std::string pair = a1;
+      pair += '_';
+      pair += a2;
+      const std::array<std::string, kNumCorrelations> names = {
+          "scale_bias", "scale_" + a1, "scale_" + a2, "bias_" + a1, "bias_" + a2, pair};
+      for (std::size_t c = 0; c < kNumCorrelations; ++c) {
+        v.number(p + "correlation." + names[c], s.correlation[c], Domain::kCorrelation);
+      }
+    }
   }
   const auto visit_set = [&v](const std::string& p, auto& set) {
     for (std::size_t i = 0; i < 6; ++i) {
@@ -92,6 +109,9 @@ void visit_fields(D& d, V& v, std::int64_t version = kFormatVersion) {
   };
   visit_set("orientation.beta.", d.beta);
   visit_set("orientation.alpha.", d.alpha);
+  // Whether sensor.N.correlation holds the solver's values or zeros standing for "not known"
+  // (data first read from a version 1 or 2 file and saved again).
+  if (version >= 3) v.correlations("orientation.correlations", d.correlations_known);
   v.compensator("compensator", d.compensator);
 }
 

@@ -23,7 +23,8 @@ constexpr std::string_view kChecksumPrefix = "fnv1a64:";
 constexpr std::string_view kHeader =
     "# gfins calibration file (docs/calibration-file.md), written by gfins-calibrate.\n"
     "# Units (also in [units]): lengths m, scale factors V/g, biases g, orientation errors\n"
-    "# degrees, ADC LSB V/count; every *_sigma_* key is the 1-sigma uncertainty of its value.\n"
+    "# degrees, ADC LSB V/count; every *_sigma_* key is the 1-sigma uncertainty of its value,\n"
+    "# sensor.N.correlation the correlation coefficients of that sensor's SF, bias and angles.\n"
     "# g in V/g and in the biases is the local gravity of the calibration site, "
     "gravity.local_mps2\n"
     "# (m/s^2); the firmware converts to m/s^2 with that value.\n"
@@ -60,6 +61,9 @@ class Writer {
   }
   void compensator(const std::string& key, nav::CompensatorKind k) {
     put(key, std::string(nav::to_string(k)));
+  }
+  void correlations(const std::string& key, bool known) {
+    put(key, std::string(known ? kCorrelationsStated : kCorrelationsUnknown));
   }
   void number(const std::string& key, double x, Domain) { put(key, x); }
   void vec3(const std::string& key, const std::array<double, 3>& v, Domain) {
@@ -113,6 +117,20 @@ class Reader {
     } else {
       fail(ErrorCode::kInvalidArgument, line_of(key),
            key + " is \"" + s + "\": expected \"table1\" or \"custom\"");
+    }
+  }
+  void correlations(const std::string& key, bool& known) {
+    std::string s;
+    text(key, s, Domain::kSource);
+    if (!ok()) return;
+    if (s == kCorrelationsStated) {
+      known = true;
+    } else if (s == kCorrelationsUnknown) {
+      known = false;
+    } else {
+      fail(ErrorCode::kInvalidArgument, line_of(key),
+           key + " is \"" + s + "\": expected \"" + kCorrelationsStated + "\" or \"" +
+               kCorrelationsUnknown + "\"");
     }
   }
   void compensator(const std::string& key, nav::CompensatorKind& k) {
@@ -249,6 +267,9 @@ FileResult<CalibrationData> parse_table(const toml::table& root, const std::stri
     d.gravity_mps2 = nav::kStandardGravity;
     d.gravity_source = kVersion1GravitySource;
   }
+  // Versions 1 and 2 stated σ but not the correlations of SF, b and the angles: 0 by assumption,
+  // and said so (docs/calibration-file.md, versioning).
+  if (file_version < 3) d.correlations_known = false;
   Reader reader(root);
   detail::visit_fields(d, reader, file_version);
   if (!reader.ok()) return FileStatus(reader.status().code(), prefix + reader.status().message());

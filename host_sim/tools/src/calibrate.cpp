@@ -348,6 +348,18 @@ calib_file::CalibrationData make_calibration_data(const CalibrationRun& run,
     s.bias_sigma_g = r.bias_std_g[j];
     s.location_error_m = settings.location[j].location_error_m;
     s.location_error_sigma_m = settings.location[j].location_error_sigma_m;
+    // The solver's 4×4 covariance is over (SF, b, angle 2r, angle 2r+1): the order of
+    // calib_file::sensor_angles() and of the file's correlation keys (format version 3).
+    const auto& c = r.covariance[j];
+    const auto cov = [&c](std::size_t a, std::size_t b) { return c[a * 4 + b]; };
+    const std::array<std::array<std::size_t, 2>, 6> pairs = {
+        {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const double den = std::sqrt(cov(pairs[k][0], pairs[k][0]) * cov(pairs[k][1], pairs[k][1]));
+      // No covariance (exactly determined, no σ stated): nothing is known, 0 is written.
+      s.correlation[k] =
+          den > 0.0 ? std::clamp(cov(pairs[k][0], pairs[k][1]) / den, -1.0, 1.0) : 0.0;
+    }
   }
   d.gravity_mps2 = settings.gravity_mps2;
   d.gravity_source = settings.gravity_source;
@@ -459,6 +471,81 @@ FileStatus check_settings(const FileSettings& settings) {
   return FileStatus(ErrorCode::kInvalidArgument, option + " (" + p.key + "): " + p.problem);
 }
 
+namespace {
+
+// The covariance the file states for sensor j's own parameters (SF [V/g], b [g], angle a1 [rad],
+// angle a2 [rad]; a1, a2 the row of C of eqs. (14)/(15) it owns, calib_file::sensor_angles()):
+// Σ_j = D R D, D the σ, R the correlations of SensorCalibration::correlation in the order
+// (SF,b) (SF,a1) (SF,a2) (b,a1) (b,a2) (a1,a2). A file older than format version 3 carries
+// zeros there (correlations_known false): R = I, "correlations unknown: taken as 0".
+Eigen::Matrix4d sensor_parameter_cov(const calib_file::CalibrationData& cal, std::size_t j) {
+  const auto& s = cal.sensors[j];
+  const calib_file::SensorAngles angles = calib_file::sensor_angles(j);
+  const auto& angle_sigma = angles.alpha ? cal.alpha.angle_sigma_deg : cal.beta.angle_sigma_deg;
+  const Eigen::Vector4d sd(s.scale_sigma_v_per_g, s.bias_sigma_g,
+                           angle_sigma[angles.angle[0]] * calib_file::kRadPerDeg,
+                           angle_sigma[angles.angle[1]] * calib_file::kRadPerDeg);
+  Eigen::Matrix4d r = Eigen::Matrix4d::Identity();
+  const std::array<std::array<Eigen::Index, 2>, 6> pairs = {
+      {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    r(pairs[k][0], pairs[k][1]) = s.correlation[k];
+    r(pairs[k][1], pairs[k][0]) = s.correlation[k];
+  }
+  return sd.asDiagonal() * r * sd.asDiagonal();
+}
+
+// ∂θ*_j/∂a (per radian) for sensor j's two angles a1, a2: θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15),
+// r its row in its set) and C is affine in its angles, so ∂C/∂a = C(e_a) − I exactly.
+std::array<nav::Vec3<double>, 2> axis_derivatives(std::size_t j,
+                                                  const nav::ArrayGeometry<double, 6>& nominal) {
+  const calib_file::SensorAngles angles = calib_file::sensor_angles(j);
+  const auto& set = angles.alpha ? nav::kSetAlpha : nav::kSetBeta;
+  std::size_t row = 0;
+  for (std::size_t r = 0; r < 3; ++r) {
+    if (static_cast<std::size_t>(set[r]) == j) row = r;
+  }
+  std::array<nav::Vec3<double>, 2> out{};
+  for (std::size_t m = 0; m < 2; ++m) {
+    std::array<double, 6> unit{};
+    unit[angles.angle[m]] = 1.0;
+    const nav::Mat3<double> dc = nav::set_matrix(unit) - nav::Mat3<double>::Identity();
+    out[m].setZero();
+    for (std::size_t k = 0; k < 3; ++k) {
+      out[m] += dc(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(k)) *
+                nominal.theta_b[static_cast<std::size_t>(set[k])];
+    }
+  }
+  return out;
+}
+
+// Covariance of sensor j's generic base perturbations (calib::kBaseOffset, kBaseGain, kBaseAxis)
+// from the file's σ and correlations of its (SF, b, angle a1, angle a2) (docs/calibration.md,
+// location σ). With T = ∂(c, k, δθ)/∂(SF, b, a1, a2), first order in the errors of eq. (21)
+// s* = (P/SF − b)·g and of θ*_j = Σ_k C_rk θ_k (eqs. (14)/(15)):
+//   SF → SF(1 + ε), ε = δSF/SF: s* → s* − ε(s* + b g), i.e. k = −ε, c = −ε b g;
+//   b → b + δb:     c = −g δb;
+//   angle a:        δθ = Σ_k ∂C_rk/∂a θ_k.
+// Returns T Σ Tᵀ with Σ = sensor_parameter_cov().
+Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams> base_perturbation_cov(
+    const calib_file::CalibrationData& cal, std::size_t j,
+    const nav::ArrayGeometry<double, 6>& nominal) {
+  const auto& s = cal.sensors[j];
+  const double g = cal.gravity_mps2;
+  Eigen::Matrix<double, calib::kNumBaseParams, 4> t =
+      Eigen::Matrix<double, calib::kNumBaseParams, 4>::Zero();
+  t(calib::kBaseOffset, 0) = -s.bias_g * g / s.scale_v_per_g;
+  t(calib::kBaseGain, 0) = -1.0 / s.scale_v_per_g;
+  t(calib::kBaseOffset, 1) = -g;
+  const auto d_theta = axis_derivatives(j, nominal);
+  for (std::size_t m = 0; m < 2; ++m) {
+    t.block<3, 1>(calib::kBaseAxis, static_cast<Eigen::Index>(2 + m)) = d_theta[m];
+  }
+  return t * sensor_parameter_cov(cal, j) * t.transpose();
+}
+
+}  // namespace
+
 FileResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& rows,
                                                     const calib_file::CalibrationData& cal,
                                                     double prior_sigma_m,
@@ -496,17 +583,39 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
   LocationReport rep;
   rep.solution = solved.value();
   const auto& sol = rep.solution;
+  // The base calibration's uncertainty, first order: Σ_j J_ij C_j J_ijᵀ (docs/calibration.md).
+  std::array<Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams>, 6> base_cov{};
+  const auto nominal = calib_file::nominal_geometry<double>(cal);
+  for (std::size_t j = 0; j < 6; ++j) base_cov[j] = base_perturbation_cov(cal, j, nominal);
+  rep.base_cov_m2 = calib::base_covariance(sol, base_cov);
   rep.lines.push_back("location errors (paper §4.2) from " + std::to_string(rows.size()) +
                       " rate-table runs in " + std::to_string(sol.num_mountings) +
                       " mounting(s); chi2/dof " +
                       fmt("%.3g", sol.dof > 0 ? sol.chi2 / sol.dof : 0.0) + " (" +
-                      std::to_string(sol.dof) + " dof)");
+                      std::to_string(sol.dof) + " dof, the runs' noise alone)");
   rep.lines.push_back(
-      "sensor  drho_x (mm)          drho_y (mm)          drho_z (mm)          "
-      "not observable");
+      std::string("sigma = the runs' noise (their std_v/sqrt(count)) and the base calibration's "
+                  "uncertainty (its sigma of SF, bias and angles") +
+      (cal.correlations_known
+           ? " and their correlations"
+           : "; its file predates format version 3 and states no correlations: taken as 0") +
+      ", propagated to first order); the last column splits it as sigma_runs / sigma_base (mm, "
+      "largest component)");
+  std::string no_sigma;  // sensors whose base states no uncertainty at all
+  for (std::size_t j = 0; j < 6; ++j) {
+    if (base_cov[j].isZero(0.0)) no_sigma += " a" + std::to_string(j + 1);
+  }
+  if (!no_sigma.empty()) {
+    rep.lines.push_back("  note: the base states sigma = 0 for SF, bias and angles of" + no_sigma +
+                        " (an exactly determined calibration without stated sigma): their "
+                        "uncertainty cannot be counted, the sigma below is the runs' alone");
+  }
+  rep.lines.push_back(
+      "sensor  drho_x (mm)          drho_y (mm)          drho_z (mm)          runs / base"
+      "           not observable");
   for (std::size_t j = 0; j < 6; ++j) {
     // Unobservable directions are held at 0; their σ is the mechanical prior, not the data's.
-    nav::Mat3<double> cov = sol.drho_cov_m2[j];
+    nav::Mat3<double> cov = sol.drho_cov_m2[j] + rep.base_cov_m2[j];
     const nav::Vec3<double> dir = sol.unobservable_dir_b[j];
     if (sol.unobservable_dims[j] > 0) cov += prior_sigma_m * prior_sigma_m * dir * dir.transpose();
     std::string line = "a" + std::to_string(j + 1) + "     ";
@@ -516,6 +625,9 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
       line += fmt(" %8.4f", sol.drho_b[j](k) * 1e3) + " ± " +
               fmt("%-8.2g", rep.sigma_m[j][static_cast<std::size_t>(k)] * 1e3);
     }
+    const double sd_runs = std::sqrt(std::max(0.0, sol.drho_cov_m2[j].diagonal().maxCoeff()));
+    const double sd_base = std::sqrt(std::max(0.0, rep.base_cov_m2[j].diagonal().maxCoeff()));
+    line += "  " + fmt("%.2g", sd_runs * 1e3) + " / " + fmt("%-8.2g", sd_base * 1e3);
     if (sol.unobservable_dims[j] > 0) {
       line += "  " + std::to_string(sol.unobservable_dims[j]) + " direction(s), e.g. [" +
               fmt("%.2f", dir.x()) + " " + fmt("%.2f", dir.y()) + " " + fmt("%.2f", dir.z()) +
@@ -541,16 +653,26 @@ FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
   if (poses) {
     for (const Pose& p : *poses) pose_of[p.attitude] = p.f_b_g;
   }
-  const auto theta_of = [](const calib_file::CalibrationData& d) {
-    return nav::misaligned_geometry(calib_file::nominal_geometry<double>(d),
-                                    calib_file::misalignment<double>(d))
-        .theta_b;
-  };
-  const auto theta = theta_of(cal);
+  const auto nominal = calib_file::nominal_geometry<double>(cal);
+  const auto theta =
+      nav::misaligned_geometry(nominal, calib_file::misalignment<double>(cal)).theta_b;
   VerifyReport rep;
   rep.lines.push_back("verification against the calibration of device " + cal.device_id +
                       ": residual P - SF (b + theta*.a) per pose and sensor (mV), z = residual / "
-                      "predicted sigma (mean noise and the file's own uncertainties)");
+                      "predicted sigma");
+  rep.lines.push_back(
+      std::string("predicted sigma = the capture's noise (std_v/sqrt(count), where given) and the "
+                  "file's covariance of each sensor's SF, bias and two angles (their sigma") +
+      (cal.correlations_known
+           ? " and correlations"
+           : "; correlations unknown: taken as 0, the file predates format version 3") +
+      "), propagated to first order through eq. (16)");
+  std::array<Eigen::Matrix4d, 6> cov{};
+  std::array<std::array<nav::Vec3<double>, 2>, 6> d_theta{};
+  for (std::size_t j = 0; j < 6; ++j) {
+    cov[j] = sensor_parameter_cov(cal, j);
+    d_theta[j] = axis_derivatives(j, nominal);
+  }
   for (const MeanRow& m : means) {
     std::array<double, 3> a{};
     if (poses) {
@@ -575,22 +697,19 @@ FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
     const double proj = theta[j].dot(av);
     const double predicted = s.scale_v_per_g * (s.bias_g + proj);  // eq. (16), g = T = 1
     const double res = m.mean_v - predicted;
-    // Predicted σ: the mean's own, and the file's σ of SF, b and every angle of the sensor's set
-    // (first order; the angles by a one-σ perturbation of each).
-    double var = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
-    var += (s.bias_g + proj) * (s.bias_g + proj) * s.scale_sigma_v_per_g * s.scale_sigma_v_per_g;
-    var += s.scale_v_per_g * s.scale_v_per_g * s.bias_sigma_g * s.bias_sigma_g;
-    for (const bool alpha : {false, true}) {
-      for (std::size_t i = 0; i < 6; ++i) {
-        calib_file::CalibrationData e = cal;
-        auto& set = alpha ? e.alpha : e.beta;
-        set.angle_deg[i] += set.angle_sigma_deg[i];
-        const double d = s.scale_v_per_g * (theta_of(e)[j].dot(av) - proj);
-        var += d * d;
-      }
-    }
+    // Predicted σ, first order: h = SF (b + θ*(a1, a2)·a) (eq. (16), θ* of eqs. (14)/(15)) has
+    // ∂h/∂(SF, b, a1, a2) = (b + θ*·a, SF, SF ∂θ*/∂a1·a, SF ∂θ*/∂a2·a); the residual's variance
+    // is the mean's own plus J Σ_j Jᵀ with the file's whole 4×4 covariance Σ_j of the sensor.
+    // Sensors are independent, so no other sensor's parameters enter.
+    const Eigen::Vector4d jac(s.bias_g + proj, s.scale_v_per_g,
+                              s.scale_v_per_g * d_theta[j][0].dot(av),
+                              s.scale_v_per_g * d_theta[j][1].dot(av));
+    const double var_mean = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
+    // A valid file's Σ_j is positive semidefinite (checked on load); max() guards rounding.
+    const double var = var_mean + std::max(0.0, jac.dot(cov[j] * jac));
     const double sigma = std::sqrt(var);
     const double z = sigma > 0.0 ? res / sigma : 0.0;
+    rep.rows.push_back(VerifyRow{m.attitude, m.sensor, res, sigma, std::sqrt(var_mean)});
     if (std::abs(z) > rep.max_abs_z) {
       rep.max_abs_z = std::abs(z);
       rep.worst_sensor = m.sensor;

@@ -76,9 +76,12 @@ FileStatus check_settings(const FileSettings& settings);
 /// Location calibration (paper §4.2) from rate-table runs, given the orientation calibration
 /// (SF, bias, angles, nominal geometry and local gravity of `cal`): Δρ_j and its 1σ per body
 /// component, and which components the runs did not determine (held at 0; their σ is the
-/// mechanical prior `prior_sigma_m`).
+/// mechanical prior `prior_sigma_m`). sigma_m counts the runs' noise (solution.drho_cov_m2) and
+/// the uncertainty of `cal`'s SF, bias and angles (base_cov_m2, first order, with `cal`'s
+/// correlations; 0 correlation when cal.correlations_known is false).
 struct LocationReport {
   calib::LocationCalibration<double> solution;
+  std::array<nav::Mat3<double>, 6> base_cov_m2{};  // Δρ_j covariance from the base, m²
   std::array<std::array<double, 3>, 6> drho_m{};
   std::array<std::array<double, 3>, 6> sigma_m{};
   std::vector<std::string> lines;  // the report
@@ -99,11 +102,21 @@ void print_report(std::ostream& out, const CalibrationRun& run);
 std::vector<std::string> verdict_warnings(const calib::MultiAttitudeResult<double>& r);
 
 /// Verification poses against an installed calibration: per pose and sensor the residual
-/// P − SF (b + θ*·a) (eq. (16), a in local g) and its z, the residual over its predicted σ (the
-/// stated σ of the mean and the file's own σ of SF, b and the angles, first order). Poses
+/// P − SF (b + θ*·a) (eqs. (16)/(21), a in local g) and its z, the residual over its predicted σ:
+/// the capture's noise (std_v/√count where given) and the file's covariance of the sensor's SF,
+/// b and two angles (its σ and correlations; correlations taken as 0 when
+/// cal.correlations_known is false), propagated to first order (docs/calibration.md §7). Poses
 /// without a poses file are numbered as in Tables 2/3.
+struct VerifyRow {
+  int attitude = 0;
+  int sensor = 0;             // 1-based
+  double residual_v = 0.0;    // P − SF (b + θ*·a), V
+  double sigma_v = 0.0;       // predicted 1σ of the residual, V
+  double sigma_mean_v = 0.0;  // the capture's part of it (std_v/√count), V
+};
 struct VerifyReport {
   std::vector<std::string> lines;
+  std::vector<VerifyRow> rows;  // one per row of the means, in their order
   double max_abs_z = 0.0;
   int worst_sensor = 0;  // 1-based
   int worst_pose = 0;

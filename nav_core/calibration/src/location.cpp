@@ -193,6 +193,46 @@ double weighted_residual_sum(const nav::ArrayGeometry<double, nav::kNumSensors>&
   return chi2;
 }
 
+// Right-hand side of the first-order change of the normal equations when sensor j's base
+// calibration moves (paper §4.2, eqs. (20)/(21); docs/calibration.md, location σ). The solution
+// satisfies Σ_r w_r a_r e_r = 0 (and its negative for the offset of the run's mounting), with
+// e_r = y_r − a_rᵀ(Δρ_j − p_m), a_r = W_r θ*_j, W_r = [ω_r×]² (symmetric), y_r = s*_r − θ*_j·h_r
+// and h_r = −g_b + W_r ρ_j. Differentiating: N dx = Σ_r w_r (a_r (dy_r − da_rᵀ(Δρ_j − p_m)) +
+// da_r e_r), where
+//   offset c:  dy_r = c,  da_r = 0;
+//   gain k:    dy_r = k s*_r,  da_r = 0;
+//   axis δθ:   dy_r = −h_rᵀ δθ,  da_r = W_r δθ.
+// The weights w_r = count/σ_r² do not move: an SF error scales every σ_r of the sensor alike, which
+// leaves the estimate unchanged with kThroughCentre (and changes it only by residual-sized terms
+// otherwise, below first order in the base error times the noise). Columns: kBaseOffset,
+// kBaseGain, kBaseAxis..+2.
+using RhsX = Eigen::Matrix<double, kNumUnknowns, kNumBaseParams>;
+
+template <typename T>
+RhsX base_rhs(const nav::ArrayGeometry<double, nav::kNumSensors>& g,
+              std::span<const LocationRun<T>> runs, bool estimate_offsets, const VecX& x, int j) {
+  RhsX rhs = RhsX::Zero();
+  const int d = drho_index(j);
+  const Eigen::Vector3d rho = g.rho_b[static_cast<std::size_t>(j)];
+  for (const auto& run : runs) {
+    const Equation e = make_equation(g, run, j);
+    const int p = offset_index(run.mounting);
+    const Eigen::Vector3d rel = x.segment<3>(d) - x.segment<3>(p);  // Δρ_j − p_m
+    const Eigen::Vector3d w = run.w_b.template cast<double>();
+    const Eigen::Matrix3d big_w = w * w.transpose() - w.squaredNorm() * Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d h = -run.g_b.template cast<double>() + big_w * rho;
+    const double residual = e.y - e.a.dot(rel);
+    Eigen::Matrix<double, 3, kNumBaseParams> block;
+    block.col(kBaseOffset) = e.weight * e.a;
+    block.col(kBaseGain) = e.weight * static_cast<double>(run.s_mean(j)) * e.a;
+    block.block<3, 3>(0, kBaseAxis) =
+        e.weight * (residual * big_w - e.a * (h + big_w * rel).transpose());
+    rhs.block<3, kNumBaseParams>(d, 0) += block;
+    if (estimate_offsets) rhs.block<3, kNumBaseParams>(p, 0) -= block;
+  }
+  return rhs;
+}
+
 }  // namespace
 
 template <typename T>
@@ -283,6 +323,17 @@ Result<LocationCalibration<T>> calibrate_location(
     out.axis_offset_b[ms] = x.segment<3>(offset_index(m)).template cast<T>();
     out.axis_offset_cov_m2[ms] =
         cov.block<3, 3>(offset_index(m), offset_index(m)).template cast<T>();
+  }
+  // Sensitivity to the base calibration: dx = S N'⁺ S · rhs (the same linear map that gives x
+  // from the right-hand side b, so held-at-zero directions stay zero).
+  for (int j = 0; j < nav::kNumSensors; ++j) {
+    const RhsX rhs = base_rhs(g, runs, estimate_offsets, x, j);
+    const RhsX scaled = block_scale.asDiagonal() * rhs;
+    const RhsX dx = block_scale.asDiagonal() * (n_pinv * scaled);
+    for (int i = 0; i < nav::kNumSensors; ++i) {
+      out.base_jacobian[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] =
+          dx.block<3, kNumBaseParams>(drho_index(i), 0).template cast<T>();
+    }
   }
   out.chi2 = weighted_residual_sum(g, runs, x);
   out.dof = ne.rows - (num_determined - num_constraints);

@@ -26,8 +26,9 @@
 namespace gfins::calib_file {
 
 /// The format version this build writes (docs/calibration-file.md, versioning). Version 2 added
-/// the local gravity of the calibration site ([gravity]).
-inline constexpr std::int64_t kFormatVersion = 2;
+/// the local gravity of the calibration site ([gravity]); version 3 the correlations of each
+/// sensor's SF, bias and two orientation angles (sensor.N.correlation).
+inline constexpr std::int64_t kFormatVersion = 3;
 /// The oldest version this build still reads (converted on load: see kVersion1GravitySource).
 inline constexpr std::int64_t kOldestFormatVersion = 1;
 inline constexpr std::size_t kNumSensors = 6;
@@ -47,6 +48,12 @@ inline constexpr std::size_t kMaxSourceLength = 256;
 /// every real site and refuse a value in another unit (1 "g", 980 Gal).
 inline constexpr double kMinGravityMps2 = 9.7;
 inline constexpr double kMaxGravityMps2 = 9.9;
+/// Values of orientation.correlations (format version 3): the correlations are the solver's, or
+/// zeros standing for "not known" (data first read from a version 1 or 2 file).
+inline constexpr const char* kCorrelationsStated = "stated";
+inline constexpr const char* kCorrelationsUnknown = "unknown: taken as 0";
+/// Largest |correlation coefficient| accepted; a coefficient is at most 1 in magnitude.
+inline constexpr double kMaxAbsCorrelation = 1.0;
 /// gravity.source given to a version-1 file on load: version 1 had no notion of the site, and
 /// its front end converted V/g with standard gravity, which the conversion keeps.
 inline constexpr const char* kVersion1GravitySource =
@@ -75,6 +82,13 @@ struct SensorCalibration {
   double bias_sigma_g = 0.0;                       // 1σ
   std::array<double, 3> location_error_m{};        // Δρ_j, m, body frame (eq. (19))
   std::array<double, 3> location_error_sigma_m{};  // 1σ per component
+  /// Correlation coefficients of this sensor's four multi-attitude parameters (SF, b and its two
+  /// orientation angles: the row of eq. (14)/(15) it owns, angles 2r and 2r+1 of its set in
+  /// nav::AngleIndex order, r = its row; see sensor_angles()), in the order kCorrelationPairs:
+  /// (SF,b) (SF,a1) (SF,a2) (b,a1) (b,a2) (a1,a2). Sensors are independent (multi_attitude.hpp),
+  /// so with the σ above this is the whole covariance of the orientation calibration (format
+  /// version 3; zero, i.e. unknown, when read from an older file: see correlations_known).
+  std::array<double, 6> correlation{};
 
   bool operator==(const SensorCalibration&) const = default;
 };
@@ -103,9 +117,35 @@ struct CalibrationData {
   /// How gravity_mps2 was obtained (free text, printable ASCII, ≤ 256): "given", or "WGS-84
   /// normal gravity at latitude 24.8 deg, height 50 m".
   std::string gravity_source;
+  /// False when read from a file older than format version 3, which carried the σ of SF, b and
+  /// the angles but not their correlations: the correlations are then 0 by assumption, and a
+  /// version-3 file written from such data says so (orientation.correlations).
+  bool correlations_known = true;
 
   bool operator==(const CalibrationData&) const = default;
 };
+
+/// The key suffixes of SensorCalibration::correlation, in its order ("1" and "2" are the
+/// sensor's two angles, named in the file by their Table 6 names: "scale_xy", "xy_xz", ...).
+inline constexpr std::size_t kNumCorrelations = 6;
+
+/// The set of sensor j (0-based) and its two angles (indices into that set's six, nav::AngleIndex
+/// order): the sensor at row r of its set owns row r of C (eqs. (14)/(15)), angles 2r and 2r+1.
+struct SensorAngles {
+  bool alpha = false;  // set α {1, 4, 6}; else set β {2, 3, 5}
+  std::array<std::size_t, 2> angle{};
+};
+inline SensorAngles sensor_angles(std::size_t j) {
+  SensorAngles a;
+  for (std::size_t r = 0; r < 3; ++r) {
+    if (static_cast<std::size_t>(nav::kSetAlpha[r]) == j) {
+      a.alpha = true;
+      a.angle = {2 * r, 2 * r + 1};
+    }
+    if (static_cast<std::size_t>(nav::kSetBeta[r]) == j) a.angle = {2 * r, 2 * r + 1};
+  }
+  return a;
+}
 
 /// The first value outside its documented domain: `key` is its path in the file
 /// ("sensor.3.scale_v_per_g"), `problem` says what is wrong. Empty key means none.

@@ -35,11 +35,20 @@
 // specific force there) together with u_m·p_m = 0 (the offset along the spin axis u_m has no
 // effect).
 //
+// Base uncertainty. drho_cov_m2 is the runs' noise alone (N'⁺ N N'⁺). SF, b and θ*_j come from
+// the multi-attitude calibration and carry its errors; base_jacobian holds the first-order
+// sensitivity of Δρ to them, per sensor as three generic perturbations (an offset c and a gain
+// k of s*_j, a tilt δθ of θ*_j): N dx = Σ_r w_r (a_r (dy_r − da_rᵀ(Δρ_j − p_m)) + da_r e_r)
+// with dy_r = c, k s*_r or −h_rᵀδθ (h_r = −g_b + [ω×]²ρ_j) and da_r = [ω×]² δθ, solved with
+// the same truncated inverse as x. The caller maps its parameters onto (c, k, δθ) (eq. (21) for
+// SF and b, eqs. (14)/(15) for the angles) and adds base_covariance() (docs/calibration.md, §5).
+//
 // No heap: the normal equations are accumulated in fixed-size matrices (computed in double for
 // float and double inputs); runs are read once from a span. Failure modes are Status values.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -99,6 +108,13 @@ struct LocationCalibration {
   int num_mountings = 0;  // 1 + largest mounting index used
   double chi2 = 0.0;      // Σ (residual/σ_mean)² at the estimate
   int dof = 0;            // equations − determined unknowns; chi2/dof ≈ 1 if σ is right
+  /// First-order sensitivity of Δρ_i to the base (multi-attitude) calibration of sensor j:
+  /// base_jacobian[i][j] = ∂Δρ_i/∂q_j, q_j = (c_j, k_j, δθ*_j) the generic base perturbations
+  /// of sensor j (kBaseOffset, kBaseGain, kBaseAxis; see base_covariance()). Zero for i ≠ j with
+  /// kThroughCentre (sensors share no unknown); the table-axis offsets couple them otherwise.
+  /// drho_cov_m2 above counts the runs' noise only; add base_covariance() for the total.
+  std::array<std::array<Eigen::Matrix<T, 3, 5>, nav::kNumSensors>, nav::kNumSensors>
+      base_jacobian{};
 
   bool fully_observable() const {
     for (const auto v : verdict) {
@@ -107,6 +123,36 @@ struct LocationCalibration {
     return true;
   }
 };
+
+/// The base perturbations of one sensor, the columns of LocationCalibration::base_jacobian, in
+/// units of s*_j (m/s²): s*_j → (1 + k) s*_j + c in every run, θ*_j → θ*_j + δθ (body, unitless).
+/// A scale-factor error SF → SF(1 + ε) of eq. (21) is k = −ε, c = −ε·b·g; a bias error δb (g) is
+/// c = −g·δb; an orientation angle moves θ*_j along ∂θ*_j/∂angle (eqs. (14)/(15)).
+inline constexpr int kBaseOffset = 0;  // c, m/s²
+inline constexpr int kBaseGain = 1;    // k, unitless
+inline constexpr int kBaseAxis = 2;    // δθ*_j, 3 components (2..4)
+inline constexpr int kNumBaseParams = 5;
+
+/// The part of the Δρ covariance that comes from the base calibration (first order):
+/// Σ_j J_ij C_j J_ijᵀ with J = solution.base_jacobian and C_j the 5×5 covariance of sensor j's
+/// base perturbations (kBaseOffset, kBaseGain, kBaseAxis order); the base calibrations of
+/// different sensors are independent (multi_attitude.hpp: no unknown is shared). Add it to
+/// drho_cov_m2 for the total.
+template <typename T>
+std::array<nav::Mat3<T>, nav::kNumSensors> base_covariance(
+    const LocationCalibration<T>& solution,
+    const std::array<Eigen::Matrix<T, kNumBaseParams, kNumBaseParams>, nav::kNumSensors>&
+        base_cov) {
+  std::array<nav::Mat3<T>, nav::kNumSensors> out{};
+  for (std::size_t i = 0; i < static_cast<std::size_t>(nav::kNumSensors); ++i) {
+    out[i] = nav::Mat3<T>::Zero();
+    for (std::size_t j = 0; j < static_cast<std::size_t>(nav::kNumSensors); ++j) {
+      const Eigen::Matrix<T, 3, kNumBaseParams>& jac = solution.base_jacobian[i][j];
+      out[i] += jac * base_cov[j] * jac.transpose();
+    }
+  }
+  return out;
+}
 
 /// Row a = [ω×]² θ of the location equation y = aᵀ(Δρ − p) (see the file comment).
 template <typename T>
