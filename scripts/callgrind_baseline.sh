@@ -10,16 +10,15 @@
 # dump holds exactly one section's instructions: set-up and printing are in none of them.
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-${root}/build/host-release}"
+# shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR
+source "$(dirname "${BASH_SOURCE[0]}")/measure_common.sh"
+gfins_build_dir "$@" build/host-release
 samples="${2:-20000}"
-exe="${build}/tests/bench/gfins_baseline_bench"
-if [[ ! -x "${exe}" ]]; then
-  echo "callgrind_baseline.sh: ${exe} not found; build target gfins_baseline_bench" >&2
-  exit 2
-fi
-out_dir="$(mktemp -d)"
-trap 'rm -rf "${out_dir}"' EXIT
+exe="${gfins_build}/tests/bench/gfins_baseline_bench"
+gfins_need_file "${exe}" "build target gfins_baseline_bench"
+gfins_need_command valgrind "apt-get install valgrind"
+gfins_scratch_dir
+out_dir="${gfins_scratch}"
 valgrind --tool=callgrind --callgrind-out-file="${out_dir}/cg.out" "${exe}" "${samples}" \
   >/dev/null 2>"${out_dir}/log" || { cat "${out_dir}/log" >&2; exit 1; }
 python3 - "${out_dir}" "${samples}" <<'PY'

@@ -14,16 +14,15 @@
 #   callgrind_annotate --auto=yes dir/callgrind.float.paper.N2.out
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-${root}/build/host-release}"
+# shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR
+source "$(dirname "${BASH_SOURCE[0]}")/measure_common.sh"
+gfins_build_dir "$@" build/host-release
+build="${gfins_build}"
 n1="${2:-20000}"
 n2="${3:-120000}"
 exe="${build}/tests/bench/gfins_pipeline_ir"
-if [[ ! -x "${exe}" ]]; then
-  echo "callgrind_per_sample.sh: ${exe} not found; build target gfins_pipeline_ir (Release," \
-       "GFINS_BUILD_BENCHMARKS=ON) first" >&2
-  exit 2
-fi
+gfins_need_file "${exe}" "build target gfins_pipeline_ir (Release, GFINS_BUILD_BENCHMARKS=ON) first"
+gfins_need_command valgrind "apt-get install valgrind"
 if ! (( n2 > n1 && n1 > 0 )); then
   echo "callgrind_per_sample.sh: need 0 < N1 < N2" >&2
   exit 2
@@ -33,9 +32,13 @@ if [[ "${build_type}" != "Release" ]]; then
   echo "warning: ${build} is a '${build_type}' build; the documented figures are Release" >&2
 fi
 
-out_dir="${GFINS_CALLGRIND_KEEP:-$(mktemp -d)}"
-mkdir -p "${out_dir}"
-[[ -n "${GFINS_CALLGRIND_KEEP:-}" ]] || trap 'rm -rf "${out_dir}"' EXIT
+if [[ -n "${GFINS_CALLGRIND_KEEP:-}" ]]; then
+  out_dir="${GFINS_CALLGRIND_KEEP}"
+  mkdir -p "${out_dir}"
+else
+  gfins_scratch_dir
+  out_dir="${gfins_scratch}"
+fi
 
 total_ir() {  # total_ir <callgrind.out>: the "summary:" (or "totals:") event count
   awk '/^(summary|totals):/ { print $2; exit }' "$1"

@@ -21,17 +21,15 @@
 # (bytes) override the defaults.
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-${root}/build/cortex-m4f}"
-elf="${build}/nav_core/baremetal/gfins_nav_baremetal.elf"
-lib="${build}/nav_core/libgfins_nav_core.a"
+# shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR
+source "$(dirname "${BASH_SOURCE[0]}")/measure_common.sh"
+gfins_build_dir "$@" build/cortex-m4f
+elf="${gfins_build}/nav_core/baremetal/gfins_nav_baremetal.elf"
+lib="${gfins_build}/nav_core/libgfins_nav_core.a"
 prefix="${GFINS_ARM_PREFIX:-arm-none-eabi-}"
 
 for f in "${elf}" "${lib}"; do
-  if [[ ! -f "${f}" ]]; then
-    echo "embedded_size.sh: ${f} not found; build the cortex-m4f preset first" >&2
-    exit 2
-  fi
+  gfins_need_file "${f}" "build the cortex-m4f preset first"
 done
 
 flash_limit="${GFINS_FLASH_LIMIT:-24576}"  # 24 KiB

@@ -15,21 +15,16 @@
 # assumptions printed with the result. Branch direction comes from the trace itself.
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-${root}/build/cortex-m4f}"
-elf="${build}/nav_core/baremetal/gfins_nav_qemu.elf"
+# shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR
+source "$(dirname "${BASH_SOURCE[0]}")/measure_common.sh"
+gfins_build_dir "$@" build/cortex-m4f
+elf="${gfins_build}/nav_core/baremetal/gfins_nav_qemu.elf"
 prefix="${GFINS_ARM_PREFIX:-arm-none-eabi-}"
-if [[ ! -f "${elf}" ]]; then
-  echo "m4f_step_cycles.sh: ${elf} not found; build the cortex-m4f preset first" >&2
-  exit 2
-fi
-if ! command -v qemu-system-arm >/dev/null; then
-  echo "m4f_step_cycles.sh: qemu-system-arm not found (apt-get install qemu-system-arm)" >&2
-  exit 2
-fi
+gfins_need_file "${elf}" "build the cortex-m4f preset first"
+gfins_need_command qemu-system-arm "apt-get install qemu-system-arm"
 
-work="$(mktemp -d)"
-trap 'rm -rf "${work}"' EXIT
+gfins_scratch_dir
+work="${gfins_scratch}"
 timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
   -semihosting-config enable=on,target=native -kernel "${elf}" \
   -singlestep -d exec,nochain -D "${work}/trace.log"

@@ -7,7 +7,8 @@
 //                                         it detects; each measured section is then dumped
 //                                         separately (CALLGRIND_DUMP_STATS_AT) and the script
 //                                         prints Ir per sample of both and their ratio.
-// The inputs and the restart at each wrap of the 1 s buffer are those of bench_scenario.hpp.
+// The inputs (host_sim's sample source) and the restart at each wrap of the 1 s buffer are those
+// of bench_scenario.hpp.
 #include <valgrind/callgrind.h>
 
 #include <algorithm>
@@ -27,9 +28,11 @@ namespace {
 template <typename T>
 class BaselineReplay {
  public:
-  BaselineReplay(nav::CompensatorKind kind, const std::vector<Counts>& buffer)
-      : buf_(buffer), base_(make_config<T>(kind), make_pipeline<T>(kind, buffer[0]).solver()) {
-    base_.start(initial_state<T>(), buf_[0]);
+  BaselineReplay(nav::CompensatorKind kind, const Workload& w)
+      : buf_(w.samples),
+        init_(initial_state<T>(w)),
+        base_(make_config<T>(kind), make_pipeline<T>(kind, w).solver()) {
+    base_.start(init_, buf_[0]);
   }
   void step() {
     ++seq_;
@@ -38,7 +41,7 @@ class BaselineReplay {
     s.t_ns = t_ns_;
     s.seq = seq_;
     if (i_ == 0) {
-      nav::NavState<T> init = initial_state<T>();
+      nav::NavState<T> init = init_;
       init.seq = seq_;
       init.t_ns = t_ns_;
       base_.start(init, s);
@@ -50,7 +53,8 @@ class BaselineReplay {
   const nav::NavState<T>& state() const { return base_.state(); }
 
  private:
-  const std::vector<Counts>& buf_;
+  const std::vector<RawSample>& buf_;
+  nav::NavState<T> init_;
   BaselineStep<T> base_;
   std::size_t i_ = 1;
   std::uint32_t seq_ = 0;
@@ -79,8 +83,8 @@ double time_ns(R& replay, long samples) {
 }
 
 template <typename T>
-void run(const char* scalar, nav::CompensatorKind kind, const std::vector<Counts>& buf,
-         long samples, bool under_callgrind) {
+void run(const char* scalar, nav::CompensatorKind kind, const Workload& buf, long samples,
+         bool under_callgrind) {
   Replay<T> core(kind, buf);
   BaselineReplay<T> base(kind, buf);
   const std::string tag = std::string(scalar) + " " + nav::to_string(kind);
@@ -117,7 +121,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "usage: %s [samples > 0]\n", argv[0]);
       return 2;
     }
-    const auto buf = b::make_counts();
+    const b::Workload buf = b::make_workload();
     if (!cg) {
       std::printf("%ld samples per run, best of 5; ns per sample\n", samples);
       std::printf("%-7s %-6s %12s %12s %8s\n", "scalar", "comp", "core", "baseline", "ratio");

@@ -1,19 +1,25 @@
-// Shared by the Google Benchmark program and the callgrind driver: a pipeline configuration with
-// the paper's calibration (Table 6) and a buffer of ADC counts from a moving, rotating array, so
-// every benchmarked step sees new, realistic inputs that the compiler cannot fold.
+// The workload of the per-sample benchmarks (gfins_nav_bench, gfins_pipeline_ir,
+// gfins_baseline_bench) and of two tests that reuse it: a pipeline configuration with the paper's
+// calibration (Table 6) and kSamples ADC samples from host_sim's one sample source
+// (sample_source.hpp): trajectory → sensor model → ADC → RawSample, the path every gfins-sim
+// command and test helper takes (docs/architecture.md, "One path for a sample").
 //
-// The buffer holds kSamples samples (1 s at 1 kHz) of a motion that is periodic in ω over that
-// second: ω(t) = [1.0 sin(2πt), 0.5 sin(4πt + 1), 0.8 sin(2πt + 2)] rad/s and a_n(t) =
-// [2 sin(2πt), cos(2πt), 0.5 sin(4πt)] m/s², attitude integrated from ω (double, rotation-vector
-// steps). Outputs come from the misaligned geometry the exact compensator models, converted to
-// counts by the inverse front end, rounded. The benchmarks replay the buffer cyclically; its
-// size is fixed, so its one-time cost cancels in callgrind's per-sample difference.
+//   trajectory   make_maneuver(1.0), the first second: |ω| up to about 1 rad/s, attitude,
+//                velocity and position all changing (trajectory.hpp)
+//   sensors      SensorArrayModel with Table 6's scale factors, biases and orientation errors,
+//                location errors of about 1 mm (array_errors()), no noise: the buffer is the same
+//                in every run
+//   converter    make_source_adc(), the register-level ADS131M06 model behind the real driver:
+//                24-bit codes with the converter's LSB
+//
+// The samples are made once, before any timed loop, by code out of line in bench_scenario.cpp
+// (library gfins::bench_workload); the benchmarks replay the buffer cyclically
+// (Replay), so every step sees new, realistic inputs the compiler cannot fold. Its size is fixed,
+// so its one-time cost cancels in callgrind's per-sample difference.
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,77 +35,49 @@ inline constexpr int kSamples = 1000;
 inline constexpr double kRateHz = 1000.0;
 inline constexpr double kRhoM = 0.1;  // half-size of the cube, m
 
-/// Pipeline configuration in T for a compensator: Table 6 scale factors, biases and orientation
-/// errors, assumed location errors of about 1 mm, ADC full scale ±16 g per channel.
+/// Location error Δρ of sensor j (m, body): about 1 mm, signs alternating, so that the exact
+/// compensator's solver has dense ω̇ rows.
+template <typename T>
+nav::Vec3<T> location_error_m(std::size_t j) {
+  const double sgn = (j % 2 == 0) ? 1.0 : -1.0;
+  return nav::Vec3<T>(static_cast<T>(0.001 * sgn), static_cast<T>(-0.0005),
+                      static_cast<T>(0.0008 * sgn));
+}
+
+/// The converter's LSB, volts at the sensor per count (what the front end is told).
+/// bench_scenario.cpp, as make_workload(): out of line, so that the set-up code of the sample
+/// source is never inlined into a benchmark's timed function and changes its code generation.
+double volts_per_count();
+
+/// Pipeline configuration in T for a compensator: the front end of the source's converter and
+/// sensors (LSB, Table 6 scale factors and biases) and the array's true misalignment (Table 6
+/// orientation errors, location_error_m()).
 template <typename T>
 nav::PipelineConfig<T> make_config(nav::CompensatorKind kind) {
   nav::PipelineConfig<T> c;
   c.nominal = nav::table1_geometry(static_cast<T>(kRhoM));
   namespace t6 = nav::paper_table6;
-  constexpr double kFullScaleG = 16.0;
-  constexpr double kCodes = 8388608.0;  // 2^23
   for (std::size_t j = 0; j < 6; ++j) {
     c.front_end.scale_v_per_g[j] = static_cast<T>(t6::kScaleVPerG[j]);
     c.front_end.bias_g[j] = static_cast<T>(t6::kBiasG[j]);
-    c.front_end.volts_per_count[j] = static_cast<T>(t6::kScaleVPerG[j] * kFullScaleG / kCodes);
+    c.front_end.volts_per_count[j] = static_cast<T>(volts_per_count());
   }
   c.misalignment = t6::misalignment<T>();
-  for (std::size_t j = 0; j < 6; ++j) {
-    const double sgn = (j % 2 == 0) ? 1.0 : -1.0;
-    c.misalignment.drho_b[j] = nav::Vec3<T>(static_cast<T>(0.001 * sgn), static_cast<T>(-0.0005),
-                                            static_cast<T>(0.0008 * sgn));
-  }
+  for (std::size_t j = 0; j < 6; ++j) c.misalignment.drho_b[j] = location_error_m<T>(j);
   c.compensator = kind;
   c.sample_rate_hz = kRateHz;
   return c;
 }
 
-struct Motion {
-  Eigen::Vector3d w_b;
-  Eigen::Vector3d wdot_b;
-  Eigen::Vector3d a_n;
+/// The samples and what was true at each.
+struct Workload {
+  std::vector<RawSample> samples;            // seq k, t_ns k·1 ms, as the source numbers them
+  std::vector<nav::NavState<double>> truth;  // at t_k = k / kRateHz (sim::to_nav_state)
 };
 
-inline Motion motion_at(double t_s) {
-  constexpr double k2Pi = 2.0 * std::numbers::pi;
-  Motion m;
-  m.w_b = {1.0 * std::sin(k2Pi * t_s), 0.5 * std::sin(2 * k2Pi * t_s + 1.0),
-           0.8 * std::sin(k2Pi * t_s + 2.0)};
-  m.wdot_b = {k2Pi * std::cos(k2Pi * t_s), 0.5 * 2 * k2Pi * std::cos(2 * k2Pi * t_s + 1.0),
-              0.8 * k2Pi * std::cos(k2Pi * t_s + 2.0)};
-  m.a_n = {2.0 * std::sin(k2Pi * t_s), std::cos(k2Pi * t_s), 0.5 * std::sin(2 * k2Pi * t_s)};
-  return m;
-}
-
-using Counts = RawSample;
-
-/// kSamples frames of counts for the array of make_config(kExact) (the misalignment is the
-/// physical one whatever compensator reads the counts).
-inline std::vector<Counts> make_counts() {
-  const auto cfg = make_config<double>(nav::CompensatorKind::kExact);
-  const auto truth =
-      nav::ArraySolver<double>::create(nav::misaligned_geometry(cfg.nominal, cfg.misalignment));
-  const auto fe = nav::FrontEnd<double, 6>::create(cfg.front_end);
-  if (!truth.is_ok() || !fe.is_ok()) throw std::runtime_error("bench scenario: bad configuration");
-  const Eigen::Vector3d g_n(0.0, 0.0, nav::kStandardGravity);
-  const double h = 1.0 / kRateHz;
-  Eigen::Quaterniond q_nb = Eigen::Quaterniond::Identity();
-  std::vector<Counts> out(kSamples);
-  for (int k = 0; k < kSamples; ++k) {
-    const double t = k * h;
-    const Motion m = motion_at(t);
-    const Eigen::Vector3d f_b = q_nb.conjugate() * (m.a_n - g_n);
-    const auto s = truth->predict(m.wdot_b, f_b, m.w_b);
-    for (int j = 0; j < 6; ++j) {
-      out[static_cast<std::size_t>(k)].counts[static_cast<std::size_t>(j)] =
-          static_cast<std::int32_t>(std::lround(fe->counts_for(j, s(j))));
-    }
-    // Attitude to the next sample: rotation vector of ω at the midpoint.
-    q_nb =
-        (q_nb * nav::quat_from_rotation_vector<double>(motion_at(t + h / 2).w_b * h)).normalized();
-  }
-  return out;
-}
+/// kSamples samples from the sample source (file comment): the array make_config() describes
+/// (Table 6, location_error_m()), no noise. Throws if the converter fails.
+Workload make_workload();
 
 inline nav::CompensatorKind parse_kind(const std::string& s) {
   if (s == "none") return nav::CompensatorKind::kNone;
@@ -108,23 +86,20 @@ inline nav::CompensatorKind parse_kind(const std::string& s) {
   throw std::invalid_argument("compensator must be none, paper or exact, not '" + s + "'");
 }
 
-/// The true state at the first frame of the buffer (identity attitude, at the origin, at rest
-/// in velocity, rotating at ω(0)).
+/// The true state at the first sample of the buffer.
 template <typename T>
-nav::NavState<T> initial_state() {
-  nav::NavState<T> init;
-  init.w_b = motion_at(0.0).w_b.cast<T>();
-  return init;
+nav::NavState<T> initial_state(const Workload& w) {
+  return w.truth.front().template cast<T>();
 }
 
 /// A configured pipeline already navigating (alignment skipped: start_at the true initial state
-/// with the first frame).
+/// with the first sample).
 template <typename T>
-nav::NavPipeline<T> make_pipeline(nav::CompensatorKind kind, const Counts& first) {
+nav::NavPipeline<T> make_pipeline(nav::CompensatorKind kind, const Workload& w) {
   nav::NavPipeline<T> p;
   const Status st = p.configure(make_config<T>(kind));
   if (!st.is_ok()) throw std::runtime_error(st.message());
-  p.start_at(initial_state<T>(), first);
+  p.start_at(initial_state<T>(w), w.samples.front());
   return p;
 }
 
@@ -136,15 +111,15 @@ nav::NavPipeline<T> make_pipeline(nav::CompensatorKind kind, const Counts& first
 template <typename T>
 class Replay {
  public:
-  Replay(nav::CompensatorKind kind, const std::vector<Counts>& buffer)
-      : buf_(buffer), pipe_(make_pipeline<T>(kind, buffer[0])) {}
+  Replay(nav::CompensatorKind kind, const Workload& w)
+      : buf_(w.samples), init_(initial_state<T>(w)), pipe_(make_pipeline<T>(kind, w)) {}
 
   /// One sample: the per-sample step (or the restart at a wrap of the buffer).
   void step() {
     ++seq_;
     t_ns_ += 1000000;
     if (i_ == 0) {
-      nav::NavState<T> init = initial_state<T>();
+      nav::NavState<T> init = init_;
       init.seq = seq_;
       init.t_ns = t_ns_;
       pipe_.start_at(init, buf_[0]);
@@ -160,7 +135,8 @@ class Replay {
   const nav::NavPipeline<T>& pipeline() const { return pipe_; }
 
  private:
-  const std::vector<Counts>& buf_;
+  const std::vector<RawSample>& buf_;
+  nav::NavState<T> init_;
   nav::NavPipeline<T> pipe_;
   std::size_t i_ = 1;
   std::uint32_t seq_ = 0;

@@ -1,8 +1,8 @@
 // Google Benchmark: one full per-sample step of nav::NavPipeline<T> (front end, compensator,
 // Chen mechanization, strapdown integration) for each compensator, in float and double, and the
-// array solver alone. Inputs are realistic, changing ADC frames replayed from a 1 s buffer
-// (bench_scenario.hpp), with a restart at the true state once per 1000 samples. Figures go to
-// docs/performance.md; nothing here asserts a time.
+// array solver alone. Inputs are realistic, changing ADC samples from host_sim's sample source
+// replayed from a 1 s buffer (bench_scenario.hpp), with a restart at the true state once per 1000
+// samples. Figures go to docs/performance.md; nothing here asserts a time.
 //
 //   build/<dir>/tests/bench/gfins_nav_bench --benchmark_repetitions=5
 #include <benchmark/benchmark.h>
@@ -16,15 +16,15 @@
 namespace gfins::bench {
 namespace {
 
-const std::vector<Counts>& counts_buffer() {
-  static const std::vector<Counts> buffer = make_counts();
-  return buffer;
+const Workload& workload() {
+  static const Workload w = make_workload();
+  return w;
 }
 
 template <typename T>
 void BM_PipelineStep(benchmark::State& state) {
   const auto kind = static_cast<nav::CompensatorKind>(state.range(0));
-  Replay<T> replay(kind, counts_buffer());
+  Replay<T> replay(kind, workload());
   for (auto _ : state) {
     replay.step();
     benchmark::DoNotOptimize(replay.pipeline().state());
@@ -35,7 +35,7 @@ void BM_PipelineStep(benchmark::State& state) {
 
 template <typename T>
 void BM_SolverAlone(benchmark::State& state) {
-  const auto& buf = counts_buffer();
+  const auto& buf = workload().samples;
   const auto cfg = make_config<T>(nav::CompensatorKind::kNone);
   const auto fe = nav::FrontEnd<T, 6>::create(cfg.front_end);
   const auto solver = nav::ArraySolver<T, 6>::create(cfg.nominal);
@@ -47,7 +47,7 @@ void BM_SolverAlone(benchmark::State& state) {
   std::vector<nav::Vec3<T>> rates(buf.size());
   for (std::size_t k = 0; k < buf.size(); ++k) {
     fe->convert(buf[k].counts, outputs[k]);
-    rates[k] = motion_at(static_cast<double>(k) / kRateHz).w_b.cast<T>();
+    rates[k] = workload().truth[k].w_b.cast<T>();
   }
   std::size_t i = 0;
   nav::Vec3<T> wdot_b;

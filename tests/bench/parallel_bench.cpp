@@ -17,6 +17,7 @@
 #include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/host_sim/trajectory.hpp"
+#include "support/covariance_spec.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -63,16 +64,11 @@ void BM_MonteCarlo(benchmark::State& state) {
 void BM_CovarianceReport(benchmark::State& state) {
   const auto jobs = static_cast<std::size_t>(state.range(0));
   const auto traj = make_maneuver(1.0);
-  CovarianceSpec spec;
-  spec.trajectory = traj.get();
-  spec.duration_s = 2.0;
-  spec.dt_s = 1e-3;
-  spec.noise.white_sigma_mps2.fill(1e-3);
-  spec.noise.bias_sigma_mps2.fill(1e-4);
-  spec.noise.bias_rw_mps2_sqrt_s.fill(1e-5);
-  spec.constants.scale_factor_sigma.fill(1e-4);
-  spec.constants.orientation_sigma_rad.fill(1e-4);
-  spec.constants.location_sigma_m.fill(1e-4);
+  test::EverySourceSigmas sigmas;
+  sigmas.white_mps2 = 1e-3;
+  sigmas.bias_rw_mps2_sqrt_s = 1e-5;
+  sigmas.orientation_rad = 1e-4;
+  const CovarianceSpec spec = test::every_source_spec(*traj, 2.0, 1e-3, sigmas);
   const std::vector<double> times = {1.0, 2.0};
   for (auto _ : state) {
     const CovarianceReport r = covariance_report(spec, times, jobs);

@@ -1,6 +1,7 @@
 // Callgrind driver: runs N per-sample pipeline steps so that scripts/callgrind_per_sample.sh can
-// take the instruction count per sample as (Ir(N2) − Ir(N1)) / (N2 − N1); the set-up (buffer,
-// configuration, process start) is the same for any N and cancels.
+// take the instruction count per sample as (Ir(N2) − Ir(N1)) / (N2 − N1); the set-up (the samples,
+// made by the sample source before the loop; configuration, process start) is the same for any N
+// and cancels.
 //
 //   gfins_pipeline_ir <float|double> <none|paper|exact> <samples>
 // Prints a checksum of the final state so the work cannot be optimised away.
@@ -17,8 +18,8 @@ namespace {
 
 template <typename T>
 double run(nav::CompensatorKind kind, long samples) {
-  const auto buf = make_counts();
-  Replay<T> replay(kind, buf);
+  const Workload w = make_workload();
+  Replay<T> replay(kind, w);
   for (long n = 0; n < samples; ++n) replay.step();
   const auto& s = replay.pipeline().state();
   return static_cast<double>(s.q_nb.w() + s.v_n.sum() + s.r_n.sum() + s.w_b.sum());

@@ -47,8 +47,9 @@ std::array<double, 3> euler_zyx(const nav::Quat<float>& qf) {
 }
 
 TEST(EndToEnd, CoreStatesSurviveTheBusWithinQuantisation) {
-  const auto counts = bench::make_counts();
-  auto pipe = bench::make_pipeline<float>(nav::CompensatorKind::kExact, counts[0]);
+  const bench::Workload w = bench::make_workload();
+  const auto& counts = w.samples;
+  auto pipe = bench::make_pipeline<float>(nav::CompensatorKind::kExact, w);
   LineBus bus;
   can::Publisher pub(bus, can::PublisherConfig{.node_id = kNode});
   std::map<std::uint32_t, nav::NavState<float>> states;  // by seq

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -14,6 +14,7 @@
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
 #include "gfins/host_sim/recording.hpp"
+#include "support/cli_fixture.hpp"
 
 namespace gfins {
 namespace {
@@ -84,72 +85,53 @@ TEST(HilWire, BadFramesAreNamed) {
 
 // ---- End to end -------------------------------------------------------------------------------
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-class HilReplay : public ::testing::Test {
+class HilReplay : public test::CliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("gfins-hil-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
   void TearDown() override {
-    if (fw_.joinable()) fw_.join();
-    fs::remove_all(dir_);
+    // A test that failed before the stream ended leaves the firmware waiting: stop it.
+    if (fw_.child.pid > 0 && !fw_done_) {
+      (void)lnx::signal_program(fw_.child, SIGTERM);
+      (void)fw_result();
+    }
   }
 
   // gfins-fw --board hil on an ephemeral loopback port; returns the port it bound.
   int start_firmware() {
-    const std::vector<std::string> argv = {GFINS_FW_EXE,
-                                           "--board",
-                                           "hil",
-                                           "--hil-port",
-                                           "0",
-                                           "--hil-port-file",
-                                           (dir_ / "port").string(),
-                                           "--watchdog",
-                                           "none"};
-    lnx::SpawnOptions so;
-    so.stdout_path = (dir_ / "fw.out").string();
-    so.stderr_path = (dir_ / "fw.err").string();
-    fw_ = std::thread([this, argv, so] { fw_exit_ = lnx::run_program(argv, so); });
+    fw_ = test::start_tool(GFINS_FW_EXE,
+                           {"--board", "hil", "--hil-port", "0", "--hil-port-file", path("port"),
+                            "--watchdog", "none"},
+                           dir() / "fw");
     // Readiness, not timing: the port file appears once the socket listens (written whole and
     // renamed). The bound only keeps a broken build from hanging the suite.
-    for (int i = 0; i < 6000 && !fs::exists(dir_ / "port"); ++i) {
+    for (int i = 0; i < 6000 && !fs::exists(dir() / "port"); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    std::ifstream f(dir_ / "port");
+    std::ifstream f(dir() / "port");
     int port = 0;
     f >> port;
     return port;
   }
 
-  lnx::ProcessExit run_host(int port, std::vector<std::string> extra, const std::string& out) {
-    std::vector<std::string> argv = {GFINS_CAN_EXE, "hil", "--port", std::to_string(port)};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    lnx::SpawnOptions so;
-    so.stdout_path = (dir_ / out).string();
-    so.stderr_path = (dir_ / (out + ".err")).string();
-    const auto r = lnx::run_program(argv, so);
-    EXPECT_TRUE(r.is_ok());
-    return r.is_ok() ? r.value() : lnx::ProcessExit{};
+  /// gfins-can hil --port PORT EXTRA..., its output in dir()/log_name.
+  test::CliResult run_host(int port, const std::vector<std::string>& extra,
+                           const std::string& log_name) const {
+    std::vector<std::string> args = {"hil", "--port", std::to_string(port)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return test::run_tool(GFINS_CAN_EXE, args, dir() / log_name);
   }
 
-  std::string fw_log() {
-    if (fw_.joinable()) fw_.join();
-    return slurp(dir_ / "fw.out") + slurp(dir_ / "fw.err");
+  /// Waits for the firmware to end (once): its exit code and output.
+  const test::CliResult& fw_result() {
+    if (!fw_done_) {
+      fw_exit_ = test::finish_tool(fw_);
+      fw_done_ = true;
+    }
+    return fw_exit_;
   }
 
-  fs::path dir_;
-  std::thread fw_;
-  Result<lnx::ProcessExit> fw_exit_ = Status(ErrorCode::kFailedPrecondition, "not run");
+  test::StartedTool fw_;
+  test::CliResult fw_exit_;
+  bool fw_done_ = false;
 };
 
 // The firmware's default output dividers (docs/can-interface.md): one epoch every 10 samples.
@@ -161,13 +143,13 @@ constexpr int kEpochs = (kSamples - 1) / kEpochDivider + 1;  // seq 0, 10, ..., 
 
 TEST_F(HilReplay, EveryEpochArrivesAndEqualsTheHostCoreRun) {
   const int port = start_firmware();
-  ASSERT_GT(port, 0) << fw_log();
+  ASSERT_GT(port, 0) << fw_result().output;
   const auto host = run_host(port,
                              {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR,
                               "--duration", std::to_string(kSeconds)},
-                             "host.out");
-  const std::string out = slurp(dir_ / "host.out");
-  EXPECT_TRUE(host.ok()) << lnx::describe(host) << "\n" << out << slurp(dir_ / "host.out.err");
+                             "host");
+  const std::string& out = host.output;
+  EXPECT_EQ(host.exit_code, 0) << out;
   const std::string n = std::to_string(kSamples), e = std::to_string(kEpochs);
   EXPECT_NE(out.find("sent " + n + ", acknowledged " + n + ", rejected 0"), std::string::npos)
       << out;
@@ -178,9 +160,8 @@ TEST_F(HilReplay, EveryEpochArrivesAndEqualsTheHostCoreRun) {
   // Counters continuous, CRCs valid: the decoder found no problem at all.
   EXPECT_NE(out.find("problems 0"), std::string::npos) << out;
   EXPECT_NE(out.find("IDENTICAL"), std::string::npos) << out;
-  const std::string log = fw_log();
-  ASSERT_TRUE(fw_exit_.is_ok());
-  EXPECT_TRUE(fw_exit_.value().ok()) << log;
+  const std::string& log = fw_result().output;
+  EXPECT_EQ(fw_result().exit_code, 0) << log;
   EXPECT_NE(log.find("stopped after " + n + " samples"), std::string::npos) << log;
   EXPECT_NE(log.find("1 connection(s), 0 dropped, " + n + " samples, 0 CRC errors"),
             std::string::npos)
@@ -189,15 +170,15 @@ TEST_F(HilReplay, EveryEpochArrivesAndEqualsTheHostCoreRun) {
 
 TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   const int port = start_firmware();
-  ASSERT_GT(port, 0) << fw_log();
+  ASSERT_GT(port, 0) << fw_result().output;
   constexpr int kAbortAfter = 1500;
   const auto cut =
       run_host(port,
                {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR, "--duration",
                 std::to_string(kSeconds), "--abort-after", std::to_string(kAbortAfter)},
-               "cut.out");
-  const std::string out = slurp(dir_ / "cut.out");
-  EXPECT_TRUE(cut.exited && cut.code == 1) << lnx::describe(cut) << out;
+               "cut");
+  const std::string& out = cut.output;
+  EXPECT_EQ(cut.exit_code, 1) << out;
   EXPECT_NE(out.find("INCOMPLETE: connection reset by this host after " +
                      std::to_string(kAbortAfter) + " sample(s)"),
             std::string::npos)
@@ -208,13 +189,12 @@ TEST_F(HilReplay, AKilledConnectionIsReportedAndTheFirmwareCarriesOn) {
   const auto second = run_host(port,
                                {"--scenario", "maneuver", "--scenario-dir", GFINS_SCENARIO_DIR,
                                 "--duration", "0.05", "--corrupt-at", "5"},
-                               "second.out");
-  const std::string out2 = slurp(dir_ / "second.out");
-  EXPECT_TRUE(second.exited && second.code == 1) << out2;
+                               "second");
+  const std::string& out2 = second.output;
+  EXPECT_EQ(second.exit_code, 1) << out2;
   EXPECT_NE(out2.find("board rejected sample 5 (bad CRC on the link)"), std::string::npos) << out2;
-  const std::string log = fw_log();
-  ASSERT_TRUE(fw_exit_.is_ok());
-  EXPECT_TRUE(fw_exit_.value().ok()) << log;
+  const std::string& log = fw_result().output;
+  EXPECT_EQ(fw_result().exit_code, 0) << log;
   // The first connection ended after its sample 1499 (the host may have had up to a window
   // more in flight, all delivered before the reset).
   EXPECT_NE(log.find("2 connection(s), 1 dropped"), std::string::npos) << log;
@@ -238,18 +218,18 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
   }
   sim::RecordingHeader h;
   h.sample_rate_hz = kRate;
-  const fs::path rec = dir_ / "stream.gfr";
+  const fs::path rec = dir() / "stream.gfr";
   ASSERT_TRUE(sim::write_recording(rec.string(), h, samples).is_ok());
   const int port = start_firmware();
-  ASSERT_GT(port, 0) << fw_log();
-  const auto host = run_host(port, {"--recording", rec.string()}, "rec.out");
-  const std::string out = slurp(dir_ / "rec.out");
-  EXPECT_TRUE(host.ok()) << lnx::describe(host) << "\n" << out << slurp(dir_ / "rec.out.err");
+  ASSERT_GT(port, 0) << fw_result().output;
+  const auto host = run_host(port, {"--recording", rec.string()}, "rec");
+  const std::string& out = host.output;
+  EXPECT_EQ(host.exit_code, 0) << out;
   const std::string e = std::to_string((kRecSamples - 1) / kEpochDivider + 1);
   EXPECT_NE(out.find("epochs: expected " + e + ", decoded " + e), std::string::npos) << out;
   EXPECT_NE(out.find("outside quantisation 0"), std::string::npos) << out;
   EXPECT_NE(out.find("IDENTICAL"), std::string::npos) << out;
-  const std::string log = fw_log();
+  const std::string& log = fw_result().output;
   EXPECT_NE(log.find("stopped after " + std::to_string(kRecSamples) + " samples"),
             std::string::npos)
       << log;

@@ -13,6 +13,7 @@
 #include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 #include "gfins/nav_core/error_model.hpp"
+#include "support/covariance_spec.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -87,17 +88,7 @@ TEST(CovarianceGrowthTest, BiasGrowthFollowsKinematics) {
 TEST(CovarianceBudgetTest, SourceVariancesAddUpToTheTotal) {
   // Given every kind of source at once on a moving trajectory,
   const auto traj = make_maneuver(1.0);
-  CovarianceSpec spec;
-  spec.trajectory = traj.get();
-  spec.geometry = nav::table1_geometry<double>(kRhoM);
-  spec.duration_s = 2.0;
-  spec.dt_s = 0.02;
-  spec.noise.white_sigma_mps2.fill(1e-2);
-  spec.noise.bias_sigma_mps2.fill(1e-4);
-  spec.noise.bias_rw_mps2_sqrt_s.fill(1e-4);
-  spec.constants.scale_factor_sigma.fill(1e-4);
-  spec.constants.orientation_sigma_rad.fill(1e-3);
-  spec.constants.location_sigma_m.fill(1e-4);
+  const CovarianceSpec spec = test::every_source_spec(*traj, 2.0, 0.02);
   // when the budget is computed,
   const ErrorBudget b = error_budget(spec, {1.0, 2.0});
   ASSERT_EQ(b.sigma.size(), kBudgetSources.size() + 1);
@@ -119,18 +110,9 @@ TEST(CovarianceBudgetTest, SourceVariancesAddUpToTheTotal) {
 TEST(CovarianceReport, SameBitsForAnyThreadCountAndTheSerialPropagation) {
   // Given every source at once along a manoeuvre (so P and all 36 constant parameters move),
   const auto traj = make_maneuver(1.0);
-  CovarianceSpec spec;
-  spec.trajectory = traj.get();
-  spec.geometry = nav::table1_geometry<double>(kRhoM);
-  spec.duration_s = 0.2;  // 20 steps: what matters is that every job has run (cheap under ASan)
-  spec.dt_s = 0.01;
+  // 20 steps: what matters is that every job has run (cheap under ASan).
+  CovarianceSpec spec = test::every_source_spec(*traj, 0.2, 0.01);
   spec.decimation = 5;
-  spec.noise.white_sigma_mps2.fill(1e-2);
-  spec.noise.bias_sigma_mps2.fill(1e-4);
-  spec.noise.bias_rw_mps2_sqrt_s.fill(1e-4);
-  spec.constants.scale_factor_sigma.fill(1e-4);
-  spec.constants.orientation_sigma_rad.fill(1e-3);
-  spec.constants.location_sigma_m.fill(1e-4);
   const std::vector<double> times = {0.1, 0.2};
   // when the report is computed on 1, 2 and 7 threads,
   const CovarianceReport one = covariance_report(spec, times, 1);

@@ -10,13 +10,12 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <random>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "gfins/drivers/linux/spawn.hpp"
+#include "support/cli_fixture.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -38,36 +37,23 @@ kind = "exact"
 const std::set<std::string> kRunFiles = {"summary.txt", "uncompensated.csv", "compensated.csv",
                                          "accel_errors.png", "nav_errors.png"};
 
-class HostileOutDir : public ::testing::Test {
+// Exit codes of gfins-sim (docs/install.md).
+constexpr int kExitOk = 0;
+constexpr int kExitPlotFailed = 3;
+
+class HostileOutDir : public test::CliTest {
  protected:
   void SetUp() override {
-    std::random_device rd;
-    root_ = fs::temp_directory_path() / ("gfins_hostile_" + std::to_string(rd()));
-    fs::create_directories(root_ / "input");
-    scenario_ = (root_ / "input" / "tiny.toml").string();
-    std::ofstream(scenario_) << kTinyScenario;
+    fs::create_directories(dir() / "input");
+    scenario_ = file("input/tiny.toml", kTinyScenario);
   }
-  void TearDown() override { fs::remove_all(root_); }
 
-  /// Runs gfins-sim run <tiny> --out=<name> in a fresh folder; returns the exit.
-  lnx::ProcessExit run_in(const fs::path& work, const std::string& out_name) {
+  /// Runs gfins-sim run <tiny> --out=<name> in a fresh folder `work` (its output in dir()).
+  test::CliResult run_in(const fs::path& work, const std::string& out_name) const {
     fs::create_directories(work);
-    const std::vector<std::string> argv = {GFINS_SIM_BIN, "run", scenario_, "--out=" + out_name};
-    lnx::SpawnOptions opts;
-    opts.cwd = work.string();
-    opts.stdout_path = (root_ / "input" / "stdout.txt").string();
-    opts.stderr_path = (root_ / "input" / "stderr.txt").string();
-    const auto r = lnx::run_program(argv, opts);
-    EXPECT_TRUE(r.is_ok()) << r.status().message();
-    return r.is_ok() ? r.value() : lnx::ProcessExit{};
+    return run(GFINS_SIM_BIN, {"run", scenario_, "--out=" + out_name}, work);
   }
 
-  std::string text(const char* file) const {
-    std::ifstream in(root_ / "input" / file);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  }
-
-  fs::path root_;
   std::string scenario_;
 };
 
@@ -93,10 +79,10 @@ TEST_F(HostileOutDir, EveryNameIsAFolderOfThatNameAndNothingElseAppears) {
   for (const std::string& name : hostile) {
     SCOPED_TRACE("folder name: " + name);
     // Given a fresh working folder, when gfins-sim runs with --out=<name>,
-    const fs::path work = root_ / ("case" + std::to_string(i++));
-    const lnx::ProcessExit e = run_in(work, name);
+    const fs::path work = dir() / ("case" + std::to_string(i++));
+    const test::CliResult r = run_in(work, name);
     // then it succeeds (the plot too),
-    EXPECT_TRUE(e.ok()) << lnx::describe(e) << "\n" << text("stderr.txt");
+    EXPECT_EQ(r.exit_code, kExitOk) << r.output;
     // the working folder holds exactly the output folder, named byte for byte,
     EXPECT_EQ(names_in(work), std::set<std::string>{name});
     // and the output folder exactly the files of a run: no PWNED, no stray file.
@@ -105,42 +91,39 @@ TEST_F(HostileOutDir, EveryNameIsAFolderOfThatNameAndNothingElseAppears) {
     }
   }
   // Nothing was created next to the inputs either.
-  EXPECT_EQ(names_in(root_ / "input"),
-            (std::set<std::string>{"tiny.toml", "stdout.txt", "stderr.txt"}));
+  EXPECT_EQ(names_in(dir() / "input"), std::set<std::string>{"tiny.toml"});
 }
 
 TEST_F(HostileOutDir, MissingMatplotlibIsAClearErrorAndExitCode3WithTheCsvWritten) {
   // Given an interpreter without matplotlib: Debian's python3 with site-packages disabled (-S),
   // behind a wrapper that passes its arguments on unchanged ("$@", no interpolation).
-  const fs::path wrapper = root_ / "input" / "python-without-site";
-  std::ofstream(wrapper) << "#!/bin/sh\nexec /usr/bin/python3 -S \"$@\"\n";
+  const std::string wrapper =
+      file("python-without-site", "#!/bin/sh\nexec /usr/bin/python3 -S \"$@\"\n");
   fs::permissions(wrapper, fs::perms::owner_all);
   ASSERT_EQ(setenv("GFINS_PYTHON", wrapper.c_str(), 1), 0);
-  const lnx::ProcessExit e = run_in(root_ / "nomatplotlib", "out");
+  const test::CliResult r = run_in(dir() / "nomatplotlib", "out");
   ASSERT_EQ(unsetenv("GFINS_PYTHON"), 0);
   // then gfins-sim exits 3 (kExitPlotFailed) with a message naming the cause,
-  EXPECT_TRUE(e.exited);
-  EXPECT_EQ(e.code, 3);
-  const std::string err = text("stderr.txt");
+  EXPECT_EQ(r.exit_code, kExitPlotFailed) << r.output;
+  const std::string& err = r.err;
   EXPECT_NE(err.find("cannot plot"), std::string::npos) << err;
   EXPECT_NE(err.find("matplotlib"), std::string::npos) << err;
   EXPECT_NE(err.find("plotting failed"), std::string::npos) << err;
   // and the CSV files are there.
-  EXPECT_TRUE(fs::exists(root_ / "nomatplotlib" / "out" / "compensated.csv"));
+  EXPECT_TRUE(fs::exists(dir() / "nomatplotlib" / "out" / "compensated.csv"));
 }
 
 TEST(Spawn, ArgumentsReachTheChildByteForByte) {
   // printf '%s' prints its argument verbatim: the oracle is the argument itself.
   const std::string arg = "a'b\"c $(x) `y` ; z\n-w";
-  const fs::path out = fs::temp_directory_path() / "gfins_spawn_arg.txt";
+  const testing::TempDir tmp;
+  const fs::path out = tmp.path() / "printf.out";
   lnx::SpawnOptions opts;
   opts.stdout_path = out.string();
   const auto r = lnx::run_program(std::vector<std::string>{"printf", "%s", arg}, opts);
   ASSERT_TRUE(r.is_ok());
   EXPECT_TRUE(r.value().ok());
-  std::ifstream in(out);
-  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), arg);
-  fs::remove(out);
+  EXPECT_EQ(testing::read_text(out), arg);
 }
 
 TEST(Spawn, AProgramThatCannotStartAndOneThatFailsAreTold) {

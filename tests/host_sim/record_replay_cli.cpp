@@ -17,8 +17,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,14 +25,15 @@
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/paper_table6.hpp"
 #include "gfins/nav_core/pipeline.hpp"
-#include "support/run_cli.hpp"
+#include "support/cli_fixture.hpp"
+#include "support/csv.hpp"
 
 namespace gfins::sim {
 namespace {
 
 namespace fs = std::filesystem;
 using test::CliResult;
-using test::run_tool;
+using test::Csv;
 
 // Exit codes of gfins-sim and gfins-replay (docs/simulation.md, docs/replay.md).
 constexpr int kExitOk = 0;
@@ -72,73 +71,18 @@ orientation = "paper_table6"
 kind = "exact"
 )TOML";
 
-class RecordReplay : public ::testing::Test {
+class RecordReplay : public test::CliTest {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    root_ = fs::temp_directory_path() / ("gfins_record_replay_" + std::to_string(rd()));
-    fs::create_directories(root_);
-  }
-  void TearDown() override { fs::remove_all(root_); }
-
-  std::string file(const std::string& name, const std::string& text) const {
-    const fs::path p = root_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  std::string path(const std::string& name) const { return (root_ / name).string(); }
-  CliResult sim(const std::vector<std::string>& args) const {
-    return run_tool(GFINS_SIM_BIN, args, root_);
-  }
+  CliResult sim(const std::vector<std::string>& args) const { return run(GFINS_SIM_BIN, args); }
   CliResult replay(const std::vector<std::string>& args) const {
-    return run_tool(GFINS_REPLAY_BIN, args, root_);
+    return run(GFINS_REPLAY_BIN, args);
   }
   CliResult calibrate(const std::vector<std::string>& args) const {
-    return run_tool(GFINS_CALIBRATE_BIN, args, root_);
-  }
-
-  fs::path root_;
-};
-
-struct Csv {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-  std::vector<double> column(const std::string& name) const {
-    std::vector<double> out;
-    for (std::size_t i = 0; i < header.size(); ++i) {
-      if (header[i] != name) continue;
-      for (const auto& r : rows) out.push_back(r.at(i));
-      return out;
-    }
-    ADD_FAILURE() << "no column " << name;
-    return out;
+    return run(GFINS_CALIBRATE_BIN, args);
   }
 };
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream in(line);
-  for (std::string cell; std::getline(in, cell, ',');) out.push_back(cell);
-  return out;
-}
-
-/// Reads a CSV with a header line; lines starting with '#' are skipped.
-Csv read_csv_text(const std::string& text) {
-  Csv c;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    if (c.header.empty()) {
-      c.header = split(line);
-      continue;
-    }
-    std::vector<double> row;
-    for (const auto& cell : split(line)) row.push_back(std::strtod(cell.c_str(), nullptr));
-    c.rows.push_back(row);
-  }
-  return c;
-}
-Csv read_csv(const std::string& p) { return read_csv_text(test::slurp(p)); }
+Csv read_csv(const std::string& p) { return test::parse_csv(test::slurp(p)); }
 
 /// True when the CSV cell `v` (printed with %.9g, 9 significant digits: enough to identify a
 /// binary32 value) is the print of a binary32 number: rounding it to float and printing it again
@@ -216,7 +160,7 @@ TEST_F(RecordReplay, DumpPrintsTheHeaderAndEverySampleWithVolts) {
   ASSERT_EQ(d.exit_code, kExitOk) << d.output;
   EXPECT_NE(d.output.find("# sample_rate_hz 200"), std::string::npos) << d.output.substr(0, 800);
   EXPECT_NE(d.output.find("record_count 1001"), std::string::npos);
-  const Csv c = read_csv_text(d.output);
+  const Csv c = test::parse_csv(d.output);
   const std::vector<std::string> want = {"seq",     "t_ns",    "count_1", "count_2", "count_3",
                                          "count_4", "count_5", "count_6", "v_1_V",   "v_2_V",
                                          "v_3_V",   "v_4_V",   "v_5_V",   "v_6_V",   "flags"};

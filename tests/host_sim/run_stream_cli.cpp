@@ -15,7 +15,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -23,7 +22,8 @@
 
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/scenario.hpp"
-#include "support/run_cli.hpp"
+#include "support/cli_fixture.hpp"
+#include "support/csv.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -56,50 +56,15 @@ std::string rest_scenario(double duration_s, double rate_hz) {
   return s.str();
 }
 
-class RunStreamCli : public ::testing::Test {
+class RunStreamCli : public test::CliTest {
  protected:
-  void SetUp() override {
-    dir_ =
-        fs::temp_directory_path() /
-        ("gfins_run_stream_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+  fs::path write_scenario(const std::string& name, const std::string& text) const {
+    return file(name + ".toml", text);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path write_scenario(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / (name + ".toml");
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  fs::path dir_;
 };
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
-}
-
-std::vector<double> fields_of(const std::string& row) {
-  std::vector<double> out;
-  std::istringstream in(row);
-  for (std::string f; std::getline(in, f, ',');) out.push_back(std::strtod(f.c_str(), nullptr));
-  return out;
-}
-
-std::size_t column(const std::string& header, const std::string& name) {
-  std::istringstream in(header);
-  std::size_t i = 0;
-  for (std::string f; std::getline(in, f, ','); ++i) {
-    if (f == name) return i;
-  }
-  ADD_FAILURE() << "no column " << name;
-  return 0;
-}
+using test::lines_of;
+using test::numbers_of;
 
 // (1) Above the memory limit, a run still completes: its files are streamed. The CSV has the
 // analytic row count and last row, and the peak memory does not follow the duration.
@@ -125,21 +90,20 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
   long rss_kib[2] = {0, 0};
   for (int i = 0; i < 2; ++i) {
     const fs::path toml = i == 0 ? short_toml : long_toml;
-    const fs::path out = dir_ / (i == 0 ? "short" : "long");
-    const CliResult r = test::run_tool(
-        GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"}, dir_);
+    const fs::path out = dir() / (i == 0 ? "short" : "long");
+    const CliResult r = run(GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"});
     ASSERT_EQ(r.exit_code, kExitOk) << r.output;
     rss_kib[i] = r.max_rss_kib;
   }
   for (int i = 0; i < 2; ++i) {
-    const fs::path out = dir_ / (i == 0 ? "short" : "long");
+    const fs::path out = dir() / (i == 0 ? "short" : "long");
     const double duration = i == 0 ? kShort : kLong;
     for (const char* file : {"uncompensated.csv", "compensated.csv"}) {
       const auto lines = lines_of(test::slurp(out / file));
       // Header + duration × rate + 1 samples (the start at t = 0 and every sample after it).
       ASSERT_EQ(lines.size(), 1 + static_cast<std::size_t>(duration * kRate) + 1) << file;
-      const std::string& head = lines.front();
-      const auto last = fields_of(lines.back());
+      const test::Csv head{test::cells_of(lines.front()), {}};
+      const auto last = numbers_of(lines.back());
       char t_text[32];
       std::snprintf(t_text, sizeof t_text, "%.6f,", duration);
       EXPECT_EQ(lines.back().rfind(t_text, 0), 0u) << "last row starts with t = " << t_text;
@@ -150,7 +114,7 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
                                    : std::string(name) == "true_r_n" ? "m"
                                    : std::string(name) == "true_w_b" ? "rps"
                                                                      : "mps2";
-          EXPECT_EQ(last.at(column(head, std::string(name) + "_" + ax + "_" + unit)), 0.0)
+          EXPECT_EQ(last.at(head.index(std::string(name) + "_" + ax + "_" + unit)), 0.0)
               << file << " " << name << " " << ax;
         }
       }
@@ -170,15 +134,14 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
 // system this test runs on has free (checked below with std::filesystem::space).
 TEST_F(RunStreamCli, RunThatCannotFitOnTheDiskIsRefusedWithTheNumbers) {
   constexpr double kMinBytesNeeded = 2e13;
-  ASSERT_LT(static_cast<double>(fs::space(dir_).available), kMinBytesNeeded);
+  ASSERT_LT(static_cast<double>(fs::space(dir()).available), kMinBytesNeeded);
   const fs::path toml = write_scenario("huge", rest_scenario(1.0e6, 1.0e5));
-  const fs::path out = dir_ / "a" / "huge";
-  const CliResult r =
-      test::run_tool(GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"}, dir_);
+  const fs::path out = dir() / "a" / "huge";
+  const CliResult r = run(GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"});
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("1e+11 samples"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("MB free"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(dir_ / "a")) << "a refused run left a folder";
+  EXPECT_FALSE(fs::exists(dir() / "a")) << "a refused run left a folder";
 }
 
 // (2) SIGINT after the first progress line: exit 130, CSV rows a prefix of an uninterrupted
@@ -187,9 +150,9 @@ TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
   ASSERT_EQ(setenv("GFINS_PROGRESS_INTERVAL_S", "0.1", 1), 0);
   constexpr double kRate = 100.0, kDuration = 800.0;  // 80,001 samples: seconds of work
   const fs::path toml = write_scenario("long", rest_scenario(kDuration, kRate));
-  const fs::path cut = dir_ / "cut";
-  const fs::path gfr = dir_ / "cut.gfr";
-  const fs::path log = dir_ / "log";
+  const fs::path cut = dir() / "cut";
+  const fs::path gfr = dir() / "cut.gfr";
+  const fs::path log = dir() / "log";
   fs::create_directories(log);
   test::StartedTool t = test::start_tool(
       GFINS_SIM_BIN,
@@ -224,9 +187,8 @@ TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
 
   // The uninterrupted run of the same scenario: the cut files are prefixes of its files.
   unsetenv("GFINS_PROGRESS_INTERVAL_S");
-  const fs::path full = dir_ / "full";
-  const CliResult f =
-      test::run_tool(GFINS_SIM_BIN, {"run", toml.string(), "-o", full.string(), "--no-plot"}, dir_);
+  const fs::path full = dir() / "full";
+  const CliResult f = run(GFINS_SIM_BIN, {"run", toml.string(), "-o", full.string(), "--no-plot"});
   ASSERT_EQ(f.exit_code, kExitOk) << f.output;
   for (const char* file : {"uncompensated.csv", "compensated.csv"}) {
     const std::string cut_text = test::slurp(cut / file);

@@ -9,12 +9,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <random>
 #include <string>
 #include <vector>
 
-#include "gfins/drivers/linux/spawn.hpp"
-#include "support/run_cli.hpp"
+#include "support/cli_fixture.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -25,45 +23,23 @@ namespace fs = std::filesystem;
 constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
 
-class ScenarioNameCli : public ::testing::Test {
+class ScenarioNameCli : public test::CliTest {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ =
-        fs::temp_directory_path() / ("gfins-names-" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(dir_ / "logs");
+  // gfins-sim ARGS run in dir() (the current folder of the child).
+  test::CliResult sim(const std::vector<std::string>& args) const {
+    return run(GFINS_SIM_BIN, args, dir());
   }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  // gfins-sim ARGS run in dir_ (the current folder of the child).
-  test::CliResult sim(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{GFINS_SIM_BIN};
-    argv.insert(argv.end(), args.begin(), args.end());
-    drivers::lnx::SpawnOptions o;
-    o.cwd = dir_.string();
-    o.search_path = false;
-    o.stdout_path = (dir_ / "logs/out").string();
-    o.stderr_path = (dir_ / "logs/err").string();
-    test::CliResult r;
-    const auto e = drivers::lnx::run_program(argv, o);
-    if (e.is_ok() && e->exited) r.exit_code = e->code;
-    r.output = test::slurp(o.stdout_path) + test::slurp(o.stderr_path);
-    return r;
-  }
-  fs::path dir_;
 };
 
 TEST_F(ScenarioNameCli, AFolderNamedLikeABuiltInDoesNotShadowIt) {
   // Given the folder left by `run paper-6.3 -o paper-6.3`.
   const auto run = sim({"run", "paper-6.3", "-o", "paper-6.3", "--no-plot"});
   ASSERT_EQ(run.exit_code, kExitOk) << run.output;
-  ASSERT_TRUE(fs::is_regular_file(dir_ / "paper-6.3/compensated.csv"));
+  ASSERT_TRUE(fs::is_regular_file(dir() / "paper-6.3/compensated.csv"));
   // When the name is used again, then it is the built-in scenario.
   const auto mc = sim({"montecarlo", "paper-6.3", "-n", "2", "-o", "mc", "--no-plot"});
   EXPECT_EQ(mc.exit_code, kExitOk) << mc.output;
-  EXPECT_TRUE(fs::is_regular_file(dir_ / "mc/montecarlo.csv")) << mc.output;
+  EXPECT_TRUE(fs::is_regular_file(dir() / "mc/montecarlo.csv")) << mc.output;
   // And the path spelling is the folder, which is no scenario file.
   const auto path = sim({"run", "./paper-6.3", "--no-plot"});
   EXPECT_EQ(path.exit_code, kExitBadInput) << path.output;
@@ -75,7 +51,7 @@ TEST_F(ScenarioNameCli, AnUnknownNameSuggestsTheClosestAndList) {
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   EXPECT_NE(r.output.find("closest: rest-calibrated, rest"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("gfins-sim list"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(dir_ / "sim-out")) << "nothing is written for a rejected name";
+  EXPECT_FALSE(fs::exists(dir() / "sim-out")) << "nothing is written for a rejected name";
 }
 
 }  // namespace

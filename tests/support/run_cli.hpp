@@ -7,18 +7,19 @@
 #pragma once
 
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "gfins/drivers/linux/spawn.hpp"
+#include "support/temp_dir.hpp"
 
 namespace gfins::test {
 
 struct CliResult {
   int exit_code = -1;    // -1: not started, or killed by a signal
   std::string output;    // stdout, then stderr
+  std::string err;       // stderr alone
   long max_rss_kib = 0;  // the child's peak resident set (wait4), KiB
 };
 
@@ -29,31 +30,34 @@ inline std::vector<std::string> split_at_spaces(const std::string& args) {
   return out;
 }
 
-inline std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+/// The whole file ("" when it cannot be opened).
+inline std::string slurp(const std::filesystem::path& p) { return testing::read_text(p); }
 
 /// A tool started without waiting (start_tool), e.g. to be interrupted: its stdout and stderr go
 /// to log_dir/cli.out and log_dir/cli.err, which the test may read while it runs.
 struct StartedTool {
   drivers::lnx::ChildProcess child;
   std::filesystem::path log_dir;
+  std::filesystem::path stdout_path() const { return log_dir / "cli.out"; }
   std::filesystem::path stderr_path() const { return log_dir / "cli.err"; }
 };
 
+/// Starts `exe args...` with its output in log_dir (made if missing) and, when `cwd` is not
+/// empty, that folder as its working directory.
 inline StartedTool start_tool(const std::string& exe, const std::vector<std::string>& args,
-                              const std::filesystem::path& log_dir) {
+                              const std::filesystem::path& log_dir,
+                              const std::filesystem::path& cwd = {}) {
   std::vector<std::string> argv{exe};
   argv.insert(argv.end(), args.begin(), args.end());
-  drivers::lnx::SpawnOptions o;
-  o.search_path = false;
-  o.stdout_path = (log_dir / "cli.out").string();
-  o.stderr_path = (log_dir / "cli.err").string();
   StartedTool t;
   t.log_dir = log_dir;
+  std::error_code ec;
+  std::filesystem::create_directories(log_dir, ec);
+  drivers::lnx::SpawnOptions o;
+  o.search_path = false;
+  o.cwd = cwd.string();
+  o.stdout_path = t.stdout_path().string();
+  o.stderr_path = t.stderr_path().string();
   if (auto c = drivers::lnx::start_program(argv, o); c.is_ok()) t.child = c.value();
   return t;
 }
@@ -66,14 +70,16 @@ inline CliResult finish_tool(StartedTool& t) {
     if (e.is_ok() && e->exited) r.exit_code = e->code;
     if (e.is_ok()) r.max_rss_kib = e->max_rss_kib;
   }
-  r.output = slurp(t.log_dir / "cli.out") + slurp(t.log_dir / "cli.err");
+  r.err = slurp(t.stderr_path());
+  r.output = slurp(t.stdout_path()) + r.err;
   return r;
 }
 
 /// Runs a tool to its end (start_tool + finish_tool): exit code and stdout + stderr.
 inline CliResult run_tool(const std::string& exe, const std::vector<std::string>& args,
-                          const std::filesystem::path& log_dir) {
-  StartedTool t = start_tool(exe, args, log_dir);
+                          const std::filesystem::path& log_dir,
+                          const std::filesystem::path& cwd = {}) {
+  StartedTool t = start_tool(exe, args, log_dir, cwd);
   return finish_tool(t);
 }
 

@@ -25,8 +25,6 @@ double LatencyHistogram::quantile_us(double q) const {
   return static_cast<double>(kBins);
 }
 
-std::uint64_t SampleLoop::built_layout_signature() { return layout_signature(); }
-
 SampleLoop::SampleLoop(SampleSource& adc, hal::CanBus& bus, EpochSink& out, hal::Clock& clock,
                        FwLogQueue& log)
     : adc_(adc), bus_(bus), out_(out), clock_(clock), log_(log) {}

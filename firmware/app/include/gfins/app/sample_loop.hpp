@@ -14,7 +14,6 @@
 #include "gfins/app/log_queue.hpp"
 #include "gfins/app/ports.hpp"
 #include "gfins/app/reload_worker.hpp"
-#include "gfins/checksum/fnv1a.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
 #include "gfins/hal/watchdog.hpp"
@@ -96,17 +95,6 @@ class SampleLoop {
   /// immediate response; nothing changes when the command is rejected.
   void execute(const Command& c, Response& r);
 
-  /// The layout of SampleLoop as the including translation unit sees it: FNV-1a 64 over the size
-  /// and alignment of the class and of each member, in declaration order. The inline accessors
-  /// (mode(), health(), ...) are compiled into the caller, the members are written by
-  /// sample_loop.cpp: when the two were compiled against different headers (a stale object in
-  /// an incremental build) the caller reads members where the library never writes, and
-  /// sizeof(SampleLoop) alone need not differ (the 16-byte alignment can absorb a grown member in
-  /// tail padding). docs/ci.md, "armhf: ... reported mode 0".
-  static constexpr std::uint64_t layout_signature();
-  /// layout_signature() as sample_loop.cpp was compiled (out of line, in the library).
-  static std::uint64_t built_layout_signature();
-
  private:
   struct Capture {
     bool active = false;
@@ -163,60 +151,5 @@ class SampleLoop {
   std::uint32_t sample_index_ = 0;
   std::uint32_t last_log_ = 0;
 };
-
-constexpr std::uint64_t SampleLoop::layout_signature() {
-  const std::array<std::size_t, 40> sizes = {
-      // size and alignment of the class and of 15 members, then the sizes of 8 member types
-      sizeof(SampleLoop),
-      alignof(SampleLoop),
-      sizeof(pipeline_),
-      alignof(decltype(pipeline_)),
-      sizeof(cal_),
-      alignof(decltype(cal_)),
-      sizeof(options_),
-      alignof(decltype(options_)),
-      sizeof(health_),
-      alignof(decltype(health_)),
-      sizeof(adc_seen_),
-      alignof(decltype(adc_seen_)),
-      sizeof(can_seen_),
-      alignof(decltype(can_seen_)),
-      sizeof(can_state_),
-      alignof(decltype(can_state_)),
-      sizeof(stuck_),
-      alignof(decltype(stuck_)),
-      sizeof(events_),
-      alignof(decltype(events_)),
-      sizeof(capture_),
-      alignof(decltype(capture_)),
-      sizeof(last_capture_),
-      alignof(decltype(last_capture_)),
-      sizeof(epoch_),
-      alignof(decltype(epoch_)),
-      sizeof(latency_),
-      alignof(decltype(latency_)),
-      sizeof(last_counts_),
-      alignof(decltype(last_counts_)),
-      sizeof(last_good_),
-      alignof(decltype(last_good_)),
-      sizeof(Command),
-      sizeof(Response),
-      sizeof(CalibrationSet),
-      sizeof(HealthCounters),
-      sizeof(hal::CanCounters),
-      sizeof(Epoch),
-      sizeof(RawSample),
-      sizeof(nav::NavState<float>),
-  };
-  Fnv1a64 h;
-  for (const std::size_t v : sizes) {
-    // the four low bytes of each value (all far below 2^32), least significant first
-    for (int shift = 0; shift < 32; shift += 8) {
-      const std::array<std::uint8_t, 1> b = {static_cast<std::uint8_t>((v >> shift) & 0xffu)};
-      h.add(b);
-    }
-  }
-  return h.value();
-}
 
 }  // namespace gfins::app
