@@ -43,9 +43,12 @@ struct Reference {
 // M = pinv(H) and K = M Q in double, from the geometry alone.
 // GCC 12 for armhf (-O3) reports the singular values read below as maybe uninitialised: a false
 // positive from inside Eigen's JacobiSVD::compute, which writes every one of them (no other
-// target's build warns). Silenced for this function only.
+// target's build warns). Silenced for this function only, and for GCC only (Clang has no such
+// warning and would report the unknown option).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 template <int N>
 Reference<N> reference(const ArrayGeometry<double, N>& g) {
   double lever = 0.0;
@@ -74,7 +77,9 @@ Reference<N> reference(const ArrayGeometry<double, N>& g) {
   r.k = r.m * q;
   return r;
 }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 struct Errors {
   double m = 0.0;     // ‖δM‖_F/‖M‖_F
