@@ -121,7 +121,9 @@ std::array<Eigen::Vector3d, 6> axes_of(const std::array<double, 6>& beta_rad,
     const Eigen::Matrix3d c = c_matrix(alpha ? alpha_rad : beta_rad);
     for (int r = 0; r < 3; ++r) {
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) v += c(r, k) * nominal[static_cast<std::size_t>(set[k])];
+      for (std::size_t k = 0; k < 3; ++k) {
+        v += c(r, static_cast<Eigen::Index>(k)) * nominal[static_cast<std::size_t>(set[k])];
+      }
       th[static_cast<std::size_t>(set[static_cast<std::size_t>(r)])] = v;
     }
   }

@@ -162,7 +162,8 @@ Eigen::Matrix4d stated_covariance(const calib_file::CalibrationData& d, std::siz
 }
 
 // A file as installed: the truth plus an error drawn from the covariance it states.
-calib_file::CalibrationData draw_file(std::mt19937_64& rng, const calib_file::CalibrationData& truth,
+calib_file::CalibrationData draw_file(std::mt19937_64& rng,
+                                      const calib_file::CalibrationData& truth,
                                       const std::array<Eigen::Matrix4d, 6>& chol) {
   std::normal_distribution<double> n01;
   calib_file::CalibrationData d = truth;
@@ -195,7 +196,8 @@ std::vector<MeanRow> capture(std::mt19937_64& rng, const calib_file::Calibration
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < kPoses.size(); ++k) {
     // At rest the sensed specific force is −g: gravity_b = −kG · (the pose's f in g).
-    const Eigen::Vector3d gravity_b = -kG * Eigen::Vector3d(kPoses[k][0], kPoses[k][1], kPoses[k][2]);
+    const Eigen::Vector3d gravity_b =
+        -kG * Eigen::Vector3d(kPoses[k][0], kPoses[k][1], kPoses[k][2]);
     for (std::size_t j = 0; j < 6; ++j) {
       const auto& s = truth.sensors[j];
       // Static: a = ω̇ = ω = 0, so ρ*_j does not enter; any value shows it.
@@ -282,10 +284,9 @@ TEST(VerifySigma, PredictedResidualSigmaMatchesAMonteCarloOverTheStatedCovarianc
       const Cell& c = cells[k][j];
       const double z2 = c.z2_stated / kDraws;
       const double z2_v2 = c.z2_uncorrelated / kDraws;
-      std::printf("%4zu   a%zu    %10.4f        %7.4f   %10.4f          %7.4f%s\n",
-                  k + kFirstPose, j + 1, c.sigma_stated / kDraws * 1e3, z2,
-                  c.sigma_uncorrelated / kDraws * 1e3, z2_v2,
-                  (z2_v2 < lo || z2_v2 > hi) ? "  <- fails without correlations" : "");
+      std::printf("%4zu   a%zu    %10.4f        %7.4f   %10.4f          %7.4f%s\n", k + kFirstPose,
+                  j + 1, c.sigma_stated / kDraws * 1e3, z2, c.sigma_uncorrelated / kDraws * 1e3,
+                  z2_v2, (z2_v2 < lo || z2_v2 > hi) ? "  <- fails without correlations" : "");
       EXPECT_GE(z2, lo) << "pose " << k + kFirstPose << " sensor a" << j + 1;
       EXPECT_LE(z2, hi) << "pose " << k + kFirstPose << " sensor a" << j + 1;
       uncorrelated_outside += (z2_v2 < lo || z2_v2 > hi);

@@ -612,7 +612,7 @@ TEST(FirmwareCalibration, PosesOfTheTablesAreFarApartComparedWithThePoseToleranc
       double d = 0;
       for (const auto& t : theta) {
         double x = 0;
-        for (int i = 0; i < 3; ++i) x += t[i] * (plan[a].f_b_g[i] - plan[c].f_b_g[i]);
+        for (std::size_t i = 0; i < 3; ++i) x += t[i] * (plan[a].f_b_g[i] - plan[c].f_b_g[i]);
         d = std::max(d, std::abs(x));
       }
       closest = std::min(closest, d);

@@ -109,26 +109,28 @@ TEST(EndToEnd, CoreStatesSurviveTheBusWithinQuantisation) {
           want = 77;
           break;
         case can::Field::kQuaternion:
-          want = qsign *
-                 std::array<double, 4>{n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()}[s.index];
+          want = qsign * std::array<double, 4>{static_cast<double>(n.q_nb.w()),
+                                               static_cast<double>(n.q_nb.x()),
+                                               static_cast<double>(n.q_nb.y()),
+                                               static_cast<double>(n.q_nb.z())}[s.index];
           break;
         case can::Field::kEuler:
           want = eul[s.index];
           break;
         case can::Field::kRate:
-          want = n.w_b[s.index];
+          want = static_cast<double>(n.w_b[s.index]);
           break;
         case can::Field::kAngularAccel:
-          want = n.wdot_b[s.index];
+          want = static_cast<double>(n.wdot_b[s.index]);
           break;
         case can::Field::kAccel:
-          want = n.f_b[s.index];
+          want = static_cast<double>(n.f_b[s.index]);
           break;
         case can::Field::kVelocity:
-          want = n.v_n[s.index];
+          want = static_cast<double>(n.v_n[s.index]);
           break;
         case can::Field::kPosition:
-          want = n.r_n[s.index];
+          want = static_cast<double>(n.r_n[s.index]);
           break;
         default:
           continue;  // health counters and sensor outputs: zero here, covered elsewhere

@@ -28,21 +28,22 @@ double expected_value(const Epoch& e, const can::SignalDef& s) {
   const int i = s.index;
   switch (s.field) {
     case can::Field::kVelocity:
-      return n.v_n(i);
+      return static_cast<double>(n.v_n(i));
     case can::Field::kPosition:
-      return n.r_n(i);
+      return static_cast<double>(n.r_n(i));
     case can::Field::kRate:
-      return n.w_b(i);
+      return static_cast<double>(n.w_b(i));
     case can::Field::kAngularAccel:
-      return n.wdot_b(i);
+      return static_cast<double>(n.wdot_b(i));
     case can::Field::kAccel:
-      return n.f_b(i);
+      return static_cast<double>(n.f_b(i));
     case can::Field::kQuaternion: {
-      const double c[4] = {n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()};
-      return (n.q_nb.w() < 0 ? -1.0 : 1.0) * c[i];  // the bus carries the w >= 0 one
+      const float c[4] = {n.q_nb.w(), n.q_nb.x(), n.q_nb.y(), n.q_nb.z()};
+      return (n.q_nb.w() < 0 ? -1.0 : 1.0) *
+             static_cast<double>(c[i]);  // the bus carries the w >= 0 one
     }
     case can::Field::kSensorAccel:
-      return e.accel_mps2[static_cast<std::size_t>(i)];
+      return static_cast<double>(e.accel_mps2[static_cast<std::size_t>(i)]);
     case can::Field::kCalId:
       return e.cal_id;
     case can::Field::kMissedEdges:

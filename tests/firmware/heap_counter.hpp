@@ -7,12 +7,27 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdlib>
+#if defined(__x86_64__) || defined(__i386__)
+// clang's <mm_malloc.h> (reached through Eigen's SSE headers) re-declares posix_memalign without
+// noexcept; seen before the definition below it is accepted, seen after it is an error.
+#include <mm_malloc.h>
+#endif
+
+// AddressSanitizer: gcc defines __SANITIZE_ADDRESS__, clang answers __has_feature.
+#if defined(__SANITIZE_ADDRESS__)
+#define GFINS_HEAP_COUNTER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define GFINS_HEAP_COUNTER_ASAN 1
+#endif
+#endif
 
 namespace gfins::testing {
 inline std::atomic<long> g_heap_calls{0};
 struct HeapCounter {
   static long calls() { return g_heap_calls.load(std::memory_order_relaxed); }
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(GFINS_HEAP_COUNTER_ASAN)
   static constexpr bool available() { return false; }
 #else
   static constexpr bool available() { return true; }
@@ -20,7 +35,7 @@ struct HeapCounter {
 };
 }  // namespace gfins::testing
 
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(GFINS_HEAP_COUNTER_ASAN)
 extern "C" {
 void* __libc_malloc(std::size_t) noexcept;
 void* __libc_calloc(std::size_t, std::size_t) noexcept;

@@ -35,7 +35,7 @@ constexpr double kCheckFromS = 0.5;   // from 50 samples on (see kRelTol)
 // the integrator's trapezoid steps; its variance differs from the PSD σ²h model by a relative
 // 1/(2k) after k samples, 1 % at k = 50 (kCheckFromS).
 constexpr double kRelTol = 0.10;
-constexpr std::array<double, 3> kCheckTimesS = {0.5, 1.0, 1.5};
+constexpr std::array<double, 3> kCheckTimesS = {kCheckFromS, 1.0, 1.5};
 // Where the linearisation stops holding (docs/error-model.md): at rest the vertical velocity has
 // no first-order tilt coupling ((C f)×φ has no z component for C f vertical), so its first-order
 // error is only the noise random walk (∝ √t), while the dropped second-order term g|φ|²/2

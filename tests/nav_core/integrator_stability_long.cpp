@@ -58,7 +58,7 @@ void run_hour_at_rest(const Quat<double>& q_nb, bool level) {
   // Kinematic bound of the input residual at time t, with a factor 2 for the rounding of the
   // integration itself (N = 3.6e6 float additions accumulate at most N·ε/2 ≈ 0.2 relative), plus
   // a floor of a few units in the last place of each quantity.
-  const double eps = std::numeric_limits<T>::epsilon();
+  const double eps = static_cast<double>(std::numeric_limits<T>::epsilon());
   const double g = kStandardGravity;
   const auto rate_bound = [&](double t) { return 2 * dwdot * t + 8 * eps; };
   const auto attitude_bound = [&](double t) { return 2 * dwdot * t * t / 2 + 8 * eps; };

@@ -31,7 +31,7 @@ namespace {
 // c of the bound above: 3 roundings of each entry of H + 6 sweeps × 5 rotations × 6u.
 constexpr double kBackwardFactor = 3.0 + 6.0 * 5.0 * 6.0;
 template <typename T>
-constexpr double kUnitRoundoff = std::numeric_limits<T>::epsilon() / 2.0;
+constexpr double kUnitRoundoff = static_cast<double>(std::numeric_limits<T>::epsilon()) / 2.0;
 
 template <int N>
 struct Reference {

@@ -11,6 +11,7 @@
 
 #include "fields.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "toml_format.hpp"
 
 namespace gfins::calib_file {
 namespace {
@@ -315,7 +316,7 @@ std::string to_toml_text(const CalibrationData& data) {
   detail::visit_fields(data, w);
   w.put(std::string(kChecksumKey), checksum_text(checksum(data)));
   std::ostringstream out;
-  out << kHeader << toml::toml_formatter(w.root) << "\n\n" << kEndMarker << "\n";
+  out << kHeader << detail::toml_text_of(w.root) << "\n\n" << kEndMarker << "\n";
   return out.str();
 }
 
