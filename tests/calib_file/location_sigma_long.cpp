@@ -23,9 +23,14 @@
 
 #include "calibrate.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
+#include "paper_axes_oracle.hpp"
 
 namespace gfins::tools {
 namespace {
+
+using test_oracle::axes_of;
+using test_oracle::Place;
+using test_oracle::place_of;
 
 // The calibration-board scenario's truth (host_sim/scenarios/calibration-board.toml) and its
 // 24.8° site (WGS-84 normal gravity at 50 m).
@@ -80,56 +85,6 @@ std::array<Eigen::Vector3d, 6> table1_rho() {
   return {Eigen::Vector3d(0, 0, -kRho), Eigen::Vector3d(0, -kRho, 0), Eigen::Vector3d(-kRho, 0, 0),
           Eigen::Vector3d(kRho, 0, 0),  Eigen::Vector3d(0, kRho, 0),  Eigen::Vector3d(0, 0, kRho)};
 }
-std::array<Eigen::Vector3d, 6> table1_theta() {
-  const double k = 1.0 / std::sqrt(2.0);
-  return {Eigen::Vector3d(k, k, 0),  Eigen::Vector3d(k, 0, k),  Eigen::Vector3d(0, k, k),
-          Eigen::Vector3d(0, -k, k), Eigen::Vector3d(-k, 0, k), Eigen::Vector3d(-k, k, 0)};
-}
-
-// Sets of eqs. (14)/(15), 0-based sensors: β = {2, 3, 5}, α = {1, 4, 6}; the sensor at row r
-// of its set senses along θ*_r = Σ_k C_rk θ_k, and row r of C holds the set's angles 2r and
-// 2r+1 (xy/xz, yx/yz, zx/zy).
-constexpr std::array<int, 3> kBeta{1, 2, 4};
-constexpr std::array<int, 3> kAlpha{0, 3, 5};
-struct Place {
-  bool alpha;
-  int row;
-};
-Place place_of(int j) {
-  for (int r = 0; r < 3; ++r) {
-    if (kAlpha[static_cast<std::size_t>(r)] == j) return {true, r};
-    if (kBeta[static_cast<std::size_t>(r)] == j) return {false, r};
-  }
-  return {false, -1};
-}
-
-// C of eq. (14)/(15) from the angles (rad) in Table 6 order xy, xz, yx, yz, zx, zy.
-Eigen::Matrix3d c_matrix(const std::array<double, 6>& a) {
-  Eigen::Matrix3d c;
-  c << 1.0, a[1], -a[0],  //
-      -a[3], 1.0, a[2],   //
-      a[5], -a[4], 1.0;
-  return c;
-}
-
-std::array<Eigen::Vector3d, 6> axes_of(const std::array<double, 6>& beta_rad,
-                                       const std::array<double, 6>& alpha_rad) {
-  const auto nominal = table1_theta();
-  std::array<Eigen::Vector3d, 6> th;
-  for (const bool alpha : {false, true}) {
-    const auto& set = alpha ? kAlpha : kBeta;
-    const Eigen::Matrix3d c = c_matrix(alpha ? alpha_rad : beta_rad);
-    for (int r = 0; r < 3; ++r) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      for (std::size_t k = 0; k < 3; ++k) {
-        v += c(r, static_cast<Eigen::Index>(k)) * nominal[static_cast<std::size_t>(set[k])];
-      }
-      th[static_cast<std::size_t>(set[static_cast<std::size_t>(r)])] = v;
-    }
-  }
-  return th;
-}
-
 Truth make_truth() {
   Truth t;
   std::array<double, 6> b{};
@@ -184,10 +139,10 @@ calib_file::CalibrationData draw_base(std::mt19937_64& rng, const Eigen::Matrix4
     s.bias_g = kBiasG[js] + e(1);
     s.bias_sigma_g = kBaseSigma[1];
     s.correlation = kBaseCorrelation;
-    const Place p = place_of(j);
+    const Place p = place_of(js);
     auto& angles = p.alpha ? d.alpha.angle_deg : d.beta.angle_deg;
-    angles[static_cast<std::size_t>(2 * p.row)] += e(2) / kDegToRad;
-    angles[static_cast<std::size_t>(2 * p.row + 1)] += e(3) / kDegToRad;
+    angles[2 * p.row] += e(2) / kDegToRad;
+    angles[2 * p.row + 1] += e(3) / kDegToRad;
   }
   return d;
 }

@@ -27,9 +27,13 @@
 
 #include "calibrate.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
+#include "paper_axes_oracle.hpp"
 
 namespace gfins::tools {
 namespace {
+
+using test_oracle::Place;
+using test_oracle::place_of;
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kG = 9.7894;  // m/s², WGS-84 normal gravity at 24.8° (the paper's site)
@@ -65,59 +69,15 @@ double chi2_mean_bound(double sd_multiple) {
 // The tool's residual must be the test's to rounding: a few ULP of ~2.5 V outputs.
 constexpr double kResidualTolV = 1e-12;
 
-// Table 1 of the paper (nominal axes), written here.
-std::array<Eigen::Vector3d, 6> table1_theta() {
-  const double k = 1.0 / std::sqrt(2.0);
-  return {Eigen::Vector3d(k, k, 0),  Eigen::Vector3d(k, 0, k),  Eigen::Vector3d(0, k, k),
-          Eigen::Vector3d(0, -k, k), Eigen::Vector3d(-k, 0, k), Eigen::Vector3d(-k, k, 0)};
-}
-
-// Sets of eqs. (14)/(15), 0-based sensors: β = {2, 3, 5}, α = {1, 4, 6}; the sensor at row r of
-// its set owns the set's angles 2r and 2r+1 (xy/xz, yx/yz, zx/zy, Table 6 order).
-constexpr std::array<int, 3> kBeta{1, 2, 4};
-constexpr std::array<int, 3> kAlpha{0, 3, 5};
-struct Place {
-  bool alpha;
-  std::size_t row;
-};
-Place place_of(std::size_t j) {
-  for (std::size_t r = 0; r < 3; ++r) {
-    if (static_cast<std::size_t>(kAlpha[r]) == j) return {true, r};
-    if (static_cast<std::size_t>(kBeta[r]) == j) return {false, r};
-  }
-  return {false, 3};
-}
-
-// C of eq. (14)/(15) from the angles (rad), order xy, xz, yx, yz, zx, zy.
-Eigen::Matrix3d c_matrix(const std::array<double, 6>& a) {
-  Eigen::Matrix3d c;
-  c << 1.0, a[1], -a[0],  //
-      -a[3], 1.0, a[2],   //
-      a[5], -a[4], 1.0;
-  return c;
-}
-
 // θ*_j of every sensor from a file's angles (deg).
 std::array<Eigen::Vector3d, 6> axes_of(const calib_file::CalibrationData& d) {
-  const auto nominal = table1_theta();
-  std::array<Eigen::Vector3d, 6> th;
-  for (const bool alpha : {false, true}) {
-    const auto& set = alpha ? kAlpha : kBeta;
-    std::array<double, 6> rad{};
-    for (std::size_t i = 0; i < 6; ++i) {
-      rad[i] = (alpha ? d.alpha.angle_deg[i] : d.beta.angle_deg[i]) * kDegToRad;
-    }
-    const Eigen::Matrix3d c = c_matrix(rad);
-    for (std::size_t r = 0; r < 3; ++r) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      for (std::size_t k = 0; k < 3; ++k) {
-        v += c(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) *
-             nominal[static_cast<std::size_t>(set[k])];
-      }
-      th[static_cast<std::size_t>(set[r])] = v;
-    }
+  std::array<double, 6> beta_rad{};
+  std::array<double, 6> alpha_rad{};
+  for (std::size_t i = 0; i < 6; ++i) {
+    beta_rad[i] = d.beta.angle_deg[i] * kDegToRad;
+    alpha_rad[i] = d.alpha.angle_deg[i] * kDegToRad;
   }
-  return th;
+  return test_oracle::axes_of(beta_rad, alpha_rad);
 }
 
 // Specific force at a sensor, m/s²: f = a + ω̇×ρ* + ω×(ω×ρ*) − g (g the gravity vector, body).
