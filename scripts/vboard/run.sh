@@ -50,6 +50,9 @@ vb_log "kernel $kver ready (+$(elapsed)s)"
 
 # Programs and files per stage; a missing one fails here, naming it.
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
+# What stage $1's script lists in its "# needs: build:<path> | repo:<path>:<vm> |
+# cache:<path>:<vm>" lines (paths in the build folder, the repository, the vboard cache).
+stage_needs() { sed -n 's/^# needs: //p' "$here/stage-$1.sh"; }
 args=()
 # The programs the stages need ("# needs: build:<path>", target = the file name) are brought up
 # to date in the build folder first, so a partial build (test.sh builds only what it runs)
@@ -60,7 +63,7 @@ for s in backend fw cmd faults canlog; do
   [ -e "$here/stage-$s.sh" ] || continue
   while read -r need; do
     case $need in build:*) targets+=("$(basename "${need#build:}")") ;; esac
-  done < <(sed -n 's/^# needs: //p' "$here/stage-$s.sh")
+  done < <(stage_needs "$s")
 done
 if want canlog || want fw; then targets+=(gfins-fw gfins-can); fi
 if [ ${#targets[@]} -gt 0 ]; then
@@ -115,8 +118,6 @@ for s in backend fw cmd faults canlog; do
   stage_script=$here/stage-$s.sh
   [ -e "$stage_script" ] || vb_die "stage '$s' has no scripts/vboard/stage-$s.sh yet"
   args+=(--file "$stage_script:/vboard/stage-$s.sh")
-  # The stage script lists what it needs in "# needs: build:<path> | repo:<path>:<vm> |
-  # cache:<path>:<vm>" lines (paths in the build folder, the repository, the vboard cache).
   while read -r need; do
     case $need in
       build:*) args+=(--bin "$build_dir/${need#build:}") ;;
@@ -124,7 +125,7 @@ for s in backend fw cmd faults canlog; do
       cache:*) spec=${need#cache:}; args+=(--file "$vboard_cache/${spec%%:*}:${spec#*:}") ;;
       *) vb_die "$stage_script: unknown need '$need'" ;;
     esac
-  done < <(sed -n 's/^# needs: //p' "$stage_script")
+  done < <(stage_needs "$s")
 done
 initrd=$vboard_cache/initramfs/initrd.gz
 "$here/make-initramfs.sh" "${args[@]}" -o "$initrd"
