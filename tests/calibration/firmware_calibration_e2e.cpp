@@ -12,7 +12,8 @@
 //
 // Both sides are the production code; only the wire is simulated: a pair of hal::CanBus ends
 // whose host end runs the board's loop while the host waits for a frame (single thread, the
-// board's time advances only while the host waits: deterministic, no sleeps).
+// board's time advances only while the host waits, and stands still while the reload worker
+// thread loads a file: deterministic, no sleeps).
 //
 // Oracle: the scenario's true parameters (the TOML file), independent of the solvers. The file
 // states SF in V per local g and biases in local g; the scenario states SF in V per standard g
@@ -20,12 +21,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdlib>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <string>
@@ -181,7 +184,18 @@ struct Board {
     // No file yet: the nominal chain (what a new board runs with), calibration id 0.
     const auto cal =
         app::load_calibration(config, app::nominal_calibration(adc->volts_per_count()));
-    reload = std::make_unique<app::ReloadWorker>(app::calibration_reloader(config));
+    // The reload worker is a thread: on a board, how many epochs a reload takes depends on the
+    // file system. Here its load waits for the loop step that requested it to end, and step()
+    // waits for the load to finish: a reload requested in step k always applies in step k + 1,
+    // so every capture after it starts at the same epoch on every run.
+    reload = std::make_unique<app::ReloadWorker>(
+        [this, load = app::calibration_reloader(config)](const nav::PipelineConfig<float>& c) {
+          {
+            std::unique_lock<std::mutex> lock(gate_mutex);
+            gate_cv.wait(lock, [this] { return !in_step; });
+          }
+          return load(c);
+        });
     loop = std::make_unique<app::SampleLoop>(*tap, *board_bus, *sink, clock, *log);
     loop->set_command_codec(codec.get());
     loop->set_reload_worker(reload.get());
@@ -191,7 +205,17 @@ struct Board {
   }
   bool step() {
     if (source->finished()) return false;
+    {
+      const std::lock_guard<std::mutex> lock(gate_mutex);
+      in_step = true;
+    }
     (void)loop->step();
+    {
+      const std::lock_guard<std::mutex> lock(gate_mutex);
+      in_step = false;
+      gate_cv.notify_all();
+    }
+    reload->wait_settled();  // board time stands still while a reload runs
     app::LogRecord r;
     while (log->pop(r)) {
     }
@@ -228,6 +252,9 @@ struct Board {
   std::unique_ptr<app::CanEpochSink> sink;
   std::unique_ptr<app::CanCommandCodec> codec;
   std::unique_ptr<app::FwLogQueue> log;
+  std::mutex gate_mutex;  // in_step, between step() and the reload worker's load
+  std::condition_variable gate_cv;
+  bool in_step = false;
   std::unique_ptr<app::ReloadWorker> reload;
   std::unique_ptr<app::SampleLoop> loop;
 };
