@@ -9,7 +9,8 @@
 //
 // The set-up (M and K) is taken from the core's ArraySolver for the same geometry: the benchmark
 // compares the per-sample step, not the one-time construction. baseline_equivalence_test.cpp
-// checks that this step and the core agree on the same inputs within a rounding tolerance.
+// checks that this step and the core agree on the same inputs and state, step by step, within a
+// rounding bound it derives.
 #pragma once
 
 #include <Eigen/Dense>
@@ -69,6 +70,19 @@ class BaselineStep {
     r_sum_ = to_x(state_.r_n);
     r_carry_ = VecX::Zero(3);
     last_seq_ = initial.seq;
+  }
+
+  /// Takes over another implementation's state after a step (baseline_equivalence_test.cpp
+  /// compares one step at a time from the same state): attitude, ω, ω̇, f, a, v and r as given,
+  /// the Kahan carries zero (the other side's carries are not part of NavState; the test's bound
+  /// allows for them).
+  void resync(const nav::NavState<T>& s) {
+    state_ = s;
+    v_sum_ = to_x(s.v_n);
+    v_carry_ = VecX::Zero(3);
+    r_sum_ = to_x(s.r_n);
+    r_carry_ = VecX::Zero(3);
+    last_seq_ = s.seq;
   }
 
   void step(const RawSample& sample) {
