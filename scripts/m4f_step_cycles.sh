@@ -7,8 +7,10 @@
 #   Needs qemu-system-arm (Debian package qemu-system-arm, in scripts/install-deps.sh).
 #
 # Method. QEMU's mps2-an386 board (a Cortex-M4 with FPU) runs gfins_nav_qemu.elf, the size probe
-# with a start-up and 64 steps, one instruction per translation block, logging the address of
-# every executed instruction (-singlestep -d exec,nochain). QEMU does not model cycles (its
+# with a start-up and 999 steps on the benchmarks' 1 kHz samples of the manoeuvre
+# (nav_core/baremetal/probe_samples.hpp: real converter codes, different at every step), one
+# instruction per translation block, logging the address of every executed instruction
+# (-singlestep -d exec,nochain). Every step is analysed; the figures are the spread over them. QEMU does not model cycles (its
 # icount counts instructions), so the cycles are an estimate: each executed instruction is
 # looked up in the disassembly and costed with the Cortex-M4 Technical Reference Manual's timing
 # (ARM DDI 0439B, Table 3-1 for the integer instructions, Table 7-1 for the FPU), under the
@@ -25,16 +27,45 @@ gfins_need_command qemu-system-arm "apt-get install qemu-system-arm"
 
 gfins_scratch_dir
 work="${gfins_scratch}"
-timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+timeout 600 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
   -semihosting-config enable=on,target=native -kernel "${elf}" \
-  -singlestep -d exec,nochain -D "${work}/trace.log"
+  -singlestep -d exec,nochain -D "${work}/trace.log" >"${work}/out.txt" 2>&1
 "${prefix}objdump" -d "${elf}" >"${work}/disasm.txt"
 "${prefix}nm" -S "${elf}" >"${work}/nm.txt"
 
-python3 - "${work}/trace.log" "${work}/disasm.txt" "${work}/nm.txt" <<'PY'
-import collections, re, sys
+samples_hpp="$(dirname "${BASH_SOURCE[0]}")/../nav_core/baremetal/probe_samples.hpp"
+python3 - "${work}/trace.log" "${work}/disasm.txt" "${work}/nm.txt" "${work}/out.txt" \
+  "${samples_hpp}" <<'PY'
+import collections, re, struct, sys
 
-trace_path, disasm_path, nm_path = sys.argv[1:4]
+trace_path, disasm_path, nm_path, out_path, samples_path = sys.argv[1:6]
+
+# The run must have navigated the manoeuvre: its final state (printed through semihosting as
+# float bit patterns) against the x86 float pipeline on the same samples (probe_samples.hpp).
+got = None
+for line in open(out_path):
+    if line.startswith("OUT "):
+        got = [int(x, 16) for x in line.split()[1:]]
+m = re.search(r"kExpectedOutBits = \{([^}]*)\}", open(samples_path).read())
+want = [int(x.strip().rstrip("u"), 16) for x in m.group(1).split(",")] if m else None
+if got is None or want is None or len(got) != len(want):
+    sys.exit("m4f_step_cycles.sh: no final state from the QEMU run (or none expected in %s)"
+             % samples_path)
+f32 = lambda b: struct.unpack("<f", struct.pack("<I", b))[0]
+names = ["q_w", "q_x", "q_y", "q_z", "v_n", "v_e", "v_d", "r_n", "r_e", "r_d"]
+diff = [abs(f32(a) - f32(b)) for a, b in zip(got, want)]
+same = sum(a == b for a, b in zip(got, want))
+print("final state after the last step (QEMU Cortex-M4F vs x86 float, same samples): "
+      "%d of %d values bit-identical, largest difference %.3g (%s)"
+      % (same, len(got), max(diff), names[diff.index(max(diff))]))
+print("  r_n = %.6f %.6f %.6f m, v_n = %.6f %.6f %.6f m/s" % tuple(f32(b) for b in got[7:10] + got[4:7]))
+# Rounding differences between the two compilers (contraction, library functions) may grow over
+# the 999 steps, but a probe that misread its samples or skipped steps would be off by metres
+# (the manoeuvre travels about 2.9 m in that second): 1e-3 (m, m/s, quaternion units) separates
+# the two by three orders of magnitude either way.
+if max(diff) > 1e-3:
+    sys.exit("m4f_step_cycles.sh: the QEMU run did not navigate the samples as x86 does")
+print()
 P = 2  # pipeline refill after a taken branch: 1..3 cycles (TRM 3.3.1); 2 assumed
 
 insn = {}  # address -> (size in bytes, mnemonic, operands)
@@ -157,19 +188,28 @@ def analyse(seq):
         ccount[cls] += 1
     return n, cyc, classes, ccount
 
-# Steady state: the last step (the first ones include the first call's paths; all 64 follow the
-# same branches after the first, which the spread shows).
-results = [analyse(s) for s in steps[1:]]
+# Every traced step: the inputs change at every sample, so the branches taken (and the libm
+# paths) may too; the spread shows whether they do.
+results = [analyse(s) for s in steps]
+by_cycles = sorted(results, key=lambda r: r[1])
 ns = sorted(r[0] for r in results)
-cs = sorted(r[1] for r in results)
-n, cyc, classes, ccount = results[-1]
-print("steps traced: %d; instructions per step min %d, max %d; estimated cycles min %d, max %d"
-      % (len(results), ns[0], ns[-1], cs[0], cs[-1]))
+cs = [r[1] for r in by_cycles]
+mid = len(results) // 2
+n, cyc, classes, ccount = by_cycles[mid]
+mean_n = sum(ns) / len(ns)
+mean_c = sum(cs) / len(cs)
+print("steps traced: %d (consecutive 1 kHz samples of the manoeuvre, different codes at each)"
+      % len(results))
+print("instructions per step: min %d, median %d, max %d, mean %.1f; %d different counts"
+      % (ns[0], ns[mid], ns[-1], mean_n, len(set(ns))))
+print("estimated cycles per step: min %d, median %d, max %d, mean %.1f"
+      % (cs[0], cs[mid], cs[-1], mean_c))
 print()
-print("one step (the last): %d instructions, %d estimated cycles (%.1f us at 168 MHz, %.2f %% of a"
-      " 1 kHz period)" % (n, cyc, cyc / 168.0, cyc / 168.0 / 10.0))
+print("median step: %d instructions, %d estimated cycles (%.1f us at 168 MHz, %.2f %% of a"
+      " 1 kHz period); worst step %d cycles (%.1f us)"
+      % (n, cyc, cyc / 168.0, cyc / 168.0 / 10.0, cs[-1], cs[-1] / 168.0))
 print()
-print("%-28s %8s %8s" % ("class", "instr", "cycles"))
+print("%-28s %8s %8s" % ("class (median step)", "instr", "cycles"))
 for cls, c in sorted(classes.items(), key=lambda kv: -kv[1]):
     print("%-28s %8d %8d" % (cls, ccount[cls], c))
 print()

@@ -4,7 +4,10 @@
 // paper's Table 6 calibration and the exact compensator (the solver of the calibrated geometry:
 // one geometry, the configuration issue 13 sizes), then runs the per-sample step on counts read
 // from a volatile buffer that stands for the ADC's DMA target, and writes the navigation state to a
-// volatile sink, so the compiler can neither fold the inputs nor drop the outputs.
+// volatile sink, so the compiler can neither fold the inputs nor drop the outputs. In the QEMU
+// build (GFINS_PROBE_STEPS) main() fills that buffer before each step with the next of the
+// benchmarks' 1 kHz samples of the manoeuvre (probe_samples.hpp): the traced steps see real,
+// varying codes and navigate the trajectory they came from.
 //
 // The per-sample work is the out-of-line function gfins_nav_step(): scripts/embedded_size.sh
 // walks the call graph from it in the disassembly and reports any soft-float double routine
@@ -14,8 +17,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "gfins/nav_core/paper_table6.hpp"
 #include "gfins/nav_core/pipeline.hpp"
+#include "probe_config.hpp"
+#include "probe_samples.hpp"
 
 namespace {
 
@@ -31,42 +35,16 @@ volatile float g_out[10];
 
 nav::NavPipeline<float> g_pipeline;
 
-// The calibration as the board would hold it: already in float. Table 6 is kept in double
-// (nav_core/paper_table6.hpp); these constexpr copies are rounded by the compiler, so the image
-// converts nothing at run time (a runtime double→float conversion is __aeabi_d2f).
-template <std::size_t N>
-constexpr std::array<float, N> to_float(const std::array<double, N>& d, double factor = 1.0) {
-  std::array<float, N> f{};
-  for (std::size_t i = 0; i < N; ++i) f[i] = static_cast<float>(d[i] * factor);
-  return f;
-}
-namespace t6 = nav::paper_table6;
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-constexpr std::array<float, 6> kScaleVPerG = to_float(t6::kScaleVPerG);
-constexpr std::array<float, 6> kBiasG = to_float(t6::kBiasG);
-constexpr std::array<float, 6> kBetaRad = to_float(t6::kBetaDeg, kDegToRad);
-constexpr std::array<float, 6> kAlphaRad = to_float(t6::kAlphaDeg, kDegToRad);
-
-// Paper Table 6 (SF in V/g, bias in g, orientation errors in radians), sensors 1..6 in Table 1
-// order, and an ADC full scale of ±16 g per channel (PGA gain matched to each load resistor).
+// Configuration and initial state: probe_config.hpp (shared with the host program that writes
+// probe_samples.hpp and the expected result of the QEMU run), the workload's converter LSB,
+// location errors and true initial state (probe_samples.hpp).
 nav::PipelineConfig<float> make_config() {
-  nav::PipelineConfig<float> c;
-  c.nominal = nav::table1_geometry(0.1f);
-  constexpr float kFullScaleG = 16.0f;
-  constexpr float kCodes = 8388608.0f;  // 2^23
-  for (std::size_t j = 0; j < 6; ++j) {
-    c.front_end.scale_v_per_g[j] = kScaleVPerG[j];
-    c.front_end.bias_g[j] = kBiasG[j];
-    c.front_end.volts_per_count[j] = kScaleVPerG[j] * kFullScaleG / kCodes;
-  }
-  c.misalignment.orientation.beta = kBetaRad;
-  c.misalignment.orientation.alpha = kAlphaRad;
-  for (std::size_t j = 0; j < 6; ++j) {
-    c.misalignment.drho_b[j] = nav::Vec3<float>(0.001f, -0.0005f, 0.0008f);  // m, assumed
-  }
-  c.compensator = nav::CompensatorKind::kExact;
-  c.sample_rate_hz = 1000.0f;
-  return c;
+  return gfins::probe::make_probe_config(gfins::probe::kVoltsPerCount, gfins::probe::kDrhoM);
+}
+
+nav::NavState<float> initial_state() {
+  namespace p = gfins::probe;
+  return p::make_probe_state(p::kQ0, p::kW0, p::kWdot0, p::kV0, p::kR0);
 }
 
 gfins::RawSample read_adc() {
@@ -96,13 +74,27 @@ extern "C" [[gnu::noinline]] void gfins_nav_step() {
 #ifdef GFINS_PROBE_STEPS
 // qemu_startup.cpp: the QEMU build (gfins_nav_qemu) runs a bounded number of steps and exits.
 extern "C" [[noreturn]] void gfins_probe_exit(int code);
+extern "C" void gfins_probe_report(const volatile float* values, int n);
+static_assert(GFINS_PROBE_STEPS < gfins::probe::kSamples, "one recorded sample per step");
+static_assert(GFINS_PROBE_STEPS == gfins::probe::kExpectedSteps,
+              "the expected result in probe_samples.hpp is for this many steps");
+
+// What the DMA would have written for sample k: the workload's codes (probe_samples.hpp).
+static void dma_sample(int k) {
+  const auto& c = gfins::probe::kCounts[static_cast<std::size_t>(k)];
+  for (std::size_t j = 0; j < c.size(); ++j) g_adc_counts[j] = c[j];
+}
 #endif
 
 int main() {
   if (!g_pipeline.configure(make_config()).is_ok()) return 1;
-  g_pipeline.start_at(nav::NavState<float>{}, read_adc());
 #ifdef GFINS_PROBE_STEPS
-  for (int i = 0; i < GFINS_PROBE_STEPS; ++i) {
+  dma_sample(0);
+#endif
+  g_pipeline.start_at(initial_state(), read_adc());
+#ifdef GFINS_PROBE_STEPS
+  for (int i = 1; i <= GFINS_PROBE_STEPS; ++i) {
+    dma_sample(i);
 #else
   for (;;) {
 #endif
@@ -111,6 +103,9 @@ int main() {
     gfins_nav_step();
   }
 #ifdef GFINS_PROBE_STEPS
+  // The state after the last step (attitude, velocity, position), for m4f_step_cycles.sh to
+  // compare with the x86 float pipeline on the same samples (probe_samples.hpp kExpectedOut).
+  gfins_probe_report(g_out, 10);
   gfins_probe_exit(0);
 #endif
 }
