@@ -39,7 +39,13 @@ echo "== Probe program (float32 pipeline, exact compensator, one geometry, stati
 "${prefix}size" "${elf}"
 echo
 echo "== Navigation core library objects (float + double instantiations) =="
-"${prefix}size" -t "${lib}"
+# With -flto (the preset's toolchain) the archive holds GIMPLE only and `size` would print zeros:
+# the code exists only once linked, so the program's figures above are the ones that count.
+if "${prefix}objdump" -h "${lib}" 2>/dev/null | grep -c '\.gnu\.lto_' >/dev/null; then
+  echo "  (link-time-optimised objects: no machine code before the link; see the program above)"
+else
+  "${prefix}size" -t "${lib}"
+fi
 echo
 echo "== Largest symbols of the program (bytes, type, name) =="
 "${prefix}nm" -C --size-sort -S --radix=d "${elf}" | tail -n 15 | cut -c 10-160
