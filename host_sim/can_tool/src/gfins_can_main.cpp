@@ -417,7 +417,7 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
   if (!o.poses.empty()) {
     const auto rows = tools::read_poses(o.poses);
     if (!rows.is_ok()) {
-      std::fprintf(stderr, "gfins-can calibrate: %s\n", rows.status().message().c_str());
+      std::fprintf(stderr, "gfins-can calibrate: %s\n", rows.error().message.c_str());
       return kExitUsage;
     }
     std::vector<std::pair<int, std::array<double, 3>>> r;
