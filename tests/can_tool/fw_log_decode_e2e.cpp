@@ -172,9 +172,9 @@ double expected(const std::string& name, const nav::NavState<float>& n) {
   const double w = qs * d(n.q_nb.w()), x = qs * d(n.q_nb.x()), y = qs * d(n.q_nb.y()),
                z = qs * d(n.q_nb.z());
   static const std::map<std::string, int> kAxis = {
-      {"RateX", 0}, {"RateY", 1}, {"RateZ", 2}, {"AngAccX", 0}, {"AngAccY", 1}, {"AngAccZ", 2},
-      {"AccelX", 0}, {"AccelY", 1}, {"AccelZ", 2}, {"VelN", 0}, {"VelE", 1}, {"VelD", 2},
-      {"PosN", 0},  {"PosE", 1},  {"PosD", 2}};
+      {"RateX", 0},   {"RateY", 1},  {"RateZ", 2},  {"AngAccX", 0}, {"AngAccY", 1},
+      {"AngAccZ", 2}, {"AccelX", 0}, {"AccelY", 1}, {"AccelZ", 2},  {"VelN", 0},
+      {"VelE", 1},    {"VelD", 2},   {"PosN", 0},   {"PosE", 1},    {"PosD", 2}};
   if (name == "TimeUs") return static_cast<double>(static_cast<std::uint32_t>(n.t_ns / 1000));
   if (name == "SampleCount") return static_cast<double>(n.seq & 0xFFFFu);
   if (name == "Qw") return w;
@@ -224,8 +224,9 @@ Comparison compare(const Table& t, const std::map<std::string, Step>& steps, con
       const Step& s = steps.at(name);
       const double got = std::stod(cell);
       const double want = std::clamp(expected(name, it->second), s.min, s.max);
-      const double tol = 0.5 * s.factor + kPrintRelative * std::abs(want) +
-                         (name == "Roll" || name == "Pitch" || name == "Yaw" ? kEulerFormulaRad : 0);
+      const double tol =
+          0.5 * s.factor + kPrintRelative * std::abs(want) +
+          (name == "Roll" || name == "Pitch" || name == "Yaw" ? kEulerFormulaRad : 0);
       const double diff = std::abs(got - want);
       c.worst_steps[name] = std::max(c.worst_steps[name], diff / s.factor);
       ++c.values;
@@ -293,9 +294,10 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
   EXPECT_EQ(c.values, static_cast<std::size_t>(kEpochs * 18 + kHalfRate * 6));
   double worst = 0;
   for (const auto& [name, steps_off] : c.worst_steps) worst = std::max(worst, steps_off);
-  std::printf("fw-log e2e: %zu values compared, %zu outside their step, largest difference %.3f "
-              "step(s)\n",
-              c.values, c.outside, worst);
+  std::printf(
+      "fw-log e2e: %zu values compared, %zu outside their step, largest difference %.3f "
+      "step(s)\n",
+      c.values, c.outside, worst);
   // The run moved: the comparison is not of zeros (maneuver: metres and tens of degrees).
   const int pn = t.col("PosN"), yaw = t.col("Yaw");
   double max_pos = 0, max_yaw = 0;
@@ -305,7 +307,7 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
     if (!row[static_cast<std::size_t>(yaw)].empty())
       max_yaw = std::max(max_yaw, std::abs(std::stod(row[static_cast<std::size_t>(yaw)])));
   }
-  EXPECT_GT(max_pos, 0.1);  // m
+  EXPECT_GT(max_pos, 0.1);                                           // m
   EXPECT_GT(max_yaw, kHeadingDeg * std::numbers::pi / 180.0 * 0.5);  // rad
 
   // Negative control: the same comparison against a core with no compensation (the scenario's
@@ -315,9 +317,10 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
   ASSERT_TRUE(wrong.error.empty()) << wrong.error;
   const Comparison cw = compare(t, steps, wrong);
   EXPECT_GT(cw.outside, cw.values / 10) << "the comparison cannot tell another compensator";
-  std::printf("fw-log e2e, negative control (compensator none): %zu of %zu values outside their "
-              "step (first: %s)\n",
-              cw.outside, cw.values, cw.first_outside.c_str());
+  std::printf(
+      "fw-log e2e, negative control (compensator none): %zu of %zu values outside their "
+      "step (first: %s)\n",
+      cw.outside, cw.values, cw.first_outside.c_str());
 }
 
 }  // namespace
