@@ -457,7 +457,7 @@ TEST_F(CanMalformedCommands, ArgumentsOutOfTheirRangeChangeNothing) {
                  "capture of 0 samples");
 }
 
-TEST_F(CanMalformedCommands, ASecondCaptureOrReloadWhileOneRunsIsBusy) {
+TEST_F(CanMalformedCommands, ASecondCaptureWhileOneRunsIsBusy) {
   can::Command c = cmd(can::Opcode::kStartCapture, 0x61);
   c.pose = 1;
   c.samples = 5000;  // 5 s at 1 kHz: still running during the checks below
