@@ -16,13 +16,16 @@ std::string describe_status(const can::Command& c, const can::ResponseFrame& r) 
   return buf;
 }
 
+// The capture's per-channel result frames: mean, std, count for each of the 6 channels.
+constexpr std::size_t kChannelParts = std::size_t{3} * 6;
+
 // Capture result parts (docs/can-interface.md, "Response parts"): 0x10 + c mean, 0x20 + c
 // standard deviation, 0x30 + c count and flags of channel c + 1.
 constexpr std::uint8_t kFirstChannelPart = 0x10;
 constexpr std::uint8_t kLastChannelPart = 0x35;
 
 /// The capture frames that did not arrive, e.g. "mean of a2, count of a6"; empty when none.
-std::string missing_capture_parts(const std::array<bool, 3 * 6>& seen) {
+std::string missing_capture_parts(const std::array<bool, kChannelParts>& seen) {
   static constexpr const char* kWhat[3] = {"mean", "std", "count"};
   std::string out;
   for (std::size_t g = 0; g < 3; ++g) {
@@ -49,7 +52,7 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
   auto deadline = Clock::now() + t.response;
   bool accepted = false;  // StartCapture: the status frame arrived, now waiting for the result
   can::CaptureAssembler capture;
-  std::array<bool, 3 * 6> seen_parts{};  // mean, std, count of each channel
+  std::array<bool, kChannelParts> seen_parts{};  // mean, std, count of each channel
   while (true) {
     bus.service();
     const auto left = deadline - Clock::now();
