@@ -241,7 +241,7 @@ void StreamDecoder::on_command(const hal::CanFrame& f, std::uint8_t node, bool r
     const auto target = static_cast<std::size_t>((p >> 16) & 0xFFu);  // DividerMessage
     if (target < can::kMessageCount) {
       n.tracks[target].period = 0;
-      n.tracks[target].pending_gap = 0;
+      n.tracks[target].pending = 0;
     }
     return;
   }
@@ -250,7 +250,7 @@ void StreamDecoder::on_command(const hal::CanFrame& f, std::uint8_t node, bool r
   if (status_part && ok) {
     for (MessageTrack& t : n.tracks) {
       t.period = 0;
-      t.pending_gap = 0;
+      t.pending = 0;
     }
   }
 }
@@ -440,9 +440,19 @@ void StreamDecoder::reset_tracks(NodeState& n, bool forget_periods) {
     t.last = -1;
     if (forget_periods) {
       t.period = default_period(can::kMessages[i]);
-      t.pending_gap = 0;
+      t.pending = 0;
     }
   }
+}
+
+void StreamDecoder::report_pending(MessageTrack& t, const can::MessageDef& m) {
+  for (std::size_t i = 0; i < t.pending; ++i) {
+    issue(IssueKind::kFrameDrop, t.pending_line[i],
+          std::string(m.name) + ": " + std::to_string(t.pending_gap[i] / t.period - 1) +
+              " frame(s) missing before this epoch (every " + std::to_string(t.period) +
+              " samples, none for " + std::to_string(t.pending_gap[i]) + ")");
+  }
+  t.pending = 0;
 }
 
 void StreamDecoder::sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index,
@@ -452,43 +462,53 @@ void StreamDecoder::sight(MessageTrack& t, const can::MessageDef& m, std::int64_
   t.last = index;
   if (last < 0) return;
   const std::int64_t g = index - last;
-  if (t.pending_gap != 0) {
-    const std::int64_t pg = t.pending_gap;
-    t.pending_gap = 0;
-    if (g == t.period) {
-      // The old spacing resumed: the long gap was frames lost, pg / period - 1 of them.
-      issue(IssueKind::kFrameDrop, t.pending_line,
-            std::string(m.name) + ": " + std::to_string(pg / t.period - 1) +
-                " frame(s) missing before this epoch (every " + std::to_string(t.period) +
-                " samples, none for " + std::to_string(pg) + ")");
-      return;
-    }
-    t.period = pg;  // the longer spacing held: a slower divider; judge g against it
-  }
-  if (t.period == 0 || g < t.period || g % t.period != 0 ||
-      g / t.period - 1 > kMaxFramesLostInARow) {
-    t.period = g;  // first spacing, a faster divider, or a spacing no loss explains
+  if (t.period == 0) {
+    t.period = g;  // the first spacing seen
     return;
   }
-  if (g == t.period) return;
-  t.pending_gap = g;  // frames lost, or a slower divider: the next frame tells
-  t.pending_line = line;
+  if (g == t.period) {
+    report_pending(t, m);  // the old spacing resumed: the longer gaps were frames lost
+    return;
+  }
+  if (t.pending == t.pending_gap.size() && g > t.period) {
+    // A fourth longer gap in a row: the earlier ones were a slower divider; g is judged
+    // against it, and so are those of the earlier gaps that are longer still.
+    t.period = *std::min_element(t.pending_gap.begin(), t.pending_gap.end());
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < t.pending; ++i) {
+      if (t.pending_gap[i] == t.period || t.pending_gap[i] % t.period != 0) continue;
+      t.pending_gap[kept] = t.pending_gap[i];
+      t.pending_line[kept] = t.pending_line[i];
+      ++kept;
+    }
+    t.pending = kept;
+    if (g == t.period) {
+      report_pending(t, m);
+      return;
+    }
+  }
+  if (g > t.period && g % t.period == 0 && g / t.period - 1 <= kMaxFramesLostInARow) {
+    t.pending_gap[t.pending] = g;  // frames lost, or a slower divider: later frames tell
+    t.pending_line[t.pending] = line;
+    ++t.pending;
+    return;
+  }
+  // A shorter gap (a faster divider), or one no loss explains: a new divider.
+  t.period = g;
+  t.pending = 0;
 }
 
 void StreamDecoder::settle_pending(NodeState& n) {
-  // A longer gap that no later frame judged: frames lost when the log went on for less than one
-  // old period after it (nothing contradicts the old spacing), else the message slowed or stopped.
+  // Longer gaps that no later frame judged: frames lost when the log went on for less than one
+  // old period after them (nothing contradicts the old spacing), else the message slowed down or
+  // stopped.
   for (std::size_t i = 0; i < n.tracks.size(); ++i) {
     MessageTrack& t = n.tracks[i];
-    if (t.pending_gap == 0) continue;
+    if (t.pending == 0) continue;
     if (t.last >= 0 && n.index - t.last < t.period) {
-      issue(IssueKind::kFrameDrop, t.pending_line,
-            std::string(can::kMessages[i].name) + ": " +
-                std::to_string(t.pending_gap / t.period - 1) +
-                " frame(s) missing before this epoch (every " + std::to_string(t.period) +
-                " samples, none for " + std::to_string(t.pending_gap) + ")");
+      report_pending(t, can::kMessages[i]);
     }
-    t.pending_gap = 0;
+    t.pending = 0;
   }
 }
 

@@ -106,10 +106,14 @@ class StreamDecoder {
  private:
   /// One message's frames on the sample axis of its node.
   struct MessageTrack {
-    std::int64_t last = -1;          // sample index of the epoch it was last seen in (-1 unknown)
-    std::int64_t period = 0;         // samples between its frames as seen (0 unknown)
-    std::int64_t pending_gap = 0;    // a longer gap, judged at the message's next frame
-    std::uint64_t pending_line = 0;  // line of the epoch where that gap showed
+    std::int64_t last = -1;   // sample index of the epoch it was last seen in (-1 unknown)
+    std::int64_t period = 0;  // samples between its frames as seen (0 unknown)
+    // Longer gaps (whole multiples of the period) not judged yet: the old spacing coming back
+    // makes them frames lost; a fourth longer gap in a row makes the longer spacing a new
+    // divider (so only four losses in strict alternation with received frames pass unseen).
+    std::array<std::int64_t, 3> pending_gap{};
+    std::array<std::uint64_t, 3> pending_line{};  // line of the epoch where each gap showed
+    std::size_t pending = 0;
   };
   struct EarlyFrame {
     bool used = false;
@@ -146,6 +150,7 @@ class StreamDecoder {
   void flush_early_as_orphans(NodeState& n, std::uint8_t lost_counter);
   static void reset_tracks(NodeState& n, bool forget_periods);
   void settle_pending(NodeState& n);
+  void report_pending(MessageTrack& t, const can::MessageDef& m);
 
   EpochSink on_epoch_;
   IssueSink on_issue_;
