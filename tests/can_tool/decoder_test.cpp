@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "decoder.hpp"
+#include "gfins/can/command.hpp"
 #include "gfins/can/publisher.hpp"
 
 namespace gfins::can_tool {
@@ -51,13 +52,27 @@ struct Change {
 
 /// Publishes samples [first, first + count) through a fresh Publisher (counter from 0, as after
 /// a start), applying `changes` on the way.
+/// With `log_commands`, each change also puts its SetDivider command and Ok response frames in
+/// the stream, as a candump of the bus would hold them.
 void publish(RecordingBus& bus, std::uint32_t first, std::uint32_t count,
-             const std::vector<Change>& changes = {}) {
+             const std::vector<Change>& changes = {}, bool log_commands = false) {
   can::Publisher pub(bus, can::PublisherConfig{});
   for (std::uint32_t s = first; s < first + count; ++s) {
     for (const Change& c : changes) {
       if (c.seq == s) {
         ASSERT_TRUE(pub.set_divider(c.message, c.divider).is_ok()) << s;
+        if (log_commands) {
+          can::Command cmd;
+          cmd.opcode = can::Opcode::kSetDivider;
+          cmd.token = 0x42;
+          cmd.message = c.message;
+          cmd.divider = c.divider;
+          bus.frames.push_back({s, can::encode_command(cmd, 0)});
+          bus.frames.push_back(
+              {s,
+               can::encode_response(
+                   can::Response{can::kOpSetDivider, 0x42, can::ResultCode::kOk, c.divider}, 0)});
+        }
       }
     }
     can::Epoch e;
@@ -121,6 +136,24 @@ TEST(DecoderChecks, RuntimeDividerChangesAreNotDrops) {
   EXPECT_TRUE(d.issues.empty()) << dump(d.issues);
   // Epochs: samples 0..4006 every 10 (401), then 4020..5980 every 20 (99).
   EXPECT_EQ(d.epochs, 401u + 99u);
+}
+
+// GfinsEuler slowed to 40 at sample 505 and back to 20 at 600: frames at ..500, 520, 560, 600,
+// 620.. Two longer gaps and the old spacing again read exactly like two lost frames; with the
+// SetDivider commands in the log (a candump of the bus holds them) the decoder learns the
+// period afresh at each and reports nothing.
+TEST(DecoderChecks, SetDividerCommandsInTheLogResolveAShortLivedChange) {
+  const std::vector<Change> changes{{505, MessageId::kEuler, 40}, {600, MessageId::kEuler, 20}};
+  RecordingBus with;
+  publish(with, 0, 1500, changes, true);
+  const Decoded d = decode(with.frames);
+  EXPECT_TRUE(d.issues.empty()) << dump(d.issues);
+  EXPECT_EQ(d.summary.commands, 2u);
+  EXPECT_EQ(d.summary.responses, 2u);
+  RecordingBus without;
+  publish(without, 0, 1500, changes, false);
+  const Decoded u = decode(without.frames);
+  EXPECT_EQ(u.issues.size(), 2u) << dump(u.issues);  // the documented ambiguity
 }
 
 // After each change above, one frame of the changed message is lost: each loss is reported

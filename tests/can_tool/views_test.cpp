@@ -91,8 +91,8 @@ TEST(Views, TableViewKeepsTheLatestValueWithItsAgeAndAlignsEveryRow) {
   constexpr std::size_t kValueEnd = 2 + 16 + 1 + 16;  // indent, name column, space, value
   for (const std::string& r : rows) {
     ASSERT_GE(r.size(), kValueEnd) << r;
-    EXPECT_NE(r[kValueEnd - 1], ' ') << "value not right-aligned at column " << kValueEnd << ": "
-                                     << r;
+    EXPECT_NE(r[kValueEnd - 1], ' ')
+        << "value not right-aligned at column " << kValueEnd << ": " << r;
   }
   // Name padded to 16, value right-aligned in 16, a space, the (empty) unit padded to 8, the age.
   EXPECT_NE(out.find("  SaturatedSamples                7           (0.250 s ago)"),
