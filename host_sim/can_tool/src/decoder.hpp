@@ -46,10 +46,11 @@ enum class IssueKind : std::uint8_t {
   kWrongLength,
   kBadCrc,
   kRemoteOrError,
-  kEpochDrop,  // epoch counter skipped: whole epochs missing
-  kFrameDrop,  // a message missing from an epoch where its period says it was due
-  kDuplicate,  // the same message twice in one epoch
-  kReordered,  // a frame of an earlier epoch, or the epoch counter going back
+  kEpochDrop,  // whole epochs missing (sample count and counter agree on how many)
+  kFrameDrop,  // frames of a message missing where its observed spacing says they were due
+  kDuplicate,  // the same message twice in one epoch, or the same Epoch frame twice
+  kReordered,  // a frame after the next epoch opened or before its own Epoch frame, or a
+               // stale Epoch frame
   kOrphan,     // data frames whose Epoch frame was lost (one per lost Epoch frame), or a
                // frame whose counter matches no epoch near the open one
   kCount_,
