@@ -138,6 +138,23 @@ TEST(DecoderChecks, RuntimeDividerChangesAreNotDrops) {
   EXPECT_EQ(d.epochs, 401u + 99u);
 }
 
+// The epoch divider doubled (every 10-divider first) a few epochs before the log ends: the
+// status frame, sent with every epoch, is not missing between two consecutive epochs.
+TEST(DecoderChecks, EpochDividerChangeNearTheEndIsNotADrop) {
+  RecordingBus bus;
+  publish(bus, 0, 2050,
+          {{1990, MessageId::kQuaternion, 20},
+           {1990, MessageId::kRate, 20},
+           {1990, MessageId::kAccel, 20},
+           {1990, MessageId::kVelocity, 20},
+           {1990, MessageId::kPositionNE, 20},
+           {1990, MessageId::kPositionD, 20},
+           {1995, MessageId::kEpoch, 20}});
+  const Decoded d = decode(bus.frames);
+  EXPECT_TRUE(d.issues.empty()) << dump(d.issues);
+  EXPECT_EQ(d.epochs, 200u + 3u);  // 0..1990 every 10, then 2000, 2020, 2040
+}
+
 // GfinsEuler slowed to 40 at sample 505 and back to 20 at 600: frames at ..500, 520, 560, 600,
 // 620.. Two longer gaps and the old spacing again read exactly like two lost frames; with the
 // SetDivider commands in the log (a candump of the bus holds them) the decoder learns the

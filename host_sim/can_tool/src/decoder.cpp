@@ -456,14 +456,18 @@ void StreamDecoder::report_pending(MessageTrack& t, const can::MessageDef& m) {
 }
 
 void StreamDecoder::sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index,
-                          std::uint64_t line) {
+                          std::uint64_t line, bool adjacent) {
   if (t.last >= 0 && index <= t.last) return;
   const std::int64_t last = t.last;
   t.last = index;
   if (last < 0) return;
   const std::int64_t g = index - last;
-  if (t.period == 0) {
-    t.period = g;  // the first spacing seen
+  if (t.period == 0 || (adjacent && g != t.period)) {
+    // The first spacing seen; or the message came in two consecutive epochs, so no frame of it
+    // can be missing in between: its spacing is the epoch spacing now (a new epoch divider, or
+    // a message sped up to every epoch), and longer gaps before were that change.
+    t.period = g;
+    t.pending = 0;
     return;
   }
   if (g == t.period) {
@@ -527,7 +531,8 @@ void StreamDecoder::open_epoch(NodeState& n, std::uint8_t node, std::uint64_t li
 void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f) {
   const std::size_t mi = msg_index(m);
   n.seen[mi] = true;
-  sight(n.tracks[mi], m, n.index, n.epoch.line);
+  MessageTrack& t = n.tracks[mi];
+  sight(t, m, n.index, n.epoch.line, n.prev_index >= 0 && t.last == n.prev_index);
   const std::uint64_t p = can::payload_of(f);
   const auto& cols = columns();
   const ColumnRange r = column_ranges()[mi];

@@ -147,7 +147,8 @@ class StreamDecoder {
   void open_epoch(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us);
   void close_epoch(NodeState& n);
   void store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f);
-  void sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index, std::uint64_t line);
+  void sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index, std::uint64_t line,
+             bool adjacent = false);
   void flush_early_as_orphans(NodeState& n, std::uint8_t lost_counter);
   static void reset_tracks(NodeState& n, bool forget_periods);
   void settle_pending(NodeState& n);
