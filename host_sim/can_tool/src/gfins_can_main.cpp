@@ -80,29 +80,6 @@ struct DecodeOptions {
   double duration_s = 0.0;  // live: stop after this long (0 = until interrupted)
 };
 
-void print_summary(const Summary& s, std::FILE* out) {
-  std::fprintf(
-      out,
-      "summary: %llu lines, %llu frames (%llu ok), %llu epochs, %llu commands, "
-      "%llu responses, %llu problems\n",
-      static_cast<unsigned long long>(s.lines), static_cast<unsigned long long>(s.frames),
-      static_cast<unsigned long long>(s.frames_ok), static_cast<unsigned long long>(s.epochs),
-      static_cast<unsigned long long>(s.commands), static_cast<unsigned long long>(s.responses),
-      static_cast<unsigned long long>(s.total_issues()));
-  for (std::size_t k = 0; k < s.issues.size(); ++k) {
-    if (s.issues[k] == 0) continue;
-    std::fprintf(out, "  %-20s %llu\n", to_string(static_cast<IssueKind>(k)),
-                 static_cast<unsigned long long>(s.issues[k]));
-  }
-  std::fprintf(out, "  frames per message:");
-  for (std::size_t m = 0; m < s.per_message.size(); ++m) {
-    if (s.per_message[m] == 0) continue;
-    std::fprintf(out, " %s=%llu", std::string(can::kMessages[m].name).c_str(),
-                 static_cast<unsigned long long>(s.per_message[m]));
-  }
-  std::putc('\n', out);
-}
-
 /// Decodes every source into `view`; returns the exit code.
 int decode(const DecodeOptions& o, View& view) {
   std::array<std::size_t, static_cast<std::size_t>(IssueKind::kCount_)> printed{};
@@ -123,6 +100,12 @@ int decode(const DecodeOptions& o, View& view) {
         }
         ++n;
       });
+  dec.set_notice_sink([&](const Notice& nt) {
+    if (!o.quiet) {
+      std::fprintf(stderr, "%s:%llu: note: %s\n", current.c_str(),
+                   static_cast<unsigned long long>(nt.line), nt.text.c_str());
+    }
+  });
   bool input_error = false;
   if (!o.iface.empty()) {
     auto bus = open_live_bus(o.iface);
@@ -146,31 +129,29 @@ int decode(const DecodeOptions& o, View& view) {
     feed_live(**bus, dec, keep_going, now_us, kPollNs);
   }
   for (const std::string& src : o.sources) {
-    current = src;
-    std::FILE* f = src == "-" ? stdin : std::fopen(src.c_str(), "rb");
-    if (f == nullptr) {
-      std::fprintf(stderr, "gfins-can: cannot open '%s': %s\n", src.c_str(), std::strerror(errno));
-      input_error = true;
-      continue;
-    }
-    for_each_line(f, [&](std::uint64_t line, std::string_view text) { dec.feed_line(line, text); });
-    if (std::ferror(f) != 0) {
-      std::fprintf(stderr, "gfins-can: read error on '%s'\n", src.c_str());
+    current = src == "-" ? std::string("-") : display_name(src);
+    const std::string error = decode_log(src, dec);
+    if (!error.empty()) {
+      std::fprintf(stderr, "gfins-can: %s\n", error.c_str());
       input_error = true;
     }
-    if (f != stdin && std::fclose(f) != 0) input_error = true;
   }
   dec.finish();
   view.finish();
   print_summary(dec.summary(), stderr);
-  switch (decode_end(dec.summary(), input_error)) {
+  switch (decode_end(dec.summary(), input_error, o.node)) {
     case DecodeEnd::kInputError:
       return kExitInput;
     case DecodeEnd::kProblems:
       return kExitIssues;
     case DecodeEnd::kNoFrames:
-      std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
-                   o.iface.empty() ? "in the input" : "arrived on the interface");
+      if (dec.summary().frames != 0) {
+        std::fprintf(stderr, "gfins-can: no epoch of node %d (--node); nodes seen: %s\n", o.node,
+                     node_list(dec.summary().nodes_seen).c_str());
+      } else {
+        std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
+                     o.iface.empty() ? "in the input" : "arrived on the interface");
+      }
       return kExitNoFrames;
     case DecodeEnd::kOk:
       break;
