@@ -15,9 +15,10 @@ presets=("$@")
 [ ${#presets[@]} -gt 0 ] || presets=(host-release aarch64-linux armhf-linux)
 out=out/deb
 mkdir -p "$out"
-command -v lintian >/dev/null || { echo "package.sh: lintian missing: apt install lintian" >&2; exit 1; }
+command -v lintian >/dev/null ||
+  { echo "package.sh: lintian missing: install Debian package 'lintian' (scripts/install-deps.sh does)" >&2; exit 1; }
 command -v dpkg-shlibdeps >/dev/null ||
-  { echo "package.sh: dpkg-shlibdeps missing: apt install dpkg-dev" >&2; exit 1; }
+  { echo "package.sh: dpkg-shlibdeps missing: install Debian package 'dpkg-dev' (scripts/install-deps.sh does)" >&2; exit 1; }
 
 for p in "${presets[@]}"; do
   echo "=== package: $p"
