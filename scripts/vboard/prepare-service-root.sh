@@ -64,7 +64,7 @@ echo "WANT_FW=$([ -n "$deb" ] && echo 1 || echo 0)" >"$out/vboard/service.env"
 for u in "$here/service/"*.service; do
   cp "$u" "$out/etc/systemd/system/"
 done
-for u in vboard-setup vboard-late-can vboard-drdy vboard-check vboard-notify-probe; do
+for u in vboard-setup vboard-drdy vboard-check vboard-notify-probe; do
   ln -sf "/etc/systemd/system/$u.service" "$out/etc/systemd/system/multi-user.target.wants/$u.service"
 done
 

@@ -33,8 +33,9 @@ cmd_ok compensator-paper compensator paper
 cmd_ok divider divider GfinsEuler 20
 cmd_ok cal-id cal-id
 # The calibration id the board reports must be the one it publishes in its epochs: one second
-# of GfinsStatus frames decoded, every CalId there (decimal in the CSV: compared as text, since
-# busybox awk's printf %x stops at 2^31) equal to the reported id (shell arithmetic is 64-bit).
+# of frames (50 GfinsStatus at 500 Hz, divider 10) decoded, every CalId there equal to the
+# reported id (decimal in the CSV, compared as text: busybox awk's printf %x stops at 2^31, the
+# shell's arithmetic converts the hex id in 64 bits).
 cal=$(tr 'A-F' 'a-f' </tmp/cmd-cal-id.out | sed -n 's/.*\(0x\)\{0,1\}\([0-9a-f]\{8\}\).*/\2/p' | head -n 1)
 cal_dec=$([ -n "$cal" ] && echo $((0x$cal)))
 timeout 1 candump -L vcan0 >/tmp/cmd-epochs.log 2>/dev/null

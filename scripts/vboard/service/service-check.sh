@@ -57,7 +57,7 @@ if [ "$WANT_FW" = 1 ]; then
     wait_for 60 settled
     if active; then
       pass "fw-active: Type=notify service reached active (READY=1); status '$(prop gfins-fw StatusText)'"
-      # can0 appears 5 s after boot (vboard-late-can.service): the unit must have waited for its
+      # can0 appears 2 s after vboard-setup (vboard-late-can.service): the unit must have waited for its
       # device unit and started once, not failed on the missing interface and been restarted.
       systemctl show -p ExecMainStartTimestampMonotonic -p NRestarts gfins-fw >/tmp/start
       start_us=$(sed -n 's/^ExecMainStartTimestampMonotonic=//p' /tmp/start)

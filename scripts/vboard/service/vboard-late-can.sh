@@ -5,7 +5,7 @@
 # (sys-subsystem-net-devices-can0.device): it must wait for it, not fail and use up its start
 # limit. The guest uptime just before the interface exists goes to /run/vboard-can0.
 set -e
-sleep "${1:-5}"
+sleep "${1:-2}"
 cut -d' ' -f1 /proc/uptime >/run/vboard-can0
 ip link add dev can0 type vcan
 ip link set up can0
