@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sim_rig.hpp"
 #include "gfins/drivers/lnx/systemd_watchdog.hpp"
+#include "sim_rig.hpp"
 #include "support/fake_clock.hpp"
 
 namespace gfins::app {
