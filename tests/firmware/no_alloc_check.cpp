@@ -47,6 +47,8 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   f.silent_from = 10000;
   f.silent_edges = 6;
   SimRig rig("rest", (kWarmUpCycles + kCountedCycles + 100) / 1000.0, f, 4096);
+  app::StatusBoard status_board;  // as gfins-fw wires it: the service status published per cycle
+  rig.loop->set_status_board(&status_board);
   rig.configure();
   rig.run_cycles(kWarmUpCycles);
   ASSERT_EQ(rig.loop->mode(), Mode::kNavigating);

@@ -15,6 +15,7 @@
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
 #include "gfins/app/sample_loop.hpp"
+#include "gfins/app/service_status.hpp"
 #include "gfins/app/startup.hpp"
 
 namespace {
@@ -55,12 +56,22 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   loop->set_command_codec(board.codec.get());
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);
+  // The service status line (systemd STATUS=): the loop leaves its mode and health counters on
+  // the board each cycle; the reporter thread formats and sends them, never the loop.
+  StatusBoard status_board;
+  loop->set_status_board(&status_board);
+  std::unique_ptr<StatusReporter> status_reporter;
+  if (board.watchdog) {
+    status_reporter =
+        std::make_unique<StatusReporter>(*board.watchdog, status_board, cfg.sample_rate_hz);
+  }
   if (const gfins::Status s = loop->configure(cal.set, loop_options(cfg)); !s.is_ok()) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;
   }
   if (const std::string warn = board.enter_realtime(cfg); !warn.empty()) spdlog::warn("{}", warn);
   if (board.watchdog) (void)board.watchdog->notify_ready();
+  if (status_reporter) status_reporter->start();
   spdlog::info("sample loop running (alignment: keep the board still for {} s)", cfg.alignment_s);
 
   std::signal(SIGINT, on_signal);
@@ -72,6 +83,10 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
+  if (status_reporter) {
+    status_reporter->stop();
+    (void)board.watchdog->notify_status("stopping");
+  }
   drain.stop();
   const HealthCounters& h = loop->health();
   const auto& st = loop->pipeline().state();
