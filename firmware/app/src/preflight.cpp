@@ -21,7 +21,8 @@ std::string output_path_problem(const std::string& path) {
   const fs::path p(path);
   if (fs::is_directory(p, ec)) return "is a folder, not a file";
   const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  if (!fs::exists(parent, ec)) return "its folder " + quote_text(parent.string()) + " does not exist";
+  if (!fs::exists(parent, ec))
+    return "its folder " + quote_text(parent.string()) + " does not exist";
   if (!fs::is_directory(parent, ec)) return quote_text(parent.string()) + " is not a folder";
   return "";
 }
@@ -78,8 +79,8 @@ std::string calibration_note(const FwConfig& c) {
   }
   const auto loaded = calib_file::load_calibration_file(c.calibration_file);
   if (loaded.is_ok()) return "";
-  return "calibration.file = " + quote_text(c.calibration_file) + ": " +
-         loaded.status().message() + kConsequence;
+  return "calibration.file = " + quote_text(c.calibration_file) + ": " + loaded.status().message() +
+         kConsequence;
 }
 
 }  // namespace gfins::app
