@@ -15,16 +15,15 @@ namespace {
 
 class FwCli : public test::CliTest {
  protected:
-  test::CliResult fw(const std::vector<std::string>& args) const {
-    return run(GFINS_FW_EXE, args);
-  }
+  test::CliResult fw(const std::vector<std::string>& args) const { return run(GFINS_FW_EXE, args); }
   // The simulated board, factory calibration, 0.2 s after the 1 s alignment: a short run.
   std::vector<std::string> sim_run(std::vector<std::string> extra,
                                    const std::string& scenario = "rest",
                                    const std::string& can_log = "") const {
-    std::vector<std::string> a = {"--sim",         scenario,           "--calibration", "",
-                                  "--duration",    "1.2",              "--can-log",
-                                  can_log.empty() ? path("out.log") : can_log,
+    std::vector<std::string> a = {"--sim",          scenario,
+                                  "--calibration",  "",
+                                  "--duration",     "1.2",
+                                  "--can-log",      can_log.empty() ? path("out.log") : can_log,
                                   "--scenario-dir", GFINS_SCENARIO_DIR};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
@@ -82,7 +81,8 @@ TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
   good.push_back("--check-config");
   const test::CliResult checked = fw(good);
   EXPECT_EQ(checked.exit_code, 0) << checked.output;
-  EXPECT_EQ(checked.output, "gfins-fw: configuration (built-in defaults + command line) is valid\n");
+  EXPECT_EQ(checked.output,
+            "gfins-fw: configuration (built-in defaults + command line) is valid\n");
   EXPECT_EQ(ran.exit_code, 0) << ran.output;
   EXPECT_NE(ran.output.find(kStarted), std::string::npos) << ran.output;
 }
@@ -111,9 +111,10 @@ TEST_F(FwCli, MessagesArriveWholeWithControlCharactersEscaped) {
 }
 
 TEST_F(FwCli, CheckConfigNamesWhatTheConfigurationIsMadeOf) {
-  const std::string cfg = file("c.toml", std::string("[board]\nkind = \"sim\"\n[calibration]\nfile = "
-                                                   "\"\"\n[sim]\nscenario_dir = \"") +
-                                           GFINS_SCENARIO_DIR + "\"\n");
+  const std::string cfg =
+      file("c.toml", std::string("[board]\nkind = \"sim\"\n[calibration]\nfile = "
+                                 "\"\"\n[sim]\nscenario_dir = \"") +
+                         GFINS_SCENARIO_DIR + "\"\n");
   EXPECT_EQ(fw({"-c", cfg, "--check-config"}).output,
             "gfins-fw: configuration (" + cfg + ") is valid\n");
   EXPECT_EQ(fw({"-c", cfg, "--node-id", "3", "--check-config"}).output,
