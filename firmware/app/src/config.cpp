@@ -137,7 +137,9 @@ class Reader {
                ch == '_' || ch == '-';
       });
       const std::string shown = bare ? std::string(name) : quote_text(name);
-      const std::string p = prefix.empty() ? shown : prefix + "." + shown;
+      std::string p = prefix;
+      if (!p.empty()) p += '.';
+      p += shown;
       if (const toml::table* sub = node.as_table(); sub != nullptr && known_tables_.count(p) != 0) {
         reject_unknown(*sub, p);
       } else if (known_.count(p) == 0) {

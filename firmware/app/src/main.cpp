@@ -56,7 +56,7 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
 
   BoardResult made = make_board(cfg);
   if (!made.board) {
-    spdlog::critical("board set-up failed: {}", made.error);
+    spdlog::critical("board set-up failed: {}", printable_text(made.error));
     return 1;
   }
   Board& board = *made.board;
@@ -64,10 +64,10 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   const StartupCalibration cal =
       load_calibration(cfg, board.defaults, board.factory ? &*board.factory : nullptr);
   if (cal.from_file) {
-    spdlog::info("{}", cal.message);
+    spdlog::info("{}", printable_text(cal.message));
   } else {
     spdlog::warn("**************************************************************************");
-    spdlog::warn("{}", cal.message);
+    spdlog::warn("{}", printable_text(cal.message));
     spdlog::warn("**************************************************************************");
   }
 
