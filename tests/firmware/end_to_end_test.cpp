@@ -13,7 +13,11 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
 #include <numbers>
+#include <sstream>
 
 #include "gfins/calib_file/calibration_file.hpp"
 #include "sim_rig.hpp"
@@ -251,6 +255,29 @@ calib_file::CalibrationData written_calibration() {
   return d;
 }
 
+// "table.key" → value text of a TOML file as written (comments and indentation stripped): to
+// read back under which documented key each number of the reference sits.
+std::map<std::string, std::string> keys_of(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(text);
+  std::string table;
+  for (std::string line; std::getline(in, line);) {
+    line = line.substr(0, line.find('#'));
+    const auto b = line.find_first_not_of(' ');
+    if (b == std::string::npos) continue;
+    line = line.substr(b, line.find_last_not_of(' ') + 1 - b);
+    if (line.front() == '[') {
+      table = line.substr(1, line.size() - 2);
+      continue;
+    }
+    const auto eq = line.find(" = ");
+    if (eq != std::string::npos) {
+      out[(table.empty() ? "" : table + ".") + line.substr(0, eq)] = line.substr(eq + 3);
+    }
+  }
+  return out;
+}
+
 // Loads the configuration text through the firmware's reader and the calibration through its
 // start-up, exactly as gfins-fw does, into the rig.
 void configure_from(SimRig& rig, const std::string& toml) {
@@ -269,6 +296,22 @@ TEST(EndToEnd, NonDefaultConfigurationAndCalibrationFileReachTheCoreAsDocumented
   const std::string cal_path = (dir.path() / "board7.toml").string();
   const calib_file::CalibrationData cal = written_calibration();
   ASSERT_TRUE(calib_file::save_calibration_file(cal_path, cal).is_ok());
+  // The file carries the values under the keys calibration_part() reads them from
+  // (docs/calibration-file.md): the reference is tied to the documented keys, not to the struct.
+  std::ifstream saved(cal_path);
+  const auto keys = keys_of(std::string(std::istreambuf_iterator<char>(saved), {}));
+  EXPECT_EQ(keys.at("compensator"), "'paper'");
+  EXPECT_EQ(keys.at("gravity.local_mps2"), "9.7893");
+  EXPECT_EQ(keys.at("orientation.beta.xy_deg"), "0.1");
+  EXPECT_EQ(keys.at("orientation.beta.xz_deg"), "-0.05");
+  EXPECT_EQ(keys.at("orientation.alpha.yz_deg"), "-0.09");
+  EXPECT_EQ(keys.at("sensor.2.location_error_m"), "[ 0.001, 0.0, -5e-04 ]");
+  EXPECT_EQ(keys.at("sensor.5.location_error_m"), "[ 0.0, -8e-04, 0.0 ]");
+  EXPECT_EQ(keys.at("sensor.3.scale_v_per_g"), "1.335");
+  EXPECT_EQ(keys.at("sensor.3.bias_g"), "3e-04");
+  EXPECT_EQ(keys.at("sensor.6.adc_lsb_v_per_count"), "1.1916160583496094e-06");
+  EXPECT_EQ(keys.at("geometry.name"), "'table1'");
+  EXPECT_EQ(keys.at("geometry.rho_m"), "0.1");
   SimRig rig("rest", 3.0);
   configure_from(rig,
                  "[board]\nkind = \"sim\"\n"
