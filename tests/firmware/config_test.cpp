@@ -272,7 +272,7 @@ TEST(Config, MessagesEscapeControlCharactersAndInvalidUtf8) {
             "valid UTF-8 without control characters (or empty for none)\n");
   EXPECT_EQ(quote_text("say \"hi\"\\\t\n"), "\"say \\\"hi\\\"\\\\\\t\\n\"");
   EXPECT_EQ(quote_text(std::string(70, 'x')), "\"" + std::string(60, 'x') + "...\"");
-  EXPECT_EQ(printable_text("line 1\nline\x1B[2J 2\n"), "line 1\nline\\u001B[2J 2\n");
+  EXPECT_EQ(printable_text("line 1\nline\x1B[2J\t2\n"), "line 1\nline\\u001B[2J\t2\n");
 }
 
 // Item 5: a problem validate() finds names the line of its key, like the reader's own.

@@ -43,9 +43,9 @@ std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& cp) {
 bool is_control(char32_t cp) { return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F); }
 
 // s with every control character and every byte of invalid UTF-8 escaped (TOML's \uXXXX
-// and short forms for controls, \xNN for a byte that is not UTF-8); `keep_newlines` leaves '\n'
-// as it is (multi-line messages). Stops after `max_chars` characters with "...".
-std::string escaped(std::string_view s, bool quote, bool keep_newlines, std::size_t max_chars) {
+// and short forms for controls, \xNN for a byte that is not UTF-8); `keep_layout` leaves '\n' and
+// '\t' as they are (multi-line messages, help text). Stops after `max_chars` characters with "...".
+std::string escaped(std::string_view s, bool quote, bool keep_layout, std::size_t max_chars) {
   std::string out;
   std::size_t shown = 0;
   for (std::size_t i = 0; i < s.size();) {
@@ -63,8 +63,8 @@ std::string escaped(std::string_view s, bool quote, bool keep_newlines, std::siz
       ++i;
       continue;
     }
-    if (cp == '\n' && keep_newlines) {
-      out += '\n';
+    if ((cp == '\n' || cp == '\t') && keep_layout) {
+      out += static_cast<char>(cp);
     } else if (quote && (cp == '"' || cp == '\\')) {
       out += '\\';
       out += static_cast<char>(cp);

@@ -146,7 +146,8 @@ std::string calibration_note(const FwConfig& c);
 /// UTF-8 escaped (\uXXXX, \xNN), cut to 60 characters: a value as a message shows it.
 std::string quote_text(std::string_view s);
 
-/// `s` with control characters other than '\n' and invalid UTF-8 escaped: safe to print.
+/// `s` with control characters other than '\n' and '\t', and invalid UTF-8, escaped: safe to
+/// print.
 std::string printable_text(std::string_view s);
 
 /// A non-empty path of at most 4095 bytes of valid UTF-8 without control characters.
