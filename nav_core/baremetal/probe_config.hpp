@@ -25,10 +25,8 @@ constexpr std::array<float, N> to_float(const std::array<double, N>& d, double f
 inline constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 inline constexpr std::array<float, 6> kScaleVPerG = to_float(nav::paper_table6::kScaleVPerG);
 inline constexpr std::array<float, 6> kBiasG = to_float(nav::paper_table6::kBiasG);
-inline constexpr std::array<float, 6> kBetaRad =
-    to_float(nav::paper_table6::kBetaDeg, kDegToRad);
-inline constexpr std::array<float, 6> kAlphaRad =
-    to_float(nav::paper_table6::kAlphaDeg, kDegToRad);
+inline constexpr std::array<float, 6> kBetaRad = to_float(nav::paper_table6::kBetaDeg, kDegToRad);
+inline constexpr std::array<float, 6> kAlphaRad = to_float(nav::paper_table6::kAlphaDeg, kDegToRad);
 
 using Vec3f = std::array<float, 3>;
 
@@ -37,7 +35,7 @@ using Vec3f = std::array<float, 3>;
 /// geometry: one geometry, the configuration issue 13 sizes), with the converter's LSB (V per
 /// count) and each sensor's location error Δρ_j (m, body) given.
 inline nav::PipelineConfig<float> make_probe_config(float volts_per_count,
-                                                     const std::array<Vec3f, 6>& drho_m) {
+                                                    const std::array<Vec3f, 6>& drho_m) {
   nav::PipelineConfig<float> c;
   c.nominal = nav::table1_geometry(0.1f);
   for (std::size_t j = 0; j < 6; ++j) {
@@ -71,8 +69,8 @@ inline nav::NavState<float> make_probe_state(const std::array<float, 4>& q, cons
 
 /// What the probe publishes after a step (main.cpp g_out): q_nb w, x, y, z, then v_n, then r_n.
 inline std::array<float, 10> probe_outputs(const nav::NavState<float>& s) {
-  return {s.q_nb.w(), s.q_nb.x(), s.q_nb.y(), s.q_nb.z(), s.v_n(0), s.v_n(1),
-          s.v_n(2),   s.r_n(0),   s.r_n(1),   s.r_n(2)};
+  return {s.q_nb.w(), s.q_nb.x(), s.q_nb.y(), s.q_nb.z(), s.v_n(0),
+          s.v_n(1),   s.v_n(2),   s.r_n(0),   s.r_n(1),   s.r_n(2)};
 }
 
 }  // namespace gfins::probe

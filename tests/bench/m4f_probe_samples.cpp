@@ -39,10 +39,10 @@ std::array<float, 10> expected_outputs(const Workload& w, int steps) {
     throw std::runtime_error("the probe's configuration is refused");
   }
   const auto& t = w.truth.front();
-  pipe.start_at(p::make_probe_state({to_f(t.q_nb.w()), to_f(t.q_nb.x()), to_f(t.q_nb.y()),
-                                     to_f(t.q_nb.z())},
-                                    to_f3(t.w_b), to_f3(t.wdot_b), to_f3(t.v_n), to_f3(t.r_n)),
-                w.samples.front());
+  pipe.start_at(
+      p::make_probe_state({to_f(t.q_nb.w()), to_f(t.q_nb.x()), to_f(t.q_nb.y()), to_f(t.q_nb.z())},
+                          to_f3(t.w_b), to_f3(t.wdot_b), to_f3(t.v_n), to_f3(t.r_n)),
+      w.samples.front());
   for (int k = 1; k <= steps; ++k) {
     gfins::RawSample s = w.samples[static_cast<std::size_t>(k)];
     s.seq = static_cast<std::uint32_t>(k);
@@ -72,7 +72,8 @@ std::string header(const Workload& w) {
     << " consecutive 1 kHz\n"
        "// samples of the first second of the manoeuvre through host_sim's sample source (Table 6\n"
        "// errors, location errors of about 1 mm, the register-level ADS131M06 model), the\n"
-       "// converter's LSB, the location errors and the true state at the first sample. Used by the\n"
+       "// converter's LSB, the location errors and the true state at the first sample. Used by "
+       "the\n"
        "// QEMU build of the bare-metal probe (main.cpp, GFINS_PROBE_STEPS); the test\n"
        "// m4f_probe_samples_current keeps it current.\n"
        "#pragma once\n\n#include <array>\n#include <cstdint>\n\n"
@@ -90,8 +91,8 @@ std::string header(const Workload& w) {
   o << "}};\n\n";
   o << "// True state at the first sample: q_nb (w, x, y, z), ω_b rad/s, ω̇_b rad/s², v_n m/s, "
        "r_n m.\n"
-    << "inline constexpr std::array<float, 4> kQ0 = {" << f32(t.q_nb.w()) << ", "
-    << f32(t.q_nb.x()) << ", " << f32(t.q_nb.y()) << ", " << f32(t.q_nb.z()) << "};\n";
+    << "inline constexpr std::array<float, 4> kQ0 = {" << f32(t.q_nb.w()) << ", " << f32(t.q_nb.x())
+    << ", " << f32(t.q_nb.y()) << ", " << f32(t.q_nb.z()) << "};\n";
   const auto vec = [&o](const char* name, const gfins::nav::Vec3<double>& v) {
     o << "inline constexpr std::array<float, 3> " << name << " = {" << f32(v.x()) << ", "
       << f32(v.y()) << ", " << f32(v.z()) << "};\n";
@@ -111,14 +112,16 @@ std::string header(const Workload& w) {
   o << "}};\n\n";
   constexpr int kSteps = gfins::bench::kSamples - 1;
   const std::array<float, 10> out = expected_outputs(w, kSteps);
-  o << "// The x86 float pipeline (same configuration code, probe_config.hpp) after steps 1.." << kSteps
+  o << "// The x86 float pipeline (same configuration code, probe_config.hpp) after steps 1.."
+    << kSteps
     << "\n// on these samples: q_nb w, x, y, z, v_n (m/s), r_n (m); below, their bit patterns.\n//";
-  for (const float f : out) o << " " << f32(f);
+  for (const float f : out) o << " " << f32(static_cast<double>(f));
   o << "\ninline constexpr int kExpectedSteps = " << kSteps << ";\n"
     << "inline constexpr std::array<std::uint32_t, 10> kExpectedOutBits = {";
   for (std::size_t i = 0; i < out.size(); ++i) {
     char buf[16];
-    std::snprintf(buf, sizeof buf, "0x%08xu", static_cast<unsigned>(std::bit_cast<std::uint32_t>(out[i])));
+    std::snprintf(buf, sizeof buf, "0x%08xu",
+                  static_cast<unsigned>(std::bit_cast<std::uint32_t>(out[i])));
     o << (i ? ", " : "") << buf;
   }
   o << "};\n\n}  // namespace gfins::probe\n// clang-format on\n";
