@@ -221,7 +221,9 @@ class AdcSource final : public SampleSource {
   }
   AdcCounters do_counters() const override {
     const drivers::Ads131m06Counters& d = driver_.counters();
-    return AdcCounters{d.crc_errors, d.missed_edges, d.extra_edges, d.chip_resets};
+    // Resets met as a register re-verification mismatch count too (docs/faults.md).
+    return AdcCounters{d.crc_errors, d.missed_edges, d.extra_edges,
+                       d.chip_resets + d.register_mismatches};
   }
   double do_volts_per_count() const override { return volts_per_count_; }
 
