@@ -13,8 +13,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <set>
 
+#include "gfins/can/command.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "sim_rig.hpp"
 
@@ -658,6 +660,32 @@ TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {
   for (std::uint32_t r : bus.response_results) EXPECT_EQ(r, 3u);  // Result 3 = BadCrc
   EXPECT_EQ(lines_with(lines_, "rejected").size(), 1u);
   expect_status_rate(bus, 1000, rig.samples);
+}
+
+TEST_F(Faults, FailedCalibrationReloadKeepsTheCalibrationAnswersFailedAndLogs) {
+  SimRig& rig = make();
+  ReloadWorker reload(
+      [](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> { return {}; });
+  rig.loop->set_reload_worker(&reload);
+  rig.run_cycles(2000);
+  const std::uint32_t cal_before = rig.loop->cal_id();
+  can::Command c;
+  c.opcode = can::Opcode::kReloadCalibration;
+  c.token = 9;
+  ASSERT_TRUE(rig.bus->inject_rx(can::encode_command(c, SimRig::kNode)));
+  rig.run_cycles(1);
+  reload.wait_settled();  // the worker's outcome is seen by the next cycle's poll
+  rig.run();
+  lines_ = rig.drain_log();
+  EXPECT_EQ(rig.loop->health().command_errors, 1u);
+  EXPECT_EQ(rig.loop->cal_id(), cal_before);
+  const Bus bus = decode(rig);
+  ASSERT_EQ(bus.response_results.size(), 1u);
+  EXPECT_EQ(bus.response_results[0], 7u);  // Result 7 = Failed
+  EXPECT_EQ(lines_with(lines_, "calibration reload failed").size(), 1u);
+  EXPECT_EQ(on_bus(bus, 3000).cal_id, cal_before);
+  expect_status_rate(bus, 1000, rig.samples);
+  EXPECT_EQ(rig.loop->pipeline().state().v_n, baseline_->loop->pipeline().state().v_n);
 }
 
 // Frames the publisher sends for the samples read in [first, last): its documented rule, every

@@ -5,6 +5,8 @@
 // formatting happens there); the queue it drains is what the loop writes to.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "heap_counter.hpp"
 #include "sim_rig.hpp"
 
@@ -14,10 +16,12 @@ namespace {
 using testing::HeapCounter;
 using testing::SimRig;
 
-// Cycles counted: 20 s at 1 kHz after alignment — long enough for every periodic path (event
-// bits expiring after kEventHoldSamples, rate-limited log records, the stuck detector's window).
+// Cycles counted (printed by the test): 20 s at 1 kHz after alignment — long enough for every
+// periodic path (event bits expiring after kEventHoldSamples, rate-limited log records, the stuck
+// detector's window).
 constexpr std::uint32_t kCountedCycles = 20000;
 constexpr std::uint32_t kWarmUpCycles = 1500;  // alignment (1000 samples) plus margin
+constexpr std::uint32_t kDeadCycles = 1000;    // 1 s of a dead ADC: every path of an outage
 
 TEST(NoAlloc, TheDetectorSeesOperatorNewAndMalloc) {
   if (!HeapCounter::available()) GTEST_SKIP() << "AddressSanitizer owns malloc";
@@ -50,23 +54,37 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   rig.configure();
   rig.run_cycles(kWarmUpCycles);
   ASSERT_EQ(rig.loop->mode(), Mode::kNavigating);
-  // When many thousand cycles run, with the CAN sink refusing and going bus-off in between
+  // When many thousand cycles run, with the CAN sink refusing and going bus-off in between, ADC
+  // reads failing (the no-sample epochs and the paced retry) and the ADC dead for a while
+  std::uint32_t counted = 0;
+  const auto cycles = [&](std::uint32_t n) {
+    rig.run_cycles(n);
+    counted += n;
+  };
   const long before = HeapCounter::calls();
-  rig.run_cycles(11000 - kWarmUpCycles);
+  cycles(11000 - kWarmUpCycles);
   rig.bus->refuse(true);
-  rig.run_cycles(500);
+  cycles(500);
   rig.bus->refuse(false);
   rig.bus->bus_off(true);
-  rig.run_cycles(500);
+  cycles(500);
   rig.bus->bus_off(false);
-  rig.run_cycles(kCountedCycles - 10000);
+  rig.faulty->fail_reads(3);
+  cycles(kCountedCycles - counted - kDeadCycles);
+  rig.faulty->set_dead(true);
+  cycles(kDeadCycles);
+  rig.faulty->set_dead(false);
   const long after = HeapCounter::calls();
+  std::printf("no-alloc window: %u loop cycles counted (%u with the ADC dead)\n", counted,
+              kDeadCycles);
   // Then the faults happened (the window exercised their paths) and nothing was allocated
   EXPECT_GT(rig.loop->health().crc_errors, 0u);
   EXPECT_GT(rig.loop->health().stuck_events, 0u);
   EXPECT_GT(rig.loop->health().drdy_timeouts, 0u);
   EXPECT_GT(rig.loop->health().can_tx_dropped, 0u);
-  EXPECT_GE(rig.loop->health().samples, kCountedCycles);
+  EXPECT_EQ(rig.loop->health().adc_read_errors, 3u + kDeadCycles);
+  EXPECT_EQ(counted, kCountedCycles);
+  EXPECT_GE(rig.loop->health().samples, kCountedCycles - kDeadCycles);
   EXPECT_EQ(after - before, 0) << "heap calls inside the sample loop";
 }
 

@@ -55,6 +55,9 @@ std::string open_bus(const FwConfig& c, hal::Clock& clock, Board& b) {
     lnx::CandumpFileBusConfig bc;
     bc.path = c.can_log;
     bc.interface = c.can_interface;
+    // File writes off the loop thread, except in fast pacing, whose output must be the same on
+    // every run (a writer thread that falls behind drops frames: a matter of scheduling).
+    bc.background_writer = !(c.board == BoardKind::kSim && c.pacing == Pacing::kFast);
     auto bus = lnx::CandumpFileBus::open(bc, clock);
     if (!bus.is_ok()) return lnx::describe(c.can_log, bus.status());
     b.bus = std::move(bus).value();
