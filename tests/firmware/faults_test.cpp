@@ -581,11 +581,13 @@ TEST_F(Faults, AdcDeadForTenSecondsStopsTheWatchdogKicks) {
   std::uint64_t kicks_at_10s = 0;
   // docs/faults.md: kicks stop once the ADC has delivered nothing for 10 s.
   constexpr std::int64_t kDeadLimitNs = 10000000000;
-  while (rig.clock.now_ns() < t0 + kDeadLimitNs + 2000000000) {
+  std::uint32_t cycles = 0;  // bounded: a loop that spins would never move the sample clock
+  while (rig.clock.now_ns() < t0 + kDeadLimitNs + 2000000000 && ++cycles < 100000) {
     rig.loop->step();
     if (rig.clock.now_ns() <= t0 + kDeadLimitNs - 2000000) kicks_at_10s = watchdog_.kicks;
   }
   const std::uint64_t kicks_dead = watchdog_.kicks;
+  EXPECT_EQ(cycles, 12000u);  // one per period
   EXPECT_FALSE(rig.loop->kicking_watchdog());
   // Kicked for 10 s at 1 kHz (±2 cycles at the ends of the window), then not at all.
   EXPECT_NEAR(static_cast<double>(kicks_dead - 2000), 10000.0, 2.0);
