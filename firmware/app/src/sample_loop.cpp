@@ -108,6 +108,8 @@ SampleLoop::Cycle SampleLoop::step() {
                 "restarts the firmware (read errors: {}; {} more since the last line)",
                 kDeadAdcWatchdogNs / 1000000, health_.adc_read_errors);
   }
+  if (status_board_ != nullptr)
+    status_board_->publish(mode_, cal_.calibrated, cal_.cal_id, health_);
   if (watchdog_ != nullptr && !watchdog_held_) (void)watchdog_->kick();
   if (cycle == Cycle::kReadError) {
     // A read that failed at once (a dead chip, an SPI error) must not make the loop spin: wait
