@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -262,6 +263,9 @@ Resume resume(const SimRig& base, const SimRig& faulty, const std::set<std::uint
 }
 
 void expect_resumes(const Resume& r) {
+  std::printf(
+      "[ resume   ] |v - v_fault-free| %.4f m/s, bound %.4f m/s, frozen would be %.4f m/s\n",
+      r.difference, r.bound, r.frozen_gap);
   EXPECT_LT(r.difference, r.bound) << "frozen would be " << r.frozen_gap;
   EXPECT_GT(r.frozen_gap, kFrozenMargin * r.bound)
       << "the bound " << r.bound << " m/s would not tell a frozen navigation from a resumed one";
