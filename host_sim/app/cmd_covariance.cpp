@@ -30,12 +30,14 @@ HostStatus check_options(const Scenario& s, const CovarianceOptions& c) {
       return HostError{ErrorCode::kInvalidArgument, buf};
     }
   }
+  // The run covers whole sample periods (sample_count): a time past its last sample is outside.
+  const double covered = covered_duration_s(s);
   for (double t : c.times_s) {
-    if (!std::isfinite(t) || t <= 0 || t > s.duration_s) {
+    if (!std::isfinite(t) || t <= 0 || t > covered * (1.0 + 1e-12)) {
       std::snprintf(buf, sizeof buf,
                     "--at %g: outside the run of scenario %s: a budget time must be in (0, %g] s "
-                    "(its duration_s)",
-                    t, s.name.c_str(), s.duration_s);
+                    "(its last sample)",
+                    t, s.name.c_str(), covered);
       return HostError{ErrorCode::kOutOfRange, buf};
     }
   }
@@ -68,7 +70,7 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   spec.trajectory = traj.value().get();
   spec.geometry = nav::table1_geometry<double>(s.rho_m);
   spec.gravity = gravity_model(s);
-  spec.duration_s = s.duration_s;
+  spec.duration_s = covered_duration_s(s);  // the same samples as a run of it
   spec.dt_s = 1.0 / s.rate_hz;
   spec.decimation = static_cast<std::size_t>(std::max(1.0, std::round(s.rate_hz / 100.0)));
   const double g = nav::kStandardGravity;
@@ -83,7 +85,7 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   spec.constants.orientation_sigma_rad.fill(c.orientation_urad * 1e-6);
   spec.constants.location_sigma_m.fill(c.location_mm * 1e-3);
   std::vector<double> times = c.times_s;
-  if (times.empty()) times = {0.25 * s.duration_s, 0.5 * s.duration_s, s.duration_s};
+  if (times.empty()) times = {0.25 * spec.duration_s, 0.5 * spec.duration_s, spec.duration_s};
   std::printf(
       "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
       describe(s).c_str(), noise, c.bias_ug, rw);
