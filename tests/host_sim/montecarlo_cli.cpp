@@ -52,8 +52,9 @@ std::string rest_scenario(double duration_s) {
 /// The "memory about N MB" of the estimate line, in bytes; -1 when absent.
 double printed_memory_bytes(const std::string& out) {
   std::smatch m;
-  if (!std::regex_search(out, m, std::regex("estimate: [0-9]+ samples x [0-9]+ runs, memory "
-                                            "about ([0-9]+) MB, time about [0-9.e+]+ s"))) {
+  if (!std::regex_search(out, m,
+                         std::regex("estimate: [0-9]+ samples x [0-9]+ runs, memory "
+                                    "about ([0-9]+) MB, time about [0-9.e+]+ s"))) {
     return -1;
   }
   return std::stod(m[1].str()) * 1e6;
@@ -69,9 +70,9 @@ TEST_F(MontecarloCli, MemoryEstimateBoundsTheMeasuredPeakForOneAndTwoThreads) {
   for (const std::size_t jobs : {std::size_t{1}, std::size_t{2}}) {
     SCOPED_TRACE("-j " + std::to_string(jobs));
     const std::size_t runs = 2 * jobs;  // every thread runs twice: results wait their turn
-    const CliResult r = run(GFINS_SIM_BIN, {"montecarlo", toml, "-n", std::to_string(runs), "-j",
-                                            std::to_string(jobs), "--no-plot", "-o",
-                                            path("mc" + std::to_string(jobs))});
+    const CliResult r = run(
+        GFINS_SIM_BIN, {"montecarlo", toml, "-n", std::to_string(runs), "-j", std::to_string(jobs),
+                        "--no-plot", "-o", path("mc" + std::to_string(jobs))});
     ASSERT_EQ(r.exit_code, kExitOk) << r.output;
     // The estimate is printed before the work (before the results' first line).
     const double printed = printed_memory_bytes(r.output);
@@ -141,11 +142,10 @@ TEST_F(MontecarloCli, ProgressReachesALogAndSigintKeepsTheFinishedRuns) {
   const fs::path out = dir() / "cut";
   const fs::path log = dir() / "log";
   fs::create_directories(log);
-  test::StartedTool t =
-      test::start_tool(GFINS_SIM_BIN,
-                       {"montecarlo", toml, "-n", std::to_string(kRuns), "-j", "1", "--no-plot",
-                        "-o", out.string()},
-                       log);
+  test::StartedTool t = test::start_tool(
+      GFINS_SIM_BIN,
+      {"montecarlo", toml, "-n", std::to_string(kRuns), "-j", "1", "--no-plot", "-o", out.string()},
+      log);
   ASSERT_GT(t.child.pid, 0);
   // when a progress line says at least 2 runs are done (bounded wait), SIGINT is sent;
   const std::regex done("progress: montecarlo: [0-9]+ % \\(([0-9]+) of 200 runs\\)");

@@ -49,8 +49,8 @@ class ReplayChecksCli : public test::CliTest {
   /// A recording made by gfins-sim run --record of `scenario` (a built-in name or a file).
   std::string record(const std::string& scenario, const std::string& name) const {
     const std::string gfr = path(name + ".gfr");
-    const CliResult r = run(GFINS_SIM_BIN, {"run", scenario, "--record", gfr, "--no-plot", "-o",
-                                            path(name + "-sim")});
+    const CliResult r = run(
+        GFINS_SIM_BIN, {"run", scenario, "--record", gfr, "--no-plot", "-o", path(name + "-sim")});
     EXPECT_EQ(r.exit_code, kExitOk) << r.output;
     return gfr;
   }
