@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "gfins/host_sim/covariance.hpp"
+#include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "run_options.hpp"
 
@@ -89,6 +90,11 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   std::printf(
       "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
       describe(s).c_str(), noise, c.bias_ug, rw);
+  // The propagation keeps decimated envelopes only; the reference run holds its series.
+  print_estimate(sample_count(s), 1,
+                 static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
+                 static_cast<double>(sample_count(s)) * kMcSecondsPerSampleRun,
+                 "the reference run; the propagation adds its own time");
   const CovarianceReport report = covariance_report(spec, times, c.jobs);
   const CovarianceResult& r = report.envelopes;
   if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
