@@ -95,7 +95,16 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
                  static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
                  static_cast<double>(sample_count(s)) * kMcSecondsPerSampleRun,
                  "the reference run; the propagation adds its own time");
+  // Ctrl-C/SIGTERM are taken between the phases (propagation, files, reference run), so every
+  // file written is whole; the phases themselves run to their end (seconds for the built-ins).
+  const StopSignals handlers;
+  const auto interrupted = [&](const char* kept) {
+    std::fprintf(stderr, "gfins-sim: interrupted (signal %d): %s\n",
+                 static_cast<int>(g_stop_signal), kept);
+    return kExitInterrupted;
+  };
   const CovarianceReport report = covariance_report(spec, times, c.jobs);
+  if (g_stop_signal != 0) return interrupted("nothing written");
   const CovarianceResult& r = report.envelopes;
   if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
@@ -118,7 +127,12 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   // One run of the scenario (its own sensor errors) through the navigation core in the chosen
   // scalar: a sample of what the envelopes predict, written next to them. The propagation
   // above is the linear error model in double whatever the core's scalar.
-  const auto ref = run_scenario(s, tty_progress("reference run"), false, scalar.value());
+  if (g_stop_signal != 0)
+    return interrupted("covariance.csv and budget.csv written, no reference run");
+  const auto ref =
+      run_scenario(s, run_progress("reference run", covered_duration_s(s)), false, scalar.value());
+  if (g_stop_signal != 0)
+    return interrupted("covariance.csv and budget.csv written, no reference run");
   if (!ref.is_ok()) return fail(ref.error(), kExitError);
   const std::string ref_path = out_dir + "/reference_run.csv";
   if (auto w = write_series_csv(ref.value().compensated, ref_path, spec.decimation); !w.is_ok()) {

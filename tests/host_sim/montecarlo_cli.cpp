@@ -183,5 +183,42 @@ TEST_F(MontecarloCli, ProgressReachesALogAndSigintKeepsTheFinishedRuns) {
   for (const auto& l : lines) ASSERT_EQ(test::cells_of(l).size(), cells) << l;
 }
 
+TEST_F(MontecarloCli, CovarianceShowsProgressInALogAndStopsBetweenPhasesOnSigint) {
+  // Given covariance of 600 s of rest (its reference run holds 600,001 samples: seconds of work)
+  // with progress every 0.05 s to a log,
+  ASSERT_EQ(setenv("GFINS_PROGRESS_INTERVAL_S", "0.05", 1), 0);
+  const std::string toml = file("c600.toml", rest_scenario(600.0));
+  const fs::path out = dir() / "cov";
+  const fs::path log = dir() / "log";
+  fs::create_directories(log);
+  test::StartedTool t =
+      test::start_tool(GFINS_SIM_BIN, {"covariance", toml, "--no-plot", "-o", out.string()}, log);
+  ASSERT_GT(t.child.pid, 0);
+  // when SIGINT comes after the reference run's first progress line,
+  bool seen = false;
+  for (int i = 0; i < 12000 && !seen; ++i) {
+    seen = test::slurp(t.stderr_path()).find("progress: reference run: ") != std::string::npos;
+    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(unsetenv("GFINS_PROGRESS_INTERVAL_S"), 0);
+  EXPECT_TRUE(seen) << "no progress line within 120 s";
+  ASSERT_TRUE(drivers::lnx::signal_program(t.child, SIGINT).is_ok());
+  const CliResult r = test::finish_tool(t);
+  // then exit 130 saying what was kept: the envelopes whole, no reference run.
+  ASSERT_EQ(r.exit_code, kExitInterrupted) << r.output;
+  EXPECT_NE(r.err.find("covariance.csv and budget.csv written, no reference run"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out / "reference_run.csv"));
+  for (const char* name : {"covariance.csv", "budget.csv"}) {
+    const std::string text = test::slurp(out / name);
+    ASSERT_FALSE(text.empty()) << name;
+    EXPECT_EQ(text.back(), '\n') << name;
+    const auto lines = test::lines_of(text);
+    const std::size_t cells = test::cells_of(lines.front()).size();
+    for (const auto& l : lines) ASSERT_EQ(test::cells_of(l).size(), cells) << name << ": " << l;
+  }
+}
+
 }  // namespace
 }  // namespace gfins::sim
