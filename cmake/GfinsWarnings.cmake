@@ -1,4 +1,4 @@
-# The warning set of STYLE.md, applied per target so third-party code is not affected.
+# The project's warning set, applied per target so third-party code is not affected.
 add_library(gfins_warnings INTERFACE)
 add_library(gfins::warnings ALIAS gfins_warnings)
 target_compile_options(gfins_warnings INTERFACE

@@ -15,24 +15,34 @@ presets=("$@")
 [ ${#presets[@]} -gt 0 ] || presets=(host-release aarch64-linux armhf-linux)
 out=out/deb
 mkdir -p "$out"
-command -v lintian >/dev/null || { echo "package.sh: lintian missing: apt install lintian" >&2; exit 1; }
+command -v lintian >/dev/null ||
+  { echo "package.sh: lintian missing: install Debian package 'lintian' (scripts/install-deps.sh does)" >&2; exit 1; }
 command -v dpkg-shlibdeps >/dev/null ||
-  { echo "package.sh: dpkg-shlibdeps missing: apt install dpkg-dev" >&2; exit 1; }
+  { echo "package.sh: dpkg-shlibdeps missing: install Debian package 'dpkg-dev' (scripts/install-deps.sh does)" >&2; exit 1; }
 
+made=()
 for p in "${presets[@]}"; do
   echo "=== package: $p"
   cmake --preset "$p" >/dev/null
   # Only what goes into the packages (a preset's tests are built and run by its own step).
   cmake --build --preset "$p" -j "$jobs" --target gfins_package_programs
+  # A fresh CPack folder: a .deb left there by an earlier version must not be copied again.
+  rm -rf "build/$p/cpack"
   cpack --config "build/$p/CPackConfig.cmake" -B "build/$p/cpack" >/dev/null
-  for deb in "build/$p/cpack"/*.deb; do
+  debs_made=("build/$p/cpack"/*.deb)
+  [ -e "${debs_made[0]}" ] || { echo "package.sh: cpack made no .deb for $p" >&2; exit 1; }
+  for deb in "${debs_made[@]}"; do
+    name=$(dpkg-deb -f "$deb" Package)
+    arch=$(dpkg-deb -f "$deb" Architecture)
+    # out/deb holds one version per package and architecture: the one just made.
+    rm -f "$out/${name}_"*"_${arch}.deb"
     cp "$deb" "$out/"
+    made+=("$out/$(basename "$deb")")
     echo "  $(basename "$deb")"
   done
 done
 
-debs=("$out"/*.deb)
-echo "=== lintian ${#debs[@]} package(s)"
+echo "=== lintian ${#made[@]} package(s) made by this run"
 # --fail-on error: warnings are shown but only errors fail the build.
-lintian --fail-on error --tag-display-limit 0 "${debs[@]}"
-echo "package.sh: ${#debs[@]} package(s) in $out, lintian: no errors"
+lintian --fail-on error --tag-display-limit 0 "${made[@]}"
+echo "package.sh: ${#made[@]} package(s) in $out, lintian: no errors"

@@ -98,7 +98,12 @@ def main():
     axs[3].set_xlabel("device time from the first epoch (s)")
     fig.suptitle(a.title + ": decoded by gfins-can", fontsize=11)
     fig.tight_layout()
-    fig.savefig(a.out, dpi=80)
+    try:
+        fig.savefig(a.out, dpi=80)
+    except OSError as e:  # one line naming the file, not a traceback
+        print("plot_can.py: cannot write " + a.out + ": " + (e.strerror or str(e)),
+              file=sys.stderr)
+        return 1
     print("plot_can.py: wrote " + a.out)
     return 0
 

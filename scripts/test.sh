@@ -134,7 +134,11 @@ step "Debian packages (amd64, arm64) and lintian"
 # installed in a clean root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in
 # docs/ci.md.
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
-fw_deb=$(ls out/deb/gfins-fw_*_amd64.deb | head -n 1)
+# scripts/package.sh keeps one version per package and architecture in out/deb: the one it made.
+fw_debs=(out/deb/gfins-fw_*_amd64.deb)
+[ ${#fw_debs[@]} -eq 1 ] && [ -e "${fw_debs[0]}" ] ||
+  { echo "test.sh: expected one out/deb/gfins-fw_*_amd64.deb, found: ${fw_debs[*]}" >&2; exit 1; }
+fw_deb=${fw_debs[0]}
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
   --deb "$fw_deb"
 

@@ -9,6 +9,8 @@ packages=(
   qemu-system-x86 busybox-static cpio gzip kmod
   iproute2 can-utils gpiod libgpiod-dev
   build-essential gcc-12 make xz-utils
+  file        # make-initramfs.sh: is /bin/busybox the static one
+  debootstrap # make-sysroot.sh: the clean Debian root of the service stage
 )
 missing=()
 for p in "${packages[@]}"; do

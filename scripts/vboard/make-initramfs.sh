@@ -27,11 +27,13 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$out" ] || vb_die "make-initramfs.sh: -o OUT missing"
 
-vb_require /bin/busybox:busybox-static cpio:cpio gzip:gzip ldd:libc-bin gcc:gcc \
+vb_require file:file /bin/busybox:busybox-static cpio:cpio gzip:gzip ldd:libc-bin gcc:gcc \
   /usr/sbin/ip:iproute2 candump:can-utils cangen:can-utils cansend:can-utils canplayer:can-utils \
   gpiodetect:gpiod gpioinfo:gpiod gpiomon:gpiod gpioset:gpiod gpioget:gpiod
-file /bin/busybox | grep -q 'statically linked' ||
-  vb_die "/bin/busybox is not the static one: install Debian package 'busybox-static'"
+# `file` was required just above: a failure here is about busybox, not a missing tool.
+busybox_type=$(file -L /bin/busybox) || vb_die "file -L /bin/busybox failed"
+grep -q 'statically linked' <<<"$busybox_type" ||
+  vb_die "/bin/busybox is not the static one ($busybox_type): install Debian package 'busybox-static'"
 [ -e /usr/lib/x86_64-linux-gnu/libc.a ] || vb_die "no static libc for drdy-toggle: install 'libc6-dev'"
 
 kver=$(vb_kernel_abi)

@@ -78,15 +78,18 @@ if [ -n "$deb" ]; then
     vb_die "the gfins-fw postinst did not enable gfins-fw.service"
   # The VM has no SPI controller: the firmware runs from a configuration for the virtual board
   # (the ADC chip model inside the process, paced by the gpio-sim line's falling edges, output
-  # on vcan0) through a unit drop-in. Default: gfins-fw-vboard.toml at this rate with the
-  # systemd watchdog, the chip found by its gpio-sim label. The scenario is not in the firmware
+  # on a vcan named can0, the interface the package's unit waits for) through a unit drop-in.
+  # Default: gfins-fw-vboard.toml at this rate with the systemd watchdog, on can0, the chip
+  # found by its gpio-sim label. The scenario is not in the firmware
   # package (scenarios ship with gfins-tools): it goes to /etc/gfins/vboard-scenarios, named
   # with --scenario-dir.
   if [ -z "$fw_config" ]; then
     fw_config=$vboard_cache/service-fw.toml
     sed -e "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/" -e 's/^gpio_chip = .*/gpio_chip = "gfins-vboard"/' \
-      -e '/^\[watchdog\]/,/^kind/ s/^kind = .*/kind = "systemd"/' "$here/gfins-fw-vboard.toml" >"$fw_config"
+      -e '/^\[watchdog\]/,/^kind/ s/^kind = .*/kind = "systemd"/' \
+      -e '/^\[can\]/,/^interface/ s/^interface = .*/interface = "can0"/' "$here/gfins-fw-vboard.toml" >"$fw_config"
     grep -q '^kind = "systemd"' "$fw_config" || vb_die "could not set [watchdog] kind = systemd in $fw_config"
+    grep -q '^interface = "can0"' "$fw_config" || vb_die "could not set [can] interface = can0 in $fw_config"
   fi
   cp "$fw_config" "$out/etc/gfins/vboard.toml"
   mkdir -p "$out/etc/gfins/vboard-scenarios"

@@ -24,22 +24,56 @@ service_icount=off  # systemd boot: icount's sleep=off would warp time over ever
 service_deb=""
 service_config=""
 measure=0
+known_stages=infra,backend,fw,cmd,faults,canlog,service
+# value OPTION ARGS...: the option's value, or a usage error naming the option when none follows
+# (set -u would otherwise stop at "$2: unbound variable").
+value() {
+  [ $# -ge 2 ] && [ -n "$2" ] && [ "${2#--}" = "$2" ] || vb_die "run.sh: $1 needs a value (try --help)"
+  echo "$2"
+}
 while [ $# -gt 0 ]; do
   case $1 in
-    --stages) stages=$2; shift 2 ;;
-    --rate) rate=$2; shift 2 ;;
-    --timeout) timeout_s=$2; shift 2 ;;
-    --build-dir) build_dir=$2; shift 2 ;;
-    --smp) smp=$2; shift 2 ;;
-    --icount) icount=$2; shift 2 ;;
-    --service-icount) service_icount=$2; shift 2 ;;
-    --deb) service_deb=$2; shift 2 ;;
-    --fw-config) service_config=$2; shift 2 ;;
+    --stages | --rate | --timeout | --build-dir | --smp | --icount | --service-icount | --deb | --fw-config)
+      v=$(value "$@") || exit 1
+      case $1 in
+        --stages) stages=$v ;;
+        --rate) rate=$v ;;
+        --timeout) timeout_s=$v ;;
+        --build-dir) build_dir=$v ;;
+        --smp) smp=$v ;;
+        --icount) icount=$v ;;
+        --service-icount) service_icount=$v ;;
+        --deb) service_deb=$v ;;
+        --fw-config) service_config=$v ;;
+      esac
+      shift 2 ;;
     --measure) measure=1; shift ;;
     -h | --help) sed -n '2,13p' "$0"; exit 0 ;;
     *) vb_die "run.sh: unknown argument '$1' (try --help)" ;;
   esac
 done
+# Every value checked before anything is installed or booted: a misspelt stage would otherwise
+# run nothing and pass, a rate the firmware refuses would fail late in the host reference run.
+for s in ${stages//,/ }; do
+  case ",$known_stages," in *",$s,"*) ;; *) vb_die "run.sh: --stages: unknown stage '$s' (known: $known_stages)" ;; esac
+done
+[ -n "${stages//,/}" ] || vb_die "run.sh: --stages names no stage (known: $known_stages)"
+is_uint() { [[ $1 =~ ^[0-9]+$ ]] && [ "$1" -gt 0 ]; }
+is_uint "$rate" || vb_die "run.sh: --rate '$rate' is not a positive whole number of Hz"
+case ",$stages," in
+  *,fw,* | *,cmd,* | *,faults,* | *,service,*)
+    # The firmware's data rates (ADS131M06 at 8.192 MHz: gfins::app::kSampleRatesHz).
+    case $rate in 500 | 1000 | 2000 | 4000) ;;
+      *) vb_die "run.sh: --rate $rate: the firmware stages need 500, 1000, 2000 or 4000 Hz (the ADC's data rates)" ;;
+    esac ;;
+esac
+is_uint "$timeout_s" || vb_die "run.sh: --timeout '$timeout_s' is not a positive whole number of seconds"
+is_uint "$smp" || vb_die "run.sh: --smp '$smp' is not a positive whole number of CPUs"
+for ic in "$icount" "$service_icount"; do
+  [ "$ic" = off ] || [[ $ic =~ ^[0-9]+$ ]] || vb_die "run.sh: icount shift '$ic' is neither a whole number nor 'off'"
+done
+if [ -n "$service_deb" ]; then [ -f "$service_deb" ] || vb_die "run.sh: --deb $service_deb: no such file"; fi
+if [ -n "$service_config" ]; then [ -f "$service_config" ] || vb_die "run.sh: --fw-config $service_config: no such file"; fi
 t_start=$(date +%s)
 elapsed() { echo $(($(date +%s) - t_start)); }
 

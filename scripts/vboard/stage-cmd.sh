@@ -32,8 +32,19 @@ cmd_ok compensator-exact compensator exact
 cmd_ok compensator-paper compensator paper
 cmd_ok divider divider GfinsEuler 20
 cmd_ok cal-id cal-id
-# The calibration id the board reports must be the one it publishes in its epochs.
+# The calibration id the board reports must be the one it publishes in its epochs: one second
+# of frames (50 GfinsStatus at 500 Hz, divider 10) decoded, every CalId there equal to the
+# reported id (decimal in the CSV, compared as text: busybox awk's printf %x stops at 2^31, the
+# shell's arithmetic converts the hex id in 64 bits).
 cal=$(tr 'A-F' 'a-f' </tmp/cmd-cal-id.out | sed -n 's/.*\(0x\)\{0,1\}\([0-9a-f]\{8\}\).*/\2/p' | head -n 1)
+cal_dec=$([ -n "$cal" ] && echo $((0x$cal)))
+timeout 1 candump -L vcan0 >/tmp/cmd-epochs.log 2>/dev/null
+gfins-can decode /tmp/cmd-epochs.log --view csv -o /tmp/cmd-epochs.csv --quiet 2>/dev/null
+ci=$(csv_col /tmp/cmd-epochs.csv CalId)
+published=$(awk -F, -v c="${ci:-0}" 'NR > 1 && c && $c != "" { print $c }' /tmp/cmd-epochs.csv | sort -u)
+n_pub=$(echo "$published" | grep -c .)
+check cmd-cal-id-published "reported 0x${cal:-nothing} = ${cal_dec:-?}; the epochs of 1 s carry CalId $(echo $published | tr ' ' ',') ($n_pub distinct)" \
+  [ -n "$cal" -a "$n_pub" -eq 1 -a "$published" = "$cal_dec" ]
 cmd_ok capture capture --pose 0 --samples 50
 # No calibration file is configured (the factory calibration is in use): a reload must be
 # refused with Result 7 failed, which gfins-can reports as exit 4 (the board rejected it).
@@ -71,4 +82,3 @@ kill -TERM $toggle_pid 2>/dev/null
 wait $toggle_pid 2>/dev/null
 check cmd-fw-exit "gfins-fw ended on SIGTERM with status $fw_rc after the commands" [ $fw_rc -eq 0 ]
 grep -iE 'command' /tmp/cmd-fw.log | head -n 12 | sed 's/^/VBOARD-LOG cmd: /'
-echo "VBOARD-INFO cmd cal-id reported: ${cal:-?}"

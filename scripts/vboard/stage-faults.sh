@@ -6,7 +6,9 @@
 #   vcan0 down for 1 s, then up   SocketCAN refuses sends (ENETDOWN): CanTxDropped grows, bit 11
 #   data-ready edges stopped 1 s   SIGSTOP/SIGCONT of the toggler: bit 15 "data-ready lost",
 #                                  MissedEdges grows by the edges the ADC would have given
-#   the bus flooded 2 s            cangen -g 0 on 0x7FF: the firmware keeps publishing
+#   the bus flooded 2 s            cangen -g 0 on 0x7FF: the receive queue overflows, bit 18
+#                                  "CAN frames lost on receive" and a log line with the count;
+#                                  the firmware keeps publishing
 # needs: build:firmware/app/gfins-fw
 # needs: build:host_sim/can_tool/gfins-can
 # needs: repo:scripts/vboard/fw-common.sh:/vboard/fw-common.sh
@@ -31,7 +33,9 @@ window() {
   w_missed=$(health_last $w.csv MissedEdges)
   w_dropped=$(health_last $w.csv CanTxDropped)
 }
-bit() { [ $(($1 / (1 << $2) % 2)) -eq 1 ]; }
+# bitname FLAGS N: "set" or "clear". Each check tests it inside its one `check` command (a
+# `check ... && bit ...` would decide outside check and throw the result away).
+bitname() { [ $(($1 / (1 << $2) % 2)) -eq 1 ] && echo set || echo clear; }
 
 drdy-toggle "$pull" "$rate" >/tmp/faults-toggle.log &
 toggle_pid=$!
@@ -46,8 +50,8 @@ ip link set down vcan0
 sleep 1
 ip link set up vcan0
 window vcan 2
-check faults-vcan-reported "after vcan0 down 1 s and up: CanTxDropped $w_dropped, status bit 11 (CAN frames dropped) $(bit $w_flags 11 && echo set || echo clear)" \
-  [ "$w_dropped" -gt 0 ] && bit $w_flags 11
+check faults-vcan-reported "after vcan0 down 1 s and up: CanTxDropped $w_dropped, status bit 11 (CAN frames dropped) $(bitname $w_flags 11)" \
+  [ "$w_dropped" -gt 0 -a "$(bitname $w_flags 11)" = set ]
 check faults-vcan-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $w_jumps counter jumps" \
   [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
 
@@ -57,11 +61,14 @@ sleep 1
 kill -CONT $toggle_pid
 window drdy 2
 # About rate x 1 s of edges lost; at least half of them (the stop lasts "sleep 1" of guest time).
-check faults-drdy-reported "after 1 s without edges: MissedEdges $missed_before -> $w_missed (>= $((rate / 2)) more), status bit 15 (data-ready lost) $(bit $w_flags 15 && echo set || echo clear)" \
-  [ "$w_missed" -ge $((missed_before + rate / 2)) ] && bit $w_flags 15
+check faults-drdy-reported "after 1 s without edges: MissedEdges $missed_before -> $w_missed (>= $((rate / 2)) more), status bit 15 (data-ready lost) $(bitname $w_flags 15)" \
+  [ "$w_missed" -ge $((missed_before + rate / 2)) -a "$(bitname $w_flags 15)" = set ]
 window drdy-after 2
 check faults-drdy-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $w_jumps counter jumps" \
   [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]
+# Before the flood nothing has been lost on receive: bit 18 clear, no such line in the log.
+rx_bit_before=$(bitname $w_flags 18)
+rx_lines_before=$(grep -c 'received CAN frame(s) lost' /tmp/faults-fw.log)
 
 # 0x7FF: the lowest priority identifier, so the firmware's frames still win arbitration on a
 # real bus; on vcan it is the socket queues that fill.
@@ -70,7 +77,15 @@ timeout 2 cangen vcan0 -g 0 -I 7FF -L 8 -i >/dev/null 2>&1 &
 flood_pid=$!
 window flood 2
 wait $flood_pid 2>/dev/null
-echo "VBOARD-INFO faults flood: $w_epochs epochs during the flood, CanTxDropped $dropped_before -> $w_dropped, flags $w_flags"
+# The loop reads at most kMaxCommandsPerCycle (2) frames per sample, 1000 frames/s at 500 Hz,
+# far fewer than cangen -g 0 sends: the socket's receive queue overflows, the kernel counts the
+# drops (SO_RXQ_OVFL) and the firmware reports them as status bit 18 "CAN frames lost on
+# receive" (docs/can-interface.md) and a log line with the running total (the CAN health frame
+# carries no receive counter). CanRxDropped below is that total from the log's last such line.
+sleep 0.2  # the logger thread writes every 10 ms: the last line reaches the file meanwhile
+rx_lost=$(sed -n 's/.*received CAN frame(s) lost before the loop read them (lost: \([0-9]*\)).*/\1/p' /tmp/faults-fw.log | tail -n 1)
+check faults-flood-reported "during a 2 s cangen flood: $w_epochs epochs, status bit 18 (CAN frames lost on receive) $rx_bit_before -> $(bitname $w_flags 18), log reports ${rx_lost:-no} lost frame(s) (lines before the flood: $rx_lines_before)" \
+  [ "$rx_bit_before" = clear -a "$rx_lines_before" -eq 0 -a "$(bitname $w_flags 18)" = set -a "${rx_lost:-0}" -gt 0 ]
 window flood-after 2
 check faults-flood-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after a 2 s cangen flood, $w_jumps counter jumps" \
   [ "$(fw_alive)" = yes -a "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 ]

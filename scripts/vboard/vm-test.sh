@@ -20,6 +20,14 @@ param() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" /proc/cmdline; }
 
 stages=$(param vboard.stages)
 [ -n "$stages" ] || stages=infra,backend,fw,cmd,faults,canlog
+# A stage name this test does not know fails (run.sh checks the names too; this catches a
+# kernel command line written by hand).
+for s in $(echo "$stages" | tr ',' ' '); do
+  case $s in
+    infra | backend | fw | cmd | faults | canlog) ;;
+    *) fail "stage-$s: no such in-VM stage (known: infra, backend, fw, cmd, faults, canlog)" ;;
+  esac
+done
 rate=$(param vboard.rate)
 [ -n "$rate" ] || rate=500
 want() { case ",$stages," in *",$1,"*) return 0 ;; esac; return 1; }
@@ -91,6 +99,15 @@ if want infra; then
   measure gpiomon-rate-hz "$1"
   measure gpiomon-max-gap-periods "$2"
   measure gpiomon-gaps-over-1.5-periods "$3"
+  # The kernel's edge timestamps one period apart: no gap over 1.5 periods (a lost or late edge
+  # makes one of 2 periods or more) and a mean rate within kRateTol of nominal. 1 %: under icount
+  # guest time counts instructions and drdy-toggle sleeps to absolute deadlines, so the mean is
+  # exact (measured 500.0 Hz); a toggler at a wrong rate or one skipping every 100th edge is off
+  # by 1 % or more.
+  gaps=${3:-x}
+  rate_ok=$(awk -v m="${1:-0}" -v r="$rate" 'BEGIN { d = m / r - 1; print (d < 0.01 && d > -0.01) ? 1 : 0 }')
+  check gpiomon-spacing "kernel timestamps: mean $1 Hz (nominal $rate, within 1 %), largest gap $2 periods (at event ${4:-none}), $gaps gap(s) over 1.5 periods" \
+    [ "$gaps" = 0 -a "$rate_ok" = 1 ]
   skipped=$(sed -n 's/.*skipped=\([0-9]*\).*/\1/p' /tmp/infra-toggle.log)
   check gpiomon-edges "gpiomon saw $got of $n falling (data-ready) edges at $rate Hz (toggler skipped ${skipped:-?})" \
     [ "$got" -eq $n -a "${skipped:-1}" -eq 0 ]

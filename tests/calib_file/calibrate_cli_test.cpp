@@ -25,8 +25,8 @@ using testing::read_text;
 using testing::TempDir;
 using testing::write_text;
 
-// notes/paper-reproduction.md §2: agreement reachable from the 6-decimal inputs of Tables 4/5
-// with Table 6 printed truncated to 6 decimals.
+// docs/paper-errata.md and docs/calibration.md (golden Tables 4/5): agreement reachable from the
+// 6-decimal inputs of Tables 4/5 with Table 6 printed truncated to 6 decimals.
 constexpr double kScaleTolVPerG = 2e-6;
 constexpr double kBiasTolG = 2e-6;
 constexpr double kAngleTolDeg = 3e-4;

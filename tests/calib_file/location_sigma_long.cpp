@@ -200,14 +200,14 @@ TEST(LocationSigma, StatedCovarianceMatchesAMonteCarloOverBaseCalibrationsAndRun
     const calib_file::CalibrationData cal = draw_base(rng, chol);
     const std::vector<LocationRunRow> rows = draw_runs(rng, t);
     const auto rep = run_location_calibration(rows, cal, 1e-3, "mc.csv");
-    ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+    ASSERT_TRUE(rep.is_ok()) << rep.error().message;
     const auto& r = rep.value();
     ASSERT_TRUE(r.solution.fully_observable());
     calib_file::CalibrationData v2 = cal;
     v2.correlations_known = false;
     for (auto& sc : v2.sensors) sc.correlation = {};
     const auto rep_v2 = run_location_calibration(rows, v2, 1e-3, "mc.csv");
-    ASSERT_TRUE(rep_v2.is_ok()) << rep_v2.status().message();
+    ASSERT_TRUE(rep_v2.is_ok()) << rep_v2.error().message;
     for (std::size_t j = 0; j < 6; ++j) {
       const Eigen::Vector3d truth =
           1e-3 * Eigen::Vector3d(kDrhoMm[3 * j], kDrhoMm[3 * j + 1], kDrhoMm[3 * j + 2]);
@@ -255,7 +255,7 @@ TEST(LocationSigma, ABaseFileWithoutCorrelationsIsUsedWithZeroCorrelationAndTheR
   cal.correlations_known = false;  // as loaded from a format version 1 or 2 file
   for (auto& s : cal.sensors) s.correlation = {};
   const auto rep = run_location_calibration(draw_runs(rng, t), cal, 1e-3, "runs.csv");
-  ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+  ASSERT_TRUE(rep.is_ok()) << rep.error().message;
   std::string text;
   for (const auto& l : rep.value().lines) text += l + "\n";
   EXPECT_NE(text.find("predates format version 3"), std::string::npos) << text;
@@ -275,7 +275,7 @@ TEST(LocationSigma, ABaseWithoutAnyStatedSigmaIsNamedInTheReport) {
   cal.alpha.angle_sigma_deg[2] = 0.0;
   cal.alpha.angle_sigma_deg[3] = 0.0;
   const auto rep = run_location_calibration(draw_runs(rng, t), cal, 1e-3, "runs.csv");
-  ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+  ASSERT_TRUE(rep.is_ok()) << rep.error().message;
   std::string text;
   for (const auto& l : rep.value().lines) text += l + "\n";
   // Then the report names it (and only it), and its base part is zero

@@ -91,11 +91,11 @@ Eigen::Vector3d specific_force(const Eigen::Vector3d& a, const Eigen::Vector3d& 
 // residuals), as `gfins-calibrate --means paper_tables_4_5.csv` writes it.
 calib_file::CalibrationData paper_file() {
   const auto means = read_means(std::string(GFINS_TEST_DATA_DIR) + "/paper_tables_4_5.csv");
-  EXPECT_TRUE(means.is_ok()) << means.status().message();
+  EXPECT_TRUE(means.is_ok()) << means.error().message;
   CalibrationInputs in;
   in.means = means.value();
   const auto run = run_calibration(in, "paper_tables_4_5.csv");
-  EXPECT_TRUE(run.is_ok()) << run.status().message();
+  EXPECT_TRUE(run.is_ok()) << run.error().message;
   FileSettings settings;
   settings.device_id = "paper";
   settings.adc_lsb_v_per_count.fill(1e-7);
@@ -206,12 +206,12 @@ TEST(VerifySigma, PredictedResidualSigmaMatchesAMonteCarloOverTheStatedCovarianc
     const calib_file::CalibrationData file = draw_file(rng, truth, chol);
     const std::vector<MeanRow> rows = capture(rng, truth, theta_true);
     const auto rep = verify_calibration(rows, poses, file, "mc.csv");
-    ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+    ASSERT_TRUE(rep.is_ok()) << rep.error().message;
     calib_file::CalibrationData v2 = file;  // the same file as a version 2 file would read
     v2.correlations_known = false;
     for (auto& s : v2.sensors) s.correlation = {};
     const auto rep_v2 = verify_calibration(rows, poses, v2, "mc.csv");
-    ASSERT_TRUE(rep_v2.is_ok()) << rep_v2.status().message();
+    ASSERT_TRUE(rep_v2.is_ok()) << rep_v2.error().message;
     ASSERT_EQ(rep.value().rows.size(), rows.size());
     const auto theta_file = axes_of(file);
     for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -268,7 +268,7 @@ TEST(VerifySigma, TheReportSaysWhichSigmaAndAnOldFileTakesCorrelationsAsZero) {
   const std::vector<MeanRow> rows = capture(rng, truth, theta_true);
   const auto text_of = [&](const calib_file::CalibrationData& d) {
     const auto rep = verify_calibration(rows, verify_poses(), d, "v.csv");
-    EXPECT_TRUE(rep.is_ok()) << rep.status().message();
+    EXPECT_TRUE(rep.is_ok()) << rep.error().message;
     std::string t;
     for (const auto& l : rep.value().lines) t += l + "\n";
     return t;

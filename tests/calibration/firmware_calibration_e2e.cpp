@@ -967,9 +967,9 @@ TEST(FirmwareCalibration, LocationErrorsFromRateTableRunsCapturedThroughTheFirmw
   // The full 3×3 covariance per sensor: the tool's own computation on the same inputs (the file
   // keeps the diagonal, checked equal below), then χ² of the truth against it.
   const auto rows = tools::read_location_runs(dir.path / "runs.csv");
-  ASSERT_TRUE(rows.is_ok()) << rows.status().message();
+  ASSERT_TRUE(rows.is_ok()) << rows.error().message;
   const auto rep = tools::run_location_calibration(rows.value(), base.value(), 1e-3, "runs.csv");
-  ASSERT_TRUE(rep.is_ok()) << rep.status().message();
+  ASSERT_TRUE(rep.is_ok()) << rep.error().message;
   double chi2 = 0.0;
   double chi2_runs = 0.0;
   double max_z_runs = 0.0;

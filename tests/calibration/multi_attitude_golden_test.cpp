@@ -14,8 +14,8 @@
 namespace gfins::calib {
 namespace {
 
-// Tolerances (notes/paper-reproduction.md §2): the agreement reachable from the 6-decimal
-// inputs of Tables 4/5 with Table 6 printed truncated to 6 decimals.
+// Tolerances (docs/paper-errata.md and docs/calibration.md (golden Tables 4/5)): the agreement
+// reachable from the 6-decimal inputs of Tables 4/5 with Table 6 printed truncated to 6 decimals.
 constexpr double kScaleTolVPerG = 2e-6;
 constexpr double kBiasTolG = 2e-6;
 constexpr double kAngleTolDeg = 3e-4;
@@ -148,7 +148,7 @@ TEST(MultiAttitudeGolden, FloatInstantiationMatchesDouble) {
 
 TEST(MultiAttitudeGolden, GravityInsteadOfSpecificForceIsFlagged) {
   // Given the paper's data with the Table 2/3 vectors negated (read as gravity, the classic
-  // mistake: notes §2 says this gives errors of about 130°)
+  // mistake: docs/calibration.md: this gives errors of about 130°)
   const PaperTableOutputs<double> p = load_tables_4_5();
   auto obs = paper_observations(p);
   for (auto& o : obs) {

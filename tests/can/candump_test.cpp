@@ -122,6 +122,27 @@ TEST(Candump, MalformedLinesNameWhatIsWrong) {
   }
 }
 
+// can-utils 2020.11 (Debian 12) canplayer and log2asc read with fgets and skip every line whose
+// first character is not '(' (checked: `log2asc -I` on a log with blank, '#' and text lines
+// prints only the frames). Binary junk is not a comment: it is reported.
+TEST(Candump, CommentLinesAreWhatCanUtilsSkips) {
+  for (const char* c : {"", "\n", "\r\n", "   ", "\t", "# recorded on the bench", "a note",
+                        "  # indented comment\r\n"}) {
+    SCOPED_TRACE(c);
+    EXPECT_TRUE(is_candump_comment(c));
+  }
+  for (std::string_view c :
+       {std::string_view("(1700000000.000000) can0 100#00"), std::string_view("  (garbage"),
+        std::string_view("\x7f"
+                         "ELF"),
+        std::string_view("bin\x01"
+                         "ary"),
+        std::string_view("nul\0in", 6)}) {
+    SCOPED_TRACE(std::string(c));
+    EXPECT_FALSE(is_candump_comment(c));
+  }
+}
+
 TEST(Candump, FormatThenParseIsIdentity) {
   for (std::uint32_t id : {0x000u, 0x100u, 0x7FFu}) {
     for (std::uint8_t len = 0; len <= 8; ++len) {

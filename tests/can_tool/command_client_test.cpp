@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <deque>
+#include <vector>
 
 #include "gfins/can/signal_codec.hpp"
 
@@ -19,6 +21,8 @@ class BoardBus final : public hal::CanBus {
  public:
   bool answer = true;
   int sent = 0;
+  // Capture result parts (docs/can-interface.md, "Response parts") the bus loses.
+  std::vector<std::uint8_t> lose_parts;
 
  private:
   Status do_send(const hal::CanFrame& f) override {
@@ -54,7 +58,12 @@ class BoardBus final : public hal::CanBus {
         for (std::size_t k = 0; k < 6; ++k) {
           r.channels[k] = {100.0f * static_cast<float>(k), 2.0f, c.samples, false, k == 1};
         }
-        for (const auto& fr : can::encode_capture_result(r, c.token, kNode)) rx_.push_back(fr);
+        for (const auto& fr : can::encode_capture_result(r, c.token, kNode)) {
+          // byte 2 of a response is its Part (docs/can-interface.md, GfinsResponse)
+          if (std::find(lose_parts.begin(), lose_parts.end(), fr.data[2]) == lose_parts.end()) {
+            rx_.push_back(fr);
+          }
+        }
         break;
       }
       case can::Opcode::kReloadCalibration:
@@ -120,6 +129,27 @@ TEST(CommandClient, CalibrationIdAndCapture) {
   EXPECT_EQ(r.capture.pose, 9);
   EXPECT_EQ(r.capture.channels[5].mean_counts, 500.0f);
   EXPECT_TRUE(r.capture.channels[1].motion);
+}
+
+TEST(CommandClient, ACaptureWithLostResultFramesIsIncompleteNamingThem) {
+  // Given a bus that loses the mean frame of channel 2 (part 0x11) and the count frame of
+  // channel 6 (part 0x35) of a capture result
+  BoardBus bus;
+  bus.lose_parts = {0x11, 0x35};
+  can::Command c;
+  c.opcode = can::Opcode::kStartCapture;
+  c.token = 7;
+  c.pose = 4;
+  c.samples = 300;
+  // When the capture is run
+  const CommandOutcome r = run_command(bus, c, kNode, short_timeouts());
+  // Then it is not an "ok" with zeros in place of the lost statistics: it is incomplete, and
+  // the message names exactly what is missing.
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kIncomplete) << r.text;
+  EXPECT_FALSE(r.capture_complete);
+  EXPECT_EQ(r.text.rfind("incomplete:", 0), 0u) << r.text;
+  EXPECT_NE(r.text.find("mean of a2, count of a6 "), std::string::npos) << r.text;
+  EXPECT_EQ(r.text.find("of a1"), std::string::npos) << r.text;
 }
 
 TEST(CommandClient, OutOfRangeCommandIsRejected) {

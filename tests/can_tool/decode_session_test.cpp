@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <deque>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "gfins/can/publisher.hpp"
@@ -118,6 +121,58 @@ TEST(DecodeSession, PrecedenceInputErrorThenProblemsThenNoFrames) {
   Summary frames;
   frames.frames = frames.frames_ok = 1;
   EXPECT_EQ(decode_end(frames, false), DecodeEnd::kOk);
+}
+
+// `decode --node 3` on a log of node 1 only: nothing to show, said as "no frames" (exit 7),
+// not "ok" with an empty output.
+TEST(DecodeSession, ANodeFilterMatchingNoNodeIsNoFrames) {
+  Summary s;
+  s.frames = s.frames_ok = 12;
+  s.nodes_seen = 1u << 1;
+  EXPECT_EQ(decode_end(s, false, 1), DecodeEnd::kOk);
+  EXPECT_EQ(decode_end(s, false, -1), DecodeEnd::kOk);
+  EXPECT_EQ(decode_end(s, false, 3), DecodeEnd::kNoFrames);
+  s.issues[static_cast<std::size_t>(IssueKind::kBadCrc)] = 1;
+  EXPECT_EQ(decode_end(s, false, 3), DecodeEnd::kProblems);  // problems still come first
+  EXPECT_EQ(node_list(0), "none");
+  EXPECT_EQ(node_list((1u << 0) | (1u << 3) | (1u << 15)), "0, 3, 15");
+}
+
+// File names in "FILE:LINE: kind: what" reports: a newline or colon in the name cannot break
+// the one-report-per-line format. Expected strings written out by hand.
+TEST(DecodeSession, FileNamesAreQuotedWhenTheyCouldBreakTheReportFormat) {
+  EXPECT_EQ(display_name("fw.log"), "fw.log");
+  EXPECT_EQ(display_name("dir/my log.log"), "dir/my log.log");
+  EXPECT_EQ(display_name("new\nline.log"), "\"new\\nline.log\"");
+  EXPECT_EQ(display_name("a:12: bad crc"), "\"a:12: bad crc\"");
+  EXPECT_EQ(display_name("q\"b\\s\t\r"), "\"q\\\"b\\\\s\\t\\r\"");
+  EXPECT_EQ(display_name(std::string("x\x01\xff", 3)), "\"x\\x01\\xff\"");
+  EXPECT_EQ(display_name(""), "\"\"");
+}
+
+// A directory given as a log is named as one (not "read error"); a missing file names errno's
+// text; a readable log is decoded and returns "".
+TEST(DecodeSession, DecodeLogNamesWhatIsWrongWithTheInput) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "gfins_decode_log_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  StreamDecoder dec(nullptr, nullptr);
+  EXPECT_EQ(decode_log(dir.string(), dec),
+            "'" + dir.string() + "' is a directory, not a candump log");
+  const std::string missing = (dir / "missing.log").string();
+  EXPECT_EQ(decode_log(missing, dec), "cannot open '" + missing + "': No such file or directory");
+  const fs::path log = dir / "one.log";
+  std::FILE* f = std::fopen(log.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  std::fputs("# comment\n(1700000000.000000) can0 100#404B4C000000020A\n", f);
+  ASSERT_EQ(std::fclose(f), 0);
+  EXPECT_EQ(decode_log(log.string(), dec), "");
+  dec.finish();
+  EXPECT_EQ(dec.summary().lines, 2u);
+  EXPECT_EQ(dec.summary().comment_lines, 1u);
+  EXPECT_EQ(dec.summary().epochs, 1u);
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -7,7 +7,11 @@
 // 1021h, seed FFFFh, over every byte before the CRC word).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cerrno>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <initializer_list>
 #include <vector>
@@ -22,6 +26,7 @@ using gfins::Result;
 using gfins::Status;
 using gfins::drivers::Ads131m06;
 using gfins::drivers::Ads131m06Config;
+using gfins::drivers::Ads131m06Counters;
 using gfins::drivers::Ads131m06State;
 using Bytes = std::vector<std::uint8_t>;
 
@@ -97,17 +102,28 @@ constexpr RegWrite kClock{0x6180, 0x4180, 0xA180, kClockValue};
 constexpr std::uint16_t kStatusRunning = 0x0100;
 constexpr std::uint16_t kStatusAfterReset = 0x0500;  // Table 8-12 reset value
 constexpr std::uint16_t kDrdyAll = 0x003F;           // DRDY5..0
+constexpr std::uint16_t kStatusCrcErr = 0x1000;      // CRC_ERR (bit 12): an input CRC error
+constexpr std::uint16_t kModeResetValue = 0x0510;    // Table 8-12
+
+// A failed transfer as the Linux spidev backend reports it: kIoError with errno (EIO).
+constexpr Status kSpiEio(ErrorCode::kIoError, "spidev: SPI_IOC_MESSAGE failed", EIO);
 
 // --- fakes -----------------------------------------------------------------------------------
 
 struct Exchange {
   Bytes tx;
   Bytes rx;
+  Status result;  // what the backend reports (ok, or the failure of a broken transfer)
 };
 
 class ScriptedSpi : public gfins::hal::SpiDevice {
  public:
-  void expect(Bytes tx, Bytes rx) { script_.push_back({std::move(tx), std::move(rx)}); }
+  void expect(Bytes tx, Bytes rx) { script_.push_back({std::move(tx), std::move(rx), {}}); }
+  /// A transfer the backend reports as failed (spidev: ioctl(SPI_IOC_MESSAGE) returned -1):
+  /// the driver must have sent `tx`; `rx` is left holding `rx_junk`, which it must not decode.
+  void fail(Bytes tx, Status error, Bytes rx_junk) {
+    script_.push_back({std::move(tx), std::move(rx_junk), error});
+  }
   bool done() const { return script_.empty(); }
   std::size_t remaining() const { return script_.size(); }
 
@@ -121,41 +137,57 @@ class ScriptedSpi : public gfins::hal::SpiDevice {
     script_.pop_front();
     EXPECT_EQ(Bytes(tx.begin(), tx.end()), e.tx);
     for (std::size_t i = 0; i < rx.size(); ++i) rx[i] = i < e.rx.size() ? e.rx[i] : 0;
-    return Status::ok();
+    return e.result;
   }
   std::deque<Exchange> script_;
 };
 
 class ScriptedLine : public gfins::hal::DataReadyLine {
  public:
-  void edge(std::int64_t t, std::uint32_t seq) { q_.push_back({t, seq}); }
+  void edge(std::int64_t t, std::uint32_t seq) { q_.push_back(Result<Edge>(Edge{t, seq})); }
+  /// A failure of the line itself (libgpiod read error), not a timeout.
+  void error(Status st) { q_.push_back(Result<Edge>(st)); }
 
  private:
-  Result<gfins::hal::DataReadyEdge> do_wait_edge(std::int64_t) override {
+  using Edge = gfins::hal::DataReadyEdge;
+  Result<Edge> do_wait_edge(std::int64_t) override {
     if (q_.empty()) return Status(ErrorCode::kTimeout, "no edge");
-    const auto e = q_.front();
+    const Result<Edge> e = q_.front();
     q_.pop_front();
     return e;
   }
-  std::deque<gfins::hal::DataReadyEdge> q_;
+  std::deque<Result<Edge>> q_;
 };
 
-// The start-up sequence of the default configuration: RESET, read ID, four write/read-back
-// pairs, a final STATUS read. Each command's answer comes in the next frame (Table 8-11).
-void script_start(ScriptedSpi& spi, std::uint16_t id = kAdsId) {
+// RESET, then read ID. Each command's answer comes in the next frame (Table 8-11).
+void script_reset_and_id(ScriptedSpi& spi, std::uint16_t id = kAdsId) {
   spi.expect(din(kReset), dout(kStatusRunning));
   spi.expect(din(kNull), dout(kResetAck));
   spi.expect(din(kRregId), dout(kStatusAfterReset));
   spi.expect(din(kNull), dout(id));
+}
+
+// One register written, acknowledged, read back and found as written.
+void script_register(ScriptedSpi& spi, const RegWrite& r) {
+  spi.expect(din(r.wreg, {r.value}), dout(kStatusAfterReset));
+  spi.expect(din(kNull), dout(r.ack));
+  spi.expect(din(r.rreg), dout(kStatusRunning));
+  spi.expect(din(kNull), dout(r.value));
+}
+
+// The final STATUS read (a NULL, answered by STATUS in the next frame).
+void script_final_status(ScriptedSpi& spi, std::uint16_t status = kStatusRunning) {
+  spi.expect(din(kNull), dout(kStatusRunning));
+  spi.expect(din(kNull), dout(status));
+}
+
+// The start-up sequence of the default configuration: RESET, read ID, four write/read-back
+// pairs, a final STATUS read.
+void script_start(ScriptedSpi& spi, std::uint16_t id = kAdsId) {
+  script_reset_and_id(spi, id);
   if ((id & 0xFF00) != 0x2600) return;  // the driver stops at a wrong ID
-  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) {
-    spi.expect(din(r.wreg, {r.value}), dout(kStatusAfterReset));
-    spi.expect(din(kNull), dout(r.ack));
-    spi.expect(din(r.rreg), dout(kStatusRunning));
-    spi.expect(din(kNull), dout(r.value));
-  }
-  spi.expect(din(kNull), dout(kStatusRunning));
-  spi.expect(din(kNull), dout(kStatusRunning));
+  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi, r);
+  script_final_status(spi);
 }
 
 constexpr std::int64_t kTimeoutNs = 2'000'000;
@@ -393,6 +425,334 @@ TEST_F(Ads131m06Scripted, ImpossibleRateIsRefused) {
   c.sample_rate_hz = 1200.0;  // 4.096 MHz / 1200 is not one of 128..16384
   Ads131m06 adc(spi_, line_, c);
   EXPECT_EQ(adc.start().code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(spi_.done());
+}
+
+// --- SPI transfer failures -------------------------------------------------------------------
+//
+// A transfer the SPI backend reports as failed is one the driver cannot trust: it must not
+// decode what the receive buffer holds and must not assume the chip saw the command. The chip,
+// for its part, answers each frame with the response to the last command it received
+// (§8.5.1.10, Table 8-11), so after a frame that never reached it the next response word is
+// still the answer to the frame before.
+
+// What the receive buffer holds after a failed transfer: a well-formed frame (valid CRC) that,
+// were it decoded, would read as a chip reset (STATUS.RESET) with every channel at positive full
+// scale, so a driver that trusted it would start a recovery the script does not allow.
+Bytes junk_frame() {
+  return dout(kStatusAfterReset | kDrdyAll,
+              {0x7FFFFF, 0x7FFFFF, 0x7FFFFF, 0x7FFFFF, 0x7FFFFF, 0x7FFFFF});
+}
+
+TEST_F(Ads131m06Scripted, SpiFailureWhileRunningIsPassedOnCountedAndTheNextFrameReadsNormally) {
+  script_start(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  line_.edge(1000, 5);
+  spi_.fail(din(kNull), kSpiEio, junk_frame());
+  const Result<RawSample> lost = adc.read_sample(kTimeoutNs);
+  ASSERT_FALSE(lost.is_ok());
+  // The backend's error reaches the caller unchanged: code, text and errno.
+  EXPECT_EQ(lost.status().code(), ErrorCode::kIoError);
+  EXPECT_STREQ(lost.status().message(), kSpiEio.message());
+  EXPECT_EQ(lost.status().os_error(), EIO);
+  EXPECT_TRUE(spi_.done());  // one frame tried: no retry inside the call, no reset
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_EQ(adc.counters().frames, 0u);  // nothing was read
+  EXPECT_EQ(adc.counters().crc_errors, 0u);
+  EXPECT_EQ(adc.counters().chip_resets, 0u);  // the junk was not decoded
+  EXPECT_EQ(adc.counters().saturated_samples, 0u);
+  EXPECT_EQ(adc.counters().recoveries, 0u);
+  EXPECT_EQ(adc.counters().missed_edges, 0u);  // the edge itself arrived
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  const Ads131m06Counters after_failure = adc.counters();
+  const Ads131m06State state_after_failure = adc.state();
+
+  // SPI works again: the next conversion is read with a plain NULL frame; its response word is
+  // STATUS (the answer to the last NULL the chip received) with DRDY5..0 set.
+  line_.edge(2000, 6);
+  spi_.expect(din(kNull), dout(kStatusRunning | kDrdyAll, {1, 2, 3, 0xFFFFFE, 0x400000, 0xC00000}));
+  const Result<RawSample> next = adc.read_sample(kTimeoutNs);
+  ASSERT_TRUE(next.is_ok());
+  EXPECT_EQ(next->seq, 6u);  // conversion 5 is a gap in the sequence, as any lost sample
+  EXPECT_EQ(next->t_ns, 2000);
+  const std::array<std::int32_t, 6> want = {1, 2, 3, -2, 0x400000, -0x400000};  // §8.5.1.9
+  EXPECT_EQ(next->counts, want);
+  EXPECT_EQ(next->flags, 0u);
+  EXPECT_EQ(adc.counters().frames, 1u);
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());
+  std::printf(
+      "SPI failure while running: read_sample -> %s (errno %d), spi_errors %u, frames %u, "
+      "state %s; SPI back: seq %u, counts %d %d %d %d %d %d, frames %u, state %s\n",
+      gfins::to_string(lost.status().code()), lost.status().os_error(),
+      static_cast<unsigned>(after_failure.spi_errors), static_cast<unsigned>(after_failure.frames),
+      to_string(state_after_failure), static_cast<unsigned>(next->seq), next->counts[0],
+      next->counts[1], next->counts[2], next->counts[3], next->counts[4], next->counts[5],
+      static_cast<unsigned>(adc.counters().frames), to_string(adc.state()));
+}
+
+TEST_F(Ads131m06Scripted, SpiFailureOnAReVerificationFrameSendsTheRregAgain) {
+  script_start(spi_);
+  Ads131m06Config c = config();
+  c.verify_every_frames = 2;
+  Ads131m06 adc(spi_, line_, c);
+  ASSERT_TRUE(adc.start().is_ok());
+  for (std::uint32_t k = 0; k < 4; ++k) line_.edge(1000 * k, k);
+  spi_.expect(din(kNull), dout(kStatusRunning | kDrdyAll));
+  spi_.fail(din(kMode.rreg), kSpiEio, junk_frame());  // the RREG MODE never reached the chip
+  // So the next frame carries it again, and its response is still STATUS (the answer to the
+  // NULL of the first frame), not MODE.
+  spi_.expect(din(kMode.rreg), dout(kStatusRunning | kDrdyAll, {7, 7, 7, 7, 7, 7}));
+  spi_.expect(din(kNull), dout(kModeValue, {8, 8, 8, 8, 8, 8}));  // MODE, as written
+  ASSERT_TRUE(adc.read_sample(kTimeoutNs).is_ok());
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kIoError);
+  const Result<RawSample> a = adc.read_sample(kTimeoutNs);
+  ASSERT_TRUE(a.is_ok());
+  EXPECT_EQ(a->counts[0], 7);
+  const Result<RawSample> b = adc.read_sample(kTimeoutNs);
+  ASSERT_TRUE(b.is_ok());
+  EXPECT_EQ(b->counts[0], 8);
+  EXPECT_TRUE(spi_.done());
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 0u);
+  EXPECT_EQ(adc.counters().recoveries, 0u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+}
+
+TEST_F(Ads131m06Scripted, SpiFailureDuringStartFailsItAndStartSucceedsOnceSpiWorks) {
+  spi_.fail(din(kReset), kSpiEio, junk_frame());
+  Ads131m06 adc(spi_, line_, config());
+  const Status st = adc.start();
+  EXPECT_EQ(st.code(), ErrorCode::kIoError);
+  EXPECT_EQ(st.os_error(), EIO);
+  EXPECT_EQ(adc.state(), Ads131m06State::kFailed);
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_TRUE(spi_.done());
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kFailedPrecondition);
+  EXPECT_TRUE(spi_.done());  // a failed driver sends nothing
+  script_start(spi_);        // start() may be called again
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, SpiFailureOnARegisterWriteIsRetried) {
+  script_reset_and_id(spi_);
+  spi_.fail(din(kMode.wreg, {kMode.value}), kSpiEio, junk_frame());
+  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi_, r);
+  script_final_status(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 0u);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, SpiFailureDuringARecoveryStaysInRecoverAndTheNextCallRecovers) {
+  script_start(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  line_.edge(1000, 1);
+  spi_.expect(din(kNull), dout(kStatusAfterReset | kDrdyAll));  // STATUS.RESET: chip reset
+  spi_.fail(din(kReset), kSpiEio, junk_frame());                // the recovery's RESET is lost
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kIoError);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRecover);
+  EXPECT_EQ(adc.counters().chip_resets, 1u);
+  EXPECT_EQ(adc.counters().recoveries, 1u);
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_TRUE(spi_.done());
+  // SPI works again: the next call finishes the recovery first, then reads the conversion.
+  script_start(spi_);
+  line_.edge(2000, 2);
+  spi_.expect(din(kNull), dout(kStatusRunning | kDrdyAll, {4, 4, 4, 4, 4, 4}));
+  const Result<RawSample> s = adc.read_sample(kTimeoutNs);
+  ASSERT_TRUE(s.is_ok());
+  EXPECT_EQ(s->seq, 2u);
+  EXPECT_EQ(s->counts[5], 4);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_EQ(adc.counters().recoveries, 2u);
+  EXPECT_TRUE(spi_.done());
+}
+
+// --- the other error paths of start() --------------------------------------------------------
+
+TEST_F(Ads131m06Scripted, OutputCrcErrorOnTheResetAcknowledgmentFailsStart) {
+  spi_.expect(din(kReset), dout(kStatusRunning));
+  spi_.expect(din(kNull), dout(kResetAck, {0, 0, 0, 0, 0, 0}, /*corrupt=*/true));
+  Ads131m06 adc(spi_, line_, config());
+  EXPECT_EQ(adc.start().code(), ErrorCode::kDataLoss);
+  EXPECT_EQ(adc.counters().crc_errors, 1u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kFailed);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, OutputCrcErrorOnARegisterReadBackIsRetried) {
+  script_reset_and_id(spi_);
+  spi_.expect(din(kMode.wreg, {kMode.value}), dout(kStatusAfterReset));
+  spi_.expect(din(kNull), dout(kMode.ack));
+  spi_.expect(din(kMode.rreg), dout(kStatusRunning));
+  spi_.expect(din(kNull), dout(kMode.value, {0, 0, 0, 0, 0, 0}, /*corrupt=*/true));
+  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi_, r);
+  script_final_status(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.counters().crc_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 0u);  // a garbled frame is not a mismatch
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, InputCrcErrorOnARegisterWriteIsCountedAndTheWriteRetried) {
+  script_reset_and_id(spi_);
+  // §8.3.12: the chip saw a bad input CRC: STATUS with CRC_ERR comes back instead of the WREG
+  // acknowledgment, and the read-back still shows MODE's reset value.
+  spi_.expect(din(kMode.wreg, {kMode.value}), dout(kStatusAfterReset));
+  spi_.expect(din(kNull), dout(kStatusAfterReset | kStatusCrcErr));
+  spi_.expect(din(kMode.rreg), dout(kStatusAfterReset));
+  spi_.expect(din(kNull), dout(kModeResetValue));
+  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi_, r);
+  script_final_status(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.counters().input_crc_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 1u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, StatusAfterConfigurationMustShowResetClearedAnd24BitWords) {
+  // STATUS (Table 8-12): RESET is bit 10, WLENGTH bits 9:8 (01b = 24 bits, 10b = 32 bits).
+  const std::uint16_t reset_still_set = 0x0500;
+  const std::uint16_t words_32_bit = 0x0200;
+  for (const std::uint16_t status : {reset_still_set, words_32_bit}) {
+    ScriptedSpi spi;
+    script_reset_and_id(spi);
+    for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi, r);
+    script_final_status(spi, status);
+    Ads131m06 adc(spi, line_, config());
+    EXPECT_EQ(adc.start().code(), ErrorCode::kDataLoss) << std::hex << status;
+    EXPECT_EQ(adc.state(), Ads131m06State::kFailed);
+    EXPECT_TRUE(spi.done());
+  }
+  // CRC_ERR in that STATUS is counted but does not fail the start.
+  script_reset_and_id(spi_);
+  for (const RegWrite& r : {kMode, kGain1, kGain2, kClock}) script_register(spi_, r);
+  script_final_status(spi_, kStatusRunning | kStatusCrcErr);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.counters().input_crc_errors, 1u);
+}
+
+TEST_F(Ads131m06Scripted, ImpossibleGainOrReferenceIsRefusedWithoutTouchingTheChip) {
+  // PGAGAIN is 3 bits: gains 1, 2, 4, ..., 128 (Table 8-12); the reference must be positive.
+  for (const std::uint8_t gain : {std::uint8_t{0}, std::uint8_t{3}, std::uint8_t{255}}) {
+    Ads131m06Config c = config();
+    c.pga_gain[2] = gain;
+    Ads131m06 adc(spi_, line_, c);
+    EXPECT_EQ(adc.start().code(), ErrorCode::kInvalidArgument) << int{gain};
+    EXPECT_EQ(adc.state(), Ads131m06State::kFailed);
+  }
+  for (const double vref : {0.0, -1.2, std::nan("")}) {
+    Ads131m06Config c = config();
+    c.vref_v = vref;
+    Ads131m06 adc(spi_, line_, c);
+    EXPECT_EQ(adc.start().code(), ErrorCode::kInvalidArgument) << vref;
+  }
+  EXPECT_TRUE(spi_.done());
+}
+
+// --- the other error paths of read_sample() --------------------------------------------------
+
+TEST_F(Ads131m06Scripted, DataReadyLineErrorIsPassedOnWithoutAFrameOrATimeoutCount) {
+  script_start(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  const Status gpio_error(ErrorCode::kIoError, "gpiod: reading the line event failed", EIO);
+  line_.error(gpio_error);
+  const Result<RawSample> r = adc.read_sample(kTimeoutNs);
+  EXPECT_EQ(r.status().code(), ErrorCode::kIoError);
+  EXPECT_STREQ(r.status().message(), gpio_error.message());
+  EXPECT_EQ(adc.counters().timeouts, 0u);
+  EXPECT_EQ(adc.counters().frames, 0u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());  // no frame without an edge
+  line_.edge(1000, 1);
+  spi_.expect(din(kNull), dout(kStatusRunning | kDrdyAll, {2, 2, 2, 2, 2, 2}));
+  ASSERT_TRUE(adc.read_sample(kTimeoutNs).is_ok());
+}
+
+TEST_F(Ads131m06Scripted, EdgesWithoutNewDataAtTheLimitEndTheRead) {
+  script_start(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  for (int k = 0; k < Ads131m06::kMaxEdgesPerRead; ++k) {
+    line_.edge(1000 + k, static_cast<std::uint32_t>(10 + k));
+    spi_.expect(din(kNull), dout(kStatusRunning));  // DRDY5..0 all 0: no conversion
+  }
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kUnavailable);
+  EXPECT_EQ(adc.counters().extra_edges, static_cast<std::uint32_t>(Ads131m06::kMaxEdgesPerRead));
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, ReVerificationAnsweredByStatusWithCrcErrIsConfirmedNotRecovered) {
+  script_start(spi_);
+  Ads131m06Config c = config();
+  c.verify_every_frames = 1;
+  Ads131m06 adc(spi_, line_, c);
+  ASSERT_TRUE(adc.start().is_ok());
+  line_.edge(0, 0);
+  line_.edge(1000, 1);
+  spi_.expect(din(kMode.rreg), dout(kStatusRunning | kDrdyAll));
+  // The chip dropped RREG MODE (input CRC error): STATUS with CRC_ERR instead of MODE.
+  spi_.expect(din(kGain1.rreg),
+              dout(kStatusRunning | kStatusCrcErr | kDrdyAll, {3, 3, 3, 3, 3, 3}));
+  spi_.expect(din(kMode.rreg), dout(kGain1.value));  // confirmation read (answers RREG GAIN1)
+  spi_.expect(din(kNull), dout(kModeValue));         // MODE is as written
+  ASSERT_TRUE(adc.read_sample(kTimeoutNs).is_ok());
+  const Result<RawSample> s = adc.read_sample(kTimeoutNs);
+  ASSERT_TRUE(s.is_ok());
+  EXPECT_EQ(s->counts[0], 3);
+  EXPECT_EQ(adc.counters().input_crc_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 0u);
+  EXPECT_EQ(adc.counters().recoveries, 0u);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, ReVerificationWhoseConfirmationFailsIsRecovered) {
+  script_start(spi_);
+  Ads131m06Config c = config();
+  c.verify_every_frames = 1;
+  Ads131m06 adc(spi_, line_, c);
+  ASSERT_TRUE(adc.start().is_ok());
+  line_.edge(0, 0);
+  line_.edge(1000, 1);
+  spi_.expect(din(kMode.rreg), dout(kStatusRunning | kDrdyAll));
+  spi_.expect(din(kGain1.rreg), dout(kStatusRunning | kStatusCrcErr | kDrdyAll));
+  spi_.fail(din(kMode.rreg), kSpiEio, junk_frame());  // the confirmation read is lost
+  script_start(spi_);  // unconfirmed: reset and write the table again
+  ASSERT_TRUE(adc.read_sample(kTimeoutNs).is_ok());
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kDataLoss);
+  EXPECT_EQ(adc.counters().spi_errors, 1u);
+  EXPECT_EQ(adc.counters().register_mismatches, 1u);
+  EXPECT_EQ(adc.counters().recoveries, 1u);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRun);
+  EXPECT_TRUE(spi_.done());
+}
+
+TEST_F(Ads131m06Scripted, ARecoveryAfterTimeoutsThatFailsReturnsItsErrorAndStaysInRecover) {
+  script_start(spi_);
+  Ads131m06 adc(spi_, line_, config());
+  ASSERT_TRUE(adc.start().is_ok());
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kTimeout);
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kTimeout);
+  script_reset_and_id(spi_, 0x0000);  // the third timeout's recovery: the chip does not identify
+  EXPECT_EQ(adc.read_sample(kTimeoutNs).status().code(), ErrorCode::kUnavailable);
+  EXPECT_EQ(adc.state(), Ads131m06State::kRecover);
+  EXPECT_EQ(adc.counters().timeouts, 3u);
+  EXPECT_EQ(adc.counters().recoveries, 1u);
   EXPECT_TRUE(spi_.done());
 }
 

@@ -179,6 +179,17 @@ class CanCommands : public ::testing::Test {
     }
     return nullptr;
   }
+  // Frames of message `m` the board sends in the next `cycles` samples (its divider at work).
+  std::size_t frames_per(can::MessageId m, std::uint32_t cycles) {
+    rig_->bus->clear_sent();
+    rig_->run_cycles(cycles);
+    std::size_t n = 0;
+    for (const hal::CanFrame& f : rig_->bus->sent()) {
+      const can::MessageDef* d = can::find_message(f.id, nullptr);
+      if (d != nullptr && d->id == m) ++n;
+    }
+    return n;
+  }
   static can::Command cmd(can::Opcode op, std::uint8_t token) {
     can::Command c;
     c.opcode = op;
@@ -231,10 +242,13 @@ TEST_F(CanCommands, SetDividerValidAndAgainstTheTableRules) {
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
   EXPECT_EQ(part(r, 0)->value, 40u);
+  EXPECT_EQ(frames_per(can::MessageId::kEuler, 400), 10u);  // every 40 samples now
   c.divider = 15;  // not a multiple of the epoch divider (10)
   r = send(c);
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOutOfRange);
+  // ... and the refused divider changed nothing: still every 40 samples, not every 15 or 20.
+  EXPECT_EQ(frames_per(can::MessageId::kEuler, 400), 10u);
 }
 
 TEST_F(CanCommands, ReportCalibrationId) {
@@ -313,6 +327,147 @@ TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {
   r = round_trip(can::encode_command(c, SimRig::kNode + 1));
   EXPECT_EQ(part(r, 0), nullptr);
   EXPECT_EQ(rig_->loop->pipeline().config().compensator, before);
+}
+
+// ---- Every opcode, malformed, as frames on the simulated board
+// -----------------------------------
+
+// What a command could change on the board, read through the loop's public state and its bus
+// output (the dividers at work).
+struct BoardState {
+  Mode mode{};
+  nav::PipelinePhase phase{};
+  float heading_rad = 0;
+  nav::CompensatorKind compensator{};
+  std::uint32_t cal_id = 0;
+  bool capture_active = false;
+  std::uint32_t commands = 0;  // commands carried out (health)
+  bool operator==(const BoardState&) const = default;
+};
+
+// A command frame, valid but for what `edit` does to its bytes; the CRC is recomputed afterwards
+// unless the edit is the CRC itself. Layout (docs/can-interface.md, GfinsCommand): byte 0
+// opcode, 1 token, arguments little-endian from byte 2, byte 7 CRC-8.
+hal::CanFrame edited(const can::Command& c, void (*edit)(hal::CanFrame&), bool reseal = true) {
+  hal::CanFrame f = can::encode_command(c, SimRig::kNode);
+  edit(f);
+  if (reseal) can::seal_frame(f);
+  return f;
+}
+
+class CanMalformedCommands : public CanCommands {
+ protected:
+  // Samples over which the Euler frames are counted: 5 at the default divider 20, 2 or 3 at 40,
+  // 6 or 7 at 15 (docs/can-interface.md, default dividers): any divider change shows.
+  static constexpr std::uint32_t kRateWindow = 100;
+  BoardState state() const {
+    const SampleLoop& l = *rig_->loop;
+    return {l.mode(),
+            l.pipeline().phase(),
+            l.pipeline().config().heading_rad,
+            l.pipeline().config().compensator,
+            l.cal_id(),
+            l.capture_active(),
+            l.health().commands};
+  }
+  // Sends `f`; expects exactly one response, status part, with `want` and the frame's token,
+  // one more command error, and no change of the board's state or its output rates.
+  void expect_refused(const hal::CanFrame& f, can::ResultCode want, const std::string& what) {
+    SCOPED_TRACE(what);
+    const BoardState before = state();
+    const std::uint32_t errors = rig_->loop->health().command_errors;
+    const std::size_t euler = frames_per(can::MessageId::kEuler, kRateWindow);
+    const auto r = round_trip(f);
+    ASSERT_EQ(r.size(), 1u);
+    EXPECT_EQ(r[0].part, can::kPartStatus);
+    EXPECT_EQ(static_cast<int>(r[0].result), static_cast<int>(want));
+    if (f.len >= 2) {
+      EXPECT_EQ(r[0].token, f.data[1]);
+    }
+    EXPECT_EQ(rig_->loop->health().command_errors, errors + 1);
+    EXPECT_EQ(state(), before);
+    EXPECT_EQ(frames_per(can::MessageId::kEuler, kRateWindow), euler);  // dividers unchanged
+  }
+};
+
+// The ResultCode values the ICD documents (docs/can-interface.md, "Commands and responses"),
+// written here rather than taken from the codec's enum.
+constexpr auto kBadLength = static_cast<can::ResultCode>(2);
+constexpr auto kBadCrc = static_cast<can::ResultCode>(3);
+constexpr auto kOutOfRange = static_cast<can::ResultCode>(4);
+constexpr auto kMalformed = static_cast<can::ResultCode>(5);
+constexpr auto kUnknownOpcode = static_cast<can::ResultCode>(1);
+constexpr auto kBusy = static_cast<can::ResultCode>(6);
+
+TEST_F(CanMalformedCommands, EveryOpcodeWithABadCrcBadLengthOrStrayBitsChangesNothing) {
+  for (int op = 1; op <= 7; ++op) {
+    can::Command c = cmd(static_cast<can::Opcode>(op), static_cast<std::uint8_t>(0x30 + op));
+    c.heading_rad = 1.0f;  // valid arguments: only the edit makes the frame wrong
+    c.compensator = nav::CompensatorKind::kPaper;
+    c.message = can::MessageId::kEuler;
+    c.divider = 40;
+    c.pose = 2;
+    c.samples = 100;
+    const std::string name = "opcode " + std::to_string(op);
+    expect_refused(edited(
+                       c, [](hal::CanFrame& f) { f.data[7] ^= 0x5A; }, false),
+                   kBadCrc, name + ", CRC");
+    expect_refused(edited(c, [](hal::CanFrame& f) { f.len = 7; }), kBadLength, name + ", 7 bytes");
+    // Byte 6 is used by no opcode: a set bit there is not a command the ICD defines.
+    expect_refused(edited(c, [](hal::CanFrame& f) { f.data[6] = 0x01; }), kMalformed,
+                   name + ", stray bit");
+  }
+}
+
+TEST_F(CanMalformedCommands, UnknownOpcodesChangeNothing) {
+  for (const int op : {0, 8, 0x7F, 0xFF}) {
+    hal::CanFrame f{};
+    f.id = 0x600 + SimRig::kNode;  // GfinsCommand, 0x600 + node
+    f.len = 8;
+    f.data[0] = static_cast<std::uint8_t>(op);
+    f.data[1] = 0x44;
+    can::seal_frame(f);
+    expect_refused(f, kUnknownOpcode, "opcode " + std::to_string(op));
+  }
+}
+
+TEST_F(CanMalformedCommands, ArgumentsOutOfTheirRangeChangeNothing) {
+  can::Command c = cmd(can::Opcode::kRealign, 0x51);
+  // Heading int16 × 1e-4 rad in [-π, π] at bytes 2-3: -32768 is the not-available code, 32767
+  // is 3.2767 rad > π.
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 0x00, f.data[3] = 0x80; }),
+                 kOutOfRange, "realign, heading N/A");
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 0xFF, f.data[3] = 0x7F; }),
+                 kOutOfRange, "realign, heading 3.2767 rad");
+  c = cmd(can::Opcode::kSetCompensator, 0x52);  // byte 2: 0 none, 1 paper, 2 exact
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 3; }), kOutOfRange, "compensator 3");
+  c = cmd(can::Opcode::kSetDivider, 0x53);  // byte 2 message 0..13, bytes 3-4 divider
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 14, f.data[3] = 10; }), kOutOfRange,
+                 "divider of message 14");
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 1, f.data[3] = 10; }), kOutOfRange,
+                 "divider of GfinsStatus (follows GfinsEpoch)");
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 3, f.data[3] = 15; }), kOutOfRange,
+                 "Euler divider 15, not a multiple of the epoch's 10");
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 0, f.data[3] = 7; }), kOutOfRange,
+                 "epoch divider 7: the others are no longer multiples of it");
+  c = cmd(can::Opcode::kStartCapture, 0x54);  // byte 2 pose 0..63, bytes 3-4 N 1..65535
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 64, f.data[3] = 100; }), kOutOfRange,
+                 "capture pose 64");
+  expect_refused(edited(c, [](hal::CanFrame& f) { f.data[2] = 3; }), kOutOfRange,
+                 "capture of 0 samples");
+}
+
+TEST_F(CanMalformedCommands, ASecondCaptureWhileOneRunsIsBusy) {
+  can::Command c = cmd(can::Opcode::kStartCapture, 0x61);
+  c.pose = 1;
+  c.samples = 5000;  // 5 s at 1 kHz: still running during the checks below
+  auto r = send(c);
+  ASSERT_NE(part(r, 0), nullptr);
+  ASSERT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  ASSERT_TRUE(rig_->loop->capture_active());
+  c.token = 0x62;
+  c.pose = 2;
+  expect_refused(can::encode_command(c, SimRig::kNode), kBusy, "second capture");
 }
 
 }  // namespace

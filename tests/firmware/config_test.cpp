@@ -101,7 +101,8 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
   const std::vector<BadCase> cases = {
       {"[can]\nnode_id = 40\n", {"bad.toml:2", "can.node_id = 40", "0..15"}},
       {"[can]\nnode_id = \"1\"\n", {"can.node_id", "integer"}},
-      {"[adc]\nsample_rate_hz = 1234\n", {"adc.sample_rate_hz = 1234", "500, 1000, 2000 or 4000"}},
+      {"[adc]\nsample_rate_hz = 1234\n",
+       {"bad.toml:2: adc.sample_rate_hz = 1234", "500, 1000, 2000 or 4000"}},
       {"[board]\nkind = \"arm\"\n", {"board.kind = \"arm\"", "\"linux\", \"sim\" or \"hil\""}},
       {"[navigation]\ncompensator = \"best\"\n", {"navigation.compensator", "\"paper\""}},
       {"[navigation]\nposition_m = [1, 2]\n", {"navigation.position_m", "3 numbers"}},
@@ -109,10 +110,10 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[navigation]\nalignment_s = 0\n", {"navigation.alignment_s = 0", "0.1..600"}},
       {"[realtime]\npriority = 100\n", {"realtime.priority = 100", "0..99"}},
       {"[realtime]\nlock_memory = 1\n", {"realtime.lock_memory", "true or false"}},
-      {"[output]\nstatus = 20\n", {"output.status = 20", "equal output.epoch"}},
+      {"[output]\nstatus = 20\n", {"bad.toml:2: output.status = 20", "equal output.epoch"}},
       {"[output]\neuler = 15\n", {"output.euler = 15", "multiple of output.epoch"}},
       {"[output]\nepoch = 0\nstatus = 0\n", {"output.epoch = 0"}},
-      {"[log]\nlevel = \"loud\"\n", {"log.level = \"loud\"", "\"warn\""}},
+      {"[log]\nlevel = \"loud\"\n", {"bad.toml:2: log.level = \"loud\"", "\"warn\""}},
       {"[can]\ninterface = \"can0/../x\"\n", {"can.interface", "without '/'"}},
       {"[adc]\nspi_device = \"/dev/sda\"\n", {"adc.spi_device = \"/dev/sda\"", "/dev/spidevB.C"}},
       {"[can]\nnodeid = 3\n", {"bad.toml:2", "unknown key 'can.nodeid'"}},
@@ -186,6 +187,212 @@ TEST(Cli, PrintDefaultConfigPrintsTheShippedFile) {
   EXPECT_FALSE(r.config);
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.message, default_config_text());
+}
+
+// ---- Issue 8 review, items 1-5: the expected messages are written out in full -----------------
+
+// Item 1: a quoted key is ONE key, dots included (TOML 1.0, "Keys"): "can.node_id" = 7 is not
+// can → node_id, so it is unknown, and must not be accepted and ignored.
+TEST(Config, QuotedDottedKeyIsUnknownNotIgnored) {
+  const ConfigResult r = parse_config("\"can.node_id\" = 7\n", "q.toml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error,
+            "q.toml:1: unknown key '\"can.node_id\"' (a quoted key is one name, dots included: "
+            "write the path unquoted, e.g. can.node_id = 7 or node_id = 7 under [can])");
+  // The same inside a table.
+  const ConfigResult t = parse_config("[adc]\n\"sample_rate_hz.x\" = 2\n", "q.toml");
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error.find("q.toml:2: unknown key 'adc.\"sample_rate_hz.x\"'"), std::string::npos)
+      << t.error;
+  // A quoted key that spells a bare name is that name (TOML: "node_id" and node_id are equal),
+  // and the dotted bare path is the path.
+  const ConfigResult a = parse_config("[can]\n\"node_id\" = 7\n", "a.toml");
+  ASSERT_TRUE(a.ok()) << a.error;
+  EXPECT_EQ(a.config->node_id, 7);
+  const ConfigResult b = parse_config("can.node_id = 6\n", "b.toml");
+  ASSERT_TRUE(b.ok()) << b.error;
+  EXPECT_EQ(b.config->node_id, 6);
+}
+
+// Item 2: paths are UTF-8 text; what is refused is a control character or bytes that are not
+// UTF-8 (RFC 3629: overlong forms and surrogates are not UTF-8).
+TEST(Config, PathsAcceptUtf8AndRefuseControlsAndInvalidUtf8) {
+  EXPECT_TRUE(valid_path("/tmp/caf\xC3\xA9.toml"));                    // é, U+00E9
+  EXPECT_TRUE(valid_path("/var/lib/gfins/\xE6\xA0\xA1\xE5\x87\x86"));  // 校准, 3-byte forms
+  EXPECT_TRUE(valid_path("/tmp/\xF0\x9F\x9B\xB0.log"));                // U+1F6F0, 4 bytes
+  EXPECT_FALSE(valid_path(""));
+  EXPECT_FALSE(
+      valid_path("a\x01"
+                 "b"));               // C0 control
+  EXPECT_FALSE(valid_path("a\x7F"));  // DEL
+  EXPECT_FALSE(
+      valid_path("a\xC2\x9B"
+                 "31m"));                            // C1 CSI, U+009B
+  EXPECT_FALSE(valid_path("a\xC3("));                // truncated sequence
+  EXPECT_FALSE(valid_path("a\xC0\xAF"));             // overlong '/'
+  EXPECT_FALSE(valid_path("a\xED\xA0\x80"));         // surrogate U+D800
+  EXPECT_FALSE(valid_path("a\xF4\x90\x80\x80"));     // U+110000
+  EXPECT_FALSE(valid_path(std::string(4096, 'a')));  // PATH_MAX with NUL
+  EXPECT_FALSE(valid_path(std::string_view("a\0b", 3)));
+  // Every path key takes UTF-8, from the file and from the command line.
+  const ConfigResult r = parse_config(
+      "[can]\nlog_file = \"/tmp/caf\xC3\xA9.log\"\n[adc]\ngpio_chip = \"/dev/gpiochip\xC3\xA9\"\n"
+      "[calibration]\nfile = \"/tmp/caf\xC3\xA9.toml\"\n[watchdog]\nkind = \"device\"\n"
+      "device = \"/dev/watchdog\xC3\xA9\"\n",
+      "utf8.toml");
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.config->calibration_file, "/tmp/caf\xC3\xA9.toml");
+}
+
+// Item 3: a value is shown escaped, never raw: no NUL cuts the message, no ESC reaches the
+// terminal, invalid UTF-8 is shown byte by byte.
+TEST(Config, MessagesEscapeControlCharactersAndInvalidUtf8) {
+  const ConfigResult n = parse_config("[can]\ninterface = \"can0\\u0000x\"\n", "n.toml");
+  ASSERT_FALSE(n.ok());
+  EXPECT_EQ(n.error,
+            "n.toml:2: can.interface = \"can0\\u0000x\": must be an interface name of 1..15 "
+            "characters without '/', ':' or spaces");
+  const ConfigResult e = parse_config("[log]\nlevel = \"info\\u001b[31m\"\n", "e.toml");
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error,
+            "e.toml:2: log.level = \"info\\u001B[31m\": must be \"trace\", \"debug\", \"info\", "
+            "\"warn\", \"error\" or \"off\"");
+  const ConfigResult c = parse_config("[calibration]\nfile = \"a\\u009b1m\"\n", "c.toml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(c.error,
+            "c.toml:2: calibration.file = \"a\\u009B1m\": must be a path of valid UTF-8 without "
+            "control characters (or empty for none)");
+  // Invalid UTF-8 comes only from the command line (TOML text must be UTF-8).
+  const CliResult bad_utf8 = [] {
+    std::vector<const char*> args = {"gfins-fw", "--calibration", "/tmp/caf\xC3(.toml"};
+    return parse_command_line(static_cast<int>(args.size()), args.data());
+  }();
+  EXPECT_EQ(bad_utf8.message,
+            "gfins-fw: command line: calibration.file = \"/tmp/caf\\xC3(.toml\": must be a path of "
+            "valid UTF-8 without control characters (or empty for none)\n");
+  EXPECT_EQ(quote_text("say \"hi\"\\\t\n"), "\"say \\\"hi\\\"\\\\\\t\\n\"");
+  EXPECT_EQ(quote_text(std::string(70, 'x')), "\"" + std::string(60, 'x') + "...\"");
+  EXPECT_EQ(printable_text("line 1\nline\x1B[2J\t2\n"), "line 1\nline\\u001B[2J\t2\n");
+}
+
+// Item 5: a problem validate() finds names the line of its key, like the reader's own.
+TEST(Config, RuleProblemsCarryTheLineOfTheirKey) {
+  const ConfigResult r = parse_config("[adc]\nsample_rate_hz = nan\n", "c.toml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error,
+            "c.toml:2: adc.sample_rate_hz = nan: must be 500, 1000, 2000 or 4000 (ADS131M06 data "
+            "rates at 8.192 MHz)");
+  const ConfigResult g = parse_config(
+      "# site\n[navigation]\n\ngravity = \"constant\"\ngravity_mps2 = 98.1\n", "g.toml");
+  ASSERT_FALSE(g.ok());
+  EXPECT_EQ(g.error,
+            "g.toml:5: navigation.gravity_mps2 = 98.1: must be 9.7..9.9 m/s² (the Earth's surface "
+            "range is 9.76..9.84)");
+  // (the defaults of the other messages, 10 to 1000, are multiples of 5)
+  const ConfigResult o = parse_config("[output]\nepoch = 5\nstatus = 5\neuler = 7\n", "o.toml");
+  ASSERT_FALSE(o.ok());
+  EXPECT_EQ(o.error,
+            "o.toml:4: output.euler = 7: must be 0 (off) or a multiple of output.epoch (5)");
+  // A rule broken between a key in the file and a default not in it: the key named is the one
+  // given, so the line is still there (epoch 20 leaves status at its default 10).
+  const ConfigResult d = parse_config("[output]\n\nepoch = 20\n", "d.toml");
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.error.rfind("d.toml: output.status = 10: must equal output.epoch (20)", 0), 0u)
+      << d.error;
+}
+
+// Item 4: the rules the run applies when it opens the board are checked by validate() too.
+TEST(Cli, ValuesTheRunWouldRefuseAreRefusedUpFront) {
+  struct Case {
+    std::vector<const char*> args;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      // The candump lines carry the interface name: checked with a log file too.
+      {{"--sim", "rest", "--can", "a b", "--can-log", "x.log"},
+       "gfins-fw: command line: can.interface = \"a b\": must be an interface name of 1..15 "
+       "characters without '/', ':' or spaces\n"},
+      {{"--board", "hil", "--hil-address", "zz zz"},
+       "gfins-fw: command line: hil.address = \"zz zz\": must be an IPv4 address a.b.c.d (each "
+       "0..255), e.g. \"127.0.0.1\"\n"},
+      {{"--hil-address", "10.0.0.256"},
+       "gfins-fw: command line: hil.address = \"10.0.0.256\": must be an IPv4 address a.b.c.d "
+       "(each 0..255), e.g. \"127.0.0.1\"\n"},
+      {{"--drdy-line", "-5"},
+       "gfins-fw: command line: adc.drdy_line = \"-5\": line offset must be 0..1023\n"},
+      {{"--drdy-line", "99999"},
+       "gfins-fw: command line: adc.drdy_line = \"99999\": line offset must be 0..1023\n"},
+      {{"--drdy-line", "99999999999999999999"},  // std::stoi would throw on this one
+       "gfins-fw: command line: adc.drdy_line = \"99999999999999999999\": line offset must be "
+       "0..1023\n"},
+  };
+  for (const Case& c : cases) {
+    std::vector<const char*> args = c.args;
+    args.insert(args.begin(), "gfins-fw");
+    const CliResult r = parse_command_line(static_cast<int>(args.size()), args.data());
+    EXPECT_FALSE(r.config) << c.message;
+    EXPECT_EQ(r.exit_code, 2) << c.message;
+    EXPECT_EQ(r.message, c.message);
+  }
+  // The file's string form obeys the same rule as its integer form and the option.
+  const ConfigResult f = parse_config("[adc]\ndrdy_line = \"99999\"\n", "f.toml");
+  EXPECT_EQ(f.error, "f.toml:2: adc.drdy_line = \"99999\": line offset must be 0..1023");
+  const ConfigResult i = parse_config("[adc]\ndrdy_line = 99999\n", "f.toml");
+  EXPECT_EQ(i.error, "f.toml:2: adc.drdy_line = 99999: line offset must be 0..1023");
+  // Names and in-range offsets stay valid.
+  for (const char* ok : {"0", "1023", "DRDY_N", "GPIO25"}) {
+    std::vector<const char*> args = {"gfins-fw", "--drdy-line", ok};
+    EXPECT_TRUE(parse_command_line(3, args.data()).config) << ok;
+  }
+}
+
+TEST(Cli, PreflightFindsWhatOnlyTheRunFoundBefore) {
+  const std::string dir = GFINS_SCENARIO_DIR;
+  FwConfig c;
+  c.board = BoardKind::kSim;
+  c.sim_scenario_dir = dir;
+  c.sim_scenario = "rest";
+  EXPECT_EQ(preflight(c, "o"), "");
+  c.sim_scenario = "nosuchscenario";
+  const std::string missing = preflight(c, "o");
+  EXPECT_EQ(missing.rfind("o: sim.scenario = \"nosuchscenario\": ", 0), 0u) << missing;
+  // The scenario's rate must be the ADC's.
+  c.sim_scenario = "rest";
+  c.sample_rate_hz = 2000;
+  EXPECT_EQ(preflight(c, "o"),
+            "o: sim.scenario = \"rest\": runs at 1000 Hz: adc.sample_rate_hz must be the same");
+  c.sample_rate_hz = 1000;
+  // Output files: the folder must exist; a folder is not a file.
+  c.can_log = "/nonexistent-gfins/x.log";
+  EXPECT_EQ(preflight(c, "o"),
+            "o: can.log_file = \"/nonexistent-gfins/x.log\": its folder \"/nonexistent-gfins\" "
+            "does not exist");
+  c.can_log = "/tmp";
+  EXPECT_EQ(preflight(c, "o"), "o: can.log_file = \"/tmp\": is a folder, not a file");
+  c.can_log = "out.log";  // the working folder
+  EXPECT_EQ(preflight(c, "o"), "");
+  EXPECT_EQ(preflight(c, "o", "/nonexistent-gfins/x.csv"),
+            "o: --latency-csv = \"/nonexistent-gfins/x.csv\": its folder \"/nonexistent-gfins\" "
+            "does not exist");
+  FwConfig h;
+  h.board = BoardKind::kHil;
+  h.hil_port_file = "/nonexistent-gfins/port";
+  EXPECT_EQ(preflight(h, "o"),
+            "o: hil.port_file = \"/nonexistent-gfins/port\": its folder \"/nonexistent-gfins\" "
+            "does not exist");
+}
+
+TEST(Cli, OriginSaysWhatTheConfigurationIsMadeOf) {
+  EXPECT_EQ(cli({}).origin, "built-in defaults");
+  EXPECT_EQ(cli({"--check-config"}).origin, "built-in defaults");
+  EXPECT_EQ(cli({"--sim", "rest", "--check-config"}).origin, "built-in defaults + command line");
+  const char* path = "cli_origin_config.toml";
+  { std::ofstream(path) << "[can]\nnode_id = 3\n"; }
+  const CliResult f = cli({"--config", path, "--check-config"});
+  const CliResult fo = cli({"--config", path, "--node-id", "4"});
+  std::remove(path);
+  EXPECT_EQ(f.origin, "cli_origin_config.toml");
+  EXPECT_EQ(fo.origin, "cli_origin_config.toml + command line");
 }
 
 }  // namespace

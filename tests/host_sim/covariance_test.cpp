@@ -23,8 +23,8 @@ using nav::err_idx::kNav;
 constexpr double kRhoM = 0.1;
 
 // ---------------------------------------------------------------------------------------------
-// Growth laws of a constant bias (notes §5): δω̇ = M_w b is constant, so δω ∝ t, φ ∝ t²,
-// the tilt-induced δv ∝ g t³ and δr ∝ g t⁴.
+// Growth laws of a constant bias (docs/math.md, "Error growth without a gyroscope"): δω̇ = M_w b is
+// constant, so δω ∝ t, φ ∝ t², the tilt-induced δv ∝ g t³ and δr ∝ g t⁴.
 
 // Fit windows and slope tolerance. The bias also enters f directly (M_f b): δv gains a t term and
 // δr a t² term. For sensor 1 of Table 1 at ρ = 0.1 m, |M_f b| = 0.5 b and |M_w b| = 5 b/m, so
@@ -74,7 +74,8 @@ TEST(CovarianceGrowthTest, BiasGrowthFollowsKinematics) {
     std::printf("%-8s log-log slope %.4f (expected %.0f)\n", names[q], slope, expected[q]);
     EXPECT_NEAR(slope, expected[q], kSlopeTol) << names[q];
   }
-  // and the magnitudes agree with the closed forms of notes §5: δω = 5 b t, φ = 5 b t²/2.
+  // and the magnitudes agree with the closed forms of docs/math.md ("Error growth without a
+  // gyroscope"): δω = 5 b t, φ = 5 b t²/2.
   constexpr double kClosedFormRelTol = 1e-6;  // Φ to second order is exact for these polynomials
   const std::size_t last = r.t_s.size() - 1;
   const double t = r.t_s[last];

@@ -46,12 +46,13 @@ TEST(MonteCarlo, CalibrationResidualGrowsRateAsTAndAttitudeAsTSquared) {
   const double t_end = r.t_s.back();
   const double w_slope = loglog_slope(r.t_s, r.rms_norm[kRate], 0.1 * t_end, t_end);
   const double a_slope = loglog_slope(r.t_s, r.rms_norm[kAttitude], 0.1 * t_end, t_end);
-  // then the slopes are those of a constant ω̇ error c: δω = c t, δθ = c t²/2 (notes §5).
-  // Tolerance: the other terms change the slope by less than this. The noise random walk has
-  // σ_ω = h σ/(√2 ρ) √k = 0.0022 rad/s at t = 0.2 s (h = 0.01 s, σ = 9.8e-3 m/s², ρ = 0.1 m),
-  // against c t ≈ 0.027 rad/s there: 0.7 % of the variance, a slope change below 0.01; the
-  // attitude reaches 0.26 rad at 2 s, where the small-angle growth law is off by a few %. 0.1
-  // covers both with margin and still separates t from √t (0.5) and t² from t^1.5.
+  // then the slopes are those of a constant ω̇ error c: δω = c t, δθ = c t²/2 (docs/math.md, "Error
+  // growth without a gyroscope"). Tolerance: the other terms change the slope by less than this.
+  // The noise random walk has σ_ω = h σ/(√2 ρ) √k = 0.0022 rad/s at t = 0.2 s (h = 0.01 s, σ
+  // = 9.8e-3 m/s², ρ = 0.1 m), against c t ≈ 0.027 rad/s there: 0.7 % of the variance, a slope
+  // change below 0.01; the attitude reaches 0.26 rad at 2 s, where the small-angle growth law is
+  // off by a few %. 0.1 covers both with margin and still separates t from √t (0.5) and t² from
+  // t^1.5.
   constexpr double kSlopeTolerance = 0.1;
   EXPECT_NEAR(w_slope, 1.0, kSlopeTolerance);
   EXPECT_NEAR(a_slope, 2.0, kSlopeTolerance);
@@ -68,7 +69,8 @@ TEST(MonteCarlo, NoiseOnlyEnvelopeMatchesTheRandomWalkOfTheTrapezoidRule) {
   constexpr std::size_t kRuns = 32;
   const MonteCarloResult r = run_montecarlo(s, kRuns, 11).value();
   // the ω error is a random walk: ω_k = h [½ n_0 + n_1 + … + n_{k−1} + ½ n_k] with n the ω̇
-  // noise of σ/(√2 ρ) per axis (notes §1), so σ_ω(k) = h σ/(√2 ρ) √(k − ½).
+  // noise of σ/(√2 ρ) per axis (Chen's ω̇ = S s/(2ρ), docs/math.md), so σ_ω(k) = h σ/(√2 ρ) √(k −
+  // ½).
   const std::size_t k = r.t_s.size() - 1;
   const double h = 1.0 / s.rate_hz;
   const double predicted =

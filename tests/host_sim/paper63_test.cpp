@@ -31,7 +31,7 @@ struct Eight {
   std::array<double, 8> v{};  // before lin lo/hi, ang lo/hi, after lin lo/hi, ang lo/hi
 };
 
-// Paper §6.3, as quoted in the notes §4.
+// Paper §6.3, as quoted in docs/simulation.md ("The eight bounds").
 constexpr Eight kPaper{{-8.0, 2.0, -0.1, 0.5, -0.002, 0.003, -0.003, 0.003}};
 constexpr std::array<const char*, 8> kNames = {
     "before linear lo", "before linear hi", "before angular lo", "before angular hi",
@@ -90,8 +90,9 @@ TEST(Paper63, BeforeCompensationTheBoundsDoNotDependOnTheNoiseSeed) {
 
 TEST(Paper63, StatedOneMilliGNoiseCannotGiveThePapersBoundsAfterCompensation) {
   // Given the paper's own 1 milli-g noise, the floor after compensation is the noise itself:
-  // σ(ω̇) = σ/(√2 ρ) = 9.81e-3/(√2·0.35) = 0.020 rad/s² per axis (notes §1), whose extremes over
-  // 600 values are about ±3σ = ±0.06 rad/s², twenty times the paper's ±0.003.
+  // σ(ω̇) = σ/(√2 ρ) = 9.81e-3/(√2·0.35) = 0.020 rad/s² per axis (Chen's ω̇ = S s/(2ρ),
+  // docs/math.md), whose extremes over 600 values are about ±3σ = ±0.06 rad/s², twenty times the
+  // paper's ±0.003.
   const Scenario s = builtin("paper-6.3-1mg");
   const Eight b = bounds_of(run_scenario(s).value());
   const double sigma_wdot = s.noise_mps2 / (std::sqrt(2.0) * s.rho_m);

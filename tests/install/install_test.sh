@@ -225,9 +225,10 @@ checks() {
   # gfins-fw on the simulated board, its candump log decoded with no problem.
   expect 0 "$bin/gfins-fw" --sim rest --calibration "" --duration 2 --can-log fw.log
   expect 0 "$bin/gfins-can" decode --view none fw.log
-  # The firmware package alone carries its scenarios; without them the error says where to look.
+  # The firmware package alone carries its scenarios; without them the error says where to look
+  # (exit 2: the configuration names a scenario that cannot be loaded, found before the run).
   expect 0 "$fw_prefix/bin/gfins-fw" --sim rest --calibration "" --duration 1 --can-log fw2.log
-  GFINS_SCENARIO_DIR=$work/none expect 1 "$fw_prefix/bin/gfins-fw" --sim rest --calibration "" \
+  GFINS_SCENARIO_DIR=$work/none expect 2 "$fw_prefix/bin/gfins-fw" --sim rest --calibration "" \
     --duration 1 --can-log fw3.log && log_has "GFINS_SCENARIO_DIR" "gfins-fw without scenarios"
 
 }

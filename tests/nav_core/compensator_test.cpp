@@ -38,7 +38,7 @@ constexpr double kExactBound = 1e-5;
 // 5× that; the paper form's spin residual (≥ 1e-2) stays far above it.
 constexpr double kFloatBound = 1e-4;
 // Below this the uncompensated array would look compensated: Table 6 angles of up to 2.7° on
-// outputs of about 10 m/s² give errors of order 0.1 m/s² (paper-reproduction notes: ≈0.35 m/s²).
+// outputs of about 10 m/s² give errors of order 0.1 m/s² (docs/simulation.md §6.3: ≈0.35 m/s²).
 constexpr double kUncompensatedAtLeast = 1e-2;
 
 Misalignment<double> table6_misalignment() {

@@ -57,7 +57,16 @@ std::string open_bus(const FwConfig& c, hal::Clock& clock, Board& b) {
     bc.interface = c.can_interface;
     auto bus = lnx::CandumpFileBus::open(bc, clock);
     if (!bus.is_ok()) return lnx::describe(c.can_log, bus.status());
+    lnx::CandumpFileBus* file = bus.value().get();
     b.bus = std::move(bus).value();
+    b.finish_output = [file, path = c.can_log] {
+      (void)file->flush();  // a failure is counted in write_errors() and reported below
+      if (file->write_errors() == 0) return std::string();
+      const hal::CanCounters k = file->counters();
+      return lnx::describe("can.log_file = " + quote_text(path), file->last_error()) + "; " +
+             std::to_string(k.tx_dropped) + " of " + std::to_string(k.tx_frames + k.tx_dropped) +
+             " frames not written (" + std::to_string(file->write_errors()) + " failed writes)";
+    };
     return "";
   }
   lnx::SocketCanConfig sc;

@@ -35,6 +35,10 @@ struct Board {
     return std::string();
   };
   std::function<void()> close = [] {};
+  /// After close(): writes what the CAN output still buffers and says what was lost ("" when
+  /// every frame reached its destination). A candump log file that failed to take frames
+  /// (disk full, /dev/full, EIO) makes the run end with exit code 1 (docs/firmware.md).
+  std::function<std::string()> finish_output = [] { return std::string(); };
 };
 
 struct BoardResult {

@@ -33,8 +33,8 @@ static_assert(static_cast<int>(CommandKind::kRealign) == can::kOpRealign &&
                   static_cast<int>(CommandKind::kCaptureCalibration) == can::kOpStartCapture &&
                   static_cast<int>(CommandKind::kReloadCalibration) == can::kOpReloadCalibration,
               "command kinds are the CAN opcodes");
-static_assert(static_cast<int>(CommandResult::kNotReady) ==
-                      static_cast<int>(can::ResultCode::kNotReady) &&
+static_assert(static_cast<int>(CommandResult::kFailed) ==
+                      static_cast<int>(can::ResultCode::kFailed) &&
                   static_cast<int>(CommandResult::kBusy) ==
                       static_cast<int>(can::ResultCode::kBusy),
               "command results are the CAN result codes");

@@ -36,8 +36,9 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   int node = 0, prio = 0;
   bool no_mlock = false, print_default = false;
 
-  app.add_option("-c,--config", config_file, "configuration file (TOML); default: built-in")
-      ->check(CLI::ExistingFile);
+  auto* o_config =
+      app.add_option("-c,--config", config_file, "configuration file (TOML); default: built-in")
+          ->check(CLI::ExistingFile);
   auto* o_sim = app.add_option("--sim", scenario,
                                "run on the simulated board with this scenario (name or .toml; "
                                "sets board.kind = \"sim\" and sim.scenario)");
@@ -83,9 +84,12 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                        ->check(CLI::IsMember({"fast", "realtime", "gpio"}));
   auto* o_dur = app.add_option("--duration", duration, "sim.duration_s (0 = the scenario's)");
   auto* o_sdir = app.add_option("--scenario-dir", scenario_dir, "sim.scenario_dir");
-  app.add_flag("--check-config", out.check_only, "validate the configuration and exit");
-  app.add_option("--latency-csv", out.latency_csv,
-                 "benchmark: write the data-ready → CAN latency histogram (us,count) here");
+  auto* o_check = app.add_flag("--check-config", out.check_only,
+                               "validate the configuration (values, scenario, output folders) "
+                               "and exit");
+  auto* o_latency =
+      app.add_option("--latency-csv", out.latency_csv,
+                     "benchmark: write the data-ready → CAN latency histogram (us,count) here");
   app.add_flag("--print-default-config", print_default, "print the commented default and exit");
 
   app.footer(
@@ -197,6 +201,14 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   }
   if (o_dur->count()) c.sim_duration_s = duration;
   if (o_sdir->count()) c.sim_scenario_dir = scenario_dir;
+
+  // What the configuration is made of, for --check-config's verdict.
+  std::size_t overrides = 0;
+  for (const CLI::Option* o : app.get_options()) {
+    if (o != o_config && o != o_check && o != o_latency) overrides += o->count();
+  }
+  out.origin = (config_file.empty() ? std::string("built-in defaults") : config_file) +
+               (overrides > 0 ? " + command line" : "");
 
   // The file was valid on its own, so a problem now comes from an option.
   const std::string origin =

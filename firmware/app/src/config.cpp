@@ -13,6 +13,7 @@
 #include "gfins/app/config.hpp"
 
 namespace gfins::app {
+
 namespace {
 
 struct ConfigError {
@@ -125,10 +126,20 @@ class Reader {
   }
 
   // The first key present in the file that no reader asked for.
+  // Paths are compared key by key, never as joined text: a key that is not a TOML bare key is
+  // shown quoted, so a quoted key with a dot in it ("can.node_id" = 7 is ONE key named
+  // can.node_id, not can → node_id) never matches a known path and is reported as unknown.
   void reject_unknown(const toml::table& t, const std::string& prefix) {
     for (const auto& [k, node] : t) {
-      const std::string p =
-          prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      const std::string_view name = k.str();
+      const bool bare = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+        return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+               ch == '_' || ch == '-';
+      });
+      const std::string shown = bare ? std::string(name) : quote_text(name);
+      std::string p = prefix;
+      if (!p.empty()) p += '.';
+      p += shown;
       if (const toml::table* sub = node.as_table(); sub != nullptr && known_tables_.count(p) != 0) {
         reject_unknown(*sub, p);
       } else if (known_.count(p) == 0) {
@@ -136,6 +147,10 @@ class Reader {
         m << source_;
         if (node.source().begin.line > 0) m << ":" << node.source().begin.line;
         m << ": unknown key '" << p << "'";
+        if (!bare && name.find('.') != std::string_view::npos) {
+          m << " (a quoted key is one name, dots included: write the path unquoted, e.g. "
+               "can.node_id = 7 or node_id = 7 under [can])";
+        }
         throw ConfigError{m.str()};
       }
     }
@@ -147,13 +162,11 @@ class Reader {
     std::ostringstream o;
     if (n.is_table()) return "{...}";
     if (n.is_array()) return "[...]";
-    if (const auto* v = n.as_string()) o << '"' << v->get() << '"';
+    if (const auto* v = n.as_string()) return quote_text(v->get());
     if (const auto* v = n.as_integer()) o << v->get();
     if (const auto* v = n.as_floating_point()) o << v->get();
     if (const auto* v = n.as_boolean()) o << (v->get() ? "true" : "false");
-    std::string s = o.str();
-    if (s.size() > 60) s = s.substr(0, 57) + "...";
-    return s;
+    return o.str();
   }
 
   const toml::table& root_;
@@ -215,147 +228,23 @@ void read_all(Reader& r, FwConfig& c) {
   r.text("hil.port_file", c.hil_port_file);
 }
 
-bool printable_path(const std::string& s) {
-  return !s.empty() && s.size() < 4096 &&
-         std::all_of(s.begin(), s.end(), [](char ch) { return ch >= 0x20 && ch != 0x7F; });
-}
-
-// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the NUL), no '/', no whitespace.
-bool valid_ifname(const std::string& s) {
-  return !s.empty() && s.size() <= 15 && std::all_of(s.begin(), s.end(), [](char ch) {
-    return ch > 0x20 && ch < 0x7F && ch != '/' && ch != ':';
-  });
-}
-
 }  // namespace
-
-std::string validate(const FwConfig& c, const std::string& origin) {
-  const auto bad = [&](const char* key, const std::string& value, const std::string& allowed) {
-    return origin + ": " + key + " = " + value + ": " + allowed;
-  };
-  const auto num = [](double x) {
-    std::ostringstream o;
-    o << x;
-    return o.str();
-  };
-  if (std::find(kSampleRatesHz.begin(), kSampleRatesHz.end(), c.sample_rate_hz) ==
-      kSampleRatesHz.end()) {
-    return bad("adc.sample_rate_hz", num(c.sample_rate_hz),
-               "must be 500, 1000, 2000 or 4000 (ADS131M06 data rates at 8.192 MHz)");
-  }
-  // spidev names its nodes /dev/spidevB.C (bus B, chip select C).
-  const std::string spidev = "/dev/spidev";
-  const std::string bc =
-      c.spi_device.rfind(spidev, 0) == 0 ? c.spi_device.substr(spidev.size()) : "";
-  const auto dot = bc.find('.');
-  const auto digits = [](const std::string& t) {
-    return !t.empty() && t.size() < 4 && t.find_first_not_of("0123456789") == std::string::npos;
-  };
-  if (dot == std::string::npos || !digits(bc.substr(0, dot)) || !digits(bc.substr(dot + 1))) {
-    return bad("adc.spi_device", "\"" + c.spi_device + "\"",
-               "must be a spidev node /dev/spidevB.C (bus B, chip select C)");
-  }
-  if (!printable_path(c.gpio_chip)) {
-    return bad("adc.gpio_chip", "\"" + c.gpio_chip + "\"", "must be a chip name or path");
-  }
-  if (c.drdy_line.empty() || c.drdy_line.size() > 31 ||
-      !std::all_of(c.drdy_line.begin(), c.drdy_line.end(),
-                   [](char ch) { return ch > 0x20 && ch < 0x7F; })) {
-    return bad("adc.drdy_line", "\"" + c.drdy_line + "\"",
-               "must be a line offset or a line name of 1..31 printable characters");
-  }
-  if (c.can_log.empty() && !valid_ifname(c.can_interface)) {
-    return bad("can.interface", "\"" + c.can_interface + "\"",
-               "must be an interface name of 1..15 characters without '/', ':' or spaces");
-  }
-  if (!c.can_log.empty() && !printable_path(c.can_log)) {
-    return bad("can.log_file", "\"" + c.can_log + "\"", "must be a printable file path");
-  }
-  if (c.node_id < 0 || c.node_id > kMaxNodeId) {
-    return bad("can.node_id", std::to_string(c.node_id),
-               "must be an integer 0.." + std::to_string(kMaxNodeId));
-  }
-  for (std::size_t m = 0; m < kNumMessages; ++m) {
-    if (c.dividers[m] > kMaxDivider) {
-      return bad(("output." + std::string(kMessageNames[m])).c_str(), std::to_string(c.dividers[m]),
-                 "must be 0 (off) .. " + std::to_string(kMaxDivider));
-    }
-  }
-  // The CAN message table's rule: epoch and status open every epoch, so they share a divider
-  // (not 0), and every other enabled message is a multiple of it (its frames follow an epoch).
-  const std::uint16_t epoch_div = c.dividers[0];
-  if (epoch_div == 0) return bad("output.epoch", "0", "must be 1.." + std::to_string(kMaxDivider));
-  if (c.dividers[1] != epoch_div) {
-    return bad("output.status", std::to_string(c.dividers[1]),
-               "must equal output.epoch (" + std::to_string(epoch_div) + ")");
-  }
-  for (std::size_t m = 2; m < kNumMessages; ++m) {
-    if (c.dividers[m] % epoch_div != 0) {
-      return bad(
-          ("output." + std::string(kMessageNames[m])).c_str(), std::to_string(c.dividers[m]),
-          "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) + ")");
-    }
-  }
-  if (!(c.gravity_mps2 >= 9.7 && c.gravity_mps2 <= 9.9)) {
-    return bad("navigation.gravity_mps2", num(c.gravity_mps2),
-               "must be 9.7..9.9 m/s² (the Earth's surface range is 9.76..9.84)");
-  }
-  if (!(std::abs(c.latitude_deg) <= 90.0)) {
-    return bad("navigation.latitude_deg", num(c.latitude_deg), "must be -90..90 degrees");
-  }
-  if (!(c.height_m >= -500.0 && c.height_m <= 20000.0)) {
-    return bad("navigation.height_m", num(c.height_m),
-               "must be -500..20000 m (the normal gravity's free-air term is first order)");
-  }
-  if (!(c.heading_deg >= -360.0 && c.heading_deg <= 360.0)) {
-    return bad("navigation.heading_deg", num(c.heading_deg), "must be -360..360 degrees");
-  }
-  for (double p : c.position_m) {
-    if (!std::isfinite(p) || std::abs(p) > 1e7) {
-      return bad("navigation.position_m", num(p), "components must be finite, |x| <= 1e7 m");
-    }
-  }
-  if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
-    return bad("navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s");
-  }
-  if (!c.calibration_file.empty() && !printable_path(c.calibration_file)) {
-    return bad("calibration.file", "\"" + c.calibration_file + "\"",
-               "must be a printable file path (or empty for none)");
-  }
-  if (c.rt_priority < 0 || c.rt_priority > kMaxRtPriority) {
-    return bad("realtime.priority", std::to_string(c.rt_priority),
-               "must be 0 (no SCHED_FIFO) .. 99");
-  }
-  if (c.watchdog == WatchdogKind::kDevice && !printable_path(c.watchdog_device)) {
-    return bad("watchdog.device", "\"" + c.watchdog_device + "\"", "must be a device path");
-  }
-  static constexpr std::array<const char*, 6> kLevels = {"trace", "debug", "info",
-                                                         "warn",  "error", "off"};
-  if (std::find_if(kLevels.begin(), kLevels.end(),
-                   [&](const char* l) { return c.log_level == l; }) == kLevels.end()) {
-    return bad("log.level", "\"" + c.log_level + "\"",
-               "must be \"trace\", \"debug\", \"info\", \"warn\", \"error\" or \"off\"");
-  }
-  if (c.board == BoardKind::kSim) {
-    if (c.sim_scenario.empty() || c.sim_scenario.size() > 4096 ||
-        c.sim_scenario.find('\0') != std::string::npos) {
-      return bad("sim.scenario", "\"" + c.sim_scenario + "\"",
-                 "must be a scenario name or a .toml file");
-    }
-    if (!(c.sim_duration_s >= 0.0 && c.sim_duration_s <= 86400.0)) {
-      return bad("sim.duration_s", num(c.sim_duration_s), "must be 0 (the scenario's) .. 86400 s");
-    }
-  }
-  return "";
-}
 
 ConfigResult parse_config(std::string_view toml_text, const std::string& source, FwConfig base) {
   ConfigResult out;
+  std::optional<ConfigProblem> problem;
+  int line = 0;  // of the key the problem names, when it is in the text
   try {
     const toml::table root = toml::parse(toml_text, source);
     Reader r(root, source);
     read_all(r, base);
     r.reject_unknown(root, "");
+    problem = check(base);
+    if (problem) {
+      if (const toml::node_view<const toml::node> n = root.at_path(problem->key)) {
+        line = static_cast<int>(n.node()->source().begin.line);
+      }
+    }
   } catch (const toml::parse_error& e) {
     std::ostringstream m;
     m << source << ":" << e.source().begin.line << ": TOML syntax: " << e.description();
@@ -368,8 +257,11 @@ ConfigResult parse_config(std::string_view toml_text, const std::string& source,
     out.error = source + ": " + e.what();
     return out;
   }
-  if (std::string problem = validate(base, source); !problem.empty()) {
-    out.error = std::move(problem);
+  if (problem) {
+    // "file:line: key = value: what is allowed", as the Reader's own messages (the line is
+    // missing only when the key is not in the file: a rule between keys broken by a default).
+    out.error = source + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " +
+                problem->key + " = " + problem->value + ": " + problem->allowed;
     return out;
   }
   out.config = std::move(base);

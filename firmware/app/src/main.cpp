@@ -3,9 +3,11 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <exception>
 #include <filesystem>
@@ -15,6 +17,7 @@
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
 #include "gfins/app/sample_loop.hpp"
+#include "gfins/app/service_status.hpp"
 #include "gfins/app/startup.hpp"
 
 namespace {
@@ -22,15 +25,39 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
+// Writes text whole, NULs and all (fputs would stop at the first), with control characters
+// escaped: a message may quote user input. Nothing to do if printing fails: the exit code
+// carries the outcome.
+void print(std::FILE* to, const std::string& text) {
+  const std::string safe = gfins::app::printable_text(text);
+  (void)std::fwrite(safe.data(), 1, safe.size(), to);
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { (void)std::fclose(f); }
+};
+
 int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   using namespace gfins::app;
   gfins::app::init_spdlog(cfg.log_level);
   spdlog::info("gfins-fw: board {}, {} Hz, node {}, compensator {}", to_string(cfg.board),
                cfg.sample_rate_hz, cfg.node_id, to_string(cfg.compensator));
 
+  // Output files are opened before any work: a run never ends with "cannot write" (the CAN log
+  // is opened with the board below, also before the loop).
+  std::unique_ptr<std::FILE, FileCloser> latency_file;
+  if (!latency_csv.empty()) {
+    latency_file.reset(std::fopen(latency_csv.c_str(), "w"));
+    if (!latency_file) {
+      spdlog::critical("--latency-csv {}: cannot be created: {}", quote_text(latency_csv),
+                       std::strerror(errno));
+      return 1;
+    }
+  }
+
   BoardResult made = make_board(cfg);
   if (!made.board) {
-    spdlog::critical("board set-up failed: {}", made.error);
+    spdlog::critical("board set-up failed: {}", printable_text(made.error));
     return 1;
   }
   Board& board = *made.board;
@@ -38,10 +65,10 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   const StartupCalibration cal =
       load_calibration(cfg, board.defaults, board.factory ? &*board.factory : nullptr);
   if (cal.from_file) {
-    spdlog::info("{}", cal.message);
+    spdlog::info("{}", printable_text(cal.message));
   } else {
     spdlog::warn("**************************************************************************");
-    spdlog::warn("{}", cal.message);
+    spdlog::warn("{}", printable_text(cal.message));
     spdlog::warn("**************************************************************************");
   }
 
@@ -55,12 +82,22 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   loop->set_command_codec(board.codec.get());
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);
+  // The service status line (systemd STATUS=): the loop leaves its mode and health counters on
+  // the board each cycle; the reporter thread formats and sends them, never the loop.
+  StatusBoard status_board;
+  loop->set_status_board(&status_board);
+  std::unique_ptr<StatusReporter> status_reporter;
+  if (board.watchdog) {
+    status_reporter =
+        std::make_unique<StatusReporter>(*board.watchdog, status_board, cfg.sample_rate_hz);
+  }
   if (const gfins::Status s = loop->configure(cal.set, loop_options(cfg)); !s.is_ok()) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;
   }
   if (const std::string warn = board.enter_realtime(cfg); !warn.empty()) spdlog::warn("{}", warn);
   if (board.watchdog) (void)board.watchdog->notify_ready();
+  if (status_reporter) status_reporter->start();
   spdlog::info("sample loop running (alignment: keep the board still for {} s)", cfg.alignment_s);
 
   std::signal(SIGINT, on_signal);
@@ -72,6 +109,10 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
+  if (status_reporter) {
+    status_reporter->stop();
+    (void)board.watchdog->notify_status("stopping");
+  }
   drain.stop();
   const HealthCounters& h = loop->health();
   const auto& st = loop->pipeline().state();
@@ -100,20 +141,29 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
         "including on the simulated board its sensor and chip models)",
         100.0 * cpu_s / wall_s, wall_s, cpu_s);
   }
-  if (!latency_csv.empty()) {
-    std::FILE* f = std::fopen(latency_csv.c_str(), "w");
-    if (f == nullptr) {
-      spdlog::error("cannot write {}", latency_csv);
-      return 1;
-    }
-    std::fprintf(f, "latency_us,count\n");
+  int status = 0;
+  if (latency_file) {
+    std::FILE* f = latency_file.get();
+    bool ok = std::fprintf(f, "latency_us,count\n") > 0;
     for (std::size_t b = 0; b < LatencyHistogram::kBins; ++b) {
-      if (loop->latency().bin(b) != 0) std::fprintf(f, "%zu,%u\n", b, loop->latency().bin(b));
+      if (loop->latency().bin(b) != 0) {
+        ok = std::fprintf(f, "%zu,%u\n", b, loop->latency().bin(b)) > 0 && ok;
+      }
     }
-    if (std::fclose(f) != 0) spdlog::error("write error on {}", latency_csv);
+    if (std::fclose(latency_file.release()) != 0 || !ok) {
+      spdlog::error("--latency-csv {}: write error: {}", quote_text(latency_csv),
+                    std::strerror(errno));
+      status = 1;
+    }
   }
   board.close();
-  return 0;
+  // A CAN log that lost frames is a failed run: its file is not the run's output (15a of the
+  // issue 8 review: /dev/full used to exit 0 with every frame dropped).
+  if (const std::string lost = board.finish_output(); !lost.empty()) {
+    spdlog::error("{}", lost);
+    status = 1;
+  }
+  return status;
 }
 
 }  // namespace
@@ -122,18 +172,25 @@ int main(int argc, char** argv) {
   try {
     const gfins::app::CliResult cli = gfins::app::parse_command_line(argc, argv);
     if (!cli.config) {
-      // Nothing to do if printing the message fails: the exit code carries the outcome.
-      (void)std::fputs(cli.message.c_str(), cli.exit_code == 0 ? stdout : stderr);
+      print(cli.exit_code == 0 ? stdout : stderr, cli.message);
       return cli.exit_code;
     }
+    // The same checks before a run and for --check-config: what one accepts the other does.
+    if (std::string problem = gfins::app::preflight(*cli.config, cli.origin, cli.latency_csv);
+        !problem.empty()) {
+      print(stderr, "gfins-fw: " + problem + "\n");
+      return 2;
+    }
     if (cli.check_only) {
-      std::printf("gfins-fw: configuration %s is valid\n",
-                  cli.config_source.empty() ? "(defaults)" : cli.config_source.c_str());
+      print(stdout, "gfins-fw: configuration (" + cli.origin + ") is valid\n");
+      if (const std::string note = gfins::app::calibration_note(*cli.config); !note.empty()) {
+        print(stdout, "gfins-fw: note: " + note + "\n");
+      }
       return 0;
     }
     return run(*cli.config, cli.latency_csv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "gfins-fw: %s\n", e.what());
+    print(stderr, std::string("gfins-fw: ") + e.what() + "\n");
     return 1;
   }
 }

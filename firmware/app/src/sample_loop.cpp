@@ -101,6 +101,8 @@ SampleLoop::Cycle SampleLoop::step() {
   }
   // The loop is alive whatever the ADC does: a hung loop stops kicking, a dead ADC shows in the
   // status instead (docs/faults.md).
+  if (status_board_ != nullptr)
+    status_board_->publish(mode_, cal_.calibrated, cal_.cal_id, health_);
   if (watchdog_ != nullptr) (void)watchdog_->kick();
   return cycle;
 }

@@ -108,6 +108,18 @@ Status parse_frame(std::string_view t, CandumpRecord& r) {
 
 }  // namespace
 
+bool is_candump_comment(std::string_view line) {
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
+  while (!line.empty() && is_space(line.front())) line.remove_prefix(1);
+  if (line.empty()) return true;
+  if (line.front() == '(') return false;
+  for (char c : line) {
+    const auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\t') || u == 0x7F) return false;
+  }
+  return true;
+}
+
 Result<CandumpRecord> parse_candump_line(std::string_view line) {
   while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
   while (!line.empty() && is_space(line.front())) line.remove_prefix(1);

@@ -257,6 +257,17 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
             }
             continue;
           }
+          if (p.kind == CommandOutcome::Kind::kIncomplete) {
+            // Result frames lost on the bus: this probe says nothing; probe again.
+            last = p.text;
+            settled = 0;
+            if (++probes >= max_probes) {
+              out.error = pose_name(pose) + ": " + last;
+              out.stop = SequenceResult::Stop::kNoAnswer;
+              return out;
+            }
+            continue;
+          }
           if (p.kind != CommandOutcome::Kind::kOk) {
             out.error = pose_name(pose) + ": probe capture failed: " + p.text;
             out.stop = SequenceResult::Stop::kNoAnswer;
@@ -279,7 +290,8 @@ SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose
         return out;
       }
       const CommandOutcome r = capture_once(bus, board_pose, o.samples, o, token);
-      if (r.kind != CommandOutcome::Kind::kOk) {
+      // kIncomplete (result frames lost) is refused below and the pose repeated.
+      if (r.kind != CommandOutcome::Kind::kOk && r.kind != CommandOutcome::Kind::kIncomplete) {
         out.error = pose_name(pose) + ": capture failed: " + r.text;
         out.stop = SequenceResult::Stop::kNoAnswer;
         return out;
@@ -485,7 +497,7 @@ RateTableCapture capture_rate_table_run(hal::CanBus& bus, const RateTableRun& ru
   c.samples = whole_revolution_samples(run.rate_rad_s, o.sample_rate_hz, o.samples);
   const CommandOutcome r =
       capture_once(bus, static_cast<std::uint8_t>(run.mounting), c.samples, o, token);
-  if (r.kind != CommandOutcome::Kind::kOk) {
+  if (r.kind != CommandOutcome::Kind::kOk && r.kind != CommandOutcome::Kind::kIncomplete) {
     c.error = std::string(name) + ": capture failed: " + r.text;
     return c;
   }

@@ -1,6 +1,8 @@
 #include "command_client.hpp"
 
+#include <array>
 #include <cstdio>
+#include <string>
 
 namespace gfins::can_tool {
 namespace {
@@ -12,6 +14,27 @@ std::string describe_status(const can::Command& c, const can::ResponseFrame& r) 
   std::snprintf(buf, sizeof buf, "%s (token %u): %s, value %u", can::to_string(c.opcode), r.token,
                 can::to_string(r.result), r.value);
   return buf;
+}
+
+// The capture's per-channel result frames: mean, std, count for each of the 6 channels.
+constexpr std::size_t kChannelParts = std::size_t{3} * 6;
+
+// Capture result parts (docs/can-interface.md, "Response parts"): 0x10 + c mean, 0x20 + c
+// standard deviation, 0x30 + c count and flags of channel c + 1.
+constexpr std::uint8_t kFirstChannelPart = 0x10;
+constexpr std::uint8_t kLastChannelPart = 0x35;
+
+/// The capture frames that did not arrive, e.g. "mean of a2, count of a6"; empty when none.
+std::string missing_capture_parts(const std::array<bool, kChannelParts>& seen) {
+  static constexpr const char* kWhat[3] = {"mean", "std", "count"};
+  std::string out;
+  for (std::size_t g = 0; g < 3; ++g) {
+    for (std::size_t ch = 0; ch < 6; ++ch) {
+      if (seen[g * 6 + ch]) continue;
+      out += (out.empty() ? "" : ", ") + std::string(kWhat[g]) + " of a" + std::to_string(ch + 1);
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -29,6 +52,7 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
   auto deadline = Clock::now() + t.response;
   bool accepted = false;  // StartCapture: the status frame arrived, now waiting for the result
   can::CaptureAssembler capture;
+  std::array<bool, kChannelParts> seen_parts{};  // mean, std, count of each channel
   while (true) {
     bus.service();
     const auto left = deadline - Clock::now();
@@ -80,13 +104,24 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
       out.text = buf;
       return out;
     } else {
+      if (r->part >= kFirstChannelPart && r->part <= kLastChannelPart && (r->part & 0x0Fu) < 6) {
+        const std::size_t group = static_cast<std::size_t>((r->part >> 4) - 1);
+        seen_parts[group * 6 + (r->part & 0x0Fu)] = true;
+      }
       capture.add(*r);
       if (capture.done()) {
         out.capture = capture.result();
         out.capture_complete = capture.complete();
-        out.kind = CommandOutcome::Kind::kOk;
-        out.text = out.capture_complete ? "ok: capture complete"
-                                        : "ok: capture done, but some channel frames are missing";
+        if (out.capture_complete) {
+          out.kind = CommandOutcome::Kind::kOk;
+          out.text = "ok: capture complete";
+        } else {
+          out.kind = CommandOutcome::Kind::kIncomplete;
+          out.text =
+              "incomplete: capture of pose " + std::to_string(out.capture.pose) +
+              " done, but these result frames never arrived: " + missing_capture_parts(seen_parts) +
+              " (frames lost on the bus; repeat the capture)";
+        }
         return out;
       }
     }

@@ -10,7 +10,9 @@
 namespace gfins::can_tool {
 
 struct CommandOutcome {
-  enum class Kind { kOk, kRejected, kTimeout, kSendFailed } kind = Kind::kTimeout;
+  // kIncomplete: StartCapture's CaptureDone arrived but some channel frames did not; `text`
+  // names them and `capture` must not be used (the missing fields are not measurements).
+  enum class Kind { kOk, kRejected, kTimeout, kSendFailed, kIncomplete } kind = Kind::kTimeout;
   can::ResponseFrame status;   // the status frame (or the calibration id frame)
   can::CaptureResult capture;  // StartCapture: the collected result
   bool capture_complete = false;

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <functional>
+#include <string>
+#include <string_view>
 
 #include "decoder.hpp"
 #include "gfins/hal/can_bus.hpp"
@@ -20,8 +23,28 @@ enum class DecodeEnd : std::uint8_t {
 };
 
 /// Precedence: an unreadable input, then problems, then "no frames". A log of malformed lines
-/// only is kProblems (its lines are reported), not kNoFrames.
-DecodeEnd decode_end(const Summary& s, bool input_error);
+/// only is kProblems (its lines are reported), not kNoFrames. With a node filter (`node` >= 0),
+/// a decode in which that node sent no GfinsEpoch frame is kNoFrames too: nothing to show.
+DecodeEnd decode_end(const Summary& s, bool input_error, int node = -1);
+
+/// "0, 3" for the nodes of a Summary::nodes_seen mask ("none" when empty).
+std::string node_list(std::uint16_t nodes_seen);
+
+/// A file name as it appears in "FILE:LINE: kind: what" reports and error messages: kept as is
+/// when it is printable ASCII without ':' or '"'; otherwise in double quotes with '"', '\\' and
+/// every control or non-ASCII byte escaped (\n, \t, \r, \xHH), so one report stays one line and
+/// the line number cannot be confused with part of the name.
+std::string display_name(std::string_view name);
+
+/// Feeds the candump log `path` ("-" = stdin) line by line into `dec`. Returns "" when it was
+/// read to the end, else what went wrong, naming the file: "cannot open ...: <errno text>",
+/// "... is a directory, not a candump log", "read error on ...: <errno text>" (the lines before a
+/// read error are decoded).
+std::string decode_log(const std::string& path, StreamDecoder& dec);
+
+/// The end-of-run summary: counts of lines, frames, epochs, problems per kind, frames per
+/// message, comment lines skipped, frames of a leading partial epoch, restarts.
+void print_summary(const Summary& s, std::FILE* out);
 
 /// Feeds the frames `bus` delivers into `dec` while `keep_going()` is true; each receive waits at
 /// most `poll_ns`, so `keep_going` is asked at least that often. Frames are numbered from 1 in

@@ -11,10 +11,15 @@
 namespace gfins::can_tool {
 namespace {
 
-constexpr std::uint8_t kCounterModulo = 16;
-// A forward jump of the 4-bit epoch counter by up to half its range is read as lost epochs; a
-// larger one as the counter going back (a late or reordered Epoch frame).
-constexpr std::uint8_t kMaxForwardJump = 8;
+constexpr std::uint8_t kCounterMask = 0x0F;      // 4-bit rolling counter (message_table.hpp)
+constexpr std::int64_t kSampleModulo = 1 << 16;  // GfinsEpoch.SampleCount is 16 bits
+// An Epoch frame at most this many epochs behind the open one, with a counter that agrees, is a
+// stale (late or replayed) frame; one further back cannot be checked by the 4-bit counter and is
+// read as the board starting again.
+constexpr std::int64_t kMaxStaleEpochs = kCounterMask;
+// A bus loses frames, not one message for this many periods on end while its epochs arrive: a
+// longer silence is the message switched off and on again (SetDivider 0, then N), not drops.
+constexpr std::int64_t kMaxFramesLostInARow = 15;
 
 std::vector<Column> make_columns() {
   std::vector<Column> cols;
@@ -30,17 +35,79 @@ std::vector<Column> make_columns() {
   return cols;
 }
 
-std::size_t msg_index(const can::MessageDef& m) { return static_cast<std::size_t>(m.id); }
-
-/// A message's period in epochs at the default dividers (0 when off by default): the prior the
-/// drop check starts from, so a frame lost in the first epochs is noticed too.
-std::int64_t default_period(const can::MessageDef& m) {
-  const std::uint16_t epoch = can::message(can::MessageId::kEpoch).default_divider;
-  return m.default_divider == 0 || epoch == 0 ? 0 : m.default_divider / epoch;
+/// [first, end) column index of each message (columns are in table order).
+struct ColumnRange {
+  std::size_t first = 0;
+  std::size_t end = 0;
+};
+const std::array<ColumnRange, can::kMessageCount>& column_ranges() {
+  static const auto ranges = [] {
+    std::array<ColumnRange, can::kMessageCount> r{};
+    const auto& cols = columns();
+    for (std::size_t i = cols.size(); i-- > 0;) {
+      ColumnRange& c = r[static_cast<std::size_t>(cols[i].message->id)];
+      if (c.end == 0) c.end = i + 1;
+      c.first = i;
+    }
+    return r;
+  }();
+  return ranges;
 }
 
-/// Consecutive equal longer gaps after which a message's period is taken to have changed.
-constexpr int kGapsToAdopt = 3;
+std::size_t msg_index(const can::MessageDef& m) { return static_cast<std::size_t>(m.id); }
+
+/// A message's period in samples at the default dividers (0 when off by default). Only the prior
+/// for the first gap: a longer gap than this is judged by the message's next frame like any
+/// other, so a log at other dividers decodes without false drops.
+std::int64_t default_period(const can::MessageDef& m) { return m.default_divider; }
+
+std::uint16_t sample_count_of(const hal::CanFrame& f) {
+  static constexpr std::size_t kSig =
+      can::signal_index(can::message(can::MessageId::kEpoch), "SampleCount");
+  static_assert(kSig != can::kNoSignal);
+  return static_cast<std::uint16_t>(
+      can::extract_bits(can::payload_of(f), can::kEpochSignals[kSig]));
+}
+
+/// How a new GfinsEpoch frame (counter c, sample count s) follows the open epoch.
+enum class EpochJump : std::uint8_t { kAdvance, kDuplicate, kStale, kRestart, kUnexplained };
+struct EpochStep {
+  EpochJump kind = EpochJump::kAdvance;
+  std::int64_t epochs = 0;   // kAdvance: epochs advanced (1 = the next one)
+  std::int64_t samples = 0;  // kAdvance: samples advanced
+  std::int64_t step = 0;     // kAdvance: samples per epoch from now on (0 = unknown)
+};
+
+/// The sample count places the epoch (any gap below 2^16 samples); the rolling counter must
+/// agree modulo 16, which tells a gap from a change of the epoch divider and from a restart.
+EpochStep classify_epoch(std::uint8_t c_old, std::uint16_t s_old, std::int64_t step,
+                         std::uint8_t c_new, std::uint16_t s_new) {
+  const std::int64_t d = (c_new - c_old) & kCounterMask;
+  const std::int64_t fwd = (std::int64_t{s_new} - s_old + kSampleModulo) % kSampleModulo;
+  if (fwd == 0) return {d == 0 ? EpochJump::kDuplicate : EpochJump::kUnexplained};
+  const std::int64_t back = kSampleModulo - fwd;
+  if (step > 0 && fwd % step == 0 && ((fwd / step) & kCounterMask) == d) {
+    return {EpochJump::kAdvance, fwd / step, fwd, step};
+  }
+  // Not whole epochs forward at the known spacing. The firmware's first epoch after a start is
+  // sample 0 with counter 0 (Publisher: seq % divider == 0, counter from 0): a restart, even when
+  // it also reads as an Epoch frame a few epochs old.
+  if (c_new == 0 && s_new < std::max<std::int64_t>(step, 1)) return {EpochJump::kRestart};
+  if (step > 0 && back % step == 0 && back / step <= kMaxStaleEpochs &&
+      ((-(back / step)) & kCounterMask) == d) {
+    return {EpochJump::kStale};
+  }
+  if (d != 0) {
+    // A new epoch divider (SetDivider GfinsEpoch) or the first spacing seen: the counter counts
+    // the epochs; the spacing is learnt when it divides evenly, else at the next epoch.
+    return {EpochJump::kAdvance, d, fwd, fwd % d == 0 ? fwd / d : 0};
+  }
+  return {EpochJump::kUnexplained};
+}
+
+std::string counter_text(std::uint8_t c, std::uint16_t s) {
+  return "counter " + std::to_string(c) + ", sample count " + std::to_string(s);
+}
 
 }  // namespace
 
@@ -92,15 +159,25 @@ std::uint64_t Summary::total_issues() const {
 }
 
 StreamDecoder::StreamDecoder(EpochSink on_epoch, IssueSink on_issue)
-    : on_epoch_(std::move(on_epoch)), on_issue_(std::move(on_issue)) {}
+    : on_epoch_(std::move(on_epoch)), on_issue_(std::move(on_issue)) {
+  for (NodeState& n : nodes_) reset_tracks(n, true);
+}
 
 void StreamDecoder::issue(IssueKind k, std::uint64_t line, std::string text) {
   ++summary_.issues[static_cast<std::size_t>(k)];
   if (on_issue_) on_issue_(Issue{k, line, std::move(text)});
 }
 
+void StreamDecoder::notice(std::uint64_t line, std::string text) {
+  if (on_notice_) on_notice_(Notice{line, std::move(text)});
+}
+
 void StreamDecoder::feed_line(std::uint64_t line_no, std::string_view line) {
   ++summary_.lines;
+  if (can::is_candump_comment(line)) {
+    ++summary_.comment_lines;
+    return;
+  }
   const Result<can::CandumpRecord> r = can::parse_candump_line(line);
   if (!r.is_ok()) {
     issue(IssueKind::kMalformedLine, line_no, r.status().message());
@@ -138,81 +215,313 @@ void StreamDecoder::feed_frame(std::uint64_t line_no, std::int64_t time_us,
   }
   ++summary_.frames_ok;
   ++summary_.per_message[msg_index(*m)];
-  if (m->kind == can::MessageKind::kCommand) {
-    ++summary_.commands;
-    return;
-  }
-  if (m->kind == can::MessageKind::kResponse) {
-    ++summary_.responses;
+  if (m->kind != can::MessageKind::kData) {
+    ++(m->kind == can::MessageKind::kCommand ? summary_.commands : summary_.responses);
+    on_command(f, node, m->kind == can::MessageKind::kResponse);
     return;
   }
   NodeState& n = nodes_[node];
-  const auto counter = static_cast<std::uint8_t>(
-      can::extract_bits(can::payload_of(f), can::counter_signal()) & 0x0Fu);
-
   if (m->id == can::MessageId::kEpoch) {
-    if (n.have_counter) {
-      const auto d =
-          static_cast<std::uint8_t>((counter - n.last_counter + kCounterModulo) % kCounterModulo);
-      if (d == 0) {
-        issue(IssueKind::kDuplicate, line_no,
-              "GfinsEpoch with counter " + std::to_string(counter) + " repeated");
-        return;
-      }
-      if (d > kMaxForwardJump) {
-        issue(IssueKind::kReordered, line_no,
-              "GfinsEpoch counter went back from " + std::to_string(n.last_counter) + " to " +
-                  std::to_string(counter));
-        return;
-      }
-      close_epoch(n);
-      if (d > 1) {
-        issue(IssueKind::kEpochDrop, line_no,
-              std::to_string(d - 1) + " epoch(s) missing: counter " +
-                  std::to_string(n.last_counter) + " -> " + std::to_string(counter));
-        for (MessageTrack& t : n.tracks) t.last_epoch = -1;  // not also frame drops
-      }
-      n.epoch_index += d;
-    } else {
-      n.epoch_index = 0;
-    }
-    n.have_counter = true;
-    n.last_counter = counter;
-    open_epoch(n, node, counter, line_no, time_us);
-    store(n, *m, f);
+    on_epoch_frame(n, node, line_no, time_us, f);
     return;
   }
-
-  if (!n.open || counter != n.last_counter) {
-    const bool late = n.open && counter == (n.last_counter + kCounterModulo - 1) % kCounterModulo;
-    if (late) {
-      // It belongs to the previous epoch (already emitted): count it there, not as a drop.
-      MessageTrack& t = n.tracks[msg_index(*m)];
-      t.last_epoch = std::max(t.last_epoch, n.epoch_index - 1);
-    }
-    issue(late ? IssueKind::kReordered : IssueKind::kOrphan, line_no,
-          std::string(m->name) + " with counter " + std::to_string(counter) +
-              (late ? " arrived after the next epoch opened"
-                    : (n.open ? " matches no open epoch (counter " +
-                                    std::to_string(n.last_counter) + ")"
-                              : " before any GfinsEpoch frame")));
-    return;
-  }
-  if (n.seen[msg_index(*m)]) {
-    issue(IssueKind::kDuplicate, line_no,
-          std::string(m->name) + " twice in epoch " + std::to_string(counter));
-    return;
-  }
-  store(n, *m, f);
+  const auto counter = static_cast<std::uint8_t>(
+      can::extract_bits(can::payload_of(f), can::counter_signal()) & kCounterMask);
+  on_data_frame(n, *m, counter, line_no, f);
 }
 
-void StreamDecoder::open_epoch(NodeState& n, std::uint8_t node, std::uint8_t counter,
-                               std::uint64_t line, std::int64_t time_us) {
+void StreamDecoder::on_command(const hal::CanFrame& f, std::uint8_t node, bool response) {
+  // A SetDivider changes a message's period on purpose: the frames around it are not drops, so
+  // the message's period is learnt again (all messages after an accepted one, whose response does
+  // not name the message).
+  NodeState& n = nodes_[node];
+  const std::uint64_t p = can::payload_of(f);
+  if (static_cast<std::uint8_t>(p & 0xFFu) != can::kOpSetDivider) return;
+  if (!response) {
+    const auto target = static_cast<std::size_t>((p >> 16) & 0xFFu);  // DividerMessage
+    if (target < can::kMessageCount) {
+      n.tracks[target].period = 0;
+      n.tracks[target].pending = 0;
+    }
+    return;
+  }
+  const bool status_part = ((p >> 16) & 0xFFu) == can::kPartStatus;
+  const bool ok = ((p >> 24) & 0xFFu) == 0;  // Result Ok
+  if (status_part && ok) {
+    for (MessageTrack& t : n.tracks) {
+      t.period = 0;
+      t.pending = 0;
+    }
+  }
+}
+
+void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_t line,
+                                   std::int64_t time_us, const hal::CanFrame& f) {
+  const auto counter = static_cast<std::uint8_t>(
+      can::extract_bits(can::payload_of(f), can::counter_signal()) & kCounterMask);
+  const std::uint16_t sample = sample_count_of(f);
+  summary_.nodes_seen = static_cast<std::uint16_t>(summary_.nodes_seen | (1u << node));
+  if (!n.have_epoch) {
+    n.have_epoch = true;
+    n.counter = counter;
+    n.sample = sample;
+    n.index = 0;
+    n.step = 0;
+    n.prev_index = -1;
+    open_epoch(n, node, line, time_us);
+    store(n, can::message(can::MessageId::kEpoch), f);
+    return;
+  }
+  const EpochStep j = classify_epoch(n.counter, n.sample, n.step, counter, sample);
+  switch (j.kind) {
+    case EpochJump::kDuplicate:
+      issue(IssueKind::kDuplicate, line,
+            "GfinsEpoch (" + counter_text(counter, sample) + ") repeated");
+      return;
+    case EpochJump::kStale:
+      issue(IssueKind::kReordered, line,
+            "GfinsEpoch (" + counter_text(counter, sample) + ") arrived after the epoch with " +
+                counter_text(n.counter, n.sample) + " had opened");
+      return;
+    case EpochJump::kRestart:
+    case EpochJump::kUnexplained: {
+      close_epoch(n);
+      flush_early_as_orphans(n, static_cast<std::uint8_t>((n.counter + 1) & kCounterMask));
+      settle_pending(n);
+      ++summary_.restarts;
+      notice(line, std::string(j.kind == EpochJump::kRestart
+                                   ? "the board started again"
+                                   : "the epoch sequence started again (no whole number of "
+                                     "epochs explains the jump)") +
+                       ": " + counter_text(n.counter, n.sample) + " -> " +
+                       counter_text(counter, sample) + "; epochs lost before it are not counted");
+      reset_tracks(n, true);
+      n.counter = counter;
+      n.sample = sample;
+      n.index += kSampleModulo;  // a new run: no gap is measured across it
+      n.step = 0;
+      n.prev_index = -1;
+      open_epoch(n, node, line, time_us);
+      store(n, can::message(can::MessageId::kEpoch), f);
+      return;
+    }
+    case EpochJump::kAdvance:
+      break;
+  }
+  close_epoch(n);
+  const std::int64_t old_index = n.index;
+  const std::uint8_t next_counter = static_cast<std::uint8_t>((n.counter + 1) & kCounterMask);
+  std::int64_t missing = j.epochs - 1;
+  bool early_belongs_here = counter == next_counter;
+  if (n.early_count != 0 && !early_belongs_here) {
+    // The frames of the next epoch came without their GfinsEpoch frame: that one frame was lost,
+    // not the epoch. Their period bookkeeping stands when that epoch sat one step on.
+    const bool placed = missing == 1 && n.step > 0;
+    if (placed) {
+      const std::int64_t at = old_index + n.step;
+      sight(n.tracks[msg_index(can::message(can::MessageId::kEpoch))],
+            can::message(can::MessageId::kEpoch), at, line);
+      for (std::size_t i = 0; i < n.early.size(); ++i) {
+        if (n.early[i].used) sight(n.tracks[i], can::kMessages[i], at, n.early[i].line);
+      }
+    }
+    flush_early_as_orphans(n, next_counter);
+    if (missing > 0) --missing;
+    if (!placed) reset_tracks(n, false);
+  }
+  if (missing > 0) {
+    issue(IssueKind::kEpochDrop, line,
+          std::to_string(missing) + " epoch(s) missing: " + counter_text(n.counter, n.sample) +
+              " -> " + counter_text(counter, sample) + " (" + std::to_string(j.samples) +
+              " samples)");
+    reset_tracks(n, false);  // the messages of the lost epochs are not also frame drops
+  }
+  n.prev_index = j.epochs == 1 ? old_index : -1;
+  n.prev_line = n.epoch.line;
+  n.prev_seen = n.seen;
+  n.index = old_index + j.samples;
+  n.step = j.step;
+  n.counter = counter;
+  n.sample = sample;
+  open_epoch(n, node, line, time_us);
+  store(n, can::message(can::MessageId::kEpoch), f);
+  if (n.early_count != 0) {
+    for (std::size_t i = 0; i < n.early.size(); ++i) {
+      EarlyFrame& e = n.early[i];
+      if (!e.used) continue;
+      issue(IssueKind::kReordered, e.line,
+            std::string(can::kMessages[i].name) + " of epoch counter " + std::to_string(counter) +
+                " arrived before its GfinsEpoch frame (line " + std::to_string(line) + ")");
+      store(n, can::kMessages[i], e.frame);
+      e.used = false;
+    }
+    n.early_count = 0;
+  }
+}
+
+void StreamDecoder::on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
+                                  std::uint64_t line, const hal::CanFrame& f) {
+  const std::size_t mi = msg_index(m);
+  if (!n.have_epoch) {
+    // candump started on a running bus: the rest of an epoch whose GfinsEpoch frame came before
+    // the log did. Nothing is wrong with it; the summary counts it.
+    if (summary_.leading_frames++ == 0) {
+      notice(line,
+             "the log starts inside an epoch: its frames before the first GfinsEpoch "
+             "frame are skipped");
+    }
+    return;
+  }
+  if (counter == n.counter) {
+    if (n.seen[mi]) {
+      issue(IssueKind::kDuplicate, line,
+            std::string(m.name) + " twice in epoch counter " + std::to_string(counter));
+      return;
+    }
+    store(n, m, f);
+    return;
+  }
+  if (counter == ((n.counter + 1) & kCounterMask)) {
+    // Ahead of its GfinsEpoch frame: held until that frame shows (reordered) or is seen lost.
+    EarlyFrame& e = n.early[mi];
+    if (e.used) {
+      issue(IssueKind::kDuplicate, line,
+            std::string(m.name) + " twice in epoch counter " + std::to_string(counter));
+      return;
+    }
+    e.used = true;
+    e.line = line;
+    e.frame = f;
+    ++n.early_count;
+    return;
+  }
+  if (counter == ((n.counter + kCounterMask) & kCounterMask) && n.prev_index >= 0) {
+    // Belongs to the previous epoch (already emitted): reported, and counted there.
+    if (n.prev_seen[mi]) {
+      issue(IssueKind::kDuplicate, line,
+            std::string(m.name) + " of epoch counter " + std::to_string(counter) +
+                " again after the next epoch opened");
+      return;
+    }
+    n.prev_seen[mi] = true;
+    sight(n.tracks[mi], m, n.prev_index, n.prev_line);
+    issue(IssueKind::kReordered, line,
+          std::string(m.name) + " of epoch counter " + std::to_string(counter) +
+              " arrived after the next epoch opened");
+    return;
+  }
+  issue(IssueKind::kOrphan, line,
+        std::string(m.name) + " with counter " + std::to_string(counter) +
+            " matches no epoch near the open one (counter " + std::to_string(n.counter) + ")");
+}
+
+void StreamDecoder::flush_early_as_orphans(NodeState& n, std::uint8_t lost_counter) {
+  if (n.early_count == 0) return;
+  std::uint64_t first = 0;
+  std::string names;
+  for (std::size_t i = 0; i < n.early.size(); ++i) {
+    EarlyFrame& e = n.early[i];
+    if (!e.used) continue;
+    if (first == 0 || e.line < first) first = e.line;
+    if (!names.empty()) names += ", ";
+    names += can::kMessages[i].name;
+    e.used = false;
+  }
+  issue(IssueKind::kOrphan, first,
+        "GfinsEpoch frame of epoch counter " + std::to_string(lost_counter) +
+            " lost: " + std::to_string(n.early_count) +
+            " frame(s) of that epoch arrived without it (" + names + ")");
+  n.early_count = 0;
+}
+
+void StreamDecoder::reset_tracks(NodeState& n, bool forget_periods) {
+  for (std::size_t i = 0; i < n.tracks.size(); ++i) {
+    MessageTrack& t = n.tracks[i];
+    t.last = -1;
+    if (forget_periods) {
+      t.period = default_period(can::kMessages[i]);
+      t.pending = 0;
+    }
+  }
+}
+
+void StreamDecoder::report_pending(MessageTrack& t, const can::MessageDef& m) {
+  for (std::size_t i = 0; i < t.pending; ++i) {
+    issue(IssueKind::kFrameDrop, t.pending_line[i],
+          std::string(m.name) + ": " + std::to_string(t.pending_gap[i] / t.period - 1) +
+              " frame(s) missing before this epoch (every " + std::to_string(t.period) +
+              " samples, none for " + std::to_string(t.pending_gap[i]) + ")");
+  }
+  t.pending = 0;
+}
+
+void StreamDecoder::sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index,
+                          std::uint64_t line, bool adjacent) {
+  if (t.last >= 0 && index <= t.last) return;
+  const std::int64_t last = t.last;
+  t.last = index;
+  if (last < 0) return;
+  const std::int64_t g = index - last;
+  if (t.period == 0 || (adjacent && g != t.period)) {
+    // The first spacing seen; or the message came in two consecutive epochs, so no frame of it
+    // can be missing in between: its spacing is the epoch spacing now (a new epoch divider, or
+    // a message sped up to every epoch), and longer gaps before were that change.
+    t.period = g;
+    t.pending = 0;
+    return;
+  }
+  if (g == t.period) {
+    report_pending(t, m);  // the old spacing resumed: the longer gaps were frames lost
+    return;
+  }
+  if (t.pending == t.pending_gap.size() && g > t.period) {
+    // A fourth longer gap in a row: the earlier ones were a slower divider; g is judged
+    // against it, and so are those of the earlier gaps that are longer still.
+    t.period = *std::min_element(t.pending_gap.begin(), t.pending_gap.end());
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < t.pending; ++i) {
+      if (t.pending_gap[i] == t.period || t.pending_gap[i] % t.period != 0) continue;
+      t.pending_gap[kept] = t.pending_gap[i];
+      t.pending_line[kept] = t.pending_line[i];
+      ++kept;
+    }
+    t.pending = kept;
+    if (g == t.period) {
+      report_pending(t, m);
+      return;
+    }
+  }
+  if (g > t.period && g % t.period == 0 && g / t.period - 1 <= kMaxFramesLostInARow) {
+    t.pending_gap[t.pending] = g;  // frames lost, or a slower divider: later frames tell
+    t.pending_line[t.pending] = line;
+    ++t.pending;
+    return;
+  }
+  // A shorter gap (a faster divider), or one no loss explains: a new divider.
+  t.period = g;
+  t.pending = 0;
+}
+
+void StreamDecoder::settle_pending(NodeState& n) {
+  // Longer gaps that no later frame judged: frames lost when the log went on for less than one
+  // old period after them (nothing contradicts the old spacing), else the message slowed down or
+  // stopped.
+  for (std::size_t i = 0; i < n.tracks.size(); ++i) {
+    MessageTrack& t = n.tracks[i];
+    if (t.pending == 0) continue;
+    if (t.last >= 0 && n.index - t.last < t.period) {
+      report_pending(t, can::kMessages[i]);
+    }
+    t.pending = 0;
+  }
+}
+
+void StreamDecoder::open_epoch(NodeState& n, std::uint8_t node, std::uint64_t line,
+                               std::int64_t time_us) {
   const std::size_t nc = columns().size();
-  n.open = true;
   n.seen.fill(false);
   n.epoch.node_id = node;
-  n.epoch.counter = counter;
+  n.epoch.counter = n.counter;
   n.epoch.line = line;
   n.epoch.log_time_us = time_us;
   n.epoch.values.assign(nc, std::numeric_limits<double>::quiet_NaN());
@@ -223,33 +532,11 @@ void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::Can
   const std::size_t mi = msg_index(m);
   n.seen[mi] = true;
   MessageTrack& t = n.tracks[mi];
-  if (t.period == 0) t.period = default_period(m);
-  if (t.last_epoch >= 0) {
-    const std::int64_t gap = n.epoch_index - t.last_epoch;
-    if (t.period == 0 || gap < t.period) {
-      t.period = gap;  // first sighting of an unknown period, or a faster divider than assumed
-      t.longer_gaps = 0;
-    } else if (gap > t.period) {
-      // The same longer gap several times in a row is a slower divider (SetDivider), not drops.
-      t.longer_gaps = gap == t.last_gap ? t.longer_gaps + 1 : 1;
-      if (t.longer_gaps >= kGapsToAdopt) {
-        t.period = gap;
-      } else if (gap % t.period == 0) {
-        issue(IssueKind::kFrameDrop, n.epoch.line,
-              std::string(m.name) + ": " + std::to_string(gap / t.period - 1) +
-                  " frame(s) missing before this epoch (period " + std::to_string(t.period) +
-                  " epochs)");
-      }
-    } else {
-      t.longer_gaps = 0;
-    }
-    t.last_gap = gap;
-  }
-  t.last_epoch = n.epoch_index;
+  sight(t, m, n.index, n.epoch.line, n.prev_index >= 0 && t.last == n.prev_index);
   const std::uint64_t p = can::payload_of(f);
   const auto& cols = columns();
-  for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (cols[i].message != &m) continue;
+  const ColumnRange r = column_ranges()[mi];
+  for (std::size_t i = r.first; i < r.end; ++i) {
     const can::SignalDef& s = *cols[i].signal;
     n.epoch.values[i] = can::decode_signal(s, can::extract_bits(p, s));
     n.epoch.present[i] = true;
@@ -257,14 +544,19 @@ void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::Can
 }
 
 void StreamDecoder::close_epoch(NodeState& n) {
-  if (!n.open) return;
-  n.open = false;
+  if (!n.have_epoch || n.epoch.values.empty()) return;
   ++summary_.epochs;
   if (on_epoch_) on_epoch_(n.epoch);
+  n.epoch.values.clear();  // emitted once
 }
 
 void StreamDecoder::finish() {
-  for (auto& [node, n] : nodes_) close_epoch(n);
+  for (NodeState& n : nodes_) {
+    if (!n.have_epoch) continue;
+    close_epoch(n);
+    flush_early_as_orphans(n, static_cast<std::uint8_t>((n.counter + 1) & kCounterMask));
+    settle_pending(n);
+  }
 }
 
 }  // namespace gfins::can_tool

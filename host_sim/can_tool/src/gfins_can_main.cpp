@@ -29,8 +29,6 @@
 #include "host_io.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL
-#include <iostream>
-
 #include "hil.hpp"
 #endif
 
@@ -42,24 +40,34 @@ using namespace gfins::can_tool;
 enum Exit : int {
   kExitOk = 0,
   kExitUsage = 1,
-  kExitInput = 2,     // a file, stdin or interface could not be read / output not written
-  kExitIssues = 3,    // decoded to the end, but problems were found (see the summary)
-  kExitRejected = 4,  // cmd: the board answered with an error result
-  kExitTimeout = 5,   // cmd: no response in time, or the command could not be sent
-  kExitPlot = 6,      // plot: the plot script could not be run or failed
-  kExitNoFrames = 7,  // decode, plot: readable, no problem, but not one frame arrived
+  kExitInput = 2,      // a file, stdin or interface could not be read / output not written
+  kExitIssues = 3,     // decoded to the end, but problems were found (see the summary)
+  kExitRejected = 4,   // cmd: the board answered with an error result
+  kExitTimeout = 5,    // cmd: no response in time, or the command could not be sent
+  kExitPlot = 6,       // plot: the plot script could not be run or failed
+  kExitNoFrames = 7,   // decode, plot: readable, no problem, but not one frame arrived
+  kExitHilDiffer = 8,  // hil: frames differ from the host-only core run, or incomplete stream
 };
+
+#if GFINS_CAN_HAVE_HIL
+static_assert(kHilExitBadInput == kExitInput && kHilExitDifferent == kExitHilDiffer,
+              "gfins-can hil's exit codes are the ones --help lists");
+#endif
 
 constexpr const char* kExitCodes =
     "Exit codes:\n"
     "  0  success (decode: no problem found)\n"
     "  1  command-line error\n"
-    "  2  input not readable (file, stdin, interface) or output not writable\n"
+    "  2  input not readable (file, stdin, interface; hil: scenario, recording, connection) or\n"
+    "     output not writable\n"
     "  3  decoded to the end, but problems were found (malformed lines, bad CRCs, drops, ...)\n"
     "  4  cmd: the board rejected the command (error response)\n"
-    "  5  cmd: no response before the timeout, or the command could not be sent\n"
+    "  5  cmd: no response before the timeout, the command could not be sent, or a capture\n"
+    "     result arrived with frames missing (no statistics are printed then)\n"
     "  6  plot: the plot script could not be started or failed\n"
-    "  7  decode, plot: no CAN frame at all (idle or wrong interface, empty log), no problem\n";
+    "  7  decode, plot: no CAN frame at all (idle or wrong interface, empty log), no problem\n"
+    "  8  hil: the board's frames differ from the host-only core run, or the stream ended\n"
+    "     early (INCOMPLETE)\n";
 
 struct DecodeOptions {
   std::vector<std::string> sources;
@@ -71,29 +79,6 @@ struct DecodeOptions {
   bool quiet = false;
   double duration_s = 0.0;  // live: stop after this long (0 = until interrupted)
 };
-
-void print_summary(const Summary& s, std::FILE* out) {
-  std::fprintf(
-      out,
-      "summary: %llu lines, %llu frames (%llu ok), %llu epochs, %llu commands, "
-      "%llu responses, %llu problems\n",
-      static_cast<unsigned long long>(s.lines), static_cast<unsigned long long>(s.frames),
-      static_cast<unsigned long long>(s.frames_ok), static_cast<unsigned long long>(s.epochs),
-      static_cast<unsigned long long>(s.commands), static_cast<unsigned long long>(s.responses),
-      static_cast<unsigned long long>(s.total_issues()));
-  for (std::size_t k = 0; k < s.issues.size(); ++k) {
-    if (s.issues[k] == 0) continue;
-    std::fprintf(out, "  %-20s %llu\n", to_string(static_cast<IssueKind>(k)),
-                 static_cast<unsigned long long>(s.issues[k]));
-  }
-  std::fprintf(out, "  frames per message:");
-  for (std::size_t m = 0; m < s.per_message.size(); ++m) {
-    if (s.per_message[m] == 0) continue;
-    std::fprintf(out, " %s=%llu", std::string(can::kMessages[m].name).c_str(),
-                 static_cast<unsigned long long>(s.per_message[m]));
-  }
-  std::putc('\n', out);
-}
 
 /// Decodes every source into `view`; returns the exit code.
 int decode(const DecodeOptions& o, View& view) {
@@ -115,6 +100,12 @@ int decode(const DecodeOptions& o, View& view) {
         }
         ++n;
       });
+  dec.set_notice_sink([&](const Notice& nt) {
+    if (!o.quiet) {
+      std::fprintf(stderr, "%s:%llu: note: %s\n", current.c_str(),
+                   static_cast<unsigned long long>(nt.line), nt.text.c_str());
+    }
+  });
   bool input_error = false;
   if (!o.iface.empty()) {
     auto bus = open_live_bus(o.iface);
@@ -138,31 +129,29 @@ int decode(const DecodeOptions& o, View& view) {
     feed_live(**bus, dec, keep_going, now_us, kPollNs);
   }
   for (const std::string& src : o.sources) {
-    current = src;
-    std::FILE* f = src == "-" ? stdin : std::fopen(src.c_str(), "rb");
-    if (f == nullptr) {
-      std::fprintf(stderr, "gfins-can: cannot open '%s': %s\n", src.c_str(), std::strerror(errno));
-      input_error = true;
-      continue;
-    }
-    for_each_line(f, [&](std::uint64_t line, std::string_view text) { dec.feed_line(line, text); });
-    if (std::ferror(f) != 0) {
-      std::fprintf(stderr, "gfins-can: read error on '%s'\n", src.c_str());
+    current = src == "-" ? std::string("-") : display_name(src);
+    const std::string error = decode_log(src, dec);
+    if (!error.empty()) {
+      std::fprintf(stderr, "gfins-can: %s\n", error.c_str());
       input_error = true;
     }
-    if (f != stdin && std::fclose(f) != 0) input_error = true;
   }
   dec.finish();
   view.finish();
   print_summary(dec.summary(), stderr);
-  switch (decode_end(dec.summary(), input_error)) {
+  switch (decode_end(dec.summary(), input_error, o.node)) {
     case DecodeEnd::kInputError:
       return kExitInput;
     case DecodeEnd::kProblems:
       return kExitIssues;
     case DecodeEnd::kNoFrames:
-      std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
-                   o.iface.empty() ? "in the input" : "arrived on the interface");
+      if (dec.summary().frames != 0) {
+        std::fprintf(stderr, "gfins-can: no epoch of node %d (--node); nodes seen: %s\n", o.node,
+                     node_list(dec.summary().nodes_seen).c_str());
+      } else {
+        std::fprintf(stderr, "gfins-can: no CAN frame %s\n",
+                     o.iface.empty() ? "in the input" : "arrived on the interface");
+      }
       return kExitNoFrames;
     case DecodeEnd::kOk:
       break;
@@ -208,8 +197,29 @@ int run_decode(const DecodeOptions& o) {
   return rc;
 }
 
+/// Whether `path` can be written, checked by opening it for appending (which neither truncates
+/// an existing file nor leaves a new one behind); the reason when not.
+std::string output_unwritable(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return "is a directory";
+  const bool existed = fs::exists(path, ec);
+  std::FILE* f = std::fopen(path.c_str(), "ab");
+  if (f == nullptr) return std::strerror(errno);
+  (void)std::fclose(f);  // nothing was written: a close error says nothing about the figure
+  if (!existed) fs::remove(path, ec);
+  return {};
+}
+
 int run_plot(const std::string& log, const std::string& png, int node, const std::string& script) {
   namespace fs = std::filesystem;
+  // Checked before the decode: a figure that cannot be written is a one-line error naming it,
+  // not a traceback of the plot script after the work.
+  if (const std::string why = output_unwritable(png); !why.empty()) {
+    std::fprintf(stderr, "gfins-can plot: cannot write the figure '%s': %s\n", png.c_str(),
+                 why.c_str());
+    return kExitInput;
+  }
   std::random_device rd;
   const fs::path csv = fs::temp_directory_path() / ("gfins-can-plot-" + std::to_string(rd()) + "-" +
                                                     std::to_string(rd()) + ".csv");
@@ -252,7 +262,32 @@ struct CmdOptions {
   int node = 0;
   int timeout_ms = 1000;
   int token = -1;
+  double rate_hz = 1000.0;  // the board's sample rate: sizes a capture's wait (N / rate + 5 s)
 };
+
+// The longest response wait a command line may ask for (10 min): longer is a typo, not a board.
+constexpr int kMaxTimeoutMs = 600000;
+
+/// A heading given in degrees: finite and within one turn either way (it is then wrapped to
+/// [-180, 180]). CLI::Range alone lets NaN through (every comparison with NaN is false).
+CLI::Validator heading_deg_check() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        double v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(text, &used);
+          if (used != text.size()) return "'" + text + "' is not a number of degrees";
+        } catch (const std::exception&) {
+          return "'" + text + "' is not a number of degrees";
+        }
+        if (!std::isfinite(v) || std::abs(v) > 360.0) {
+          return "heading '" + text + "' must be a finite number of degrees in [-360, 360]";
+        }
+        return {};
+      },
+      "DEGREES in [-360, 360]");
+}
 
 int run_cmd(const CmdOptions& o, can::Command c) {
   auto bus = open_live_bus(o.iface);
@@ -265,10 +300,16 @@ int run_cmd(const CmdOptions& o, can::Command c) {
                                                    : std::random_device{}() & 0xFFu);
   CommandTimeouts t;
   t.response = std::chrono::milliseconds(o.timeout_ms);
+  t.sample_rate_hz = o.rate_hz;
   const CommandOutcome r = run_command(**bus, c, static_cast<std::uint8_t>(o.node), t);
+  if (r.kind == CommandOutcome::Kind::kIncomplete) {
+    // Missing statistics are not zeros: print none of them (gfins-can calibrate refuses such a
+    // pose too, capture_sequence.cpp).
+    std::fprintf(stderr, "gfins-can cmd: %s\n", r.text.c_str());
+    return kExitTimeout;
+  }
   std::printf("%s\n", r.text.c_str());
-  if (r.capture_complete ||
-      (c.opcode == can::Opcode::kStartCapture && r.kind == CommandOutcome::Kind::kOk)) {
+  if (r.capture_complete) {
     std::printf("pose %u, %u samples\nchannel,mean_counts,std_counts,count,saturated,motion\n",
                 r.capture.pose, r.capture.samples);
     for (std::size_t ch = 0; ch < 6; ++ch) {
@@ -417,7 +458,7 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
   if (!o.poses.empty()) {
     const auto rows = tools::read_poses(o.poses);
     if (!rows.is_ok()) {
-      std::fprintf(stderr, "gfins-can calibrate: %s\n", rows.status().message().c_str());
+      std::fprintf(stderr, "gfins-can calibrate: %s\n", rows.error().message.c_str());
       return kExitUsage;
     }
     std::vector<std::pair<int, std::array<double, 3>>> r;
@@ -527,13 +568,21 @@ int main_impl(int argc, char** argv) {
   auto* cmd = app.add_subcommand("cmd", "send one command and wait for its response");
   cmd->add_option("--iface", co.iface, "SocketCAN interface")->required();
   cmd->add_option("--node", co.node, "node id of the board")->check(CLI::Range(0, 15));
-  cmd->add_option("--timeout-ms", co.timeout_ms, "response timeout")->capture_default_str();
+  cmd->add_option("--timeout-ms", co.timeout_ms, "response timeout, ms")
+      ->check(CLI::Range(1, kMaxTimeoutMs))
+      ->capture_default_str();
   cmd->add_option("--token", co.token, "token (default: random)")->check(CLI::Range(0, 255));
+  cmd->add_option("--rate", co.rate_hz,
+                  "the board's sample rate, Hz (capture: wait N / rate + 5 s for the result)")
+      ->check(CLI::Range(1.0, 100000.0))
+      ->capture_default_str();
   cmd->require_subcommand(1);
   can::Command c;
   double heading_deg = 0;
   auto* realign = cmd->add_subcommand("realign", "re-align with the given heading");
-  realign->add_option("--heading-deg", heading_deg, "heading, degrees")->required();
+  realign->add_option("--heading-deg", heading_deg, "heading, degrees in [-360, 360]")
+      ->required()
+      ->check(heading_deg_check());
   auto* reset = cmd->add_subcommand("reset", "reset navigation");
   std::string comp;
   auto* compensator = cmd->add_subcommand("compensator", "switch compensator");
@@ -543,11 +592,16 @@ int main_impl(int argc, char** argv) {
   std::string div_msg;
   int divider = 0;
   auto* div = cmd->add_subcommand("divider", "set the output divider of a message");
+  // GfinsStatus is not offered: its divider follows GfinsEpoch's (the board refuses it alone,
+  // docs/can-interface.md, "Rates, dividers and bus load").
   std::vector<std::string> data_names;
   for (const auto& m : can::kMessages) {
-    if (m.kind == can::MessageKind::kData) data_names.emplace_back(m.name);
+    if (m.kind == can::MessageKind::kData && m.id != can::MessageId::kStatus) {
+      data_names.emplace_back(m.name);
+    }
   }
-  div->add_option("message", div_msg, "message name (GfinsQuaternion, ...)")
+  div->add_option("message", div_msg,
+                  "message name (GfinsQuaternion, ...; GfinsStatus follows GfinsEpoch)")
       ->required()
       ->check(CLI::IsMember(data_names));
   div->add_option("divider", divider, "divider of the sample rate, 0 = off")
@@ -615,7 +669,9 @@ int main_impl(int argc, char** argv) {
   calibrate->add_option("--retries", so.retries, "refused captures of a pose before giving up")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
-  calibrate->add_option("--timeout-ms", so.timeout_ms, "response timeout")->capture_default_str();
+  calibrate->add_option("--timeout-ms", so.timeout_ms, "response timeout, ms")
+      ->check(CLI::Range(1, kMaxTimeoutMs))
+      ->capture_default_str();
 
 #if GFINS_CAN_HAVE_HIL
   HilOptions ho;

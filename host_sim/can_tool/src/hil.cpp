@@ -168,15 +168,15 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   Input in;
   if (o.scenario.empty() == o.recording.empty()) {
     err << "gfins-can hil: give one of --scenario or --recording\n";
-    return 2;
+    return kHilExitBadInput;
   }
   if (!o.scenario.empty()) {
-    if (!scenario_samples(o, in, err)) return 2;
+    if (!scenario_samples(o, in, err)) return kHilExitBadInput;
   } else {
     auto rec = sim::read_recording(o.recording);
     if (!rec.is_ok()) {
       err << "gfins-can hil: " << rec.error().message << "\n";
-      return 2;
+      return kHilExitBadInput;
     }
     in.samples = rec.value().samples;
     in.rate_hz = rec.value().header.sample_rate_hz;
@@ -184,7 +184,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   }
   if (in.samples.empty()) {
     err << "gfins-can hil: " << in.what << " holds no sample\n";
-    return 2;
+    return kHilExitBadInput;
   }
 
   // ---- Host-only run of the core: the firmware's start-up, then process() per sample ---------
@@ -193,14 +193,14 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
     app::ConfigResult r = app::load_config(o.fw_config);
     if (!r.ok()) {
       err << "gfins-can hil: " << r.error << "\n";
-      return 2;
+      return kHilExitBadInput;
     }
     fc = *r.config;
   }
   if (fc.sample_rate_hz != in.rate_hz) {
     err << "gfins-can hil: " << in.what << " runs at " << in.rate_hz
         << " Hz but the firmware's adc.sample_rate_hz is " << fc.sample_rate_hz << "\n";
-    return 2;
+    return kHilExitBadInput;
   }
   const app::StartupCalibration cal =
       app::load_calibration(fc, app::nominal_calibration(chain_volts_per_count(fc.sample_rate_hz)));
@@ -212,7 +212,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   auto pipe = std::make_unique<nav::NavPipeline<float>>();
   if (const Status st = pipe->configure(cfg); !st.is_ok()) {
     err << "gfins-can hil: pipeline configuration: " << st.message() << "\n";
-    return 2;
+    return kHilExitBadInput;
   }
   const std::uint16_t epoch_div = fc.dividers[0];
   std::vector<nav::NavState<float>> published;  // the core's state of every published sample
@@ -234,7 +234,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
                 ? std::string(": ") + std::strerror(client.status().os_error())
                 : std::string())
         << "\n";
-    return 2;
+    return kHilExitBadInput;
   }
   lnx::HilClient& link = *client.value();
   std::vector<DecodedEpoch> epochs;
@@ -353,7 +353,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       << (complete && equal ? "IDENTICAL (within quantisation)"
                             : (equal ? "consistent so far, but incomplete" : "DIFFERENT"))
       << "\n";
-  return complete && equal && naks == 0 ? 0 : 1;
+  return complete && equal && naks == 0 ? 0 : kHilExitDifferent;
 }
 
 }  // namespace gfins::can_tool

@@ -24,8 +24,13 @@ struct HilOptions {
   int corrupt_at = -1;       // test hook: flip one bit of this sample's frame (bad CRC)
 };
 
-/// Exit code: 0 every epoch arrived and equals the core within quantisation; 1 differences or
-/// an incomplete stream (reported); 2 bad input (scenario, recording, connection).
+/// Exit codes of gfins-can hil (gfins-can --help, docs/hil.md): 0 every epoch arrived and
+/// equals the core within quantisation; kHilExitBadInput a scenario, recording, configuration or
+/// connection that cannot be used; kHilExitDifferent differences or an incomplete stream
+/// (reported). Distinct from gfins-can's 1 (command-line error).
+inline constexpr int kHilExitBadInput = 2;
+inline constexpr int kHilExitDifferent = 8;
+
 int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err);
 
 }  // namespace gfins::can_tool

@@ -1,6 +1,8 @@
 #include "views.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 #include <stdexcept>
 
@@ -24,23 +26,55 @@ std::string mode_name(double v) {
   return std::to_string(static_cast<int>(v));
 }
 
+/// A group of signals of one message in the line view: "(v v v)" scaled by `scale` with
+/// `decimals` decimals; "-" when the message was not sent in this epoch; "n/a" for a value sent
+/// as not available.
+std::string group(const DecodedEpoch& e, std::initializer_list<const char*> names, double scale,
+                  int decimals) {
+  std::string out = "(";
+  bool any = false;
+  for (const char* name : names) {
+    const int i = column_index(name);
+    if (i >= 0 && e.present[static_cast<std::size_t>(i)]) any = true;
+  }
+  if (!any) return "-";
+  if (names.size() == 1) out.clear();
+  for (const char* name : names) {
+    if (out.size() > 1) out += ' ';
+    const double v = col(e, name);
+    if (std::isnan(v)) {
+      out += "n/a";
+      continue;
+    }
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v * scale);
+    out += buf;
+  }
+  return names.size() == 1 ? out : out + ")";
+}
+
+/// One line per epoch; a message not sent in the epoch (its divider skipped it) shows as "-".
 class LineView final : public View {
  public:
   explicit LineView(std::FILE* out) : out_(out) {}
   void epoch(const DecodedEpoch& e) override {
-    std::fprintf(
-        out_,
-        "node %u t=%.6f s seq=%s %s rpy=(%.3f %.3f %.3f) deg w=(%.4f %.4f %.4f) rad/s "
-        "v=(%.2f %.2f %.2f) m/s r=(%.2f %.2f %.2f) m flags=0x%05X\n",
-        e.node_id, col(e, "TimeUs") * 1e-6, format_value(col(e, "SampleCount")).c_str(),
-        mode_name(col(e, "Mode")).c_str(), col(e, "Roll") * kRadToDeg, col(e, "Pitch") * kRadToDeg,
-        col(e, "Yaw") * kRadToDeg, col(e, "RateX"), col(e, "RateY"), col(e, "RateZ"),
-        col(e, "VelN"), col(e, "VelE"), col(e, "VelD"), col(e, "PosN"), col(e, "PosE"),
-        col(e, "PosD"),
-        std::isnan(col(e, "StatusFlags")) ? 0u : static_cast<unsigned>(col(e, "StatusFlags")));
+    const double flags = col(e, "StatusFlags");
+    std::fprintf(out_, "node %u t=%s s seq=%s %s rpy=%s deg w=%s rad/s v=%s m/s r=%s m flags=%s\n",
+                 e.node_id, group(e, {"TimeUs"}, 1e-6, 6).c_str(),
+                 format_value(col(e, "SampleCount")).c_str(), mode_name(col(e, "Mode")).c_str(),
+                 group(e, {"Roll", "Pitch", "Yaw"}, kRadToDeg, 3).c_str(),
+                 group(e, {"RateX", "RateY", "RateZ"}, 1.0, 4).c_str(),
+                 group(e, {"VelN", "VelE", "VelD"}, 1.0, 2).c_str(),
+                 group(e, {"PosN", "PosE", "PosD"}, 1.0, 2).c_str(),
+                 std::isnan(flags) ? "-" : hex_flags(flags).c_str());
   }
 
  private:
+  static std::string hex_flags(double v) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%05X", static_cast<unsigned>(v));
+    return buf;
+  }
   std::FILE* out_;
 };
 
@@ -89,13 +123,26 @@ class JsonView final : public View {
 };
 
 /// Redraws at most every kRefresh of wall-clock time (and once at the end), so a fast log or a
-/// 100 Hz bus does not flood the terminal.
+/// 100 Hz bus does not flood the terminal. Every signal shows its latest value, with its age
+/// (device time since the epoch that carried it) when that was not the latest epoch: messages
+/// on slower dividers (Euler, health counters) stay readable between their frames.
 class TableView final : public View {
  public:
-  explicit TableView(std::FILE* out) : out_(out) {}
+  explicit TableView(std::FILE* out) : out_(out) {
+    const auto& cols = columns();
+    values_.assign(cols.size(), std::nan(""));
+    seen_at_us_.assign(cols.size(), -1);
+    for (const Column& c : cols) name_width_ = std::max(name_width_, c.signal->name.size());
+  }
   void epoch(const DecodedEpoch& e) override {
     latest_ = e;
     have_ = true;
+    now_us_ = epoch_time_us(e);
+    for (std::size_t i = 0; i < e.values.size(); ++i) {
+      if (!e.present[i]) continue;
+      values_[i] = e.values[i];
+      seen_at_us_[i] = now_us_;
+    }
     const auto now = std::chrono::steady_clock::now();
     if (now - last_draw_ >= kRefresh) {
       draw();
@@ -108,6 +155,20 @@ class TableView final : public View {
 
  private:
   static constexpr std::chrono::milliseconds kRefresh{100};
+  static constexpr std::int64_t kTimeWrapUs = std::int64_t{1} << 32;  // TimeUs is mod 2^32 µs
+
+  /// Device time of the epoch, unwrapped across the 32-bit wrap; the log time when the epoch
+  /// frame carried none.
+  std::int64_t epoch_time_us(const DecodedEpoch& e) {
+    const double t = col(e, "TimeUs");
+    if (std::isnan(t)) return e.log_time_us;
+    const auto raw = static_cast<std::int64_t>(t);
+    if (have_time_ && raw < last_raw_us_) wraps_ += kTimeWrapUs;
+    last_raw_us_ = raw;
+    have_time_ = true;
+    return raw + wraps_;
+  }
+
   void draw() {
     std::fprintf(out_, "\x1b[H\x1b[2J");  // cursor home, clear screen (ANSI)
     std::fprintf(out_, "gfins-can  node %u  epoch counter %u  line %llu  log time %.6f s\n\n",
@@ -115,14 +176,25 @@ class TableView final : public View {
                  static_cast<double>(latest_.log_time_us) * 1e-6);
     const auto& cols = columns();
     const can::MessageDef* last = nullptr;
+    const int w = static_cast<int>(name_width_);
     for (std::size_t i = 0; i < cols.size(); ++i) {
       if (cols[i].message != last) {
         last = cols[i].message;
         std::fprintf(out_, "%s\n", std::string(last->name).c_str());
       }
-      const std::string v = latest_.present[i] ? format_value(latest_.values[i]) : std::string("-");
-      std::fprintf(out_, "  %-14s %16s %s\n", std::string(cols[i].signal->name).c_str(),
-                   v.empty() ? "n/a" : v.c_str(), std::string(cols[i].signal->unit).c_str());
+      std::string v = "-";  // never received
+      std::string age;
+      if (seen_at_us_[i] >= 0) {
+        v = std::isnan(values_[i]) ? std::string("n/a") : format_value(values_[i]);
+        if (seen_at_us_[i] != now_us_) {
+          char buf[40];
+          std::snprintf(buf, sizeof buf, "  (%.3f s ago)",
+                        static_cast<double>(now_us_ - seen_at_us_[i]) * 1e-6);
+          age = buf;
+        }
+      }
+      std::fprintf(out_, "  %-*s %16s %-8s%s\n", w, std::string(cols[i].signal->name).c_str(),
+                   v.c_str(), std::string(cols[i].signal->unit).c_str(), age.c_str());
     }
     // A failed write shows again in ferror() when the output is closed (close_output).
     static_cast<void>(std::fflush(out_));
@@ -130,6 +202,13 @@ class TableView final : public View {
   std::FILE* out_;
   DecodedEpoch latest_;
   bool have_ = false;
+  std::vector<double> values_;            // latest value per column
+  std::vector<std::int64_t> seen_at_us_;  // device time of the epoch that carried it, -1 never
+  std::int64_t now_us_ = 0;
+  std::int64_t last_raw_us_ = 0;
+  std::int64_t wraps_ = 0;
+  bool have_time_ = false;
+  std::size_t name_width_ = 0;
   std::chrono::steady_clock::time_point last_draw_{};
 };
 

@@ -17,11 +17,11 @@ bool in_set(const std::array<int, 3>& set, int sensor0) {
   return set[0] == sensor0 || set[1] == sensor0 || set[2] == sensor0;
 }
 
-FileStatus bad(const std::string& what) { return FileStatus(ErrorCode::kInvalidArgument, what); }
+HostError bad(const std::string& what) { return HostError{ErrorCode::kInvalidArgument, what, 0}; }
 
-FileStatus solver_failure(Status s) {
-  return FileStatus(
-      s.code(), std::string("calibration failed (") + to_string(s.code()) + "): " + s.message());
+// The solver's Status, lifted with the words the exit status of gfins-calibrate keys on.
+HostError solver_failure(const Status& s) {
+  return sim::host_error(s, std::string("calibration failed (") + to_string(s.code()) + "): ");
 }
 
 // σ of a mean: std/√count, passed to the solver as a σ with count 1 so rows may differ in count.
@@ -31,7 +31,7 @@ void set_sigma(calib::AttitudeObservation<double>& o, std::size_t sensor0, const
   o.sample_count = 1;
 }
 
-FileResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const std::string& file) {
+HostResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const std::string& file) {
   // Tables 4/5: every sensor in attitudes 1..6 of its set's table (2 for β, 3 for α).
   calib::PaperTableOutputs<double> p;
   std::array<std::array<const MeanRow*, 6>, 6> at{};
@@ -91,7 +91,7 @@ FileResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
   return run;
 }
 
-FileResult<CalibrationRun> run_with_poses(const CalibrationInputs& in, const std::string& file) {
+HostResult<CalibrationRun> run_with_poses(const CalibrationInputs& in, const std::string& file) {
   if (in.method == Method::kPaper) {
     return bad("the paper procedure needs the Table 2/3 poses; use --method general with --poses");
   }
@@ -193,7 +193,7 @@ std::string rejection_text(const calib::RejectedPose<double>& r, const Recording
 
 }  // namespace
 
-FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
+HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
                                                      const std::optional<std::vector<Pose>>& poses,
                                                      const RecordingOptions& options_in,
                                                      const std::string& recording_file) {
@@ -325,7 +325,7 @@ FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   return run;
 }
 
-FileResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
+HostResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
                                            const std::string& means_file) {
   return in.poses ? run_with_poses(in, means_file) : run_paper_layout(in, means_file);
 }
@@ -446,7 +446,7 @@ void print_report(std::ostream& out, const CalibrationRun& run) {
   for (const std::string& w : verdict_warnings(r)) out << "  warning: " << w << "\n";
 }
 
-FileStatus check_settings(const FileSettings& settings) {
+HostStatus check_settings(const FileSettings& settings) {
   // A trial file with these settings and neutral calibrated values: the file's own validation
   // (docs/calibration-file.md, ranges) names the first setting it would refuse.
   calib_file::CalibrationData d;
@@ -462,13 +462,13 @@ FileStatus check_settings(const FileSettings& settings) {
     d.sensors[j].location_error_sigma_m = settings.location[j].location_error_sigma_m;
   }
   const calib_file::Problem p = calib_file::validate(d);
-  if (!p.found()) return FileStatus::ok();
+  if (!p.found()) return Done{};
   std::string option = p.key;
   if (p.key == "device_id") option = "--device-id";
   if (p.key.find("adc_lsb") != std::string::npos) option = "--adc-lsb";
   if (p.key == "geometry.rho_m") option = "--rho";
   if (p.key.rfind("gravity.", 0) == 0) option = "--gravity / --latitude";
-  return FileStatus(ErrorCode::kInvalidArgument, option + " (" + p.key + "): " + p.problem);
+  return bad(option + " (" + p.key + "): " + p.problem);
 }
 
 namespace {
@@ -546,7 +546,7 @@ Eigen::Matrix<double, calib::kNumBaseParams, calib::kNumBaseParams> base_perturb
 
 }  // namespace
 
-FileResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& rows,
+HostResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& rows,
                                                     const calib_file::CalibrationData& cal,
                                                     double prior_sigma_m,
                                                     const std::string& runs_file) {
@@ -576,9 +576,8 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
   const auto solved = calib::calibrate_location<double>(
       calibrated, std::span<const calib::LocationRun<double>>(runs.data(), runs.size()));
   if (!solved.is_ok()) {
-    return FileStatus(solved.status().code(), runs_file + ": location calibration failed (" +
-                                                  to_string(solved.status().code()) +
-                                                  "): " + solved.status().message());
+    return sim::host_error(solved.status(), runs_file + ": location calibration failed (" +
+                                                to_string(solved.status().code()) + "): ");
   }
   LocationReport rep;
   rep.solution = solved.value();
@@ -645,7 +644,7 @@ FileResult<LocationReport> run_location_calibration(const std::vector<LocationRu
   return rep;
 }
 
-FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
+HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
                                             const std::optional<std::vector<Pose>>& poses,
                                             const calib_file::CalibrationData& cal,
                                             const std::string& means_file) {

@@ -10,6 +10,7 @@
 
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/host_sim/error.hpp"
 #include "gfins/nav_core/calibration/location.hpp"
 #include "gfins/nav_core/calibration/multi_attitude.hpp"
 #include "gfins/nav_core/calibration/static_detector.hpp"
@@ -39,7 +40,7 @@ struct CalibrationRun {
 /// Builds the observations and runs the solver. Fails (kInvalidArgument) naming the file line or
 /// the missing (sensor, attitude) pair when the means do not match the layout, and passes on the
 /// solver's Status otherwise.
-FileResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
+HostResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
                                            const std::string& means_file);
 
 /// A raw recording: the static detector (gfins::calib::StaticDetector) finds the poses, each
@@ -52,7 +53,7 @@ struct RecordingOptions {
   double min_still_s = 2.0;
   std::array<double, 6> nominal_scale_v_per_g{};  // to tell the poses apart (sign matters)
 };
-FileResult<CalibrationRun> run_recording_calibration(const Recording& rec,
+HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
                                                      const std::optional<std::vector<Pose>>& poses,
                                                      const RecordingOptions& options,
                                                      const std::string& recording_file);
@@ -71,7 +72,7 @@ struct FileSettings {
 
 /// The first setting outside the calibration file's domain (device id, ADC LSB, ρ, gravity),
 /// found before anything is solved; message names the option.
-FileStatus check_settings(const FileSettings& settings);
+HostStatus check_settings(const FileSettings& settings);
 
 /// Location calibration (paper §4.2) from rate-table runs, given the orientation calibration
 /// (SF, bias, angles, nominal geometry and local gravity of `cal`): Δρ_j and its 1σ per body
@@ -86,7 +87,7 @@ struct LocationReport {
   std::array<std::array<double, 3>, 6> sigma_m{};
   std::vector<std::string> lines;  // the report
 };
-FileResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& runs,
+HostResult<LocationReport> run_location_calibration(const std::vector<LocationRunRow>& runs,
                                                     const calib_file::CalibrationData& cal,
                                                     double prior_sigma_m,
                                                     const std::string& runs_file);
@@ -121,7 +122,7 @@ struct VerifyReport {
   int worst_sensor = 0;  // 1-based
   int worst_pose = 0;
 };
-FileResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
+HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
                                             const std::optional<std::vector<Pose>>& poses,
                                             const calib_file::CalibrationData& cal,
                                             const std::string& means_file);

@@ -30,7 +30,7 @@ std::vector<std::string> split(const std::string& line) {
   }
 }
 
-FileStatus bad(const std::string& what) { return FileStatus(ErrorCode::kInvalidArgument, what); }
+HostError bad(const std::string& what) { return HostError{ErrorCode::kInvalidArgument, what, 0}; }
 
 std::string join(const std::vector<std::string>& names) {
   std::string out;
@@ -41,7 +41,7 @@ std::string join(const std::vector<std::string>& names) {
 // Every column of the header must be one of `required` or `optional`, and every required one
 // must be there; the message names the offending column and lists the accepted names, so a
 // header that differs in one name ("mean" for "mean_v") says what it should be.
-FileStatus check_header(const CsvTable& t, const std::vector<std::string>& required,
+HostStatus check_header(const CsvTable& t, const std::vector<std::string>& required,
                         const std::vector<std::string>& optional) {
   std::vector<std::string> accepted = required;
   accepted.insert(accepted.end(), optional.begin(), optional.end());
@@ -68,7 +68,7 @@ FileStatus check_header(const CsvTable& t, const std::vector<std::string>& requi
       return bad(msg);
     }
   }
-  return FileStatus::ok();
+  return Done{};
 }
 
 }  // namespace
@@ -84,7 +84,7 @@ std::string CsvTable::where(const CsvRow& row) const {
   return file + ":" + std::to_string(row.line) + ": ";
 }
 
-FileResult<double> CsvTable::number(const CsvRow& row, int col) const {
+HostResult<double> CsvTable::number(const CsvRow& row, int col) const {
   const std::string& text = row.cells[static_cast<std::size_t>(col)];
   double x = 0.0;
   const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
@@ -96,7 +96,7 @@ FileResult<double> CsvTable::number(const CsvRow& row, int col) const {
   return x;
 }
 
-FileResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int64_t lo,
+HostResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int64_t lo,
                                            std::int64_t hi) const {
   const std::string& text = row.cells[static_cast<std::size_t>(col)];
   std::int64_t x = 0;
@@ -109,11 +109,11 @@ FileResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int6
   return x;
 }
 
-FileResult<CsvTable> read_csv(const std::filesystem::path& path) {
+HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
   CsvTable t;
   t.file = path.string();
   std::ifstream in(path);
-  if (!in) return FileStatus(ErrorCode::kIoError, t.file + ": cannot open");
+  if (!in) return HostError{ErrorCode::kIoError, t.file + ": cannot open", 0};
   std::string line;
   int n = 0;
   while (std::getline(in, line)) {
@@ -131,20 +131,15 @@ FileResult<CsvTable> read_csv(const std::filesystem::path& path) {
     }
     t.rows.push_back(CsvRow{n, std::move(cells)});
   }
-  if (in.bad()) return FileStatus(ErrorCode::kIoError, t.file + ": read error");
+  if (in.bad()) return HostError{ErrorCode::kIoError, t.file + ": read error", 0};
   if (t.header.empty()) return bad(t.file + ": empty (no header row)");
   if (t.rows.empty()) return bad(t.file + ": no data rows after the header");
   return t;
 }
 
-FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
-  auto table = read_csv(path);
-  if (!table.is_ok()) return table.status();
-  const CsvTable& t = table.value();
-  if (const FileStatus h = check_header(t, {"sensor", "attitude", "mean_v"}, {"std_v", "count"});
-      !h.is_ok()) {
-    return h;
-  }
+HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
+  GFINS_TRY(const CsvTable t, read_csv(path));
+  GFINS_TRY_STATUS(check_header(t, {"sensor", "attitude", "mean_v"}, {"std_v", "count"}));
   const int c_sensor = t.column("sensor");
   const int c_attitude = t.column("attitude");
   const int c_mean = t.column("mean_v");
@@ -158,23 +153,18 @@ FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
   for (const CsvRow& r : t.rows) {
     MeanRow m;
     m.line = r.line;
-    const auto sensor = t.integer(r, c_sensor, 1, 6);
-    if (!sensor.is_ok()) return sensor.status();
-    const auto attitude = t.integer(r, c_attitude, 1, 1000);
-    if (!attitude.is_ok()) return attitude.status();
-    const auto mean = t.number(r, c_mean);
-    if (!mean.is_ok()) return mean.status();
-    m.sensor = static_cast<int>(sensor.value());
-    m.attitude = static_cast<int>(attitude.value());
-    m.mean_v = mean.value();
+    GFINS_TRY(const auto sensor, t.integer(r, c_sensor, 1, 6));
+    GFINS_TRY(const auto attitude, t.integer(r, c_attitude, 1, 1000));
+    GFINS_TRY(const auto mean, t.number(r, c_mean));
+    m.sensor = static_cast<int>(sensor);
+    m.attitude = static_cast<int>(attitude);
+    m.mean_v = mean;
     if (c_std >= 0) {
-      const auto sd = t.number(r, c_std);
-      if (!sd.is_ok()) return sd.status();
-      const auto count = t.integer(r, c_count, 1, 1'000'000'000);
-      if (!count.is_ok()) return count.status();
-      if (sd.value() < 0.0) return bad(t.where(r) + "std_v must not be negative");
-      m.std_v = sd.value();
-      m.count = static_cast<std::uint32_t>(count.value());
+      GFINS_TRY(const auto sd, t.number(r, c_std));
+      GFINS_TRY(const auto count, t.integer(r, c_count, 1, 1'000'000'000));
+      if (sd < 0.0) return bad(t.where(r) + "std_v must not be negative");
+      m.std_v = sd;
+      m.count = static_cast<std::uint32_t>(count);
     }
     if (!seen.insert({m.sensor, m.attitude}).second) {
       return bad(t.where(r) + "sensor " + std::to_string(m.sensor) + " attitude " +
@@ -185,13 +175,9 @@ FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
   return rows;
 }
 
-FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
-  auto table = read_csv(path);
-  if (!table.is_ok()) return table.status();
-  const CsvTable& t = table.value();
-  if (const FileStatus h = check_header(t, {"attitude", "fx_g", "fy_g", "fz_g"}, {}); !h.is_ok()) {
-    return h;
-  }
+HostResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
+  GFINS_TRY(const CsvTable t, read_csv(path));
+  GFINS_TRY_STATUS(check_header(t, {"attitude", "fx_g", "fy_g", "fz_g"}, {}));
   const int c_att = t.column("attitude");
   const std::array<int, 3> c_f = {t.column("fx_g"), t.column("fy_g"), t.column("fz_g")};
   std::vector<Pose> poses;
@@ -199,13 +185,11 @@ FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
   for (const CsvRow& r : t.rows) {
     Pose p;
     p.line = r.line;
-    const auto att = t.integer(r, c_att, 1, 1000);
-    if (!att.is_ok()) return att.status();
-    p.attitude = static_cast<int>(att.value());
+    GFINS_TRY(const auto att, t.integer(r, c_att, 1, 1000));
+    p.attitude = static_cast<int>(att);
     for (std::size_t k = 0; k < 3; ++k) {
-      const auto f = t.number(r, c_f[k]);
-      if (!f.is_ok()) return f.status();
-      p.f_b_g[k] = f.value();
+      GFINS_TRY(const auto f, t.number(r, c_f[k]));
+      p.f_b_g[k] = f;
     }
     const double norm = std::hypot(p.f_b_g[0], p.f_b_g[1], p.f_b_g[2]);
     // At rest the specific force is 1 g; 10 % covers a local gravity model and rounding.
@@ -230,10 +214,11 @@ bool has_gfr_magic(const std::filesystem::path& path) {
   return in.gcount() == static_cast<std::streamsize>(magic.size()) && magic == sim::kRecordingMagic;
 }
 
-FileResult<Recording> read_gfr(const std::filesystem::path& path) {
+HostResult<Recording> read_gfr(const std::filesystem::path& path) {
   auto file = sim::read_recording(path.string());
   if (!file.is_ok()) {
-    return FileStatus(file.error().code, path.string() + ": " + file.error().message);
+    return HostError{file.error().code, path.string() + ": " + file.error().message,
+                     file.error().byte_offset};
   }
   const sim::Recording& r = file.value();
   Recording rec;
@@ -265,11 +250,9 @@ FileResult<Recording> read_gfr(const std::filesystem::path& path) {
 
 }  // namespace
 
-FileResult<Recording> read_recording(const std::filesystem::path& path) {
+HostResult<Recording> read_recording(const std::filesystem::path& path) {
   if (has_gfr_magic(path)) return read_gfr(path);
-  auto table = read_csv(path);
-  if (!table.is_ok()) return table.status();
-  const CsvTable& t = table.value();
+  GFINS_TRY(const CsvTable t, read_csv(path));
   std::array<int, 6> c{};
   for (std::size_t j = 0; j < 6; ++j) {
     c[j] = t.column("v" + std::to_string(j + 1));
@@ -285,9 +268,8 @@ FileResult<Recording> read_recording(const std::filesystem::path& path) {
   for (const CsvRow& r : t.rows) {
     std::array<double, 6> s{};
     for (std::size_t j = 0; j < 6; ++j) {
-      const auto v = t.number(r, c[j]);
-      if (!v.is_ok()) return v.status();
-      s[j] = v.value();
+      GFINS_TRY(const auto v, t.number(r, c[j]));
+      s[j] = v;
     }
     rec.samples_v.push_back(s);
   }
@@ -298,50 +280,42 @@ FileResult<Recording> read_recording(const std::filesystem::path& path) {
 
 namespace gfins::tools {
 
-FileResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path) {
-  auto table = read_csv(path);
-  if (!table.is_ok()) return table.status();
-  const CsvTable& t = table.value();
+HostResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path) {
+  GFINS_TRY(const CsvTable t, read_csv(path));
   std::vector<std::string> required = {"mounting", "axis_x", "axis_y", "axis_z", "rate_rad_s"};
   for (int j = 1; j <= 6; ++j) required.push_back("mean_v" + std::to_string(j));
   for (int j = 1; j <= 6; ++j) required.push_back("std_v" + std::to_string(j));
   required.push_back("count");
-  if (const FileStatus h = check_header(t, required, {}); !h.is_ok()) return h;
+  GFINS_TRY_STATUS(check_header(t, required, {}));
   std::vector<LocationRunRow> rows;
   for (const CsvRow& r : t.rows) {
     LocationRunRow run;
     run.line = r.line;
-    const auto m = t.integer(r, t.column("mounting"), 0, 7);
-    if (!m.is_ok()) return m.status();
-    run.mounting = static_cast<int>(m.value());
+    GFINS_TRY(const auto m, t.integer(r, t.column("mounting"), 0, 7));
+    run.mounting = static_cast<int>(m);
     for (std::size_t k = 0; k < 3; ++k) {
-      const auto a = t.number(r, t.column(std::string("axis_") + "xyz"[k]));
-      if (!a.is_ok()) return a.status();
-      run.axis_up_b[k] = a.value();
+      GFINS_TRY(const auto a, t.number(r, t.column(std::string("axis_") + "xyz"[k])));
+      run.axis_up_b[k] = a;
     }
     const double norm = std::hypot(run.axis_up_b[0], run.axis_up_b[1], run.axis_up_b[2]);
     if (!(norm > 0.5)) {
       return bad(t.where(r) + "the table axis (axis_x, axis_y, axis_z) has length " +
                  std::to_string(norm) + ": give the upward unit axis in body axes");
     }
-    const auto rate = t.number(r, t.column("rate_rad_s"));
-    if (!rate.is_ok()) return rate.status();
-    run.rate_rad_s = rate.value();
+    GFINS_TRY(const auto rate, t.number(r, t.column("rate_rad_s")));
+    run.rate_rad_s = rate;
     for (std::size_t j = 0; j < 6; ++j) {
-      const auto mean = t.number(r, t.column("mean_v" + std::to_string(j + 1)));
-      if (!mean.is_ok()) return mean.status();
-      const auto sd = t.number(r, t.column("std_v" + std::to_string(j + 1)));
-      if (!sd.is_ok()) return sd.status();
-      if (!(sd.value() > 0.0)) {
+      GFINS_TRY(const auto mean, t.number(r, t.column("mean_v" + std::to_string(j + 1))));
+      GFINS_TRY(const auto sd, t.number(r, t.column("std_v" + std::to_string(j + 1))));
+      if (!(sd > 0.0)) {
         return bad(t.where(r) + "std_v" + std::to_string(j + 1) +
                    " must be positive (the noise of the samples, V)");
       }
-      run.mean_v[j] = mean.value();
-      run.std_v[j] = sd.value();
+      run.mean_v[j] = mean;
+      run.std_v[j] = sd;
     }
-    const auto count = t.integer(r, t.column("count"), 1, 1'000'000'000);
-    if (!count.is_ok()) return count.status();
-    run.count = static_cast<std::uint32_t>(count.value());
+    GFINS_TRY(const auto count, t.integer(r, t.column("count"), 1, 1'000'000'000));
+    run.count = static_cast<std::uint32_t>(count);
     rows.push_back(run);
   }
   return rows;

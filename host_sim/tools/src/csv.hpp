@@ -9,12 +9,16 @@
 #include <string>
 #include <vector>
 
-#include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/host_sim/error.hpp"
 
 namespace gfins::tools {
 
-using calib_file::FileResult;
-using calib_file::FileStatus;
+// The host's one error type (gfins/host_sim/error.hpp): every reader and every step of the
+// calibration returns a HostResult whose HostError message names the file, line and column.
+using sim::Done;
+using sim::HostError;
+using sim::HostResult;
+using sim::HostStatus;
 
 struct CsvRow {
   int line = 0;  // 1-based line in the file
@@ -31,13 +35,13 @@ struct CsvTable {
   /// "file:line: " for messages.
   std::string where(const CsvRow& row) const;
   /// The number in `col` of `row`; fails naming file, line, column and text.
-  FileResult<double> number(const CsvRow& row, int col) const;
+  HostResult<double> number(const CsvRow& row, int col) const;
   /// An integer in [lo, hi].
-  FileResult<std::int64_t> integer(const CsvRow& row, int col, std::int64_t lo,
+  HostResult<std::int64_t> integer(const CsvRow& row, int col, std::int64_t lo,
                                    std::int64_t hi) const;
 };
 
-FileResult<CsvTable> read_csv(const std::filesystem::path& path);
+HostResult<CsvTable> read_csv(const std::filesystem::path& path);
 
 /// Mean outputs per sensor and attitude (paper Tables 4/5 layout): columns sensor, attitude,
 /// mean_v and optionally std_v (sample standard deviation, V) with count (samples averaged).
@@ -49,7 +53,7 @@ struct MeanRow {
   std::uint32_t count = 0;  // 0 when not given
   int line = 0;
 };
-FileResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path);
+HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path);
 
 /// Poses: columns attitude, fx_g, fy_g, fz_g — the specific force sensed in that pose, body
 /// axes, in g (at rest: minus gravity, i.e. "up", as in the paper's Tables 2/3).
@@ -58,7 +62,7 @@ struct Pose {
   std::array<double, 3> f_b_g{};
   int line = 0;
 };
-FileResult<std::vector<Pose>> read_poses(const std::filesystem::path& path);
+HostResult<std::vector<Pose>> read_poses(const std::filesystem::path& path);
 
 /// A raw recording, either
 ///   - a .gfr file (docs/recording-format.md, recognised by its magic): counts × the header's ADC
@@ -76,7 +80,7 @@ struct Recording {
   double rate_hz = 0.0;                     // .gfr header; 0 for CSV
   std::array<double, 6> volts_per_count{};  // .gfr header; zeros for CSV
 };
-FileResult<Recording> read_recording(const std::filesystem::path& path);
+HostResult<Recording> read_recording(const std::filesystem::path& path);
 
 /// One constant-rate rate-table run (location calibration, paper §4.2): the fixture pose
 /// ("mounting"), the table axis in body axes pointing UP (the table axis is vertical, so gravity
@@ -92,6 +96,6 @@ struct LocationRunRow {
   std::uint32_t count = 0;
   int line = 0;
 };
-FileResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path);
+HostResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem::path& path);
 
 }  // namespace gfins::tools

@@ -179,16 +179,18 @@ int settings_from(const Options& o, const Recording* rec, FileSettings& s) {
                 "--gravity M/S2, or --latitude DEG [--height M] (WGS-84 normal gravity); the "
                 "poses sense 1 local g, which is the g of every V/g in the file");
   }
-  if (const FileStatus st = check_settings(s); !st.is_ok()) return fail(kExitInput, st.message());
+  if (const HostStatus st = check_settings(s); !st.is_ok()) {
+    return fail(kExitInput, st.error().message);
+  }
   return kExitOk;
 }
 
 // Runs the solver on the chosen input; kExitOk or the exit status of the failure.
 int calibrate(const Options& o, const std::optional<Recording>& rec, CalibrationInputs& in,
-              FileResult<CalibrationRun>& out) {
+              HostResult<CalibrationRun>& out) {
   if (!o.poses.empty()) {
     const auto poses = read_poses(o.poses);
-    if (!poses.is_ok()) return fail(kExitInput, poses.status().message());
+    if (!poses.is_ok()) return fail(kExitInput, poses.error().message);
     in.poses = poses.value();
   }
   if (rec) {
@@ -209,7 +211,7 @@ int calibrate(const Options& o, const std::optional<Recording>& rec, Calibration
     return kExitOk;
   }
   const auto means = read_means(o.means);
-  if (!means.is_ok()) return fail(kExitInput, means.status().message());
+  if (!means.is_ok()) return fail(kExitInput, means.error().message);
   in.means = means.value();
   in.method = o.method == "paper"                 ? Method::kPaper
               : o.method == "general" || in.poses ? Method::kGeneral
@@ -227,13 +229,13 @@ int verify(const Options& o) {
   std::optional<std::vector<Pose>> poses;
   if (!o.poses.empty()) {
     const auto p = read_poses(o.poses);
-    if (!p.is_ok()) return fail(kExitInput, p.status().message());
+    if (!p.is_ok()) return fail(kExitInput, p.error().message);
     poses = p.value();
   }
   const auto means = read_means(o.means);
-  if (!means.is_ok()) return fail(kExitInput, means.status().message());
+  if (!means.is_ok()) return fail(kExitInput, means.error().message);
   const auto rep = verify_calibration(means.value(), poses, cal.value(), o.means);
-  if (!rep.is_ok()) return fail(kExitInput, rep.status().message());
+  if (!rep.is_ok()) return fail(kExitInput, rep.error().message);
   for (const auto& line : rep.value().lines) std::cout << line << "\n";
   if (rep.value().max_abs_z > kVerifyMaxZ) {
     return fail(kExitVerdict, "verification failed: sensor a" +
@@ -251,7 +253,7 @@ int run(const Options& o) {
   std::optional<Recording> rec;
   if (!o.recording.empty()) {
     auto r = read_recording(o.recording);
-    if (!r.is_ok()) return fail(kExitInput, r.status().message());
+    if (!r.is_ok()) return fail(kExitInput, r.error().message);
     rec = std::move(r).value();
   }
   FileSettings settings;
@@ -259,7 +261,7 @@ int run(const Options& o) {
   std::optional<std::vector<LocationRunRow>> location_rows;
   if (!o.location_runs.empty()) {
     auto rows = read_location_runs(o.location_runs);
-    if (!rows.is_ok()) return fail(kExitInput, rows.status().message());
+    if (!rows.is_ok()) return fail(kExitInput, rows.error().message);
     location_rows = std::move(rows).value();
   }
 
@@ -269,19 +271,19 @@ int run(const Options& o) {
   const bool orientation = !o.means.empty() || rec.has_value();
   if (orientation) {
     CalibrationInputs in;
-    FileResult<CalibrationRun> calibrated(FileStatus(ErrorCode::kUnimplemented, "not run"));
+    HostResult<CalibrationRun> calibrated(HostError{ErrorCode::kUnimplemented, "not run", 0});
     if (const int rc = calibrate(o, rec, in, calibrated); rc != kExitOk) return rc;
     const std::string input = o.recording.empty() ? o.means : o.recording;
     settings.source = "gfins-calibrate " +
                       std::string(in.method == Method::kPaper ? "paper" : "general") + " from " +
                       std::filesystem::path(input).filename().string();
     if (!calibrated.is_ok()) {
-      const auto& st = calibrated.status();
-      return fail(st.code() == ErrorCode::kInvalidArgument &&
-                          st.message().find("calibration failed") == std::string::npos
+      const HostError& e = calibrated.error();
+      return fail(e.code == ErrorCode::kInvalidArgument &&
+                          e.message.find("calibration failed") == std::string::npos
                       ? kExitInput
                       : kExitSolver,
-                  st.message());
+                  e.message);
     }
     const CalibrationRun& cal = calibrated.value();
     print_report(std::cout, cal);
@@ -311,8 +313,8 @@ int run(const Options& o) {
     const auto loc =
         run_location_calibration(*location_rows, data, o.location_prior_m, o.location_runs);
     if (!loc.is_ok()) {
-      return fail(loc.status().code() == ErrorCode::kInvalidArgument ? kExitInput : kExitSolver,
-                  loc.status().message());
+      return fail(loc.error().code == ErrorCode::kInvalidArgument ? kExitInput : kExitSolver,
+                  loc.error().message);
     }
     std::cout << "\n";
     for (const auto& line : loc.value().lines) std::cout << line << "\n";

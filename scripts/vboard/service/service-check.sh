@@ -24,6 +24,7 @@ wait_for() { # wait_for SECONDS COMMAND...: poll every 0.5 s until the command s
   return 1
 }
 . /vboard/service.env
+. /vboard/rate.env
 say "VBOARD-BOOTED uptime=$(cut -d' ' -f1 /proc/uptime) (systemd $(systemctl --version | head -n 1 | cut -d' ' -f2))"
 
 # --- Debian's systemd-notify as the service: the service manager's side ----------------------
@@ -56,13 +57,23 @@ if [ "$WANT_FW" = 1 ]; then
     wait_for 60 settled
     if active; then
       pass "fw-active: Type=notify service reached active (READY=1); status '$(prop gfins-fw StatusText)'"
+      # can0 appears 2 s after vboard-setup (vboard-late-can.service): the unit must have waited for its
+      # device unit and started once, not failed on the missing interface and been restarted.
+      systemctl show -p ExecMainStartTimestampMonotonic -p NRestarts gfins-fw >/tmp/start
+      start_us=$(sed -n 's/^ExecMainStartTimestampMonotonic=//p' /tmp/start)
+      nr0=$(sed -n 's/^NRestarts=//p' /tmp/start)
+      can_up=$(cat /run/vboard-can0 2>/dev/null)
+      late=$(awk -v s="${start_us:-0}" -v c="${can_up:-1e9}" 'BEGIN { print (s / 1e6 > c) ? 1 : 0 }')
+      [ "$late" = 1 -a "$nr0" = 0 ] &&
+        pass "fw-waits-for-can0: started at ${start_us}us, after can0 appeared (uptime ${can_up}s), NRestarts 0" ||
+        fail "fw-waits-for-can0: started at ${start_us:-?}us, can0 appeared at uptime ${can_up:-never}s, NRestarts ${nr0:-?} (expected a start after can0 and no restart)"
     else
       fail "fw-active: state $(prop gfins-fw ActiveState)/$(prop gfins-fw SubState) after 60 s"
       journalctl -u gfins-fw --no-pager | grep -E 'critical|error|Failed' | tail -n 8 | sed 's/^/VBOARD-LOG fw: /' | tee -a $out
     fi
     if ! active; then
       # Nothing below can happen without a running service: say so instead of waiting.
-      for c in fw-runs-as-gfins fw-frames fw-watchdog-pings fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
+      for c in fw-waits-for-can0 fw-runs-as-gfins fw-frames fw-status-text fw-watchdog-pings fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
         fail "$c: not reached, gfins-fw.service is $(prop gfins-fw ActiveState) (NRestarts $(prop gfins-fw NRestarts))"
       done
     else
@@ -74,9 +85,9 @@ if [ "$WANT_FW" = 1 ]; then
       fail "fw-runs-as-gfins: MainPID $pid runs as uid(s) '${uids:-?}', gfins is $want_uid"
     policy=$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *//p' | head -n 1)
     say "VBOARD-INFO fw scheduling: $policy"
-    frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
-    [ "$frames" -eq 20 ] && pass "fw-frames: 20 frames on vcan0 from the service" ||
-      fail "fw-frames: $frames of 20 frames on vcan0 within 5 s"
+    frames=$(timeout 5 candump -n 20 can0 | wc -l)
+    [ "$frames" -eq 20 ] && pass "fw-frames: 20 frames on can0 from the service" ||
+      fail "fw-frames: $frames of 20 frames on can0 within 5 s"
     # The loop's WATCHDOG=1 pings: over more than WatchdogSec the service stays the same process.
     # One systemctl call per look (each costs the emulated guest about a second or more);
     # sets st (ActiveState), mp (MainPID), nr (NRestarts), wd (WatchdogUSec).
@@ -95,6 +106,23 @@ if [ "$WANT_FW" = 1 ]; then
       fail "fw-watchdog-pings: after 3 s (WatchdogSec $wd): state $st, PID $pid -> $mp, NRestarts $n0 -> $nr"
     fi
 
+    # The firmware's STATUS= line (its reporter thread, once a second when it changes): past the
+    # 1 s alignment, "navigating at <rate> Hz, calibration <id>; faults: none|<name> <count>, ...",
+    # or DEGRADED when an input fault makes the output untrustworthy (an emulated guest under
+    # host load misses data-ready edges) - and then it names at least one fault.
+    status_ok() {
+      text=$(prop gfins-fw StatusText)
+      fault='[A-Za-z -]+ ([0-9]+|0x[0-9a-f]{2})'
+      echo "$text" | grep -Eq "^(navigating|DEGRADED \(navigating on a faulty input\)) at $RATE Hz, (calibration [0-9a-f]{8}|UNCALIBRATED \(nominal parameters\)); faults: (none|$fault(, $fault)*)\$" ||
+        return 1
+      case $text in DEGRADED*"faults: none") return 1 ;; esac
+    }
+    if wait_for 3 status_ok; then
+      pass "fw-status-text: systemctl show -p StatusText: '$text'"
+    else
+      fail "fw-status-text: StatusText '$text', expected '(navigating|DEGRADED ...) at $RATE Hz, calibration ...; faults: ...'"
+    fi
+
     # A hung loop: stop the process; the watchdog must fire and systemd restart it.
     before=$nr
     kill -STOP "$pid"
@@ -107,8 +135,8 @@ if [ "$WANT_FW" = 1 ]; then
     journalctl -u gfins-fw --no-pager | grep -q 'Watchdog timeout' &&
       pass "fw-watchdog-journal: the journal names the watchdog timeout" ||
       fail "fw-watchdog-journal: no 'Watchdog timeout' in gfins-fw's journal"
-    frames=$(timeout 5 candump -n 20 vcan0 | wc -l)
-    [ "$frames" -eq 20 ] && pass "fw-frames-after-restart: frames on vcan0 again" ||
+    frames=$(timeout 5 candump -n 20 can0 | wc -l)
+    [ "$frames" -eq 20 ] && pass "fw-frames-after-restart: frames on can0 again" ||
       fail "fw-frames-after-restart: $frames of 20 frames within 5 s"
     fi
   fi

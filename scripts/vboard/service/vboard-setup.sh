@@ -1,13 +1,12 @@
 #!/bin/sh
 # vboard-setup.service (service-manager stage, inside the VM's Debian root): the kernel side
-# the firmware needs, before gfins-fw.service starts: vcan0 up, a gpio-sim chip whose line 0 is
-# named adc-drdy, and the data-ready toggler.
+# the firmware needs, before gfins-fw.service starts: the CAN modules, a gpio-sim chip whose
+# line 0 is named adc-drdy, and the data-ready toggler. The CAN interface itself (a vcan named
+# can0, as the package's unit expects) comes late, from vboard-late-can.service.
 set -e
 modprobe vcan
 modprobe gpio-sim-oot
 mountpoint -q /sys/kernel/config || mount -t configfs none /sys/kernel/config
-ip link add dev vcan0 type vcan 2>/dev/null || true
-ip link set up vcan0
 d=/sys/kernel/config/gpio-sim/vboard
 if [ ! -e $d/live ] || [ "$(cat $d/live)" != 1 ]; then
   mkdir -p $d/bank0/line0

@@ -4,8 +4,13 @@
 A candump log is read with python-can (Debian python3-can: can.CanutilsLogReader), each frame's
 CRC-8/SAE-J1850 and epoch counter are checked by code written here from the ICD, the frames are
 decoded with candied (a third-party DBC decoder from npm, pinned by package-lock.json) using the
-committed docs/can/gfins.dbc, and every signal value is compared with what `gfins-can decode
---view json` printed for the same epoch.
+committed docs/can/gfins.dbc (node 0; `gfins-can dbc --node N` for other nodes), and every signal
+value is compared with what `gfins-can decode --view json` printed for the same epoch.
+
+Two logs: the synthetic one of `gfins-can-gen log`, and an extended one this script builds from
+it with frames encoded here from the ICD's byte layout: the optional compensated-accelerometer
+frames (GfinsSensorsA/B) in every epoch, values at the documented saturation limits and at the
+not-available raw value, and every frame copied to node 3 (identifier + 3, CRC recomputed).
 
 Usage: independent_decode_test.py --gfins-can EXE --gen EXE --dbc FILE --workdir DIR [--log LOG]
 Exit 0 when every value agrees; 1 with a list of disagreements otherwise.
@@ -49,24 +54,77 @@ def ensure_candied():
     subprocess.run([npm, 'ci', '--no-audit', '--no-fund'], cwd=HERE, check=True)
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument('--gfins-can', required=True)
-    ap.add_argument('--gen', required=True)
-    ap.add_argument('--dbc', required=True)
-    ap.add_argument('--workdir', required=True)
-    ap.add_argument('--log')
-    ap.add_argument('--seconds', type=float, default=20.0)
-    a = ap.parse_args()
+NODE_COPY = 3                  # the extended log's second node
+NA_RAW16 = -32768               # not-available raw value of a signed 16-bit signal (ICD)
+RATE_LIMIT_RAW = 32000          # GfinsAngularRate: +-16 rad/s limit / 5e-4 rad/s per bit (ICD)
+SENSOR_LIMIT_RAW = 30000        # GfinsSensorsA/B: +-600 m/s^2 limit / 0.02 m/s^2 per bit (ICD)
 
+
+def le16(v):
+    v &= 0xFFFF
+    return [v & 0xFF, v >> 8]
+
+
+def sealed(cid, data7):
+    """Data bytes 0..6 + the CRC-8 over the identifier (2 bytes LE) and them (ICD)."""
+    return data7 + [crc8_sae_j1850([cid & 0xFF, cid >> 8] + data7)]
+
+
+def three_signals(a, b, c, counter):
+    """Three signed 16-bit signals at bits 0, 16, 32, the counter in bits 52..55 (byte 6 high)."""
+    return le16(a) + le16(b) + le16(c) + [counter << 4]
+
+
+def build_extended(src, dst):
+    """Writes the extended log; returns {(line, signal)} of the values written as not available."""
+    lines = [l.rstrip('\n') for l in open(src) if l.strip()]
+    out = []
+    na = set()
+
+    def emit(ts, cid, data):
+        out.append(f'{ts} can0 {cid:03X}#' + ''.join(f'{b:02X}' for b in data))
+        return len(out)
+
+    k = -1
+    counter = 0
+    for l in lines:
+        ts, iface, frame = l.split(' ')
+        cid_s, data_s = frame.split('#')
+        cid = int(cid_s, 16)
+        data = list(bytes.fromhex(data_s))
+        if cid == 0x100:
+            k += 1
+            counter = data[6] >> 4
+        if cid == 0x140 and k % 7 == 3:
+            # Angular rate at the limits and not available: RateX N/A, RateY +limit, RateZ -limit.
+            data = sealed(cid, three_signals(NA_RAW16, RATE_LIMIT_RAW, -RATE_LIMIT_RAW, counter))
+            na.add((emit(ts, cid, data), 'RateX'))
+        else:
+            emit(ts, cid, data)
+        copy = cid + NODE_COPY
+        line = emit(ts, copy, sealed(copy, data[:7]))
+        if cid == 0x140 and k % 7 == 3:
+            na.add((line, 'RateX'))
+        if cid == 0x190:  # after the last default frame of the epoch: the optional sensors
+            for base, names in ((0x1C0, ('Sensor1', 'Sensor2', 'Sensor3')),
+                                (0x1D0, ('Sensor4', 'Sensor5', 'Sensor6'))):
+                raw = [((k * 997 + j * 7919) % 60001) - 30000 for j in range(3)]
+                if k % 5 == 1:
+                    raw[0] = NA_RAW16
+                if k % 5 == 2:
+                    raw[1], raw[2] = SENSOR_LIMIT_RAW, -SENSOR_LIMIT_RAW
+                for node in (0, NODE_COPY):
+                    line = emit(ts, base + node, sealed(base + node, three_signals(*raw, counter)))
+                    if raw[0] == NA_RAW16:
+                        na.add((line, names[0]))
+    with open(dst, 'w') as f:
+        f.write('\n'.join(out) + '\n')
+    return na
+
+
+def check_log(a, log, na_expected, dbc_for_node):
+    """Returns (frames, epochs, values compared, failures) for one log."""
     import can  # python3-can
-
-    os.makedirs(a.workdir, exist_ok=True)
-    log = a.log
-    if log is None:
-        log = os.path.join(a.workdir, 'independent.log')
-        with open(log, 'wb') as f:
-            subprocess.run([a.gen, 'log', str(a.seconds)], stdout=f, check=True)
 
     # 1. python-can reads the log.
     frames = list(can.CanutilsLogReader(log))
@@ -76,7 +134,7 @@ def main():
     # 2. CRC and epoch counter, from the ICD: CRC over id low, id high, bytes 0..6 = byte 7;
     #    counter = high nibble of byte 6, equal within an epoch (opened by id 0x100 + node).
     failures = []
-    epoch_counter = None
+    epoch_counter = {}
     for i, m in enumerate(frames):
         d = bytes(m.data)
         if m.is_extended_id or len(d) != 8:
@@ -87,22 +145,29 @@ def main():
             failures.append(f'frame {i + 1}: CRC mismatch')
         if 0x600 <= cid < 0x700:
             continue  # commands/responses carry no epoch counter
+        node = cid & 0xF
         counter = d[6] >> 4
         if 0x100 <= cid < 0x110:
-            if epoch_counter is not None and counter != (epoch_counter + 1) % 16:
-                failures.append(f'frame {i + 1}: epoch counter {epoch_counter} -> {counter}')
-            epoch_counter = counter
-        elif counter != epoch_counter:
-            failures.append(f'frame {i + 1}: counter {counter} != epoch {epoch_counter}')
+            last = epoch_counter.get(node)
+            if last is not None and counter != (last + 1) % 16:
+                failures.append(f'frame {i + 1}: epoch counter {last} -> {counter}')
+            epoch_counter[node] = counter
+        elif counter != epoch_counter.get(node):
+            failures.append(f'frame {i + 1}: counter {counter} != epoch {epoch_counter.get(node)}')
 
-    # 3. candied decodes every frame with the committed DBC.
+    # 3. candied decodes every frame with its node's DBC.
     ensure_candied()
-    node_in = '\n'.join(json.dumps({'i': i + 1, 'id': m.arbitration_id, 'data': list(m.data)})
-                        for i, m in enumerate(frames))
     env = dict(os.environ, NODE_PATH=os.path.join(HERE, 'node_modules'))
-    res = subprocess.run(['node', os.path.join(HERE, 'decode_with_candied.cjs'), a.dbc],
-                         input=node_in.encode(), stdout=subprocess.PIPE, check=True, env=env)
-    decoded = [json.loads(l) for l in res.stdout.decode().splitlines() if l.strip()]
+    decoded = []
+    for node in sorted({m.arbitration_id & 0xF for m in frames}):
+        node_in = '\n'.join(
+            json.dumps({'i': i + 1, 'id': m.arbitration_id, 'data': list(m.data)})
+            for i, m in enumerate(frames) if m.arbitration_id & 0xF == node)
+        res = subprocess.run(['node', os.path.join(HERE, 'decode_with_candied.cjs'),
+                              dbc_for_node(node)],
+                             input=node_in.encode(), stdout=subprocess.PIPE, check=True, env=env)
+        decoded += [json.loads(l) for l in res.stdout.decode().splitlines() if l.strip()]
+    decoded.sort(key=lambda d: d['i'])
 
     # 4. gfins-can's values per epoch (keyed by the line of its GfinsEpoch frame).
     res = subprocess.run([a.gfins_can, 'decode', log, '--view', 'json', '--quiet'],
@@ -114,39 +179,90 @@ def main():
         e = json.loads(l)
         epochs[e['line']] = e
 
-    # 5. Compare: every decoded signal (except the end-to-end fields) of every frame.
+    # 5. Compare: every decoded signal (except the end-to-end fields) of every frame. A value
+    #    gfins-can shows as not available (null) must be one this script wrote as such, and
+    #    candied must see the not-available raw value there.
     compared = 0
-    current = None
+    na_seen = set()
+    current = {}
     for d in decoded:
         if d['msg'] is None:
             failures.append(f"frame {d['i']}: candied does not know the identifier")
             continue
+        node = frames[d['i'] - 1].arbitration_id & 0xF
         if d['msg'] == 'GfinsEpoch':
-            current = epochs.get(d['i'])
-            if current is None:
+            current[node] = epochs.get(d['i'])
+            if current[node] is None:
                 failures.append(f"frame {d['i']}: gfins-can reported no epoch at this line")
-        if current is None or d['msg'] in ('GfinsCommand', 'GfinsResponse'):
+            elif current[node]['node'] != node:
+                failures.append(f"frame {d['i']}: gfins-can says node {current[node]['node']}")
+        cur = current.get(node)
+        if cur is None or d['msg'] in ('GfinsCommand', 'GfinsResponse'):
             continue
         for name, v in d['values'].items():
             if name in ('Counter', 'Crc'):
                 continue
-            mine = current.get(name)
+            mine = cur.get(name)
             theirs = v['value']
             if mine is None:
-                failures.append(f"frame {d['i']}: {d['msg']}.{name}: gfins-can has no value")
+                if (d['i'], name) in na_expected and v['raw'] == NA_RAW16:
+                    na_seen.add((d['i'], name))
+                else:
+                    failures.append(f"frame {d['i']}: {d['msg']}.{name}: gfins-can has no "
+                                    f"value, candied {theirs} (raw {v['raw']})")
             elif abs(mine - theirs) > ABS_TOL + REL_TOL * max(abs(mine), abs(theirs)):
                 failures.append(f"frame {d['i']}: {d['msg']}.{name}: gfins-can {mine}, "
                                 f"candied {theirs}")
             compared += 1
+    for miss in sorted(na_expected - na_seen):
+        failures.append(f'frame {miss[0]}: {miss[1]} written as not available, not shown so')
+    return len(frames), len(epochs), compared, failures
 
-    print(f'independent decode: {len(frames)} frames, {len(epochs)} epochs, '
-          f'{compared} values compared, {len(failures)} disagreements')
-    for f in failures[:50]:
-        print('  ' + f)
-    if compared < 10 * len(epochs):
-        print('independent decode: too few values compared')
-        return 1
-    return 1 if failures else 0
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--gfins-can', required=True)
+    ap.add_argument('--gen', required=True)
+    ap.add_argument('--dbc', required=True)
+    ap.add_argument('--workdir', required=True)
+    ap.add_argument('--log')
+    ap.add_argument('--seconds', type=float, default=20.0)
+    a = ap.parse_args()
+
+    os.makedirs(a.workdir, exist_ok=True)
+    log = a.log
+    if log is None:
+        log = os.path.join(a.workdir, 'independent.log')
+        with open(log, 'wb') as f:
+            subprocess.run([a.gen, 'log', str(a.seconds)], stdout=f, check=True)
+
+    dbcs = {0: a.dbc}
+
+    def dbc_for_node(node):
+        if node not in dbcs:
+            path = os.path.join(a.workdir, f'gfins_node{node}.dbc')
+            subprocess.run([a.gfins_can, 'dbc', '--node', str(node), '-o', path], check=True)
+            dbcs[node] = path
+        return dbcs[node]
+
+    extended = os.path.join(a.workdir, 'independent_extended.log')
+    na = build_extended(log, extended)
+    status = 0
+    for name, path, na_expected in (('synthetic', log, set()), ('extended', extended, na)):
+        n_frames, n_epochs, compared, failures = check_log(a, path, na_expected, dbc_for_node)
+        print(f'independent decode ({name}): {n_frames} frames, {n_epochs} epochs, '
+              f'{compared} values compared, {len(failures)} disagreements')
+        for f in failures[:50]:
+            print('  ' + f)
+        if compared < 10 * n_epochs:
+            print('independent decode: too few values compared')
+            status = 1
+        if failures:
+            status = 1
+    if len(na) < 10:
+        print('independent decode: too few not-available values written')
+        status = 1
+    return status
 
 
 if __name__ == '__main__':

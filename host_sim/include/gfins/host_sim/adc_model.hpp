@@ -1,5 +1,6 @@
-// The 6-channel, 24-bit simultaneous-sampling delta-sigma ADC (TI ADS131M06 class, DESIGN.md) as
-// a behavioural model: volts at the sensor outputs → one RawSample per data-ready edge.
+// The 6-channel, 24-bit simultaneous-sampling delta-sigma ADC (TI ADS131M06 class,
+// docs/architecture.md) as a behavioural model: volts at the sensor outputs → one RawSample per
+// data-ready edge.
 //
 // Signal chain per channel (all channels sampled at the same instant):
 //

@@ -4,8 +4,9 @@
 //
 // Why slopes 1 and 2. ω is integrated from ω̇; a residual of the compensation that is constant
 // over a run (a calibration error of the angles, a bias) gives a constant ω̇ error c, hence
-// δω = c t and δθ ≈ c t²/2: log-log slopes 1 and 2 (notes §5). White sensor noise alone gives a
-// random walk: δω ∝ √t and δθ ∝ t^1.5 (slopes 0.5 and 1.5).
+// δω = c t and δθ ≈ c t²/2: log-log slopes 1 and 2 (docs/math.md, "Error growth without a
+// gyroscope"). White sensor noise alone gives a random walk: δω ∝ √t and δθ ∝ t^1.5 (slopes 0.5
+// and 1.5).
 #pragma once
 
 #include <array>

@@ -1,5 +1,5 @@
 // The one sample source of the host: trajectory → sensor model → ADC → RawSample, the frames the
-// board's ADC driver would hand to the pipeline (DESIGN.md, "one path for a sample").
+// board's ADC driver would hand to the pipeline (docs/architecture.md, "one path for a sample").
 //
 //   Trajectory::at(t_k)            truth at t_k = k / rate (analytic, trajectory.hpp)
 //   SensorArrayModel::volts(x)     six QA-1100 output voltages, with every sensor error

@@ -1,8 +1,9 @@
 // Trajectories with analytic truth: attitude, rate, angular acceleration, position, velocity and
 // kinematic acceleration of the array centre o_b at any instant, exact to floating-point rounding.
 //
-// Frames (DESIGN.md): navigation frame NED fixed at the alignment point and treated as inertial;
-// body frame FRD at the array centre o_b. q_nb rotates body vectors into the navigation frame.
+// Frames (docs/architecture.md): navigation frame NED fixed at the alignment point and treated as
+// inertial; body frame FRD at the array centre o_b. q_nb rotates body vectors into the navigation
+// frame.
 //
 // How the truth is made exact. Every trajectory is written once as a function of time over the
 // jet scalar of jet.hpp: position r_n(t) as three jets and attitude q_nb(t) as a quaternion of

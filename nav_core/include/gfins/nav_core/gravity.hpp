@@ -1,6 +1,6 @@
-// Gravity in the navigation frame of DESIGN.md: local-level North-East-Down axes fixed at the
-// alignment point and treated as inertial (Earth rate neglected, as in the paper), so gravity
-// points along +z (down). Two models: a constant magnitude, or WGS-84 normal gravity at the
+// Gravity in the navigation frame of docs/architecture.md: local-level North-East-Down axes fixed
+// at the alignment point and treated as inertial (Earth rate neglected, as in the paper), so
+// gravity points along +z (down). Two models: a constant magnitude, or WGS-84 normal gravity at the
 // alignment latitude with its free-air variation along the height.
 #pragma once
 

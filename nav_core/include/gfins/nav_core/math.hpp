@@ -1,6 +1,6 @@
 // Fixed-size linear algebra vocabulary of the navigation core and the few rotation helpers the
 // integrator needs. Everything is templated on the scalar: float on the target, double for the
-// host reference (DESIGN.md). No function here allocates.
+// host reference (docs/architecture.md). No function here allocates.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,6 +1,6 @@
 // The per-sample navigation pipeline: front end → compensator → Chen mechanization → strapdown
 // integrator, with static alignment at start. This is what the firmware's sample loop and the
-// host simulation both run (DESIGN.md, data flow).
+// host simulation both run (docs/architecture.md, data flow).
 #pragma once
 
 #include <array>
@@ -92,8 +92,8 @@ class NavPipeline {
     start_at_specific_force(initial, s);
   }
 
-  /// One ADC frame: the pipeline's one input (DESIGN.md, "one path for a sample"). Returns the
-  /// phase after it; in kNavigating, state() is valid at s.t_ns.
+  /// One ADC frame: the pipeline's one input (docs/architecture.md, "one path for a sample").
+  /// Returns the phase after it; in kNavigating, state() is valid at s.t_ns.
   ///
   /// Per frame, in this order:
   ///   - counters().samples grows;

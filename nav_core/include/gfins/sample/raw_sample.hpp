@@ -1,6 +1,7 @@
 // One ADC frame as it crosses the sample seam: what the ADC driver produces on the board, what
 // the host simulation and the replay produce on the PC, and the one input of the navigation
-// pipeline (DESIGN.md, data flow). A std-only vocabulary type shared by every layer, like Status.
+// pipeline (docs/architecture.md, data flow). A std-only vocabulary type shared by every layer,
+// like Status.
 #pragma once
 
 #include <array>

@@ -111,9 +111,47 @@ ConfigResult parse_config(std::string_view toml_text, const std::string& source,
 /// Reads and parses a file.
 ConfigResult load_config(const std::string& path, FwConfig base = {});
 
-/// Checks every field (ranges, enumerations, consistency); `origin` names where the values came
+/// The first rule a configuration breaks: `key` ("can.node_id"), `value` as shown in messages
+/// (strings quoted and escaped by quote_text()) and `allowed` (what the key accepts).
+struct ConfigProblem {
+  std::string key;
+  std::string value;
+  std::string allowed;
+};
+
+/// Checks every field (ranges, enumerations, consistency, and every rule on values the run
+/// applies when it opens the board: interface names, line offsets, addresses, paths). Returns
+/// the first problem, or nothing when all are valid.
+std::optional<ConfigProblem> check(const FwConfig& c);
+
+/// check() as one message "ORIGIN: key = value: allowed"; `origin` names where the values came
 /// from. Returns "" when all are valid.
 std::string validate(const FwConfig& c, const std::string& origin);
+
+/// Checks against the file system what the run would otherwise find only when it gets there:
+/// the scenario of the simulated board (it loads, and runs at adc.sample_rate_hz) and the output
+/// files (can.log_file, hil.port_file on the hil board, `latency_csv` when not empty: the folder
+/// exists and the path is not a folder). Devices (SPI, GPIO, CAN interface, watchdog) are not
+/// opened: the run reports those at start-up, before the loop starts. Returns "" or
+/// "ORIGIN: key = value: problem".
+std::string preflight(const FwConfig& c, const std::string& origin,
+                      const std::string& latency_csv = {});
+
+/// For --check-config: "" when the run would navigate with a calibration (calibration.file
+/// loads, or it is empty on the simulated board, whose factory calibration is used), else why
+/// it would navigate UNCALIBRATED (not an error: the run starts, flagged, docs/firmware.md).
+std::string calibration_note(const FwConfig& c);
+
+/// `s` in double quotes with '"', '\', control characters (C0, DEL, C1) and the bytes of invalid
+/// UTF-8 escaped (\uXXXX, \xNN), cut to 60 characters: a value as a message shows it.
+std::string quote_text(std::string_view s);
+
+/// `s` with control characters other than '\n' and '\t', and invalid UTF-8, escaped: safe to
+/// print.
+std::string printable_text(std::string_view s);
+
+/// A non-empty path of at most 4095 bytes of valid UTF-8 without control characters.
+bool valid_path(std::string_view s);
 
 /// The commented default configuration (what firmware/app/gfins-fw.toml ships).
 std::string default_config_text();
@@ -135,6 +173,7 @@ nav::CompensatorKind resolve_compensator(CompensatorChoice choice, nav::Compensa
 struct CliResult {
   std::optional<FwConfig> config;
   std::string config_source;  // the file the configuration came from ("" = built-in defaults)
+  std::string origin;         // "my.toml", "my.toml + command line", "built-in defaults", ...
   bool check_only = false;    // --check-config: validate and exit
   std::string latency_csv;    // --latency-csv: write the edge→CAN latency histogram (benchmark)
   int exit_code = 0;          // when !config

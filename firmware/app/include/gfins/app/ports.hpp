@@ -105,7 +105,6 @@ enum class CommandResult : std::uint8_t {
   kMalformed = 5,   // frame could not be decoded
   kBusy = 6,        // a capture or reload is already running
   kFailed = 7,      // executed but failed (reload: bad file; the previous calibration stays)
-  kNotReady = 8,    // not possible in the current mode
 };
 
 /// Calibration capture statistics of one channel, in ADC codes.

@@ -14,6 +14,7 @@
 #include "gfins/app/log_queue.hpp"
 #include "gfins/app/ports.hpp"
 #include "gfins/app/reload_worker.hpp"
+#include "gfins/app/status_board.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
 #include "gfins/hal/watchdog.hpp"
@@ -73,6 +74,9 @@ class SampleLoop {
   void set_command_codec(const CommandCodec* codec) { codec_ = codec; }
   void set_watchdog(hal::Watchdog* wd) { watchdog_ = wd; }
   void set_reload_worker(ReloadWorker* w) { reload_ = w; }
+  /// Where each cycle leaves the mode and health for the service status line (read by another
+  /// thread: service_status.hpp).
+  void set_status_board(StatusBoard* b) { status_board_ = b; }
 
   /// Start-up: configures the pipeline (alignment starts with the first sample).
   [[nodiscard]] Status configure(const CalibrationSet& cal, const LoopOptions& options);
@@ -126,6 +130,7 @@ class SampleLoop {
   const CommandCodec* codec_ = nullptr;
   hal::Watchdog* watchdog_ = nullptr;
   ReloadWorker* reload_ = nullptr;
+  StatusBoard* status_board_ = nullptr;
 
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};

@@ -38,6 +38,11 @@ struct CandumpRecord {
   std::int64_t time_us() const { return seconds * 1000000 + micros; }
 };
 
+/// True for a line can-utils skips as a comment: blank, or not starting with '(' (canplayer and
+/// log2asc skip every such line; leading blanks are allowed here, as the parser allows them).
+/// A line holding control characters (binary data) is not a comment: it is reported malformed.
+bool is_candump_comment(std::string_view line);
+
 /// Parses one line (trailing "\r\n" ignored). Errors are kInvalidArgument with a message naming
 /// the part that is wrong ("candump: identifier is not 3 or 8 hex digits", ...), or
 /// kUnimplemented for a CAN FD frame.

@@ -34,7 +34,8 @@ enum class ResultCode : std::uint8_t {
   kMalformed = 5,  // bits the opcode does not use are not zero
   kBusy = 6,       // e.g. a capture is already running
   kFailed = 7,     // valid command, execution failed (e.g. calibration file unreadable)
-  kNotReady = 8,   // valid command, not possible in the current mode
+  // 8 was "NotReady" in the first drafts of the ICD; no command depends on the mode (every one
+  // is valid while aligning or navigating), so it is not a result the board gives.
 };
 
 const char* to_string(ResultCode r);

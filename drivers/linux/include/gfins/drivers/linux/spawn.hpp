@@ -1,5 +1,5 @@
-// Starting a helper program without a shell (DESIGN.md: process I/O is a Linux backend; the
-// project brief: user text never goes through a shell; posix_spawn with an argument vector).
+// Starting a helper program without a shell (docs/architecture.md: process I/O is a Linux backend;
+// the project brief: user text never goes through a shell; posix_spawn with an argument vector).
 //
 // The program and every argument go to posix_spawn(3) as separate argv strings, so an argument
 // is never parsed: quotes, `;`, `$()`, spaces, newlines and a leading `-` reach the child as the

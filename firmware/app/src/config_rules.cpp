@@ -1,0 +1,197 @@
+// The value rules of the configuration (gfins/app/config.hpp, check()): ranges, enumerations,
+// rules between keys, and every rule the board's backends apply to a value when the run opens
+// them, so that a configuration check() accepts is not refused later for its values.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "gfins/app/config.hpp"
+
+namespace gfins::app {
+namespace {
+
+// Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the NUL), no '/', no whitespace.
+bool valid_ifname(const std::string& s) {
+  return !s.empty() && s.size() <= 15 && std::all_of(s.begin(), s.end(), [](char ch) {
+    return ch > 0x20 && ch < 0x7F && ch != '/' && ch != ':';
+  });
+}
+
+// A dotted-quad IPv4 address, as inet_pton(AF_INET) accepts it: four decimal numbers 0..255.
+bool valid_ipv4(const std::string& s) {
+  int parts = 0;
+  std::size_t i = 0;
+  while (i <= s.size()) {
+    std::size_t j = i;
+    while (j < s.size() && s[j] >= '0' && s[j] <= '9') ++j;
+    if (j == i || j - i > 3 || std::stoi(s.substr(i, j - i)) > 255) return false;
+    // inet_pton accepts no leading zero ("01" is refused as possibly octal)
+    if (j - i > 1 && s[i] == '0') return false;
+    ++parts;
+    if (j == s.size()) break;
+    if (s[j] != '.' || parts == 4) return false;
+    i = j + 1;
+  }
+  return parts == 4;
+}
+
+// The data-ready line as gfins-fw opens it (open_drdy): all digits = a line offset, anything
+// else a line name; a sign in front of digits is a mistyped offset, not a name.
+std::string drdy_line_problem(const std::string& s) {
+  constexpr int kMaxLineOffset = 1023;  // = the TOML integer form's bound (Reader::line)
+  const std::size_t digits_from = !s.empty() && (s[0] == '-' || s[0] == '+') ? 1 : 0;
+  if (s.size() > digits_from &&
+      s.find_first_not_of("0123456789", digits_from) == std::string::npos) {
+    if (digits_from == 1 || s.size() > 4 || std::stoi(s) > kMaxLineOffset) {
+      return "line offset must be 0.." + std::to_string(kMaxLineOffset);
+    }
+    return "";
+  }
+  if (s.empty() || s.size() > 31 ||
+      !std::all_of(s.begin(), s.end(), [](char ch) { return ch > 0x20 && ch < 0x7F; })) {
+    return "must be a line offset 0..1023 or a line name of 1..31 printable ASCII characters "
+           "without spaces";
+  }
+  return "";
+}
+
+std::string num(double x) {
+  std::ostringstream o;
+  o << x;
+  return o.str();
+}
+
+constexpr const char* kPathRule = "must be a path of valid UTF-8 without control characters";
+
+// The first rule `c` breaks: which key, its value as shown, and what is allowed.
+}  // namespace
+
+std::optional<ConfigProblem> check(const FwConfig& c) {
+  using P = ConfigProblem;
+  if (std::find(kSampleRatesHz.begin(), kSampleRatesHz.end(), c.sample_rate_hz) ==
+      kSampleRatesHz.end()) {
+    return P{"adc.sample_rate_hz", num(c.sample_rate_hz),
+             "must be 500, 1000, 2000 or 4000 (ADS131M06 data rates at 8.192 MHz)"};
+  }
+  // spidev names its nodes /dev/spidevB.C (bus B, chip select C).
+  const std::string spidev = "/dev/spidev";
+  const std::string bc =
+      c.spi_device.rfind(spidev, 0) == 0 ? c.spi_device.substr(spidev.size()) : "";
+  const auto dot = bc.find('.');
+  const auto digits = [](const std::string& t) {
+    return !t.empty() && t.size() < 4 && t.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (dot == std::string::npos || !digits(bc.substr(0, dot)) || !digits(bc.substr(dot + 1))) {
+    return P{"adc.spi_device", quote_text(c.spi_device),
+             "must be a spidev node /dev/spidevB.C (bus B, chip select C)"};
+  }
+  if (!valid_path(c.gpio_chip)) {
+    return P{"adc.gpio_chip", quote_text(c.gpio_chip),
+             "must be a chip name or path of valid UTF-8 without control characters"};
+  }
+  if (std::string why = drdy_line_problem(c.drdy_line); !why.empty()) {
+    return P{"adc.drdy_line", quote_text(c.drdy_line), why};
+  }
+  // Checked with a log file too: the candump lines carry the interface name.
+  if (!valid_ifname(c.can_interface)) {
+    return P{"can.interface", quote_text(c.can_interface),
+             "must be an interface name of 1..15 characters without '/', ':' or spaces"};
+  }
+  if (!c.can_log.empty() && !valid_path(c.can_log)) {
+    return P{"can.log_file", quote_text(c.can_log),
+             std::string(kPathRule) + " (or empty for none)"};
+  }
+  if (c.node_id < 0 || c.node_id > kMaxNodeId) {
+    return P{"can.node_id", std::to_string(c.node_id),
+             "must be an integer 0.." + std::to_string(kMaxNodeId)};
+  }
+  for (std::size_t m = 0; m < kNumMessages; ++m) {
+    if (c.dividers[m] > kMaxDivider) {
+      return P{"output." + std::string(kMessageNames[m]), std::to_string(c.dividers[m]),
+               "must be 0 (off) .. " + std::to_string(kMaxDivider)};
+    }
+  }
+  // The CAN message table's rule: epoch and status open every epoch, so they share a divider
+  // (not 0), and every other enabled message is a multiple of it (its frames follow an epoch).
+  const std::uint16_t epoch_div = c.dividers[0];
+  if (epoch_div == 0) return P{"output.epoch", "0", "must be 1.." + std::to_string(kMaxDivider)};
+  if (c.dividers[1] != epoch_div) {
+    return P{"output.status", std::to_string(c.dividers[1]),
+             "must equal output.epoch (" + std::to_string(epoch_div) + ")"};
+  }
+  for (std::size_t m = 2; m < kNumMessages; ++m) {
+    if (c.dividers[m] % epoch_div != 0) {
+      return P{"output." + std::string(kMessageNames[m]), std::to_string(c.dividers[m]),
+               "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) + ")"};
+    }
+  }
+  if (!(c.gravity_mps2 >= 9.7 && c.gravity_mps2 <= 9.9)) {
+    return P{"navigation.gravity_mps2", num(c.gravity_mps2),
+             "must be 9.7..9.9 m/s² (the Earth's surface range is 9.76..9.84)"};
+  }
+  if (!(std::abs(c.latitude_deg) <= 90.0)) {
+    return P{"navigation.latitude_deg", num(c.latitude_deg), "must be -90..90 degrees"};
+  }
+  if (!(c.height_m >= -500.0 && c.height_m <= 20000.0)) {
+    return P{"navigation.height_m", num(c.height_m),
+             "must be -500..20000 m (the normal gravity's free-air term is first order)"};
+  }
+  if (!(c.heading_deg >= -360.0 && c.heading_deg <= 360.0)) {
+    return P{"navigation.heading_deg", num(c.heading_deg), "must be -360..360 degrees"};
+  }
+  for (double p : c.position_m) {
+    if (!std::isfinite(p) || std::abs(p) > 1e7) {
+      return P{"navigation.position_m", num(p), "components must be finite, |x| <= 1e7 m"};
+    }
+  }
+  if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
+    return P{"navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s"};
+  }
+  if (!c.calibration_file.empty() && !valid_path(c.calibration_file)) {
+    return P{"calibration.file", quote_text(c.calibration_file),
+             std::string(kPathRule) + " (or empty for none)"};
+  }
+  if (c.rt_priority < 0 || c.rt_priority > kMaxRtPriority) {
+    return P{"realtime.priority", std::to_string(c.rt_priority), "must be 0 (no SCHED_FIFO) .. 99"};
+  }
+  if (!valid_path(c.watchdog_device)) {
+    return P{"watchdog.device", quote_text(c.watchdog_device), kPathRule};
+  }
+  static constexpr std::array<const char*, 6> kLevels = {"trace", "debug", "info",
+                                                         "warn",  "error", "off"};
+  if (std::find_if(kLevels.begin(), kLevels.end(),
+                   [&](const char* l) { return c.log_level == l; }) == kLevels.end()) {
+    return P{"log.level", quote_text(c.log_level),
+             "must be \"trace\", \"debug\", \"info\", \"warn\", \"error\" or \"off\""};
+  }
+  if (!valid_path(c.sim_scenario)) {
+    return P{"sim.scenario", quote_text(c.sim_scenario),
+             "must be a scenario name or a .toml file (valid UTF-8, no control characters)"};
+  }
+  if (!c.sim_scenario_dir.empty() && !valid_path(c.sim_scenario_dir)) {
+    return P{"sim.scenario_dir", quote_text(c.sim_scenario_dir),
+             std::string(kPathRule) + " (or empty for the installed scenarios)"};
+  }
+  if (!(c.sim_duration_s >= 0.0 && c.sim_duration_s <= 86400.0)) {
+    return P{"sim.duration_s", num(c.sim_duration_s), "must be 0 (the scenario's) .. 86400 s"};
+  }
+  if (!valid_ipv4(c.hil_address)) {
+    return P{"hil.address", quote_text(c.hil_address),
+             "must be an IPv4 address a.b.c.d (each 0..255), e.g. \"127.0.0.1\""};
+  }
+  if (c.hil_port < 0 || c.hil_port > 65535) {
+    return P{"hil.port", std::to_string(c.hil_port), "must be 0 (ephemeral) .. 65535"};
+  }
+  if (!c.hil_port_file.empty() && !valid_path(c.hil_port_file)) {
+    return P{"hil.port_file", quote_text(c.hil_port_file),
+             std::string(kPathRule) + " (or empty for none)"};
+  }
+  return std::nullopt;
+}
+
+std::string validate(const FwConfig& c, const std::string& origin) {
+  const std::optional<ConfigProblem> p = check(c);
+  return p ? origin + ": " + p->key + " = " + p->value + ": " + p->allowed : std::string();
+}
+
+}  // namespace gfins::app

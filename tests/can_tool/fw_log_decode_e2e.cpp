@@ -1,0 +1,327 @@
+// The must-show, end to end with the real programs: `gfins-fw --sim` writes a candump log
+// (--can-log), `gfins-can decode --view csv` decodes it, and every decoded navigation value
+// equals a host-only run of the navigation core on the same scenario's samples within that
+// signal's quantisation step; gfins-can's summary shows continuous counters and valid CRCs.
+//
+// Independent of the code under test: the steps and limits are read from the committed DBC text
+// (docs/can/gfins.dbc, "SG_ name : start|len@1± (factor,offset) [min|max]"), the default output
+// dividers and the quaternion/Euler conventions are written here from docs/can-interface.md, and
+// the reference is NavPipeline<float>::process() on the samples of host_sim's sample source
+// through the ADC chip model (the firmware's start-up configuration, not its loop or publisher).
+// A negative control runs the same comparison against a core with another compensator and
+// requires it to fail: the comparison can tell a wrong state from a right one.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gfins/app/config.hpp"
+#include "gfins/app/startup.hpp"
+#include "gfins/host_sim/scenario.hpp"
+#include "gfins/nav_core/pipeline.hpp"
+#include "gfins/sim_board/sim_board.hpp"
+#include "support/cli_fixture.hpp"
+
+namespace gfins {
+namespace {
+
+// ---- The run ----------------------------------------------------------------------------------
+
+constexpr const char* kScenario = "maneuver";  // 6-DoF motion: every signal moves
+constexpr int kSeconds = 4;
+constexpr double kHeadingDeg = 30.0;  // non-zero, so the initial heading must be carried
+constexpr int kRateHz = 1000;         // the scenario's rate = the firmware's adc.sample_rate_hz
+constexpr std::uint32_t kSamples = kSeconds * kRateHz + 1;  // seq 0 .. 4000
+
+// Default dividers (docs/can-interface.md, "Rates, dividers and bus load"): a message is in the
+// epoch of sample seq when seq % divider == 0.
+constexpr std::uint32_t kEpochDivider = 10;
+const std::map<std::string, std::uint32_t> kDividerOf = {
+    {"TimeUs", 10}, {"SampleCount", 10}, {"Qw", 10},      {"Qx", 10},      {"Qy", 10},
+    {"Qz", 10},     {"Roll", 20},        {"Pitch", 20},   {"Yaw", 20},     {"RateX", 10},
+    {"RateY", 10},  {"RateZ", 10},       {"AngAccX", 20}, {"AngAccY", 20}, {"AngAccZ", 20},
+    {"AccelX", 10}, {"AccelY", 10},      {"AccelZ", 10},  {"VelN", 10},    {"VelE", 10},
+    {"VelD", 10},   {"PosN", 10},        {"PosE", 10},    {"PosD", 10}};
+
+// The CSV prints each value with %.10g (docs/can-interface.md, views): a relative rounding of at
+// most 5e-10; 1e-9 of the value covers it and is far below any step (1e-4 rad of 3 rad is 3e-5).
+constexpr double kPrintRelative = 1e-9;
+// The two Euler computations (the firmware's and this test's, both from the same float
+// quaternion in double) differ by a few double ulps: 1e-9 rad, 1e-5 of the 1e-4 rad step.
+constexpr double kEulerFormulaRad = 1e-9;
+
+// ---- The DBC, read as text --------------------------------------------------------------------
+
+struct Step {
+  double factor = 0, min = 0, max = 0;
+};
+
+std::map<std::string, Step> dbc_steps(const std::string& path) {
+  std::ifstream f(path);
+  std::map<std::string, Step> out;
+  std::string line;
+  while (std::getline(f, line)) {
+    // " SG_ Roll : 0|16@1- (0.0001,0) [-3.1416|3.1416] "rad" HOST"
+    std::istringstream in(line);
+    std::string tag, name, colon, layout;
+    if (!(in >> tag >> name >> colon >> layout) || tag != "SG_" || colon != ":") continue;
+    Step s;
+    char c = 0;
+    double offset = 0;
+    in >> c >> s.factor >> c >> offset >> c >> c >> s.min >> c >> s.max;
+    if (in && offset == 0) out[name] = s;
+  }
+  return out;
+}
+
+// ---- The decoded CSV --------------------------------------------------------------------------
+
+struct Table {
+  std::vector<std::string> names;  // "Roll" of "Roll[rad]"
+  std::vector<std::vector<std::string>> rows;
+  int col(const std::string& n) const {
+    const auto it = std::find(names.begin(), names.end(), n);
+    return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+  }
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(s);
+  while (std::getline(in, cell, ',')) out.push_back(cell);
+  if (!s.empty() && s.back() == ',') out.emplace_back();
+  return out;
+}
+
+Table read_csv(const std::string& text) {
+  Table t;
+  std::istringstream in(text);
+  std::string line;
+  if (std::getline(in, line)) {
+    for (const std::string& h : split(line)) t.names.push_back(h.substr(0, h.find('[')));
+  }
+  while (std::getline(in, line)) t.rows.push_back(split(line));
+  return t;
+}
+
+// ---- The host-only core run -------------------------------------------------------------------
+
+struct HostRun {
+  std::map<std::uint32_t, nav::NavState<float>> at_seq;  // the core's state after sample seq
+  std::string error;
+};
+
+/// The samples gfins-fw --sim reads (host_sim's sample source → ADS131M06 model → real driver,
+/// sample k at t = k · 1 ms), through the core configured as the firmware's start-up configures
+/// it with --calibration "" on the simulated board (its factory calibration, the scenario's).
+/// `compensator_override`: the negative control.
+HostRun host_core_run(const nav::CompensatorKind* compensator_override) {
+  HostRun out;
+  auto parsed = sim::load_scenario(kScenario, GFINS_SCENARIO_DIR);
+  if (!parsed.is_ok()) return {{}, parsed.error().message};
+  const sim::Scenario& s = parsed.value();
+  auto stream = sim_board::make_scenario_stream(s);
+  if (!stream.is_ok()) return {{}, stream.error().message};
+  sim_board::ChipAdc adc(s.rate_hz);
+  if (!adc.start().is_ok()) return {{}, "chip model did not start"};
+
+  app::FwConfig fc;
+  fc.calibration_file.clear();
+  fc.heading_deg = kHeadingDeg;
+  const calib_file::CalibrationData factory =
+      sim_board::scenario_calibration(s, adc.volts_per_count());
+  const app::StartupCalibration cal = app::load_calibration(fc, factory, &factory);
+  const app::LoopOptions lo = app::loop_options(fc);
+  nav::PipelineConfig<float> cfg = cal.set.config;
+  cfg.sample_rate_hz = static_cast<float>(lo.sample_rate_hz);
+  cfg.heading_rad = lo.initial_heading_rad;
+  cfg.r0_n = lo.initial_position_n;
+  if (compensator_override != nullptr) cfg.compensator = *compensator_override;
+  auto pipe = std::make_unique<nav::NavPipeline<float>>();
+  if (!pipe->configure(cfg).is_ok()) return {{}, "pipeline configuration refused"};
+  for (std::uint32_t k = 0; k < kSamples; ++k) {
+    const auto t_ns = static_cast<std::int64_t>(k) * (1'000'000'000 / kRateHz);
+    auto r = adc.convert(stream.value()->volts(k), k, t_ns);
+    if (!r.is_ok()) return {{}, "sample " + std::to_string(k) + ": " + r.status().message()};
+    pipe->process(r.value());
+    if (k % kEpochDivider == 0) {
+      nav::NavState<float> n = pipe->state();
+      n.t_ns = t_ns;
+      n.seq = k;
+      out.at_seq[k] = n;
+    }
+  }
+  return out;
+}
+
+/// The value the ICD says a signal carries for state n (docs/can-interface.md, Messages).
+double expected(const std::string& name, const nav::NavState<float>& n) {
+  const auto d = [](float v) { return static_cast<double>(v); };
+  // The bus carries the quaternion with w >= 0 (q and -q are one attitude).
+  const double qs = n.q_nb.w() < 0 ? -1.0 : 1.0;
+  const double w = qs * d(n.q_nb.w()), x = qs * d(n.q_nb.x()), y = qs * d(n.q_nb.y()),
+               z = qs * d(n.q_nb.z());
+  static const std::map<std::string, int> kAxis = {
+      {"RateX", 0},   {"RateY", 1},  {"RateZ", 2},  {"AngAccX", 0}, {"AngAccY", 1},
+      {"AngAccZ", 2}, {"AccelX", 0}, {"AccelY", 1}, {"AccelZ", 2},  {"VelN", 0},
+      {"VelE", 1},    {"VelD", 2},   {"PosN", 0},   {"PosE", 1},    {"PosD", 2}};
+  if (name == "TimeUs") return static_cast<double>(static_cast<std::uint32_t>(n.t_ns / 1000));
+  if (name == "SampleCount") return static_cast<double>(n.seq & 0xFFFFu);
+  if (name == "Qw") return w;
+  if (name == "Qx") return x;
+  if (name == "Qy") return y;
+  if (name == "Qz") return z;
+  // ZYX Euler angles of q_nb (roll, pitch, yaw), the aerospace formulas.
+  if (name == "Roll") return std::atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y));
+  if (name == "Pitch") return std::asin(std::clamp(2 * (w * y - z * x), -1.0, 1.0));
+  if (name == "Yaw") return std::atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z));
+  const int i = kAxis.at(name);
+  if (name.starts_with("Rate")) return d(n.w_b(i));
+  if (name.starts_with("AngAcc")) return d(n.wdot_b(i));
+  if (name.starts_with("Accel")) return d(n.f_b(i));
+  if (name.starts_with("Vel")) return d(n.v_n(i));
+  return d(n.r_n(i));
+}
+
+struct Comparison {
+  std::size_t values = 0, outside = 0, missing = 0, unknown_rows = 0;
+  std::map<std::string, double> worst_steps;
+  std::string first_outside;
+};
+
+Comparison compare(const Table& t, const std::map<std::string, Step>& steps, const HostRun& host) {
+  Comparison c;
+  const int sc = t.col("SampleCount");
+  for (const auto& row : t.rows) {
+    if (sc < 0 || row.size() != t.names.size()) {
+      ++c.unknown_rows;
+      continue;
+    }
+    // 4000 samples: SampleCount (seq mod 2^16) is seq itself.
+    const auto seq = static_cast<std::uint32_t>(std::stoul(row[static_cast<std::size_t>(sc)]));
+    const auto it = host.at_seq.find(seq);
+    if (it == host.at_seq.end()) {
+      ++c.unknown_rows;
+      continue;
+    }
+    for (const auto& [name, divider] : kDividerOf) {
+      if (seq % divider != 0) continue;  // not due in this epoch
+      const std::string& cell = row[static_cast<std::size_t>(t.col(name))];
+      if (cell.empty()) {
+        ++c.missing;
+        continue;
+      }
+      const Step& s = steps.at(name);
+      const double got = std::stod(cell);
+      const double want = std::clamp(expected(name, it->second), s.min, s.max);
+      const double tol =
+          0.5 * s.factor + kPrintRelative * std::abs(want) +
+          (name == "Roll" || name == "Pitch" || name == "Yaw" ? kEulerFormulaRad : 0);
+      const double diff = std::abs(got - want);
+      c.worst_steps[name] = std::max(c.worst_steps[name], diff / s.factor);
+      ++c.values;
+      if (diff > tol) {
+        if (c.outside++ == 0) {
+          c.first_outside = name + " at seq " + std::to_string(seq) + ": decoded " + cell +
+                            ", core " + std::to_string(want);
+        }
+      }
+    }
+  }
+  return c;
+}
+
+// ---- The test ---------------------------------------------------------------------------------
+
+class FwLogDecode : public test::CliTest {};
+
+TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
+  // Given the steps of the committed DBC
+  const auto steps = dbc_steps(GFINS_DBC);
+  for (const auto& [name, divider] : kDividerOf) {
+    ASSERT_TRUE(steps.contains(name)) << name << " not in " << GFINS_DBC;
+  }
+  EXPECT_EQ(steps.at("Roll").factor, 1e-4);  // the ICD's Euler step, rad: the parser works
+  EXPECT_EQ(steps.at("PosN").factor, 0.01);
+
+  // When gfins-fw --sim writes its candump log and gfins-can decodes it
+  const std::string log = path("fw.log"), csv = path("fw.csv");
+  const auto fw = run(GFINS_FW_EXE, {"--sim", kScenario, "--scenario-dir", GFINS_SCENARIO_DIR,
+                                     "--calibration", "", "--heading-deg", "30", "--can-log", log,
+                                     "--duration", std::to_string(kSeconds), "--watchdog", "none"});
+  ASSERT_EQ(fw.exit_code, 0) << fw.output;
+  const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--view", "csv", "-o", csv});
+  ASSERT_EQ(dec.exit_code, 0) << dec.output;
+  const Table t = read_csv(test::slurp(csv));
+
+  // Then gfins-can's summary: every epoch, every frame ok, no problem at all (no bad CRC, no
+  // counter jump, no drop, duplicate or reorder). Frame counts from the default dividers:
+  // 401 epochs (seq 0, 10, ..., 4000), 201 at divider 20, 5 health frames (seq 0, 1000, ...).
+  constexpr int kEpochs = kSamples / kEpochDivider + 1;
+  constexpr int kHalfRate = kSamples / 20 + 1, kHealth = kSeconds + 1;
+  constexpr int kFrames = 8 * kEpochs + 2 * kHalfRate + 2 * kHealth;
+  const std::string f = std::to_string(kFrames);
+  EXPECT_NE(dec.err.find("summary: " + f + " lines, " + f + " frames (" + f + " ok), " +
+                         std::to_string(kEpochs) + " epochs, 0 commands, 0 responses, 0 problems"),
+            std::string::npos)
+      << dec.err;
+  EXPECT_NE(dec.err.find("GfinsEpoch=" + std::to_string(kEpochs) +
+                         " GfinsStatus=" + std::to_string(kEpochs)),
+            std::string::npos)
+      << dec.err;
+  EXPECT_NE(dec.err.find("GfinsEuler=" + std::to_string(kHalfRate)), std::string::npos) << dec.err;
+  ASSERT_EQ(t.rows.size(), static_cast<std::size_t>(kEpochs));
+
+  // ... and every navigation value equals the host-only core run within its step
+  const HostRun host = host_core_run(nullptr);
+  ASSERT_TRUE(host.error.empty()) << host.error;
+  const Comparison c = compare(t, steps, host);
+  EXPECT_EQ(c.unknown_rows, 0u);
+  EXPECT_EQ(c.missing, 0u) << "a message due in an epoch was not decoded";
+  EXPECT_EQ(c.outside, 0u) << c.first_outside;
+  // 401 epochs × (time 2 + quaternion 4 + rate 3 + accel 3 + velocity 3 + position 3 = 18)
+  // + 201 × (Euler 3 + angular acceleration 3) values
+  EXPECT_EQ(c.values, static_cast<std::size_t>(kEpochs * 18 + kHalfRate * 6));
+  double worst = 0;
+  for (const auto& [name, steps_off] : c.worst_steps) worst = std::max(worst, steps_off);
+  std::printf(
+      "fw-log e2e: %zu values compared, %zu outside their step, largest difference %.3f "
+      "step(s)\n",
+      c.values, c.outside, worst);
+  // The run moved: the comparison is not of zeros (maneuver: metres and tens of degrees).
+  const int pn = t.col("PosN"), yaw = t.col("Yaw");
+  double max_pos = 0, max_yaw = 0;
+  for (const auto& row : t.rows) {
+    if (!row[static_cast<std::size_t>(pn)].empty())
+      max_pos = std::max(max_pos, std::abs(std::stod(row[static_cast<std::size_t>(pn)])));
+    if (!row[static_cast<std::size_t>(yaw)].empty())
+      max_yaw = std::max(max_yaw, std::abs(std::stod(row[static_cast<std::size_t>(yaw)])));
+  }
+  EXPECT_GT(max_pos, 0.1);                                           // m
+  EXPECT_GT(max_yaw, kHeadingDeg * std::numbers::pi / 180.0 * 0.5);  // rad
+
+  // Negative control: the same comparison against a core with no compensation (the scenario's
+  // array is misaligned, Table 6) must find values outside their step.
+  const nav::CompensatorKind none = nav::CompensatorKind::kNone;
+  const HostRun wrong = host_core_run(&none);
+  ASSERT_TRUE(wrong.error.empty()) << wrong.error;
+  const Comparison cw = compare(t, steps, wrong);
+  EXPECT_GT(cw.outside, cw.values / 10) << "the comparison cannot tell another compensator";
+  std::printf(
+      "fw-log e2e, negative control (compensator none): %zu of %zu values outside their "
+      "step (first: %s)\n",
+      cw.outside, cw.values, cw.first_outside.c_str());
+}
+
+}  // namespace
+}  // namespace gfins

@@ -1,0 +1,151 @@
+// gfins-fw as a user runs it (issue 8 review, items 3, 4 and 15a): --check-config and the run
+// accept and refuse the same configurations with the same message; messages reach the terminal
+// whole and escaped; output paths are checked before any work; a CAN log that loses frames
+// makes the run fail. The expected texts are written out here.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "support/cli_fixture.hpp"
+
+namespace gfins {
+namespace {
+
+class FwCli : public test::CliTest {
+ protected:
+  test::CliResult fw(const std::vector<std::string>& args) const { return run(GFINS_FW_EXE, args); }
+  // The simulated board, factory calibration, 0.2 s after the 1 s alignment: a short run.
+  std::vector<std::string> sim_run(std::vector<std::string> extra,
+                                   const std::string& scenario = "rest",
+                                   const std::string& can_log = "") const {
+    std::vector<std::string> a = {"--sim",          scenario,
+                                  "--calibration",  "",
+                                  "--duration",     "1.2",
+                                  "--can-log",      can_log.empty() ? path("out.log") : can_log,
+                                  "--scenario-dir", GFINS_SCENARIO_DIR};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  }
+};
+
+// The run's own start-up line: present only when the run got as far as starting.
+constexpr const char* kStarted = "sample loop running";
+
+TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;  // stderr, whole
+  };
+  const std::vector<Case> cases = {
+      {sim_run({"--can", "a b"}),
+       "gfins-fw: command line: can.interface = \"a b\": must be an interface name of 1..15 "
+       "characters without '/', ':' or spaces\n"},
+      {sim_run({"--drdy-line", "-5"}),
+       "gfins-fw: command line: adc.drdy_line = \"-5\": line offset must be 0..1023\n"},
+      {sim_run({"--sample-rate", "2000"}),
+       "gfins-fw: built-in defaults + command line: sim.scenario = \"rest\": runs at 1000 Hz: "
+       "adc.sample_rate_hz must be the same\n"},
+      {sim_run({}, "nosuchscenario"), ""},  // the loader's message, checked by prefix
+      {sim_run({}, "rest", "/nonexistent-gfins/out.log"),
+       "gfins-fw: built-in defaults + command line: can.log_file = "
+       "\"/nonexistent-gfins/out.log\": its folder \"/nonexistent-gfins\" does not exist\n"},
+      {sim_run({"--latency-csv", "/nonexistent-gfins/x.csv"}),
+       "gfins-fw: built-in defaults + command line: --latency-csv = \"/nonexistent-gfins/x.csv\": "
+       "its folder \"/nonexistent-gfins\" does not exist\n"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> check = c.args;
+    check.push_back("--check-config");
+    const test::CliResult checked = fw(check);
+    const test::CliResult ran = fw(c.args);
+    EXPECT_EQ(checked.exit_code, 2) << checked.output;
+    EXPECT_EQ(ran.exit_code, 2) << ran.output;
+    EXPECT_EQ(checked.err, ran.err);
+    if (!c.message.empty()) {
+      EXPECT_EQ(ran.err, c.message);
+    } else {
+      EXPECT_EQ(ran.err.rfind("gfins-fw: built-in defaults + command line: sim.scenario = "
+                              "\"nosuchscenario\": ",
+                              0),
+                0u)
+          << ran.err;
+    }
+    // Refused before anything started (the output files were never created).
+    EXPECT_EQ(ran.output.find(kStarted), std::string::npos) << ran.output;
+  }
+  // And a configuration one accepts, the other runs.
+  std::vector<std::string> good = sim_run({});
+  const test::CliResult ran = fw(good);
+  good.push_back("--check-config");
+  const test::CliResult checked = fw(good);
+  EXPECT_EQ(checked.exit_code, 0) << checked.output;
+  EXPECT_EQ(checked.output,
+            "gfins-fw: configuration (built-in defaults + command line) is valid\n");
+  EXPECT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_NE(ran.output.find(kStarted), std::string::npos) << ran.output;
+}
+
+TEST_F(FwCli, MessagesArriveWholeWithControlCharactersEscaped) {
+  // A NUL inside a value used to end the message there (no reason, no newline); an ESC went to
+  // the terminal raw.
+  const std::string nul = file("n.toml", "[can]\ninterface = \"can0\\u0000x\"\n");
+  const test::CliResult n = fw({"-c", nul, "--check-config"});
+  EXPECT_EQ(n.exit_code, 2);
+  EXPECT_EQ(n.err, "gfins-fw: " + nul +
+                       ":2: can.interface = \"can0\\u0000x\": must be an interface name of 1..15 "
+                       "characters without '/', ':' or spaces\n");
+  const std::string esc = file("e.toml", "[log]\nlevel = \"info\\u001b[31m\"\n");
+  const test::CliResult e = fw({"-c", esc, "--check-config"});
+  EXPECT_EQ(e.exit_code, 2);
+  EXPECT_EQ(e.err, "gfins-fw: " + esc +
+                       ":2: log.level = \"info\\u001B[31m\": must be \"trace\", \"debug\", "
+                       "\"info\", \"warn\", \"error\" or \"off\"\n");
+  EXPECT_EQ(e.err.find('\x1B'), std::string::npos);
+  // Options too (CLI11's own message quotes the value): an ESC given on the command line.
+  const test::CliResult o = fw({"--compensator", "best\x1B[2J"});
+  EXPECT_EQ(o.exit_code, 2);
+  EXPECT_EQ(o.err.find('\x1B'), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("best\\u001B[2J"), std::string::npos) << o.err;
+}
+
+TEST_F(FwCli, CheckConfigNamesWhatTheConfigurationIsMadeOf) {
+  const std::string cfg =
+      file("c.toml", std::string("[board]\nkind = \"sim\"\n[calibration]\nfile = "
+                                 "\"\"\n[sim]\nscenario_dir = \"") +
+                         GFINS_SCENARIO_DIR + "\"\n");
+  EXPECT_EQ(fw({"-c", cfg, "--check-config"}).output,
+            "gfins-fw: configuration (" + cfg + ") is valid\n");
+  EXPECT_EQ(fw({"-c", cfg, "--node-id", "3", "--check-config"}).output,
+            "gfins-fw: configuration (" + cfg + " + command line) is valid\n");
+  // A UTF-8 path is a path (item 2); the missing file is a note, not an error: the run would
+  // start flagged uncalibrated.
+  const std::string cafe = path("caf\xC3\xA9.toml");
+  const test::CliResult c = fw({"--calibration", cafe, "--check-config"});
+  EXPECT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("is valid\ngfins-fw: note: calibration.file = \"" + cafe + "\": "),
+            std::string::npos)
+      << c.output;
+  EXPECT_NE(c.output.find("a run would navigate UNCALIBRATED"), std::string::npos) << c.output;
+}
+
+TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  // /dev/full refuses every write with ENOSPC: every frame is lost.
+  const test::CliResult r = fw(sim_run({}, "rest", "/dev/full"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("[error] can.log_file = \"/dev/full\": candump file: disk full, frames "
+                          "dropped: No space left on device (errno 28); "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(" frames not written ("), std::string::npos) << r.output;
+  // The same run into a file that takes the frames ends well, its log complete.
+  const test::CliResult ok = fw(sim_run({}));
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_EQ(ok.output.find("frames not written"), std::string::npos) << ok.output;
+  EXPECT_GT(std::filesystem::file_size(path("out.log")), 0u);
+}
+
+}  // namespace
+}  // namespace gfins
