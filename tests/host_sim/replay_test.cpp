@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
@@ -99,8 +101,11 @@ TYPED_TEST(ReplayTest, ReplayFromAFileEqualsReplayFromMemory) {
   h.sample_rate_hz = kRateHz;
   h.volts_per_count.fill(f.adc.volts_per_count());
   h.geometry = nav::table1_geometry(kRhoM);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "gfins_replay_test.gfr").string();
+  // One file per run and scalar: ctest runs the float and double cases at the same time.
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("gfins_replay_test_" + std::to_string(std::random_device{}()) + "_" +
+                             std::to_string(sizeof(TypeParam)) + ".gfr"))
+                               .string();
   ASSERT_TRUE(write_recording(path, h, f.samples).is_ok());
   const auto rec = read_recording(path);
   ASSERT_TRUE(rec.is_ok()) << rec.error().message;
