@@ -13,7 +13,12 @@ Run it with /usr/bin/python3 (Debian's python3-matplotlib).
 import csv
 import math
 import os
+import signal
 import sys
+
+# Ctrl-C (SIGINT, which the terminal sends to gfins-sim and this script alike) ends the script
+# the way it ends any command-line program, without a Python traceback: the default action.
+signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 try:
     import matplotlib
@@ -88,7 +93,8 @@ def plot_envelopes(out_dir, fig_title):
     for ax in axes[-1]:
         ax.set_xlabel("t, s")
     fig.suptitle(f"predicted error envelopes: {fig_title}", fontsize=11)
-    fig.tight_layout()
+    # The title gets its own band above the first row (tight_layout alone lets the two meet).
+    fig.tight_layout(rect=(0, 0, 1, 0.965))
     fig.savefig(os.path.join(out_dir, "covariance.png"), dpi=110)
     plt.close(fig)
 
@@ -122,9 +128,15 @@ def plot_budget(out_dir, fig_title):
             ax.set_ylabel(f"1σ ({unit})")
             ax.set_title(f"{title} at t = {t_b:g} s", fontsize=9)
             ax.grid(True, axis="y", which="both", alpha=0.3)
-            ax.legend(fontsize=6)
+            # Headroom above the tallest bar (a third of the log span) holds the legend in one
+            # row, so it covers no bar (it sat on the z bars before).
+            ys = [float(r[n]) * scale for r in rows for n in names if float(r[n]) > 0]
+            if ys:
+                lo, hi = min(ys) / 3, max(ys) * 3
+                ax.set_ylim(lo, hi * (hi / lo) ** 0.45)
+            ax.legend(fontsize=6, loc="upper center", ncol=max(1, len(rows)), frameon=False)
     fig.suptitle(f"error budget by source: {fig_title}", fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.975))
     fig.savefig(os.path.join(out_dir, "budget.png"), dpi=90)
     plt.close(fig)
 

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "gfins/host_sim/covariance.hpp"
+#include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "run_options.hpp"
 
@@ -30,12 +31,14 @@ HostStatus check_options(const Scenario& s, const CovarianceOptions& c) {
       return HostError{ErrorCode::kInvalidArgument, buf};
     }
   }
+  // The run covers whole sample periods (sample_count): a time past its last sample is outside.
+  const double covered = covered_duration_s(s);
   for (double t : c.times_s) {
-    if (!std::isfinite(t) || t <= 0 || t > s.duration_s) {
+    if (!std::isfinite(t) || t <= 0 || t > covered * (1.0 + 1e-12)) {
       std::snprintf(buf, sizeof buf,
                     "--at %g: outside the run of scenario %s: a budget time must be in (0, %g] s "
-                    "(its duration_s)",
-                    t, s.name.c_str(), s.duration_s);
+                    "(its last sample)",
+                    t, s.name.c_str(), covered);
       return HostError{ErrorCode::kOutOfRange, buf};
     }
   }
@@ -68,7 +71,7 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   spec.trajectory = traj.value().get();
   spec.geometry = nav::table1_geometry<double>(s.rho_m);
   spec.gravity = gravity_model(s);
-  spec.duration_s = s.duration_s;
+  spec.duration_s = covered_duration_s(s);  // the same samples as a run of it
   spec.dt_s = 1.0 / s.rate_hz;
   spec.decimation = static_cast<std::size_t>(std::max(1.0, std::round(s.rate_hz / 100.0)));
   const double g = nav::kStandardGravity;
@@ -83,11 +86,25 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   spec.constants.orientation_sigma_rad.fill(c.orientation_urad * 1e-6);
   spec.constants.location_sigma_m.fill(c.location_mm * 1e-3);
   std::vector<double> times = c.times_s;
-  if (times.empty()) times = {0.25 * s.duration_s, 0.5 * s.duration_s, s.duration_s};
+  if (times.empty()) times = {0.25 * spec.duration_s, 0.5 * spec.duration_s, spec.duration_s};
   std::printf(
       "gfins-sim covariance %s: noise %.3g m/s^2, bias %.3g ug, bias rw %.3g m/s^2/sqrt(s)\n",
       describe(s).c_str(), noise, c.bias_ug, rw);
+  // The propagation keeps decimated envelopes only; the reference run holds its series.
+  print_estimate(sample_count(s), 1,
+                 static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
+                 static_cast<double>(sample_count(s)) * kMcSecondsPerSampleRun,
+                 "the reference run; the propagation adds its own time");
+  // Ctrl-C/SIGTERM are taken between the phases (propagation, files, reference run), so every
+  // file written is whole; the phases themselves run to their end (seconds for the built-ins).
+  const StopSignals handlers;
+  const auto interrupted = [&](const char* kept) {
+    std::fprintf(stderr, "gfins-sim: interrupted (signal %d): %s\n",
+                 static_cast<int>(g_stop_signal), kept);
+    return kExitInterrupted;
+  };
   const CovarianceReport report = covariance_report(spec, times, c.jobs);
+  if (g_stop_signal != 0) return interrupted("nothing written");
   const CovarianceResult& r = report.envelopes;
   if (auto w = write_covariance_csv(r, out_dir + "/covariance.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
@@ -110,7 +127,12 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   // One run of the scenario (its own sensor errors) through the navigation core in the chosen
   // scalar: a sample of what the envelopes predict, written next to them. The propagation
   // above is the linear error model in double whatever the core's scalar.
-  const auto ref = run_scenario(s, tty_progress("reference run"), false, scalar.value());
+  if (g_stop_signal != 0)
+    return interrupted("covariance.csv and budget.csv written, no reference run");
+  const auto ref =
+      run_scenario(s, run_progress("reference run", covered_duration_s(s)), false, scalar.value());
+  if (g_stop_signal != 0)
+    return interrupted("covariance.csv and budget.csv written, no reference run");
   if (!ref.is_ok()) return fail(ref.error(), kExitError);
   const std::string ref_path = out_dir + "/reference_run.csv";
   if (auto w = write_series_csv(ref.value().compensated, ref_path, spec.decimation); !w.is_ok()) {

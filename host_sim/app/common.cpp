@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -24,6 +25,21 @@ HostStatus make_dir(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return HostError{ErrorCode::kIoError, "cannot create " + dir + ": " + ec.message()};
+  return Done{};
+}
+
+HostStatus check_writable(const std::vector<std::string>& paths) {
+  for (const std::string& p : paths) {
+    std::error_code ec;
+    const bool existed = std::filesystem::exists(p, ec);
+    std::FILE* f = std::fopen(p.c_str(), existed ? "r+" : "w");
+    if (f == nullptr) {
+      return HostError{ErrorCode::kIoError, "cannot write " + p + ": " + std::strerror(errno) +
+                                                " (checked before the work)"};
+    }
+    static_cast<void>(std::fclose(f));
+    if (!existed) static_cast<void>(std::remove(p.c_str()));
+  }
   return Done{};
 }
 
@@ -85,7 +101,46 @@ ProgressFn tty_progress(const std::string& what) {
   };
 }
 
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+namespace {
+extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+}  // namespace
+
+StopSignals::StopSignals() {
+  g_stop_signal = 0;
+  old_int_ = std::signal(SIGINT, on_stop_signal);
+  old_term_ = std::signal(SIGTERM, on_stop_signal);
+}
+
+StopSignals::~StopSignals() {
+  std::signal(SIGINT, old_int_);
+  std::signal(SIGTERM, old_term_);
+}
+
+void print_estimate(std::uint64_t samples, std::size_t runs, double memory_bytes, double seconds,
+                    const std::string& note) {
+  std::string text = "estimate: " + std::to_string(samples) + " samples";
+  if (runs > 1) text += " x " + std::to_string(runs) + " runs";
+  char buf[128];
+  if (memory_bytes >= 0) {
+    std::snprintf(buf, sizeof buf, ", memory about %.0f MB", memory_bytes / 1e6);
+    text += buf;
+  }
+  if (seconds >= 0) {
+    std::snprintf(buf, sizeof buf, ", time about %.2g s", seconds);
+    text += buf;
+  }
+  if (!note.empty()) text += " (" + note + ")";
+  std::printf("%s\n", text.c_str());
+  static_cast<void>(std::fflush(stdout));
+}
+
 ProgressFn run_progress(const std::string& what, double duration_s) {
+  return log_progress(what, duration_s, "s");
+}
+
+ProgressFn log_progress(const std::string& what, double total, const std::string& unit) {
   if (isatty(fileno(stderr)) != 0) return tty_progress(what);
   double interval = kProgressIntervalS;
   if (const char* v = std::getenv("GFINS_PROGRESS_INTERVAL_S"); v != nullptr && *v != '\0') {
@@ -96,12 +151,17 @@ ProgressFn run_progress(const std::string& what, double duration_s) {
   using Clock = std::chrono::steady_clock;
   const auto every =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(interval));
-  return [what, duration_s, every, next = Clock::now() + every](double f) mutable {
+  return [what, total, unit, every, next = Clock::now() + every](double f) mutable {
     const auto now = Clock::now();
     if (now < next || f >= 1.0) return;
     next = now + every;
-    std::fprintf(stderr, "progress: %s: %.0f %% (t = %.3f of %.3f s)\n", what.c_str(), f * 100.0,
-                 f * duration_s, duration_s);
+    if (unit == "s") {
+      std::fprintf(stderr, "progress: %s: %.0f %% (t = %.3f of %.3f s)\n", what.c_str(), f * 100.0,
+                   f * total, total);
+    } else {
+      std::fprintf(stderr, "progress: %s: %.0f %% (%.0f of %.0f %s)\n", what.c_str(), f * 100.0,
+                   std::floor(f * total + 1e-9), total, unit.c_str());
+    }
     static_cast<void>(std::fflush(stderr));
   };
 }
@@ -130,7 +190,18 @@ std::string describe(const Scenario& s) {
                 gfins::nav::to_string(s.compensator),
                 s.misalignment_source == MisalignmentSource::kTrue ? "true" : "calibrated",
                 s.adc ? "counts through the ADC" : "m/s^2 without ADC (paper §6.3)");
-  return buf;
+  std::string text = buf;
+  // A duration that is not a whole number of sample periods ends at the last whole one
+  // (sample_count): said, so that 1.4 s at 1 Hz is not mistaken for a run to 1.4 s.
+  if (covered_duration_s(s) < s.duration_s * (1.0 - 1e-9)) {
+    std::snprintf(buf, sizeof buf,
+                  "\n  duration_s %g is not a whole number of sample periods at %g Hz: the run "
+                  "ends at the last whole one, t = %.9g s (%llu samples)",
+                  s.duration_s, s.rate_hz, covered_duration_s(s),
+                  static_cast<unsigned long long>(sample_count(s)));
+    text += buf;
+  }
+  return text;
 }
 
 void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c) {

@@ -2,6 +2,8 @@
 // scripts (started without a shell), progress and the summary tables.
 #pragma once
 
+#include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -30,6 +32,11 @@ HostResult<Scenario> load(const std::string& file_or_name);
 /// Creates the output folder (and its parents).
 HostStatus make_dir(const std::string& dir);
 
+/// Before the work: each of `paths` can be created for writing (a read-only folder, a name that
+/// is a folder, a full disk's quota fail here, not after minutes of work). The probe files are
+/// removed again.
+HostStatus check_writable(const std::vector<std::string>& paths);
+
 /// Closes an output file. A failed write or close (disk full, I/O error) leaves the file
 /// incomplete, so it is an error. The error flag is read first because fclose alone reports
 /// only the last flush (glibc returns 0 after an earlier ENOSPC).
@@ -52,6 +59,35 @@ ProgressFn tty_progress(const std::string& what);
 /// first line before they interrupt a run.
 ProgressFn run_progress(const std::string& what, double duration_s);
 inline constexpr double kProgressIntervalS = 5.0;
+
+/// The same for work counted in other units (montecarlo: runs; replay: samples): off a terminal
+/// "progress: NAME: P % (X of TOTAL UNIT)" every kProgressIntervalS (or
+/// $GFINS_PROGRESS_INTERVAL_S) seconds.
+ProgressFn log_progress(const std::string& what, double total, const std::string& unit);
+
+/// Set to the signal's number by the handler StopSignals installs; the long commands (run,
+/// montecarlo, gfins-replay) poll it and stop at a clean point, with what they wrote complete.
+extern volatile std::sig_atomic_t g_stop_signal;
+
+/// SIGINT/SIGTERM handlers for the lifetime of the object (g_stop_signal reset to 0 first), the
+/// previous ones back on destruction.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  void (*old_int_)(int);
+  void (*old_term_)(int);
+};
+
+/// Printed before the work starts (issue 10, "estimate samples, memory and time before
+/// starting"): "estimate: N samples[ x R runs], memory about M MB, time about T s". A negative
+/// memory or time is left out.
+void print_estimate(std::uint64_t samples, std::size_t runs, double memory_bytes, double seconds,
+                    const std::string& note);
 
 struct NavSummary {
   double att_final_deg = 0, att_max_deg = 0;

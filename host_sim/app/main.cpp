@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commands.hpp"
@@ -64,8 +65,8 @@ int sim_main(int argc, char** argv) {
   cli.add_option("--scalar", o.scalar, "navigation core scalar")
       ->check(CLI::IsMember({"float", "double"}))
       ->capture_default_str();
-  cli.add_option("--csv", o.csv_path,
-                 "write t, attitude/velocity/position errors of the ideal run");
+  auto* csv_opt = cli.add_option("--csv", o.csv_path,
+                                 "write t, attitude/velocity/position errors of the ideal run");
 
   std::string scenario_name;
   app::OutputOptions out;
@@ -96,9 +97,10 @@ int sim_main(int argc, char** argv) {
   cov->add_option("--location-mm", cov_opts.location_mm,
                   "residual location error 1 sigma per axis, mm");
   cov->add_option("--at", cov_opts.times_s, "budget times, s (default T/4, T/2, T)");
-  run_cmd->add_option("--record", out.record,
-                      "also write the raw-sample recording (.gfr, docs/recording-format.md) of "
-                      "the samples the run navigated");
+  auto* record_opt =
+      run_cmd->add_option("--record", out.record,
+                          "also write the raw-sample recording (.gfr, docs/recording-format.md) of "
+                          "the samples the run navigated");
   run_cmd->add_option("--decimate", out.decimate, "write every N-th sample to the CSV files")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
@@ -130,6 +132,16 @@ int sim_main(int argc, char** argv) {
   }
   out.plot = !no_plot;
   for (const auto* opt : out_opts) out.dir_given = out.dir_given || opt->count() > 0;
+  // An empty file name given on purpose is a mistake, not "no file" (it was silently ignored).
+  for (const auto& [opt, value, what] :
+       {std::tuple{record_opt, &out.record, "the recording's file name (.gfr)"},
+        std::tuple{csv_opt, &o.csv_path, "the CSV file's name"}}) {
+    if (opt->count() > 0 && value->empty()) {
+      std::fprintf(stderr, "gfins-sim: %s is empty: give %s, or leave the option out\n",
+                   opt->get_name().c_str(), what);
+      return app::kExitBadInput;
+    }
+  }
   if (*run_cmd) return app::cmd_run(scenario_name, out);
   if (*p63) return app::cmd_paper63(out);
   if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out);

@@ -11,6 +11,7 @@
 // the first --align-s seconds (roll and pitch from the mean specific force, heading given), then
 // strapdown navigation, driven by sample index (never wall-clock), bit-exact run to run.
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -45,6 +46,7 @@ struct ReplayOptions {
   std::string recording;
   std::string cal;
   app::OutputOptions out;
+  bool still_check = true;  // !--no-still-check
   double align_s = 1.0;
   double heading_deg = 0.0;
   double gravity_mps2 = nav::kStandardGravity;
@@ -55,13 +57,37 @@ struct ReplayOptions {
 /// the 1e-9 of a decimal round trip of a double means a file of another board or gain.
 constexpr double kLsbMismatchRel = 1e-6;
 
+/// Largest standard deviation of a channel, in g, over a still alignment window: the QA-1100's
+/// 70 µg rms noise (datasheet, 10-500 Hz) and a lab bench's vibration stay far below it, while
+/// an array that turns (spin.gfr at 3 rad/s: 0.15-0.6 g) or is carried is far above it. The
+/// calibration's static detector decides stillness the same way (channel standard deviations).
+constexpr double kStillStdG = 5e-3;
+
+/// `text` with control characters shown as \xNN, for a one-line '#' header or message (a file
+/// name may contain a newline).
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\x%02x", static_cast<unsigned>(u));
+      out += esc;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 // ---- dump -------------------------------------------------------------------------------------
 
 int dump(const std::string& path) {
   auto reader = sim::RecordingReader::open(path);
   if (!reader.is_ok()) return fail(reader.error().message, app::kExitBadInput);
   const sim::RecordingHeader& h = reader.value().header();
-  std::printf("# gfins raw-sample recording %s (docs/recording-format.md)\n", path.c_str());
+  std::printf("# gfins raw-sample recording %s (docs/recording-format.md)\n",
+              printable(path).c_str());
   std::printf("# version %u, %u channels, %u records per block, record_count %s\n",
               static_cast<unsigned>(h.version), static_cast<unsigned>(h.channel_count),
               static_cast<unsigned>(h.records_per_block),
@@ -315,12 +341,17 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   std::uint64_t written = 0;
   nav::NavState<T> last{};
   std::uint64_t since = every;  // write the first state
-  // Progress on a terminal, from the record count of a closed recording.
+  // Progress (a terminal: percentage; a log: a line every few seconds), from the record count of
+  // a closed recording.
   const sim::ProgressFn progress =
-      h.record_count != sim::kRecordCountUnknown ? app::tty_progress("replay") : sim::ProgressFn{};
+      h.record_count != sim::kRecordCountUnknown
+          ? app::log_progress("replay", static_cast<double>(h.record_count), "samples")
+          : sim::ProgressFn{};
   const std::uint64_t step = std::max<std::uint64_t>(h.record_count / 100, 1);
+  const app::StopSignals handlers;  // Ctrl-C/SIGTERM: stop between two samples, files complete
   const auto result = sim::replay_recording<T>(
-      o.recording, *pipeline, [&](std::uint64_t index, const nav::NavState<T>& s) {
+      o.recording, *pipeline,
+      [&](std::uint64_t index, const nav::NavState<T>& s) {
         if (progress && (index % step == 0 || index + 1 == h.record_count)) {
           progress(static_cast<double>(index + 1) / static_cast<double>(h.record_count));
         }
@@ -332,7 +363,9 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
         if (since++ % every != 0) return;
         write_row(csv, static_cast<double>(s.t_ns - t0_ns) * 1e-9, s);
         ++written;
-      });
+      },
+      &app::g_stop_signal);
+  const int stop_signal = app::g_stop_signal;
   // The last state always ends the file (decimated or not), so the CSV reaches the end.
   if (result.is_ok() && have_t0 && (since - 1) % every != 0) {
     write_row(csv, static_cast<double>(last.t_ns - t0_ns) * 1e-9, last);
@@ -355,6 +388,12 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
                  app::scalar_text(std::is_same_v<T, float> ? sim::NavScalar::kFloat
                                                            : sim::NavScalar::kDouble));
     print_report(f, r, h.sample_rate_hz);
+    if (stop_signal != 0) {
+      std::fprintf(f,
+                   "interrupted (signal %d) after %" PRIu64
+                   " samples: navigation.csv holds the states up to there\n",
+                   stop_signal, r.samples);
+    }
     if (r.navigating > 0) {
       const auto& v = last.v_n;
       const auto& p = last.r_n;
@@ -369,6 +408,13 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   std::printf("written: %s (%" PRIu64 " states%s), %s\n", csv_path.c_str(), written,
               every > 1 ? (", every " + std::to_string(every) + "th state").c_str() : "",
               summary_path.c_str());
+  if (stop_signal != 0) {
+    std::fprintf(stderr, "gfins-replay: interrupted after %" PRIu64 " samples (%s)\n", r.samples,
+                 summary_path.c_str());
+    return app::kExitInterrupted;
+  }
+  // Only a recording whose writer was not closed (record count unknown) gets here: a closed
+  // one too short for the alignment is refused before any work (run_navigate).
   if (r.navigating == 0) {
     return fail("no navigation state: the recording (" + std::to_string(r.samples) +
                     " samples) ends within the alignment of " +
@@ -387,6 +433,59 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   }
   std::printf("figures: %s/replay.png\n", out_dir.c_str());
   return app::kExitOk;
+}
+
+/// Static alignment takes roll and pitch from the mean specific force of its window, which is
+/// gravity only when the array is still. The window's samples are read first and each channel's
+/// standard deviation, in g through the front end's LSB and scale factor, must stay within
+/// kStillStdG; otherwise the run is refused with the figures (--no-still-check overrides).
+gfins::sim::HostStatus check_still(const std::string& path, const nav::PipelineConfig<double>& c) {
+  auto reader = sim::RecordingReader::open(path);
+  if (!reader.is_ok()) return reader.error();
+  const std::uint64_t n = c.alignment_samples;
+  std::array<double, 6> mean{};
+  std::array<double, 6> m2{};
+  std::uint64_t k = 0;
+  std::vector<RawSample> block;
+  while (k < n) {
+    auto more = reader.value().next_block(block);
+    if (!more.is_ok()) return more.error();
+    if (!more.value()) break;
+    for (const RawSample& x : block) {
+      if (k >= n) break;
+      if ((x.flags & (gfins::sample_flags::kCrcError | gfins::sample_flags::kSaturated)) != 0) {
+        continue;  // rejected by the pipeline too
+      }
+      ++k;
+      for (std::size_t j = 0; j < 6; ++j) {  // Welford's running mean and sum of squares
+        const double g = static_cast<double>(x.counts[j]) * c.front_end.volts_per_count[j] /
+                         c.front_end.scale_v_per_g[j];
+        const double d = g - mean[j];
+        mean[j] += d / static_cast<double>(k);
+        m2[j] += d * (g - mean[j]);
+      }
+    }
+  }
+  if (k < 2) return gfins::sim::Done{};  // too short to tell; the length checks report it
+  std::size_t worst = 0;
+  std::array<double, 6> sd{};
+  for (std::size_t j = 0; j < 6; ++j) {
+    sd[j] = std::sqrt(m2[j] / static_cast<double>(k - 1));
+    if (sd[j] > sd[worst]) worst = j;
+  }
+  if (!(sd[worst] > kStillStdG)) return gfins::sim::Done{};
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "%s: the array is not still during the alignment (the first %llu samples, %.6g "
+                "s): standard deviation of the sensor outputs a1..a6 = %.3g %.3g %.3g %.3g %.3g "
+                "%.3g g, largest a%zu, where a still array stays below %.3g g. Alignment takes "
+                "roll and pitch from the mean specific force, which is gravity only at rest: "
+                "start the recording at rest, shorten --align-s to the still part, or pass "
+                "--no-still-check",
+                printable(path).c_str(), static_cast<unsigned long long>(k),
+                static_cast<double>(n) / c.sample_rate_hz, sd[0], sd[1], sd[2], sd[3], sd[4], sd[5],
+                worst + 1, kStillStdG);
+  return gfins::sim::HostError{ErrorCode::kInvalidArgument, buf};
 }
 
 int run_navigate(ReplayOptions& o) {
@@ -411,6 +510,23 @@ int run_navigate(ReplayOptions& o) {
   std::string cal_text;
   const auto cfg = config_of(o, h, cal_text);
   if (!cfg.is_ok()) return fail(cfg.error().message, app::kExitBadInput);
+  if (h.record_count != sim::kRecordCountUnknown &&
+      cfg.value().alignment_samples >= h.record_count) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "--align-s %g: the alignment takes %u samples, the recording has %llu (%.6g s at "
+                  "%g Hz): nothing would be left to navigate; give --align-s below %.6g s",
+                  o.align_s, static_cast<unsigned>(cfg.value().alignment_samples),
+                  static_cast<unsigned long long>(h.record_count),
+                  static_cast<double>(h.record_count) / h.sample_rate_hz, h.sample_rate_hz,
+                  static_cast<double>(h.record_count - 1) / h.sample_rate_hz);
+    return fail(buf, app::kExitBadInput);
+  }
+  if (o.still_check) {
+    if (auto st = check_still(o.recording, cfg.value()); !st.is_ok()) {
+      return fail(st.error().message, app::kExitBadInput);
+    }
+  }
   if (auto d = app::make_dir(dir.value()); !d.is_ok()) {
     return fail(d.error().message, app::kExitError);
   }
@@ -422,11 +538,17 @@ int run_navigate(ReplayOptions& o) {
 int replay_main(int argc, char** argv) {
   const char* footer =
       "Exit codes: 0 ok; 1 an output could not be written; 2 command line, recording or "
-      "calibration file rejected; 3 CSV written but plotting failed (PNG asked for).";
+      "calibration file rejected (also: --align-s longer than the recording, an array that is "
+      "not still during the alignment); 3 CSV written but plotting failed (PNG asked for); 130 "
+      "stopped by Ctrl-C/SIGINT or SIGTERM, navigation.csv and summary.txt complete up to the "
+      "sample in summary.txt.";
+  // dump and means write to stdout only: no folder, no plot.
+  const char* stdout_footer =
+      "Exit codes: 0 ok; 1 stdout could not be written; 2 command line or recording rejected.";
   if (argc >= 2 && std::string(argv[1]) == "dump") {
     CLI::App cli{"gfins-replay dump: a recording's header and samples as CSV on stdout",
                  "gfins-replay dump"};
-    cli.footer(footer);
+    cli.footer(stdout_footer);
     std::string path;
     cli.add_option("recording", path, "raw-sample recording (.gfr)")->required();
     try {
@@ -442,7 +564,7 @@ int replay_main(int argc, char** argv) {
         "§5) from a rate-table recording: per-sensor mean and standard deviation (V) over its "
         "whole revolutions",
         "gfins-replay means"};
-    cli.footer(footer);
+    cli.footer(stdout_footer);
     MeansOptions m;
     cli.add_option("recording", m.recording, "rate-table recording (.gfr)")->required();
     cli.add_option("--mounting", m.mounting, "fixture pose of the run (0..7)")
@@ -483,6 +605,10 @@ int replay_main(int argc, char** argv) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
   cli.add_option("--align-s", o.align_s, "static alignment at the start, s")->capture_default_str();
+  bool no_still_check = false;
+  cli.add_flag("--no-still-check", no_still_check,
+               "navigate even when the alignment window is not still (channel standard deviation "
+               "above 5 mg)");
   cli.add_option("--heading-deg", o.heading_deg,
                  "initial heading (nothing on board senses it), deg")
       ->check(CLI::Range(-360.0, 360.0))
@@ -496,6 +622,7 @@ int replay_main(int argc, char** argv) {
     return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
   }
   o.out.plot = !no_plot;
+  o.still_check = !no_still_check;
   o.out.dir_given = out_opt->count() > 0;
   return run_navigate(o);
 }

@@ -11,12 +11,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "support/fake_clock.hpp"
@@ -182,6 +186,84 @@ TEST(CandumpFileBus, APartlyWrittenLineIsCutSoTheFileStaysAValidLog) {
     EXPECT_EQ(bus.value()->counters().tx_dropped, 2u);
   }
   EXPECT_EQ(read_text(path), first);
+}
+
+// The real kernel, but every write() waits until the test opens the gate, and says which thread
+// called it.
+class GatedOs : public Os {
+ public:
+  long write(int fd, const void* b, std::size_t n) override {
+    writer_thread = std::this_thread::get_id();
+    calls.fetch_add(1);
+    while (!open.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return Os::write(fd, b, n);
+  }
+  std::atomic<bool> open{false};
+  std::atomic<int> calls{0};
+  std::thread::id writer_thread{};
+};
+
+TEST(CandumpFileBus, BackgroundWriterKeepsFileWritesOffTheCallersThreadAndNeverWaits) {
+  const TempDir dir;
+  const auto path = (dir.path() / "out.log").string();
+  SimClock clock;
+  GatedOs os;
+  // Buffers of 4 line maxima; each line "(0000000000.000000) can0 123#01\n" is 32 bytes and a
+  // buffer is handed over when less than one line maximum is left: L lines per buffer.
+  constexpr std::size_t kLine = 32;
+  constexpr std::size_t kCapacity = 4 * CandumpFileBus::kLineMax;
+  constexpr std::size_t kLinesPerBuffer = (kCapacity - CandumpFileBus::kLineMax) / kLine + 1;
+  auto bus = CandumpFileBus::open(
+      {.path = path, .interface = "can0", .buffer_bytes = kCapacity, .background_writer = true},
+      clock, os);
+  ASSERT_TRUE(bus.is_ok()) << bus.status().message();
+  // Whatever fails below, the disk answers before the bus is destroyed (its flush would wait).
+  struct OpenAtExit {
+    GatedOs& os;
+    ~OpenAtExit() { os.open.store(true); }
+  } open_at_exit{os};
+  const hal::CanFrame f = make(0x123, false, {0x01});
+  // The first buffer fills and goes to the writer, whose write() hangs; the second fills; the
+  // next frame finds the writer still busy: dropped, counted, and send() returned at once.
+  std::size_t accepted = 0;
+  Status refused;
+  for (int i = 0; i < 100; ++i) {
+    const Status st = bus.value()->send(f);
+    if (!st.is_ok()) {
+      refused = st;
+      break;
+    }
+    ++accepted;
+  }
+  EXPECT_EQ(accepted, 2 * kLinesPerBuffer);
+  EXPECT_EQ(refused.code(), ErrorCode::kResourceExhausted);
+  EXPECT_EQ(bus.value()->counters().tx_dropped, 1u);
+  for (int i = 0; i < 5000 && os.calls.load() == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GT(os.calls.load(), 0) << "the writer thread never wrote";
+  EXPECT_NE(os.writer_thread, std::this_thread::get_id());  // not the caller's thread
+  EXPECT_EQ(read_text(path), "");                           // nothing written yet
+  // The disk answers: flush() waits for both buffers, every accepted line is in the file.
+  os.open.store(true);
+  ASSERT_TRUE(bus.value()->flush().is_ok());
+  EXPECT_EQ(bus.value()->counters().tx_frames, accepted);
+  const std::string text = read_text(path);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')), accepted);
+}
+
+TEST(CandumpFileBus, BackgroundWriterReportsADiskThatIsFull) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "no /dev/full";
+  SimClock clock;
+  auto bus = CandumpFileBus::open(
+      {.path = "/dev/full", .interface = "can0", .background_writer = true}, clock);
+  ASSERT_TRUE(bus.is_ok());
+  send_three(*bus.value(), clock);
+  const Status s = bus.value()->flush();
+  EXPECT_EQ(s.os_error(), ENOSPC);
+  EXPECT_EQ(bus.value()->counters().tx_dropped, 3u);
+  EXPECT_EQ(bus.value()->write_errors(), 1u);
+  EXPECT_EQ(bus.value()->last_error().os_error(), ENOSPC);
 }
 
 TEST(CandumpFileBus, AFileThatCannotBeCreatedIsAnIoErrorWithErrno) {

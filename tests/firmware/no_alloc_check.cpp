@@ -16,10 +16,12 @@ namespace {
 using testing::HeapCounter;
 using testing::SimRig;
 
-// Cycles counted: 20 s at 1 kHz after alignment — long enough for every periodic path (event
-// bits expiring after kEventHoldSamples, rate-limited log records, the stuck detector's window).
+// Cycles counted (printed by the test): 20 s at 1 kHz after alignment — long enough for every
+// periodic path (event bits expiring after kEventHoldSamples, rate-limited log records, the stuck
+// detector's window).
 constexpr std::uint32_t kCountedCycles = 20000;
 constexpr std::uint32_t kWarmUpCycles = 1500;  // alignment (1000 samples) plus margin
+constexpr std::uint32_t kDeadCycles = 1000;    // 1 s of a dead ADC: every path of an outage
 
 TEST(NoAlloc, TheDetectorSeesOperatorNewAndMalloc) {
   if (!HeapCounter::available()) GTEST_SKIP() << "AddressSanitizer owns malloc";
@@ -54,13 +56,15 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   rig.configure();
   rig.run_cycles(kWarmUpCycles);
   ASSERT_EQ(rig.loop->mode(), Mode::kNavigating);
-  // When many thousand cycles run, with the CAN sink refusing and going bus-off in between
+  // When many thousand cycles run, with the CAN sink refusing and going bus-off in between, ADC
+  // reads failing (the no-sample epochs and the paced retry) and the ADC dead for a while.
   // The window, phase by phase; the phases add up to kCountedCycles (docs/firmware.md quotes it).
   constexpr std::uint32_t kToFaultsEnd = 11000 - kWarmUpCycles;  // faults at samples 3000..10006
   constexpr std::uint32_t kRefusing = 500;
   constexpr std::uint32_t kBusOff = 500;
-  constexpr std::uint32_t kAfter = kCountedCycles - kToFaultsEnd - kRefusing - kBusOff;
-  static_assert(kToFaultsEnd + kRefusing + kBusOff + kAfter == kCountedCycles);
+  constexpr std::uint32_t kAfter =
+      kCountedCycles - kToFaultsEnd - kRefusing - kBusOff - kDeadCycles;
+  static_assert(kToFaultsEnd + kRefusing + kBusOff + kAfter + kDeadCycles == kCountedCycles);
   std::uint32_t cycles = 0;
   const auto run = [&](std::uint32_t n) {  // counts the cycles that really ran
     for (std::uint32_t i = 0; i < n && !rig.source->finished(); ++i, ++cycles) rig.loop->step();
@@ -73,7 +77,11 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   rig.bus->bus_off(true);
   run(kBusOff);
   rig.bus->bus_off(false);
+  rig.faulty->fail_reads(3);  // three SPI errors at the start of this phase
   run(kAfter);
+  rig.faulty->set_dead(true);  // reads fail at once: the paced no-sample cycles
+  run(kDeadCycles);
+  rig.faulty->set_dead(false);
   const long after = HeapCounter::calls();
   std::printf("[ counted  ] %u sample-loop cycles after start-up, %ld heap calls\n", cycles,
               after - before);
@@ -83,7 +91,8 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   EXPECT_GT(rig.loop->health().stuck_events, 0u);
   EXPECT_GT(rig.loop->health().drdy_timeouts, 0u);
   EXPECT_GT(rig.loop->health().can_tx_dropped, 0u);
-  EXPECT_GE(rig.loop->health().samples, kCountedCycles);
+  EXPECT_EQ(rig.loop->health().adc_read_errors, 3u + kDeadCycles);
+  EXPECT_GE(rig.loop->health().samples, kCountedCycles - kDeadCycles);
   EXPECT_EQ(after - before, 0) << "heap calls inside the sample loop";
 }
 

@@ -40,6 +40,76 @@ class TapSource final : public app::SampleSource {
   std::vector<RawSample> samples_;
 };
 
+/// ADC read failures the chip model cannot make (tests/firmware/faults_test.cpp):
+///  - fail_reads(n): the next n reads take their conversion and then fail as an SPI transfer
+///    error does (kIoError): that conversion is lost;
+///  - set_dead(true): every read fails at once without waiting for an edge, as the ADS131M06
+///    driver does in its kFailed state (kFailedPrecondition). When the ADC comes back, the
+///    conversions made meanwhile are lost (read and dropped until one is not older than the
+///    clock), so the sample clock never runs backwards.
+class FaultySource final : public app::SampleSource {
+ public:
+  FaultySource(app::SampleSource& inner, hal::Clock& clock) : inner_(inner), clock_(clock) {}
+  void fail_reads(std::uint32_t n) { fail_ = n; }
+  void set_dead(bool dead) {
+    if (dead_ && !dead) revive_ = true;
+    dead_ = dead;
+  }
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override {
+    if (dead_) {
+      return Status(ErrorCode::kFailedPrecondition,
+                    "adc: not running (start() failed or not called)");
+    }
+    if (revive_) {
+      revive_ = false;
+      const std::int64_t t = clock_.now_ns();
+      for (;;) {
+        Result<RawSample> r = inner_.read_sample(timeout_ns);
+        if (!r.is_ok() || r.value().t_ns >= t) return r;
+      }
+    }
+    Result<RawSample> r = inner_.read_sample(timeout_ns);
+    if (fail_ > 0 && r.is_ok()) {
+      --fail_;
+      return Status(ErrorCode::kIoError, "spidev: SPI_IOC_MESSAGE failed");
+    }
+    return r;
+  }
+  app::AdcCounters do_counters() const override { return inner_.counters(); }
+  double do_volts_per_count() const override { return inner_.volts_per_count(); }
+
+  app::SampleSource& inner_;
+  hal::Clock& clock_;
+  std::uint32_t fail_ = 0;
+  bool dead_ = false;
+  bool revive_ = false;
+};
+
+/// A publisher that takes too long: while stalls are pending, each epoch handed over moves the
+/// (sample) clock to `stall_ns` after the epoch's edge, as a cycle that overran would.
+class StallingSink final : public app::EpochSink {
+ public:
+  StallingSink(app::EpochSink& next, sim_board::SampleClock& clock) : next_(next), clock_(clock) {}
+  void stall(std::uint32_t epochs, std::int64_t stall_ns) { left_ = epochs, stall_ns_ = stall_ns; }
+  std::uint32_t publish(const app::Epoch& e) override {
+    const std::uint32_t n = next_.publish(e);
+    if (left_ > 0) {
+      --left_;
+      clock_.set(e.nav.t_ns + stall_ns_);
+    }
+    return n;
+  }
+  Status set_divider(std::size_t m, std::uint16_t d) override { return next_.set_divider(m, d); }
+
+ private:
+  app::EpochSink& next_;
+  sim_board::SampleClock& clock_;
+  std::uint32_t left_ = 0;
+  std::int64_t stall_ns_ = 0;
+};
+
 struct SimRig {
   /// `scenario`: a name in host_sim/scenarios; `seconds`: run length (samples = seconds·rate+1).
   SimRig(const std::string& scenario, double seconds, const sim_board::FaultPlan& faults = {},
@@ -54,11 +124,14 @@ struct SimRig {
     stream = std::move(chain.stream);
     adc = std::move(chain.adc);
     source = std::move(chain.source);
-    tap = std::make_unique<TapSource>(*source, samples);
+    faulty = std::make_unique<FaultySource>(*source, clock);
+    tap = std::make_unique<TapSource>(*faulty, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
     publisher = std::make_unique<app::CanEpochSink>(*bus, kNode, app::to_can_dividers(config));
+    stalling = std::make_unique<StallingSink>(*publisher, clock);
     codec = std::make_unique<app::CanCommandCodec>(kNode);
-    recording = std::make_unique<app::RecordingSink>(publisher.get(), samples);
+    // Twice the samples: cycles without a sample publish epochs too (one per period).
+    recording = std::make_unique<app::RecordingSink>(stalling.get(), 2 * std::size_t{samples});
     log = std::make_unique<app::FwLogQueue>();
     factory = sim_board::scenario_calibration(s, adc->volts_per_count());
     cal = app::load_calibration(config, factory, &factory).set;
@@ -97,9 +170,11 @@ struct SimRig {
   std::unique_ptr<sim_board::ChipAdc> adc;
   sim_board::SampleClock clock;
   std::unique_ptr<sim_board::SimSampleSource> source;
+  std::unique_ptr<FaultySource> faulty;
   std::unique_ptr<TapSource> tap;
   std::unique_ptr<sim_board::MemoryCanBus> bus;
   std::unique_ptr<app::CanEpochSink> publisher;
+  std::unique_ptr<StallingSink> stalling;
   std::unique_ptr<app::CanCommandCodec> codec;
   std::unique_ptr<app::RecordingSink> recording;
   std::unique_ptr<app::FwLogQueue> log;

@@ -4,8 +4,8 @@
 // entry, the folder with the exact bytes of the name, and in it exactly the files `run` writes
 // (docs/simulation.md): nothing a shell would have made (PWNED*), nothing else.
 //
-// Runs the real binary (GFINS_SIM_BIN) and the real plot script, so it needs python3-matplotlib
-// (scripts/install-deps.sh); each run is a tiny scenario (0.05 s at 100 Hz).
+// Runs the real binaries (GFINS_SIM_BIN, GFINS_REPLAY_BIN) and the real plot scripts, so it needs
+// python3-matplotlib (scripts/install-deps.sh); each run is a tiny scenario (0.05 s at 100 Hz).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -92,6 +92,78 @@ TEST_F(HostileOutDir, EveryNameIsAFolderOfThatNameAndNothingElseAppears) {
   }
   // Nothing was created next to the inputs either.
   EXPECT_EQ(names_in(dir() / "input"), std::set<std::string>{"tiny.toml"});
+}
+
+/// Every entry under `dir`, recursively, whose name starts with "PWNED" (what the hostile names
+/// would have made through a shell).
+std::vector<std::string> pwned_under(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.path().filename().string().rfind("PWNED", 0) == 0) out.push_back(e.path().string());
+  }
+  return out;
+}
+
+TEST_F(HostileOutDir, EveryOtherCommandThatPlotsOrWritesTakesTheNameAsItIs) {
+  // The names that break a shell command line in the most ways (quote, substitution, newline,
+  // leading dash), through each other command that starts a plot script or writes a file named by
+  // the user: montecarlo, covariance, paper63 (one name: 16 figures), gfins-replay, --record.
+  const std::vector<std::string> hostile = {"q'; touch PWNED; '", "$(touch PWNED3)", "new\nline",
+                                            "-leading-dash"};
+  const std::string gfr = (dir() / "input" / "tiny.gfr").string();
+  const test::CliResult rec = run(GFINS_SIM_BIN, {"run", scenario_, "--record=" + gfr, "--no-plot",
+                                                  "--out=" + (dir() / "input" / "rec").string()});
+  ASSERT_EQ(rec.exit_code, kExitOk) << rec.output;
+  struct Command {
+    const char* what;
+    std::vector<std::string> args;  // the name is appended as --out=NAME
+    bool all_names;
+  };
+  const std::vector<Command> commands = {
+      {"montecarlo", {"montecarlo", scenario_, "-n", "2"}, true},
+      {"covariance", {"covariance", scenario_}, true},
+      {"paper63", {"paper63"}, false},
+  };
+  int i = 0;
+  for (const Command& c : commands) {
+    for (const std::string& name : hostile) {
+      if (!c.all_names && name != hostile.front()) continue;
+      SCOPED_TRACE(std::string(c.what) + ", folder name: " + name);
+      const fs::path work = dir() / ("other" + std::to_string(i++));
+      fs::create_directories(work);
+      std::vector<std::string> args = c.args;
+      args.push_back("--out=" + name);
+      const test::CliResult r = run(GFINS_SIM_BIN, args, work);
+      EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+      EXPECT_EQ(names_in(work), std::set<std::string>{name});
+      EXPECT_TRUE(pwned_under(work).empty());
+    }
+  }
+  for (const std::string& name : hostile) {
+    SCOPED_TRACE("gfins-replay, folder name: " + name);
+    const fs::path work = dir() / ("replay" + std::to_string(i++));
+    fs::create_directories(work);
+    const test::CliResult r = run(GFINS_REPLAY_BIN, {gfr, "--align-s=0.01", "--out=" + name}, work);
+    EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+    EXPECT_EQ(names_in(work), std::set<std::string>{name});
+    if (fs::is_directory(work / name)) {
+      EXPECT_EQ(names_in(work / name),
+                (std::set<std::string>{"navigation.csv", "summary.txt", "replay.png"}));
+    }
+    EXPECT_TRUE(pwned_under(work).empty());
+  }
+  for (const std::string& name : hostile) {
+    SCOPED_TRACE("--record name: " + name);
+    const fs::path work = dir() / ("record" + std::to_string(i++));
+    fs::create_directories(work);
+    const test::CliResult r =
+        run(GFINS_SIM_BIN, {"run", scenario_, "--record=" + name + ".gfr", "--out=o", "--no-plot"},
+            work);
+    EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+    EXPECT_EQ(names_in(work), (std::set<std::string>{name + ".gfr", "o"}));
+    EXPECT_TRUE(pwned_under(work).empty());
+  }
+  EXPECT_EQ(names_in(dir() / "input"), (std::set<std::string>{"tiny.toml", "tiny.gfr", "rec"}));
 }
 
 TEST_F(HostileOutDir, MissingMatplotlibIsAClearErrorAndExitCode3WithTheCsvWritten) {

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -98,8 +101,11 @@ TYPED_TEST(ReplayTest, ReplayFromAFileEqualsReplayFromMemory) {
   h.sample_rate_hz = kRateHz;
   h.volts_per_count.fill(f.adc.volts_per_count());
   h.geometry = nav::table1_geometry(kRhoM);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "gfins_replay_test.gfr").string();
+  // One file per run and scalar: ctest runs the float and double cases at the same time.
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("gfins_replay_test_" + std::to_string(std::random_device{}()) + "_" +
+                             std::to_string(sizeof(TypeParam)) + ".gfr"))
+                               .string();
   ASSERT_TRUE(write_recording(path, h, f.samples).is_ok());
   const auto rec = read_recording(path);
   ASSERT_TRUE(rec.is_ok()) << rec.error().message;
@@ -162,6 +168,38 @@ TYPED_TEST(ReplayTest, CrcErrorSamplesArePassedAsInvalid) {
   EXPECT_EQ(r.invalid, 1u);
   EXPECT_EQ(p.counters().rejected, 1u);
   EXPECT_EQ(r.navigating, kSamples - kAlignSamples);
+}
+
+TYPED_TEST(ReplayTest, SaturatedFlaggedSamplesAreRejectedLikeCrcErrors) {
+  // Given one sample the converter flagged saturated whose counts are NOT on a rail (the flag is
+  // the only sign: docs/replay.md says flagged frames are rejected),
+  const Fixture f;
+  auto s = f.samples;
+  constexpr std::size_t kFlagged = 900;
+  s[kFlagged].flags |= sample_flags::kSaturated;
+  for (const auto c : s[kFlagged].counts) {
+    ASSERT_LT(c, kAdcCodeMax);
+    ASSERT_GT(c, kAdcCodeMin);
+  }
+  // when replayed,
+  nav::NavPipeline<TypeParam> p;
+  ASSERT_TRUE(p.configure(f.config<TypeParam>()).is_ok());
+  std::vector<std::uint32_t> seqs;
+  const NavReport r =
+      replay(p, std::span<const RawSample>(s),
+             [&](std::uint64_t, const nav::NavState<TypeParam>& st) { seqs.push_back(st.seq); });
+  // then it is counted under its own flag, not as a CRC error, and rejected;
+  EXPECT_EQ(r.flagged_saturated, 1u);
+  EXPECT_EQ(r.invalid, 0u);
+  EXPECT_EQ(r.rejected, 1u);
+  EXPECT_EQ(p.counters().rejected, 1u);
+  // no state is produced for it (the state before it is followed directly by the one after it),
+  EXPECT_EQ(std::count(seqs.begin(), seqs.end(), static_cast<std::uint32_t>(kFlagged)), 0);
+  EXPECT_EQ(std::count(seqs.begin(), seqs.end(), static_cast<std::uint32_t>(kFlagged + 1)), 1);
+  // exactly as many states as with a CRC-error frame at the same place (the test above),
+  EXPECT_EQ(r.navigating, kSamples - kAlignSamples);
+  // and no gap is reported: the frame arrived, it only is not a measurement.
+  EXPECT_TRUE(r.gaps.empty());
 }
 
 }  // namespace

@@ -54,5 +54,44 @@ TEST_F(ScenarioNameCli, AnUnknownNameSuggestsTheClosestAndList) {
   EXPECT_FALSE(fs::exists(dir() / "sim-out")) << "nothing is written for a rejected name";
 }
 
+TEST_F(ScenarioNameCli, AScenarioNameCannotPutOutputOutsideTheCurrentFolder) {
+  // Given the review's file, whose name climbs three folders, run from dir()/a/b/c,
+  const fs::path work = dir() / "a" / "b" / "c";
+  fs::create_directories(work);
+  testing::write_text(work / "t.toml",
+                      "[scenario]\nname = \"../../../escaped\"\nduration_s = 0.1\n"
+                      "rate_hz = 100\n[trajectory]\nkind = \"rest\"\n");
+  for (const char* cmd : {"run", "montecarlo", "covariance"}) {
+    SCOPED_TRACE(cmd);
+    // when run (without -o, so the default folder sim-out/<name> applies),
+    const auto r = run(GFINS_SIM_BIN, {cmd, "./t.toml", "--no-plot"}, work);
+    // then it is refused before any work, naming the key and what is allowed,
+    EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+    EXPECT_NE(r.err.find("scenario.name"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("letters, digits"), std::string::npos) << r.err;
+    // and nothing is written anywhere: not where the name points, not in the current folder.
+    EXPECT_FALSE(fs::exists(dir() / "escaped"));
+    EXPECT_FALSE(fs::exists(work / "sim-out"));
+  }
+}
+
+TEST_F(ScenarioNameCli, ARunShorterThanTwoSamplesIsRefused) {
+  // The review's cases: half a sample period in a file (was run to t = 1 s) and on the command
+  // line of the default command; floor(0.5 × 1) + 1 = 1 sample.
+  testing::write_text(dir() / "s2.toml",
+                      "[scenario]\nduration_s = 0.5\nrate_hz = 1\n[trajectory]\nkind = \"rest\"\n");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"run", "./s2.toml", "-o", "s2", "--no-plot"},
+        std::vector<std::string>{"montecarlo", "./s2.toml", "-o", "s2", "--no-plot"},
+        std::vector<std::string>{"covariance", "./s2.toml", "-o", "s2", "--no-plot"},
+        std::vector<std::string>{"-d", "0.5", "-r", "1"}}) {
+    SCOPED_TRACE(args[0]);
+    const auto r = sim(args);
+    EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+    EXPECT_NE(r.err.find("at least 2 samples"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir() / "s2"));
+  }
+}
+
 }  // namespace
 }  // namespace gfins::sim

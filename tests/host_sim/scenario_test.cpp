@@ -141,6 +141,66 @@ TEST(ScenarioParse, UnknownKeyAndSyntaxErrorAreReported) {
                {"bad.toml:5:", "TOML syntax error"});
 }
 
+TEST(ScenarioParse, ANameThatIsNotAPlainFileNameComponentIsRefused) {
+  // The name becomes the output folder sim-out/<name>: given names that would reach outside it
+  // or hide (review of issue 10: "../../../escaped" wrote to ../../../escaped/), parsing fails
+  // naming the key and the characters allowed.
+  // ("new\\nline" is a TOML escape: a real newline in the name.)
+  for (const char* name : {"../../../escaped", "/tmp/abs", "a/b", ".hidden", "..", "-x", "",
+                           "two words", "new\\nline", "q'uote"}) {
+    SCOPED_TRACE(name);
+    expect_error(replace(kGood, "[scenario]", std::string("[scenario]\nname = \"") + name + "\""),
+                 {"bad.toml:3:", "scenario.name", "letters, digits, '.', '_' and '-'"});
+  }
+  // A file whose stem is not a plain name and that has no name key: the same, and the hint.
+  const HostResult<Scenario> stem = parse_scenario(kGood, "dir/my run.toml");
+  ASSERT_FALSE(stem.is_ok());
+  EXPECT_NE(stem.error().message.find("set one"), std::string::npos) << stem.error().message;
+  // Plain names pass, the built-in ones among them (EveryBuiltinScenarioParses...).
+  for (const char* name : {"rest", "paper-6.3-1mg", "rate_table.z", "A1"}) {
+    SCOPED_TRACE(name);
+    const HostResult<Scenario> ok = parse_scenario(
+        replace(kGood, "[scenario]", std::string("[scenario]\nname = \"") + name + "\""), "x.toml");
+    ASSERT_TRUE(ok.is_ok()) << ok.error().message;
+    EXPECT_EQ(ok.value().name, name);
+  }
+}
+
+TEST(ScenarioParse, FewerThanTwoSamplesIsRefusedAndPartialPeriodsAreFloored) {
+  // Samples are t = 0 and every whole period up to duration_s: floor(duration × rate) + 1
+  // (written out here for each case).
+  struct Case {
+    const char* duration;
+    const char* rate;
+    std::uint64_t samples;  // 0: refused
+  };
+  const Case cases[] = {
+      {"0.5", "1", 0},       // the review's case: half a period, was run to t = 1 s
+      {"0.999", "1", 0},     // just under one period
+      {"1.0", "1", 2},       // exactly one period: t = 0, 1 s
+      {"1.4", "1", 2},       // 1.4 periods: ends at t = 1 s, not 1.4 (and not rounded up)
+      {"1.6", "1", 2},       // 1.6 periods: was llround → 3 samples, to t = 2 s, past the end
+      {"0.3", "1000", 301},  // 0.3 × 1000 is 299.99999999999994 in binary: still 300 periods
+      {"0.1", "100", 11},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.duration) + " s at " + c.rate + " Hz");
+    std::string text =
+        replace(kGood, "duration_s = 2.0", std::string("duration_s = ") + c.duration);
+    text = replace(text, "rate_hz = 100.0", std::string("rate_hz = ") + c.rate);
+    const HostResult<Scenario> p = parse_scenario(text, "short.toml");
+    if (c.samples == 0) {
+      ASSERT_FALSE(p.is_ok());
+      EXPECT_NE(p.error().message.find("scenario.duration_s"), std::string::npos);
+      EXPECT_NE(p.error().message.find("at least 2 samples"), std::string::npos);
+      continue;
+    }
+    ASSERT_TRUE(p.is_ok()) << p.error().message;
+    EXPECT_EQ(sample_count(p.value()), c.samples);
+    EXPECT_LE(covered_duration_s(p.value()), p.value().duration_s);
+  }
+}
+
 TEST(ScenarioParse, MissingFileOrNameIsReported) {
   const HostResult<Scenario> p = load_scenario("no-such-scenario", kBuiltinDir);
   ASSERT_FALSE(p.is_ok());

@@ -189,6 +189,25 @@ checks() {
   expect 0 "$bin/gfins-sim" covariance rest -o cov --no-plot
   expect 0 "$bin/gfins-sim" --duration 1
 
+  # Record, replay (navigate, PNG, dump, means), from the prefix with the trees hidden (issue 10):
+  # gfins-replay finds its plot script relative to itself, like gfins-sim.
+  if [ -x "$bin/gfins-replay" ]; then
+    if expect 0 "$bin/gfins-sim" run rest -o rec-rest --no-plot --record rest.gfr; then
+      [ -s rest.gfr ] || fail "run --record: no rest.gfr"
+    fi
+    if expect 0 "$bin/gfins-replay" rest.gfr -o replay-rest "${plot[@]}"; then
+      [ -s replay-rest/navigation.csv ] || fail "gfins-replay: no navigation.csv"
+      if [ ${#plot[@]} = 0 ]; then
+        [ -s replay-rest/replay.png ] || fail "gfins-replay: no replay.png"
+      fi
+    fi
+    expect 0 "$bin/gfins-replay" dump rest.gfr && log_has "seq,t_ns,count_1" "gfins-replay dump"
+    expect 0 "$bin/gfins-replay" means rest.gfr --mounting 0 --up 0 0 1 --rate-rad-s 6 --header &&
+      log_has "mounting,axis_x" "gfins-replay means"
+    expect 0 "$bin/gfins-replay" dump --help && log_has "Exit codes" "gfins-replay dump --help"
+    if grep -q -F "plotting" "$log"; then fail "gfins-replay dump --help lists plot exit codes"; fi
+  fi
+
   # gfins-calibrate on the shipped example (the paper's Tables 4/5).
   ex=$prefix/share/gfins/examples
   expect 0 "$bin/gfins-calibrate" --means "$ex/paper_tables_4_5.csv" --latitude 24.8 \

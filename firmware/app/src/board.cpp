@@ -55,6 +55,9 @@ std::string open_bus(const FwConfig& c, hal::Clock& clock, Board& b) {
     lnx::CandumpFileBusConfig bc;
     bc.path = c.can_log;
     bc.interface = c.can_interface;
+    // File writes off the loop thread, except in fast pacing, whose output must be the same on
+    // every run (a writer thread that falls behind drops frames: a matter of scheduling).
+    bc.background_writer = !(c.board == BoardKind::kSim && c.pacing == Pacing::kFast);
     auto bus = lnx::CandumpFileBus::open(bc, clock);
     if (!bus.is_ok()) return lnx::describe(c.can_log, bus.status());
     lnx::CandumpFileBus* file = bus.value().get();
@@ -230,7 +233,9 @@ class AdcSource final : public SampleSource {
   }
   AdcCounters do_counters() const override {
     const drivers::Ads131m06Counters& d = driver_.counters();
-    return AdcCounters{d.crc_errors, d.missed_edges, d.extra_edges, d.chip_resets};
+    // Resets met as a register re-verification mismatch count too (docs/faults.md).
+    return AdcCounters{d.crc_errors, d.missed_edges, d.extra_edges,
+                       d.chip_resets + d.register_mismatches};
   }
   double do_volts_per_count() const override { return volts_per_count_; }
 

@@ -70,6 +70,7 @@ can::Epoch to_can_epoch(const Epoch& e) {
   c.health.can_tx_dropped = e.health.can_tx_dropped;
   c.health.bus_off_events = e.health.bus_off_events;
   c.health.loop_overruns = e.health.loop_overruns;
+  c.health.log_dropped = e.health.log_dropped;
   return c;
 }
 

@@ -1,18 +1,12 @@
 #include "gfins/app/sample_loop.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "gfins/app/config.hpp"
 
 namespace gfins::app {
-namespace {
-
-// Rate limit of repeated log records of one loop: one per second of samples at 1 kHz, carrying
-// the counter so nothing is lost from the record, only from the log.
-constexpr std::uint32_t kLogEverySamples = 1000;
-
-}  // namespace
 
 double LatencyHistogram::quantile_us(double q) const {
   if (count_ == 0) return 0.0;
@@ -45,6 +39,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   adc_seen_ = adc_.counters();
   can_seen_ = bus_.counters();
   can_state_ = bus_.state();
+  ref_t_ns_ = clock_.now_ns();
   mode_ = Mode::kAligning;
   return Status::ok();
 }
@@ -57,79 +52,164 @@ void SampleLoop::log(LogLevel level, std::int64_t t_ns, const char* fmt, std::in
 SampleLoop::Cycle SampleLoop::step() {
   const Result<RawSample> r = adc_.read_sample(kReadTimeoutPeriods * period_ns_);
   Cycle cycle = Cycle::kSample;
-  std::int64_t t_edge = 0;
   if (r.is_ok()) {
-    t_edge = r.value().t_ns;
+    t_cycle_ = r.value().t_ns;
     on_sample(r.value());
   } else {
-    t_edge = clock_.now_ns();
+    t_cycle_ = clock_.now_ns();
     if (r.status().code() == ErrorCode::kTimeout) {
       ++health_.drdy_timeouts;
       events_.set(status_bits::kDataReadyLost, sample_index_);
-      log(LogLevel::kError, t_edge, "no data-ready edge for {} periods (timeouts: {})",
-          kReadTimeoutPeriods, health_.drdy_timeouts);
+      limited_log(LogKind::kDataReadyTimeout, LogLevel::kError, t_cycle_,
+                  "no data-ready edge for {} periods (timeouts: {}; {} more since the last line)",
+                  kReadTimeoutPeriods, health_.drdy_timeouts);
       cycle = Cycle::kTimeout;
     } else {
-      ++health_.adc_read_errors;
-      log(LogLevel::kError, t_edge, "ADC read failed: error code {} (read errors: {})",
-          static_cast<std::int64_t>(r.status().code()), health_.adc_read_errors);
+      on_read_error(t_cycle_, r.status());
       cycle = Cycle::kReadError;
     }
     update_adc_counters(sample_index_);
   }
 
   // Latency: edge → the epoch's frames handed to the bus backend (cycles that sent frames).
-  const std::uint32_t frames = r.is_ok() ? out_.publish(epoch_) : 0;
-  if (frames > 0) latency_.add(clock_.now_ns() - t_edge);
+  if (r.is_ok()) {
+    const std::uint32_t frames = out_.publish(epoch_);
+    published_seq_ = r.value().seq;
+    have_published_ = true;
+    if (frames > 0) latency_.add(clock_.now_ns() - t_cycle_);
+  } else {
+    // No sample: the periods the ADC should have filled still get their status and health
+    // frames (the fault bits set, navigation values not available).
+    publish_gap(t_cycle_, cycle == Cycle::kTimeout ? status_bits::kDataReadyLost
+                                                   : status_bits::kAdcReadError);
+  }
   bus_.service();
-  update_can_counters(sample_index_, t_edge);
+  update_can_counters(sample_index_, t_cycle_);
 
-  handle_commands(t_edge);
-  poll_reload(t_edge);
+  handle_commands(t_cycle_);
+  poll_reload(t_cycle_);
 
   // Overrun: this cycle's work ended after the next edge was due (that sample waits, and a
   // second overrun in a row loses it: the ADC overwrites its output buffer).
-  if (r.is_ok() && clock_.now_ns() > t_edge + period_ns_) {
+  if (r.is_ok() && clock_.now_ns() > t_cycle_ + period_ns_) {
     ++health_.loop_overruns;
     events_.set(status_bits::kLoopOverrun, sample_index_);
-    if (sample_index_ - last_log_ >= kLogEverySamples || health_.loop_overruns == 1) {
-      last_log_ = sample_index_;
-      log(LogLevel::kWarn, t_edge,
-          "loop overrun: cycle took {} ns of a {} ns period (overruns: {})",
-          clock_.now_ns() - t_edge, period_ns_, health_.loop_overruns);
-    }
+    limited_log(LogKind::kOverrun, LogLevel::kWarn, t_cycle_,
+                "loop overrun: cycle took {} ns of a {} ns period (overruns: {}; {} more since the "
+                "last line)",
+                clock_.now_ns() - t_cycle_, period_ns_, health_.loop_overruns);
   }
   // The loop is alive whatever the ADC does: a hung loop stops kicking, a dead ADC shows in the
-  // status instead (docs/faults.md).
+  // status instead, until it has delivered nothing for kDeadAdcWatchdogNs (docs/faults.md).
+  if (adc_failing_ && !watchdog_held_ && t_cycle_ - failing_since_ns_ >= kDeadAdcWatchdogNs) {
+    watchdog_held_ = true;
+    limited_log(LogKind::kAdcDead, LogLevel::kError, t_cycle_,
+                "ADC delivered no sample for {} ms: watchdog kicks stop so the service manager "
+                "restarts the firmware (read errors: {}; {} more since the last line)",
+                kDeadAdcWatchdogNs / 1000000, health_.adc_read_errors);
+  }
   if (status_board_ != nullptr)
     status_board_->publish(mode_, cal_.calibrated, cal_.cal_id, health_);
-  if (watchdog_ != nullptr) (void)watchdog_->kick();
+  if (watchdog_ != nullptr && !watchdog_held_) (void)watchdog_->kick();
+  if (cycle == Cycle::kReadError) {
+    // A read that failed at once (a dead chip, an SPI error) must not make the loop spin: wait
+    // for the next sample period on the grid of the last edge, as a data-ready wait would.
+    const std::int64_t since = t_cycle_ - ref_t_ns_;
+    const std::int64_t next =
+        ref_t_ns_ + (since < 0 ? period_ns_ : (since / period_ns_ + 1) * period_ns_);
+    (void)clock_.sleep_until_ns(next);
+  }
   return cycle;
+}
+
+void SampleLoop::on_read_error(std::int64_t t_ns, const Status& st) {
+  ++health_.adc_read_errors;
+  events_.set(status_bits::kAdcReadError, sample_index_);
+  if (!adc_failing_) {
+    adc_failing_ = true;
+    failing_since_ns_ = t_ns;
+  }
+  limited_log(LogKind::kAdcReadError, LogLevel::kError, t_ns,
+              "ADC read failed: error code {} (read errors: {}; {} more since the last line)",
+              static_cast<std::int64_t>(st.code()), health_.adc_read_errors);
+}
+
+void SampleLoop::publish_gap(std::int64_t t_ns, std::uint32_t cause) {
+  // The conversions the ADC should have delivered since the last sample: the periods that ended
+  // at least half a period before now (the half period keeps a late edge that is still coming
+  // from being published twice).
+  const std::int64_t elapsed = t_ns - ref_t_ns_ - period_ns_ / 2;
+  if (elapsed < period_ns_) return;
+  const auto periods = static_cast<std::uint32_t>(elapsed / period_ns_);
+  const std::uint32_t last = ref_seq_ + periods;
+  std::uint32_t k = have_published_ ? published_seq_ + 1u : ref_seq_ + 1u;
+  if (static_cast<std::int32_t>(last - k) < 0) return;  // already published up to `last`
+  if (last - k >= kMaxGapEpochsPerCycle) k = last - kMaxGapEpochsPerCycle + 1u;
+  for (;; ++k) {
+    build_gap_epoch(k, ref_t_ns_ + static_cast<std::int64_t>(k - ref_seq_) * period_ns_, cause);
+    (void)out_.publish(epoch_);
+    if (k == last) break;
+  }
+  published_seq_ = last;
+  have_published_ = true;
+}
+
+void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint32_t cause) {
+  // No sample behind this epoch: time and counter are the period's nominal ones, the navigation
+  // values are not available (NaN: the encoder sends each signal's not-available code and the
+  // status frame's "a value was not available" bit), the state itself is kept for when samples
+  // return (NavPipeline integrates across the gap).
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const bool aligned = pipeline_.phase() == nav::PipelinePhase::kNavigating;
+  epoch_.nav = pipeline_.state();
+  epoch_.nav.t_ns = t_ns;
+  epoch_.nav.seq = seq;
+  epoch_.nav.q_nb = nav::Quat<float>(kNaN, kNaN, kNaN, kNaN);
+  epoch_.nav.w_b.setConstant(kNaN);
+  epoch_.nav.wdot_b.setConstant(kNaN);
+  epoch_.nav.f_b.setConstant(kNaN);
+  epoch_.nav.v_n.setConstant(kNaN);
+  epoch_.nav.r_n.setConstant(kNaN);
+  epoch_.nav.status = nav::nav_status::kInputInvalid | (aligned ? nav::nav_status::kAligned : 0u);
+  epoch_.accel_mps2.fill(kNaN);
+  std::uint32_t bits = events_.get(sample_index_) | cause | status_bits::kInputInvalid;
+  if (!cal_.calibrated) bits |= status_bits::kUncalibrated;
+  if (aligned) bits |= status_bits::kAligned;
+  if (health_.stuck_mask != 0) bits |= status_bits::kStuckChannel;
+  if (capture_.active) bits |= status_bits::kCaptureActive;
+  // Nothing is being measured: the output is degraded whatever the cause.
+  bits |= status_bits::kDegraded;
+  mode_ = aligned ? Mode::kDegraded : Mode::kAligning;
+  epoch_.mode = mode_;
+  epoch_.status_bits = bits;
+  epoch_.cal_id = cal_.cal_id;
+  health_.log_dropped = log_.dropped();
+  epoch_.health = health_;
 }
 
 void SampleLoop::update_adc_counters(std::uint32_t sample) {
   const AdcCounters c = adc_.counters();
   if (c.crc_errors != adc_seen_.crc_errors) {
-    const std::uint32_t before = health_.crc_errors;
     health_.crc_errors += c.crc_errors - adc_seen_.crc_errors;
     events_.set(status_bits::kCrcError, sample);
-    if (before == 0 || sample - last_log_ >= kLogEverySamples) {
-      last_log_ = sample;
-      log(LogLevel::kWarn, 0, "ADC frame CRC error: sample skipped (CRC errors: {})",
-          health_.crc_errors);
-    }
+    limited_log(LogKind::kCrcError, LogLevel::kWarn, t_cycle_,
+                "ADC frame CRC error: sample skipped (CRC errors: {}; {} more since the last line)",
+                health_.crc_errors);
   }
   if (c.chip_resets != adc_seen_.chip_resets) {
     health_.adc_resets += c.chip_resets - adc_seen_.chip_resets;
     events_.set(status_bits::kAdcRecovered, sample);
-    log(LogLevel::kError, 0, "ADC reset detected and reconfigured (resets: {})",
-        health_.adc_resets);
+    limited_log(LogKind::kAdcReset, LogLevel::kError, t_cycle_,
+                "ADC reset detected and reconfigured (resets: {}; {} more since the last line)",
+                health_.adc_resets);
   }
   if (c.extra_edges != adc_seen_.extra_edges) {
     health_.extra_edges += c.extra_edges - adc_seen_.extra_edges;
     events_.set(status_bits::kExtraEdge, sample);
-    log(LogLevel::kWarn, 0, "data-ready edge without a new conversion (extra edges: {})",
-        health_.extra_edges);
+    limited_log(LogKind::kExtraEdge, LogLevel::kWarn, t_cycle_,
+                "data-ready edge without a new conversion (extra edges: {}; {} more since the "
+                "last line)",
+                health_.extra_edges);
   }
   adc_seen_ = c;
 }
@@ -137,14 +217,11 @@ void SampleLoop::update_adc_counters(std::uint32_t sample) {
 void SampleLoop::update_can_counters(std::uint32_t sample, std::int64_t t_ns) {
   const hal::CanCounters c = bus_.counters();
   if (c.tx_dropped != can_seen_.tx_dropped) {
-    const std::uint32_t before = health_.can_tx_dropped;
     health_.can_tx_dropped += c.tx_dropped - can_seen_.tx_dropped;
     events_.set(status_bits::kCanTxDrop, sample);
-    if (before == 0 || sample - last_log_ >= kLogEverySamples) {
-      last_log_ = sample;
-      log(LogLevel::kWarn, t_ns, "CAN frames dropped by the bus backend (dropped: {})",
-          health_.can_tx_dropped);
-    }
+    limited_log(LogKind::kCanTxDrop, LogLevel::kWarn, t_ns,
+                "CAN frames dropped by the bus backend (dropped: {}; {} more since the last line)",
+                health_.can_tx_dropped);
   }
   // Commands arrive on the receive side: a lost frame may be a lost command (the host's cmd
   // times out and says so), so the loss is flagged and counted, never silent.
@@ -153,20 +230,28 @@ void SampleLoop::update_can_counters(std::uint32_t sample, std::int64_t t_ns) {
   if (rx_lost != 0) {
     health_.can_rx_dropped += rx_lost;
     events_.set(status_bits::kCanRxDrop, sample);
-    log(LogLevel::kWarn, t_ns, "{} received CAN frame(s) lost before the loop read them (lost: {})",
-        rx_lost, health_.can_rx_dropped);
+    limited_log(LogKind::kCanRxDrop, LogLevel::kWarn, t_ns,
+                "{} received CAN frame(s) lost before the loop read them (lost: {}; {} more "
+                "since the last line)",
+                rx_lost, health_.can_rx_dropped);
   }
   if (c.bus_off_events != can_seen_.bus_off_events) {
     health_.bus_off_events += c.bus_off_events - can_seen_.bus_off_events;
     events_.set(status_bits::kBusOff, sample);
-    log(LogLevel::kError, t_ns, "CAN bus-off (events: {}); frames are dropped until it recovers",
-        health_.bus_off_events);
+    limited_log(LogKind::kBusOff, LogLevel::kError, t_ns,
+                "CAN bus-off (events: {}); frames are dropped until it recovers ({} more since "
+                "the last line)",
+                health_.bus_off_events);
   }
   const hal::CanBusState state = bus_.state();
   if (state == hal::CanBusState::kBusOff) events_.set(status_bits::kBusOff, sample);
   if (state != can_state_) {
-    log(LogLevel::kInfo, t_ns, "CAN state {} -> {} (0 active, 1 warning, 2 passive, 3 off, 4 down)",
-        static_cast<std::int64_t>(can_state_), static_cast<std::int64_t>(state));
+    const bool worse = state == hal::CanBusState::kErrorPassive ||
+                       state == hal::CanBusState::kBusOff || state == hal::CanBusState::kDown;
+    limited_log(worse ? LogKind::kCanStateWorse : LogKind::kCanStateBetter, LogLevel::kInfo, t_ns,
+                "CAN state {} -> {} (0 active, 1 warning, 2 passive, 3 off, 4 down; {} more "
+                "changes since the last line)",
+                static_cast<std::int64_t>(can_state_), static_cast<std::int64_t>(state));
     can_state_ = state;
   }
   can_seen_ = c;
@@ -180,11 +265,18 @@ void SampleLoop::on_sample(const RawSample& s) {
     const std::uint32_t lost = s.seq - last_seq_ - 1u;
     health_.missed_edges += lost;
     events_.set(status_bits::kSampleGap, k);
-    log(LogLevel::kWarn, s.t_ns, "{} data-ready edge(s) missed before sample {} (missed: {})", lost,
-        s.seq, health_.missed_edges);
+    limited_log(LogKind::kMissedEdges, LogLevel::kWarn, s.t_ns,
+                "{} data-ready edge(s) missed before sample {} (missed: {}; {} more since the "
+                "last line)",
+                lost, s.seq, health_.missed_edges);
   }
   last_seq_ = s.seq;
   have_seq_ = true;
+  // The time base of no-sample epochs, and the end of any ADC failure.
+  ref_seq_ = s.seq;
+  ref_t_ns_ = s.t_ns;
+  adc_failing_ = false;
+  watchdog_held_ = false;
   update_adc_counters(k);
 
   const bool crc_ok = (s.flags & sample_flags::kCrcError) == 0;
@@ -197,11 +289,11 @@ void SampleLoop::on_sample(const RawSample& s) {
   if (crc_ok) {
     health_.saturated_mask = saturated;
     if (saturated != 0) {
-      if (health_.saturated_samples++ == 0 || k - last_log_ >= kLogEverySamples) {
-        last_log_ = k;
-        log(LogLevel::kWarn, s.t_ns, "channel mask {:#x} at full scale (saturated samples: {})",
-            saturated, health_.saturated_samples);
-      }
+      ++health_.saturated_samples;
+      limited_log(LogKind::kSaturated, LogLevel::kWarn, s.t_ns,
+                  "channel mask {:#x} at full scale (saturated samples: {}; {} more since the "
+                  "last line)",
+                  saturated, health_.saturated_samples);
       events_.set(status_bits::kSaturated, k);
     }
     const std::uint8_t stuck = stuck_.update(s.counts);
@@ -209,11 +301,13 @@ void SampleLoop::on_sample(const RawSample& s) {
       const auto fresh = static_cast<std::uint8_t>(stuck & ~health_.stuck_mask);
       if (fresh != 0) {
         for (std::size_t j = 0; j < kAdcChannels; ++j) health_.stuck_events += (fresh >> j) & 1u;
-        log(LogLevel::kError, s.t_ns,
-            "channel mask {} stuck: code unchanged for {} samples (stuck events: {})", stuck,
-            kStuckSamples, health_.stuck_events);
+        limited_log(LogKind::kStuck, LogLevel::kError, s.t_ns,
+                    "channel mask {} stuck: code unchanged for {} samples (stuck events: {}; {} "
+                    "more since the last line)",
+                    stuck, kStuckSamples, health_.stuck_events);
       } else {
-        log(LogLevel::kInfo, s.t_ns, "stuck channel mask now {}", stuck);
+        limited_log(LogKind::kStuckCleared, LogLevel::kInfo, s.t_ns,
+                    "stuck channel mask now {} ({} more since the last line)", stuck);
       }
       health_.stuck_mask = stuck;
     }
@@ -252,9 +346,10 @@ void SampleLoop::build_epoch(const RawSample& s) {
   if (health_.stuck_mask != 0) bits |= status_bits::kStuckChannel;
   if (capture_.active) bits |= status_bits::kCaptureActive;
   // Degraded: the solution integrates inputs known to be wrong (a stuck or saturated channel) or
-  // the ADC stopped delivering; a CRC error or a missed edge alone costs one step across a gap.
+  // the ADC stopped delivering (no edge, or a read that failed); a CRC error or a missed edge
+  // alone costs one step across a gap.
   const bool degraded = (bits & (status_bits::kStuckChannel | status_bits::kSaturated |
-                                 status_bits::kDataReadyLost)) != 0;
+                                 status_bits::kDataReadyLost | status_bits::kAdcReadError)) != 0;
   if (degraded) bits |= status_bits::kDegraded;
   mode_ = !aligned ? Mode::kAligning : (degraded ? Mode::kDegraded : Mode::kNavigating);
   epoch_.mode = mode_;
@@ -279,8 +374,9 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
       r.token = d.token;
       r.result = d.error;
       ++health_.command_errors;
-      log(LogLevel::kWarn, t_ns, "command frame id {:#x} rejected: result {}", f.value().id,
-          static_cast<std::int64_t>(d.error));
+      limited_log(LogKind::kCommandRejected, LogLevel::kWarn, t_ns,
+                  "command frame id {:#x} rejected: result {} ({} more since the last line)",
+                  f.value().id, static_cast<std::int64_t>(d.error));
     } else {
       execute(d.command, r);
       log(LogLevel::kInfo, t_ns, "command {} token {} -> result {}",

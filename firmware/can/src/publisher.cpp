@@ -108,6 +108,8 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
       return e.health.bus_off_events;
     case Field::kLoopOverruns:
       return e.health.loop_overruns;
+    case Field::kLogDropped:
+      return e.health.log_dropped;
     default:
       return 0.0;
   }

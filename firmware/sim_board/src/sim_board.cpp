@@ -304,7 +304,9 @@ app::AdcCounters ChipAdc::counters() const {
   c.crc_errors = d.crc_errors;
   c.missed_edges = d.missed_edges;
   c.extra_edges = d.extra_edges;
-  c.chip_resets = d.chip_resets;
+  // A reset the driver meets as a re-verification mismatch (its RREG answer replaced the STATUS
+  // word that would have shown RESET) is recovered the same way: both count (docs/faults.md).
+  c.chip_resets = d.chip_resets + d.register_mismatches;
   return c;
 }
 void ChipAdc::corrupt_next_frame() { impl_->adc.chip().corrupt_output_crc(1); }

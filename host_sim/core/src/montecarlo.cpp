@@ -1,6 +1,7 @@
 // Monte-Carlo statistics over seeds (montecarlo.hpp).
 #include "gfins/host_sim/montecarlo.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -47,11 +48,66 @@ HostResult<RunErrors> one_run(const Scenario& base, std::uint64_t seed0, std::si
   return r;
 }
 
+/// Bytes per sample of one RunErrors (t_s and the error row).
+constexpr std::uint64_t kRunErrorsBytesPerSample =
+    sizeof(double) + sizeof(std::array<double, kMcQuantities * 4>);
+/// Bytes per sample of the running sums (sum, sum2: 3 axes; norm2) and of the result (t_s, mean,
+/// std: 3 axes; rms_norm).
+constexpr std::uint64_t kSumsBytesPerSample = (2 * 3 + 1) * kMcQuantities * sizeof(double);
+constexpr std::uint64_t kResultBytesPerSample =
+    sizeof(double) + (2 * 3 + 1) * kMcQuantities * sizeof(double);
+
+std::size_t effective_jobs(std::size_t runs, std::size_t jobs) {
+  return std::max<std::size_t>(1, std::min(jobs == 0 ? default_jobs() : jobs, runs));
+}
+
 }  // namespace
+
+std::uint64_t montecarlo_memory_bytes(const Scenario& s, std::size_t runs, std::size_t jobs) {
+  const auto samples = static_cast<double>(sample_count(s));
+  const auto j = static_cast<double>(effective_jobs(runs, jobs));
+  // A run in flight: run_scenario's own peak, then its error rows while its outcome is alive.
+  const double in_run = static_cast<double>(run_memory_bytes(s, false)) / samples +
+                        static_cast<double>(kRunErrorsBytesPerSample);
+  // Finished runs waiting for their turn: a thread claims run k only while k < consumed + 2 ×
+  // jobs (parallel.hpp), so runs in flight and waiting are at most min(2 × jobs, runs) together;
+  // with one thread none waits.
+  const double alive = std::min(2.0 * j, static_cast<double>(runs));
+  const double waiting = j > 1 ? (alive - j) * static_cast<double>(kRunErrorsBytesPerSample) : 0.0;
+  const double during = j * in_run + waiting + static_cast<double>(kSumsBytesPerSample);
+  const double at_end = static_cast<double>(kSumsBytesPerSample + kResultBytesPerSample);
+  const double bytes = samples * std::max(during, at_end) + static_cast<double>(kProcessBaseBytes);
+  return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
+}
+
+HostStatus check_montecarlo_size(const Scenario& s, std::size_t runs, std::size_t jobs) {
+  GFINS_TRY_STATUS(check_run_size(s, false, /*in_memory=*/false));
+  const std::uint64_t bytes = montecarlo_memory_bytes(s, runs, jobs);
+  const std::uint64_t limit = max_run_memory_bytes();
+  if (bytes <= limit) return Done{};
+  const std::size_t j = effective_jobs(runs, jobs);
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "scenario %s: %llu samples per run (duration_s %g x rate_hz %g), %zu run%s at "
+                "a time (-j %zu): about %.3g GiB of memory, above the limit of %.3g GiB: use "
+                "fewer threads (-j 1 needs about %.3g GiB), a shorter run or a lower rate",
+                s.name.c_str(), static_cast<unsigned long long>(sample_count(s)), s.duration_s,
+                s.rate_hz, j, j == 1 ? "" : "s", j, static_cast<double>(bytes) / double(1u << 30),
+                static_cast<double>(limit) / double(1u << 30),
+                static_cast<double>(montecarlo_memory_bytes(s, runs, 1)) / double(1u << 30));
+  return HostError{ErrorCode::kOutOfRange, buf};
+}
+
+double montecarlo_seconds_estimate(const Scenario& s, std::size_t runs, std::size_t jobs) {
+  const auto j = static_cast<double>(effective_jobs(runs, jobs));
+  return static_cast<double>(sample_count(s)) * static_cast<double>(runs) * kMcSecondsPerSampleRun /
+         j;
+}
 
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
                                             std::uint64_t seed0, const ProgressFn& progress,
-                                            NavScalar scalar, std::size_t jobs) {
+                                            NavScalar scalar, std::size_t jobs,
+                                            const volatile std::sig_atomic_t* stop) {
   if (runs < 2) {
     return HostError{ErrorCode::kInvalidArgument, "montecarlo: at least two runs are needed"};
   }
@@ -64,7 +120,10 @@ HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t ru
   std::array<std::vector<double>, kMcQuantities> norm2;
   double cal2 = 0;
   std::optional<HostError> failed;
+  std::size_t folded = 0;
+  const auto stopped = [stop] { return stop != nullptr && *stop != 0; };
   const auto fold = [&](std::size_t k, HostResult<RunErrors>&& run) {
+    if (stopped()) return false;  // the runs folded so far stay; nothing further is taken
     if (!run.is_ok()) {
       failed = std::move(run).take_error();
       return false;
@@ -97,13 +156,26 @@ HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t ru
         norm2[q][i] += o.e[i][q * 4 + 3];
       }
     }
+    folded = k + 1;
     if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(runs));
     return true;
   };
   ordered_parallel_for(
-      runs, jobs, [&](std::size_t k) { return one_run(base, seed0, k, scalar); }, fold);
+      runs, jobs,
+      [&](std::size_t k) -> HostResult<RunErrors> {
+        // A run not started before the stop is skipped (fold drops it).
+        if (stopped()) return HostError{ErrorCode::kFailedPrecondition, "montecarlo: stopped"};
+        return one_run(base, seed0, k, scalar);
+      },
+      fold);
   if (failed) return *failed;
-  const auto nr = static_cast<double>(runs);
+  if (folded < 2) {
+    return HostError{ErrorCode::kFailedPrecondition, "montecarlo: stopped after " +
+                                                         std::to_string(folded) +
+                                                         " run(s): statistics need at least two"};
+  }
+  r.runs = folded;
+  const auto nr = static_cast<double>(folded);
   const std::size_t n = r.t_s.size();
   for (std::size_t q = 0; q < kMcQuantities; ++q) {
     for (std::size_t a = 0; a < 3; ++a) {

@@ -6,7 +6,8 @@ namespace gfins::sim {
 
 template <typename T>
 HostResult<NavReport> replay_recording(const std::string& path, nav::NavPipeline<T>& pipeline,
-                                       typename NavLoop<T>::Sink sink) {
+                                       typename NavLoop<T>::Sink sink,
+                                       const volatile std::sig_atomic_t* stop) {
   auto reader = RecordingReader::open(path);
   if (!reader.is_ok()) return reader.error();
   NavLoop<T> loop(pipeline, std::move(sink));
@@ -15,15 +16,20 @@ HostResult<NavReport> replay_recording(const std::string& path, nav::NavPipeline
     auto more = reader.value().next_block(block);
     if (!more.is_ok()) return more.error();
     if (!more.value()) break;
-    loop.run(block);
+    for (const RawSample& x : block) {
+      if (stop != nullptr && *stop != 0) return loop.report();
+      loop.step(x);
+    }
   }
   return loop.report();
 }
 
 template HostResult<NavReport> replay_recording<float>(const std::string&, nav::NavPipeline<float>&,
-                                                       NavLoop<float>::Sink);
+                                                       NavLoop<float>::Sink,
+                                                       const volatile std::sig_atomic_t*);
 template HostResult<NavReport> replay_recording<double>(const std::string&,
                                                         nav::NavPipeline<double>&,
-                                                        NavLoop<double>::Sink);
+                                                        NavLoop<double>::Sink,
+                                                        const volatile std::sig_atomic_t*);
 
 }  // namespace gfins::sim

@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -218,6 +219,16 @@ void check_trajectory_keys(const toml::table& tr, const Reader& rd, const std::s
 
 constexpr double kBig = 1e9;
 
+/// Checks the scenario's name where it came from: the [scenario] name key (its line), or the
+/// file name's stem when the key is absent.
+void check_name(const toml::table& sc, const Reader& rd, const std::string& name) {
+  const std::string problem = scenario_name_problem(name);
+  if (problem.empty()) return;
+  if (const toml::node* n = sc.get("name"); n != nullptr) rd.fail(n, "scenario.name", problem);
+  rd.fail(nullptr, "scenario.name",
+          problem + " (the name is the file's stem when [scenario] has no name key: set one)");
+}
+
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
   Scenario s;
   s.source = source;
@@ -228,9 +239,18 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   const toml::table& sc = *rd.table(root, "scenario", true);
   rd.only(sc, "scenario.", {"name", "description", "duration_s", "rate_hz", "rho_m", "seed"});
   s.name = rd.string(sc, "scenario.", "name", s.name);
+  check_name(sc, rd, s.name);
   s.description = rd.string(sc, "scenario.", "description", std::string());
   s.duration_s = rd.number(sc, "scenario.", "duration_s", std::nullopt, 1e-3, 1e6);
   s.rate_hz = rd.number(sc, "scenario.", "rate_hz", std::nullopt, 1.0, 1e5);
+  if (sample_count(s) < 2) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "duration_s %g x rate_hz %g = %.3g sample periods: a run needs at least 2 "
+                  "samples, t = 0 and one period later (duration_s >= %g s at this rate)",
+                  s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, 1.0 / s.rate_hz);
+    rd.fail(sc.get("duration_s"), "scenario.duration_s", buf);
+  }
   s.rho_m = rd.number(sc, "scenario.", "rho_m", 0.1, 1e-3, 10.0);
   s.seed = rd.integer(sc, "scenario.", "seed", 1);
 
@@ -411,6 +431,43 @@ class DriveTrajectory final : public JetTrajectory {
 };
 
 }  // namespace
+
+std::uint64_t sample_count(const Scenario& s) {
+  const double periods = s.duration_s * s.rate_hz;
+  if (!(periods >= 0.0) || !std::isfinite(periods)) return 0;
+  return static_cast<std::uint64_t>(std::floor(periods + 1e-9 * std::max(1.0, periods))) + 1;
+}
+
+double covered_duration_s(const Scenario& s) {
+  const std::uint64_t n = sample_count(s);
+  return n < 1 ? 0.0 : static_cast<double>(n - 1) / s.rate_hz;
+}
+
+std::string scenario_name_problem(const std::string& name) {
+  const auto allowed = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+           c == '_' || c == '-';
+  };
+  const bool ok = !name.empty() && name.size() <= kMaxScenarioNameChars &&
+                  std::all_of(name.begin(), name.end(), allowed) && name.front() != '.' &&
+                  name.front() != '-';
+  if (ok) return {};
+  std::string shown;
+  for (const char c : name) {
+    // Control characters shown escaped, so a newline in the name cannot split the message.
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\x%02x",
+                    static_cast<unsigned>(static_cast<unsigned char>(c)));
+      shown += esc;
+    } else {
+      shown += c;
+    }
+  }
+  return "\"" + shown + "\" is not a plain name: the scenario's name becomes the output folder " +
+         "(sim-out/<name>), so it takes 1 to " + std::to_string(kMaxScenarioNameChars) +
+         " letters, digits, '.', '_' and '-', not starting with '.' or '-' (no '/', no spaces)";
+}
 
 HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source) {
   try {

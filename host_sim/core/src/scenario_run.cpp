@@ -3,12 +3,16 @@
 // through nav::NavPipeline<T>, once without compensation and once with the scenario's
 // compensator; the simulated multi-attitude calibration gives the compensator its parameters on
 // request.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <random>
+#include <sstream>
+#include <string>
 #include <utility>
 
 #include "gfins/host_sim/adc_model.hpp"
@@ -40,7 +44,7 @@ HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
   SampleSource source(traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
                       s.rate_hz);
   if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
-  const auto steps = static_cast<std::size_t>(std::llround(s.duration_s * s.rate_hz));
+  const auto steps = static_cast<std::size_t>(sample_count(s) - 1);
   Stream st;
   st.volts_per_count = source.volts_per_count();
   for (std::size_t j = 0; j < 6; ++j) st.scale_v_per_g[j] = errors.sensors[j].scale_v_per_g;
@@ -243,7 +247,7 @@ HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s) {
 }
 
 std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated) {
-  const double samples = std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0;
+  const auto samples = static_cast<double>(sample_count(s));
   const std::uint64_t per_sample = sizeof(TruthState) +
                                    (s.adc ? 2 * sizeof(RawSample) : sizeof(Vec6d)) +
                                    (with_uncompensated ? 2u : 1u) * sizeof(SampleRecord);
@@ -251,18 +255,44 @@ std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated) {
   return bytes >= 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(bytes);
 }
 
+namespace {
+/// The soft address-space limit of this process (`ulimit -v`), bytes, from /proc/self/limits
+/// (read as a file: no OS header here); 0 when unlimited or unknown.
+std::uint64_t address_space_limit_bytes() {
+  std::ifstream f("/proc/self/limits");
+  const std::string key = "Max address space";
+  for (std::string line; std::getline(f, line);) {
+    if (line.rfind(key, 0) != 0) continue;
+    std::istringstream in(line.substr(key.size()));
+    std::string soft;
+    in >> soft;
+    if (soft == "unlimited") return 0;
+    return std::strtoull(soft.c_str(), nullptr, 10);
+  }
+  return 0;
+}
+}  // namespace
+
 std::uint64_t max_run_memory_bytes() {
+  std::uint64_t limit = kMaxRunMemoryBytes;
   const char* v = std::getenv("GFINS_MAX_RUN_MEMORY_BYTES");
-  if (v == nullptr || *v == '\0') return kMaxRunMemoryBytes;
-  char* end = nullptr;
-  const unsigned long long n = std::strtoull(v, &end, 10);
-  return (*end == '\0' && n > 0) ? static_cast<std::uint64_t>(n) : kMaxRunMemoryBytes;
+  if (v != nullptr && *v != '\0') {
+    char* end = nullptr;
+    const unsigned long long n = std::strtoull(v, &end, 10);
+    if (*end == '\0' && n > 0) limit = static_cast<std::uint64_t>(n);
+  }
+  // Under `ulimit -v` the series must fit in what the address space leaves after the program's
+  // own mappings (std::bad_alloc otherwise, the review's case).
+  if (const std::uint64_t as = address_space_limit_bytes(); as > 0) {
+    limit = std::min(limit, as > kAddressSpaceReserveBytes ? as - kAddressSpaceReserveBytes : 0);
+  }
+  return limit;
 }
 
 HostStatus check_run_size(const Scenario& s, bool with_uncompensated, bool in_memory) {
   char buf[320];
   const double periods = s.duration_s * s.rate_hz;
-  if (!(std::floor(periods + 0.5) >= 1.0)) {
+  if (sample_count(s) < 2) {
     std::snprintf(buf, sizeof buf,
                   "scenario %s: duration_s %g x rate_hz %g = %.3g sample periods: a run needs at "
                   "least 2 samples (duration_s >= %g s at this rate)",
@@ -276,7 +306,7 @@ HostStatus check_run_size(const Scenario& s, bool with_uncompensated, bool in_me
     std::snprintf(buf, sizeof buf,
                   "scenario %s: duration_s %g x rate_hz %g = %.4g samples would need %.3g GiB "
                   "of memory, above the limit of %.3g GiB: shorten the run or lower the rate",
-                  s.name.c_str(), s.duration_s, s.rate_hz, std::floor(periods + 0.5) + 1.0,
+                  s.name.c_str(), s.duration_s, s.rate_hz, static_cast<double>(sample_count(s)),
                   static_cast<double>(bytes) / double(1u << 30),
                   static_cast<double>(limit) / double(1u << 30));
     return HostError{ErrorCode::kOutOfRange, buf};
@@ -545,7 +575,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
                        const std::array<double, 6>& bias_comp, const std::array<double, 6>& sf,
                        std::optional<RecordingWriter>& rec, StreamedOutcome& out) {
   const bool navigate_runs = s.trajectory.kind != "calibration_poses";
-  const auto steps = static_cast<std::uint64_t>(std::llround(s.duration_s * s.rate_hz));
+  const std::uint64_t steps = sample_count(s) - 1;
   out.samples_planned = steps + 1;
   const double vpc = source.volts_per_count();
   std::vector<std::unique_ptr<StreamedSeries<T>>> runs;
@@ -703,7 +733,7 @@ HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const Strea
 }
 
 std::uint64_t run_disk_bytes(const Scenario& s, std::size_t decimate, bool with_recording) {
-  const double samples = std::floor(s.duration_s * s.rate_hz + 0.5) + 1.0;
+  const auto samples = static_cast<double>(sample_count(s));
   const double rows = std::ceil(samples / static_cast<double>(std::max<std::size_t>(decimate, 1)));
   double bytes = 0;
   if (s.trajectory.kind != "calibration_poses") {

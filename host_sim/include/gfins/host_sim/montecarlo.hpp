@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <csignal>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -42,10 +43,36 @@ struct MonteCarloResult {
 /// --scalar double). The runs go to `jobs` threads (0: one per hardware thread, parallel.hpp); the
 /// result is bit for bit the same for every `jobs`: each run's random streams come from (seed0, k)
 /// only and the statistics add the runs in the order k = 0, 1, 2, ...
+///
+/// `stop` (may be null), polled between runs: once non-zero (a SIGINT/SIGTERM handler sets it)
+/// no further run starts, and the result holds the runs finished in order so far (runs = their
+/// count; kFailedPrecondition with fewer than 2).
 HostResult<MonteCarloResult> run_montecarlo(const Scenario& base, std::size_t runs,
                                             std::uint64_t seed0, const ProgressFn& progress = {},
                                             NavScalar scalar = NavScalar::kDouble,
-                                            std::size_t jobs = 0);
+                                            std::size_t jobs = 0,
+                                            const volatile std::sig_atomic_t* stop = nullptr);
+
+/// Peak memory of run_montecarlo (bytes), an upper bound: per sample, every run in flight
+/// (run_memory_bytes without the uncompensated run, plus its error rows), the 2 × jobs finished
+/// runs that may wait for their turn (parallel.hpp), the running sums, and at the end the result;
+/// plus kProcessBaseBytes. `jobs` as run_montecarlo's (0: the hardware's), capped at `runs`.
+/// Checked against a measured peak (getrusage ru_maxrss of a child run) in
+/// tests/host_sim/estimate_cli.cpp.
+std::uint64_t montecarlo_memory_bytes(const Scenario& s, std::size_t runs, std::size_t jobs);
+
+/// Before any work: at least two samples and montecarlo_memory_bytes within
+/// max_run_memory_bytes(); the message gives samples, runs, threads, the estimate and the limit,
+/// and says that fewer threads (-j) or a shorter run fit.
+HostStatus check_montecarlo_size(const Scenario& s, std::size_t runs, std::size_t jobs);
+
+/// Wall-clock time a Monte-Carlo of `runs` runs is expected to take on `jobs` threads, s, from
+/// kMcSecondsPerSampleRun.
+double montecarlo_seconds_estimate(const Scenario& s, std::size_t runs, std::size_t jobs);
+/// Measured cost of one sample of one Monte-Carlo run (simulation, ADC model, float32 core,
+/// statistics): 60 s of `rest` at 1 kHz, 2 runs, -j 1, took 1.60 s on the 2-core development
+/// machine (1.38 s for `drive`): 13 µs.
+inline constexpr double kMcSecondsPerSampleRun = 13e-6;
 
 /// Least-squares slope of log y against log t over the samples with t in [t_lo, t_hi] and y > 0.
 /// Returns NaN with fewer than two such samples.

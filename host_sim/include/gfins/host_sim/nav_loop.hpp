@@ -10,7 +10,9 @@
 //
 // Per sample the loop:
 //   - hands the RawSample to NavPipeline::process(), the pipeline's one entry. The pipeline
-//     counts sequence gaps (the only place that does) and rejects kCrcError and saturated frames;
+//     counts sequence gaps (the only place that does) and rejects kCrcError frames and frames
+//     with a count on a rail; a frame flagged sample_flags::kSaturated is rejected too (the loop
+//     hands it on marked kCrcError, nav_loop.cpp says why);
 //     the loop reads its counters to report each gap with the sample index, the expected and the
 //     seen counter and the number of samples missing;
 //   - if the pipeline navigates and did not reject the sample, hashes its state and hands it to

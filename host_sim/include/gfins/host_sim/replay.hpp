@@ -2,6 +2,7 @@
 // (nav_loop.hpp): the same report, hash and sink as every other host run.
 #pragma once
 
+#include <csignal>
 #include <span>
 #include <string>
 
@@ -23,16 +24,21 @@ NavReport replay(nav::NavPipeline<T>& pipeline, std::span<const RawSample> sampl
 /// Streams the recording at `path` block by block (memory: one block) through `pipeline`. On a
 /// truncated or corrupt file the error names its byte offset; the pipeline has then consumed
 /// every sample before the broken block (the checks of a block come before any of its samples
-/// is offered).
+/// is offered). `stop` (may be null) is polled before each sample: once non-zero (a SIGINT/SIGTERM
+/// handler sets it) the replay ends there, between two samples, and returns the report so far
+/// (the caller reads *stop to tell).
 template <typename T>
 HostResult<NavReport> replay_recording(const std::string& path, nav::NavPipeline<T>& pipeline,
-                                       typename NavLoop<T>::Sink sink = {});
+                                       typename NavLoop<T>::Sink sink = {},
+                                       const volatile std::sig_atomic_t* stop = nullptr);
 
 extern template HostResult<NavReport> replay_recording<float>(const std::string&,
                                                               nav::NavPipeline<float>&,
-                                                              NavLoop<float>::Sink);
+                                                              NavLoop<float>::Sink,
+                                                              const volatile std::sig_atomic_t*);
 extern template HostResult<NavReport> replay_recording<double>(const std::string&,
                                                                nav::NavPipeline<double>&,
-                                                               NavLoop<double>::Sink);
+                                                               NavLoop<double>::Sink,
+                                                               const volatile std::sig_atomic_t*);
 
 }  // namespace gfins::sim

@@ -249,6 +249,26 @@ ArrayErrors array_errors(const Scenario& s);
 /// Scalar of the navigation core a run uses: float is the board's, double the host reference.
 enum class NavScalar : std::uint8_t { kFloat, kDouble };
 
+/// Samples of a run of `s`: t = 0 and every whole sample period up to duration_s,
+/// floor(duration_s × rate_hz) + 1. A duration that is not a whole number of periods ends at the
+/// last whole period before it (1.4 s at 1 Hz: t = 0 and 1 s); describe() says so. The product is
+/// floored after a relative 1e-9 allowance, so 0.3 s × 1000 Hz (299.99999999999994 in binary) is
+/// 300 periods.
+std::uint64_t sample_count(const Scenario& s);
+
+/// The simulated time a run of `s` covers: (sample_count(s) − 1) / rate_hz, s.
+double covered_duration_s(const Scenario& s);
+
+/// Longest scenario name accepted (scenario_name_problem).
+inline constexpr std::size_t kMaxScenarioNameChars = 64;
+
+/// Empty when `name` may be a scenario's name, else why not. The name becomes a folder name
+/// (sim-out/<name>, sim-out/montecarlo-<name>) and a title: it must be one plain file-name
+/// component ([A-Za-z0-9._-], 1 to kMaxScenarioNameChars, not starting with '.' or '-'), so a name
+/// such as "../../x" or "/tmp/x" can never put output outside the folder the user runs in.
+/// parse_scenario refuses other names with this message.
+std::string scenario_name_problem(const std::string& name);
+
 /// Memory a run of `s` holds (bytes): per sample the truth, the converter's output and one
 /// SampleRecord per run (two with the uncompensated run), times duration × rate + 1 samples.
 std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated = true);
@@ -257,10 +277,20 @@ std::uint64_t run_memory_bytes(const Scenario& s, bool with_uncompensated = true
 /// development machine or CI runner, so a run never ends in std::bad_alloc after minutes of work.
 inline constexpr std::uint64_t kMaxRunMemoryBytes = std::uint64_t{2} << 30;
 
+/// Resident memory of a host tool before any run (program, libraries, stacks): 5.1 MB measured
+/// for a streamed `gfins-sim run` (getrusage ru_maxrss), rounded up. Added to the estimates.
+inline constexpr std::uint64_t kProcessBaseBytes = std::uint64_t{8} << 20;
+
 /// The memory limit in force: kMaxRunMemoryBytes, or $GFINS_MAX_RUN_MEMORY_BYTES (bytes, a
 /// positive integer) when set. The variable is for tests, which show with a small limit that a
 /// streamed run (run_scenario_streamed) does not depend on it.
+/// Under an address-space limit (`ulimit -v`, read from /proc/self/limits) the limit is at most
+/// that minus kAddressSpaceReserveBytes.
 std::uint64_t max_run_memory_bytes();
+/// Address space a host tool maps beside its data: program and libraries (~30 MB), and per thread
+/// a glibc heap arena (up to 64 MiB reserved) and an 8 MiB stack. Measured: VmPeak − VmHWM of
+/// `montecarlo -j 2` on 60 s of rest was 130 MB; 256 MiB covers three threads.
+inline constexpr std::uint64_t kAddressSpaceReserveBytes = std::uint64_t{256} << 20;
 
 /// Checks before any work: at least two samples (duration × rate ≥ 1 sample period), and the
 /// memory estimate within max_run_memory_bytes(). The message names the scenario, the figures and

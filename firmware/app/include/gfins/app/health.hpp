@@ -59,6 +59,7 @@ inline constexpr std::uint32_t kDataReadyLost = can::status_bits::kDataReadyLost
 inline constexpr std::uint32_t kBusOff = can::status_bits::kBusOff;                // *
 inline constexpr std::uint32_t kExtraEdge = can::status_bits::kExtraEdge;          // *
 inline constexpr std::uint32_t kCanRxDrop = can::status_bits::kCanRxDropped;       // *
+inline constexpr std::uint32_t kAdcReadError = can::status_bits::kAdcReadError;    // *
 }  // namespace status_bits
 
 /// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).

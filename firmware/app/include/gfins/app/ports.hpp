@@ -2,7 +2,8 @@
 // (the ADS131M06 driver on the board and on the simulated board), where epochs go (the CAN
 // publisher), how command frames are decoded and responses encoded (the CAN command codec).
 // Everything the loop calls through these is allocation-free and non-blocking (read_sample waits
-// for data-ready with a timeout: that wait is the loop's only sleep).
+// for data-ready with a timeout: that wait, and the loop's pause of one period after a read that
+// failed at once, are its only sleeps).
 #pragma once
 
 #include <array>

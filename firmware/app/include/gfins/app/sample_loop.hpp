@@ -3,8 +3,16 @@
 //   read frame → NavPipeline::process → health → Publisher (dividers) → CAN service →
 //   commands (receive with timeout 0, at most kMaxCommandsPerCycle) → watchdog kick
 //
+// A cycle without a sample (data-ready timeout, ADC read error, a dead ADC) still publishes: one
+// "no-sample" epoch per sample period the ADC would have delivered (navigation values not
+// available, the fault bits set), so the status and health frames keep their rates while the
+// ADC is silent. A read error that returns at once is paced to the sample period (the loop never
+// spins) and the watchdog stops being kicked after kDeadAdcWatchdogNs without a sample
+// (docs/faults.md, "Watchdog").
+//
 // After configure() nothing here allocates, blocks (except the data-ready wait inside
-// read_sample) or formats text: events go to the log queue as fixed-size records.
+// read_sample and the pause after a read error) or formats text: events go to the log queue as
+// fixed-size records, at most one per kind per kLogIntervalNs (LogLimiter).
 #pragma once
 
 #include <array>
@@ -27,6 +35,17 @@ namespace gfins::app {
 inline constexpr int kMaxCommandsPerCycle = 2;
 /// read_sample waits this many sample periods before reporting a lost data-ready line.
 inline constexpr std::int64_t kReadTimeoutPeriods = 3;
+/// Log rate limit per kind: one record per second of loop time (the sample clock), docs/faults.md.
+inline constexpr std::int64_t kLogIntervalNs = 1000000000;
+/// Consecutive time without a sample, with the ADC failing to answer (read errors, not mere
+/// data-ready timeouts), after which the loop stops kicking the watchdog so the service manager
+/// restarts the firmware and with it the ADC start-up (reset, identity check, configuration).
+/// 10 s: long against a transient (the driver's own recovery takes a few ms), short against an
+/// operator's patience with a board that publishes only "ADC read failed".
+inline constexpr std::int64_t kDeadAdcWatchdogNs = 10000000000;
+/// No-sample epochs published per cycle at most: a cycle that was stalled for longer (the loop
+/// was descheduled) publishes only the most recent periods instead of a burst on the bus.
+inline constexpr auto kMaxGapEpochsPerCycle = static_cast<std::uint32_t>(2 * kReadTimeoutPeriods);
 /// A calibration capture averages at most this many samples (65 s at 1 kHz).
 inline constexpr std::uint32_t kMaxCaptureSamples = 65535;
 inline constexpr std::uint8_t kMaxPose = 63;
@@ -59,6 +78,55 @@ class LatencyHistogram {
   std::int64_t max_ns_ = 0;
 };
 
+/// What the loop logs, each kind rate-limited on its own (a storm of one kind never hides another).
+enum class LogKind : std::uint8_t {
+  kDataReadyTimeout,
+  kAdcReadError,
+  kAdcDead,
+  kCrcError,
+  kAdcReset,
+  kExtraEdge,
+  kMissedEdges,
+  kSaturated,
+  kStuck,
+  kStuckCleared,
+  kCanTxDrop,
+  kCanRxDrop,
+  kBusOff,
+  kCanStateWorse,   // into error-passive, bus-off or down
+  kCanStateBetter,  // back to error-active or warning
+  kOverrun,
+  kCommandRejected,
+  kCount,
+};
+
+/// Per-kind rate limit: the first record of a kind goes out, then at most one per
+/// kLogIntervalNs; the occurrences in between are counted and the next record of that kind says
+/// how many were not logged. Times are the loop's clock (sample time on the simulated board).
+class LogLimiter {
+ public:
+  /// True when a record of `kind` may be queued at t_ns; then `suppressed` is the number of
+  /// occurrences of that kind not logged since its previous record.
+  bool allow(LogKind kind, std::int64_t t_ns, std::int64_t& suppressed) {
+    Entry& e = entries_[static_cast<std::size_t>(kind)];
+    if (e.logged && t_ns - e.last_t_ns < kLogIntervalNs) {
+      ++e.suppressed;
+      return false;
+    }
+    suppressed = e.suppressed;
+    e = Entry{true, t_ns, 0};
+    return true;
+  }
+
+ private:
+  struct Entry {
+    bool logged = false;
+    std::int64_t last_t_ns = 0;
+    std::int64_t suppressed = 0;
+  };
+  std::array<Entry, static_cast<std::size_t>(LogKind::kCount)> entries_{};
+};
+
 struct LoopOptions {
   double sample_rate_hz = 1000.0;
   float initial_heading_rad = 0;
@@ -86,6 +154,9 @@ class SampleLoop {
   Cycle step();
 
   const HealthCounters& health() const { return health_; }
+  /// False once the ADC has delivered nothing for kDeadAdcWatchdogNs with read errors: the loop
+  /// no longer kicks the watchdog.
+  bool kicking_watchdog() const { return !watchdog_held_; }
   const LatencyHistogram& latency() const { return latency_; }
   const nav::NavPipeline<float>& pipeline() const { return pipeline_; }
   Mode mode() const { return mode_; }
@@ -118,6 +189,20 @@ class SampleLoop {
   void poll_reload(std::int64_t t_ns);
   void send_response(const Response& r);
   void build_epoch(const RawSample& s);
+  void publish_gap(std::int64_t t_ns, std::uint32_t cause);
+  void build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint32_t cause);
+  void on_read_error(std::int64_t t_ns, const Status& st);
+  /// A record of `kind` through the rate limit; the count of records it held back since the
+  /// previous one is the argument after `args`.
+  template <typename... Args>
+  void limited_log(LogKind kind, LogLevel level, std::int64_t t_ns, const char* fmt, Args... args) {
+    static_assert(sizeof...(Args) < LogRecord::kMaxArgs, "one argument is the suppressed count");
+    std::int64_t suppressed = 0;
+    if (!limiter_.allow(kind, t_ns, suppressed)) return;
+    const std::array<std::int64_t, LogRecord::kMaxArgs> a{static_cast<std::int64_t>(args)...,
+                                                          suppressed};
+    log(level, t_ns, fmt, a[0], a[1], a[2], a[3]);
+  }
   Status reconfigure_keep_navigation(const nav::PipelineConfig<float>& cfg);
   void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
            std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0);
@@ -154,7 +239,16 @@ class SampleLoop {
   bool reload_pending_ = false;
   Mode mode_ = Mode::kStartup;
   std::uint32_t sample_index_ = 0;
-  std::uint32_t last_log_ = 0;
+  LogLimiter limiter_{};
+  std::int64_t t_cycle_ = 0;  // time of this cycle's edge (or of the failed read)
+  // The time base of no-sample epochs: the last sample read (or configure()'s time before any).
+  std::uint32_t ref_seq_ = 0;
+  std::int64_t ref_t_ns_ = 0;
+  std::uint32_t published_seq_ = 0;  // the last sample counter handed to the publisher
+  bool have_published_ = false;
+  bool adc_failing_ = false;  // a read error since the last sample
+  std::int64_t failing_since_ns_ = 0;
+  bool watchdog_held_ = false;
 };
 
 }  // namespace gfins::app

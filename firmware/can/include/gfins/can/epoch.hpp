@@ -45,6 +45,8 @@ inline constexpr std::uint32_t kExtraEdge = 1u << 17;  // a data-ready edge with
 inline constexpr std::uint32_t kCanRxDropped = 1u
                                                << 18;  // received CAN frames were lost (the
                                                        // kernel's socket queue or the controller)
+inline constexpr std::uint32_t kAdcReadError = 1u << 19;   // the ADC delivered no sample (SPI or
+                                                           // driver failure, a dead chip)
 inline constexpr std::uint32_t kAllBits = (1u << 20) - 1;  // width of the bus field
 static_assert(kAligned == nav::nav_status::kAligned && kSampleGap == nav::nav_status::kSampleGap &&
                   kInputInvalid == nav::nav_status::kInputInvalid &&
@@ -64,6 +66,7 @@ struct Health {
   std::uint32_t can_tx_dropped = 0;     // frames the CAN backend dropped
   std::uint32_t bus_off_events = 0;     // transitions into bus-off
   std::uint32_t loop_overruns = 0;      // sample-loop deadline misses
+  std::uint32_t log_dropped = 0;        // log records lost to a full log queue
 };
 
 /// One sample's worth of what may be published. Every value refers to nav.t_ns, the sampling

@@ -56,6 +56,7 @@ enum class Field : std::uint8_t {
   kCanTxDropped,
   kBusOffEvents,
   kLoopOverruns,
+  kLogDropped,
   // command
   kCmdOpcode,
   kCmdToken,
@@ -296,14 +297,14 @@ inline constexpr std::array<SignalDef, 5> kEpochSignals{{
 }};
 
 inline constexpr std::array<SignalDef, 4> kStatusSignals{{
-    unsigned_int("StatusFlags", Field::kStatusFlags, 0, 0, 20, 1048575.0, kNotMultiplexed, {},
-                 kAtSample,
-                 "Validity and health bits: 0 aligned, 1 sample gap, 2 input invalid, 3 "
-                 "compensated, 4 a value of this epoch saturated on CAN, 5 a value was not "
-                 "available, 6 ADC CRC error, 7 ADC saturated, 8 ADC channel stuck, 9 nominal "
-                 "calibration, 10 loop overrun, 11 CAN frames dropped, 12 capture active, 13 "
-                 "health degraded, 14 ADC recovered from a reset, 15 data-ready lost, 16 CAN "
-                 "bus-off, 17 extra data-ready edge, 18 CAN frames lost on receive; 19 reserved"),
+    unsigned_int(
+        "StatusFlags", Field::kStatusFlags, 0, 0, 20, 1048575.0, kNotMultiplexed, {}, kAtSample,
+        "Validity and health bits: 0 aligned, 1 sample gap, 2 input invalid, 3 "
+        "compensated, 4 a value of this epoch saturated on CAN, 5 a value was not "
+        "available, 6 ADC CRC error, 7 ADC saturated, 8 ADC channel stuck, 9 nominal "
+        "calibration, 10 loop overrun, 11 CAN frames dropped, 12 capture active, 13 "
+        "health degraded, 14 ADC recovered from a reset, 15 data-ready lost, 16 CAN "
+        "bus-off, 17 extra data-ready edge, 18 CAN frames lost on receive, 19 ADC read failed"),
     unsigned_int("CalId", Field::kCalId, 0, 20, 32, 4294967295.0, kNotMultiplexed, {}, kAtSample,
                  "Identity of the calibration in use (0 = nominal parameters)"),
     counter_signal(),
@@ -393,7 +394,7 @@ inline constexpr std::array<SignalDef, 3> kPositionDSignals{{
     crc_signal(),
 }};
 
-inline constexpr std::array<SignalDef, 6> kHealthAdcSignals{{
+inline constexpr std::array<SignalDef, 7> kHealthAdcSignals{{
     wrapping("MissedEdges", Field::kMissedEdges, 0, 16, "", kCumulative,
              "Data-ready edges the sample loop did not service, mod 2^16"),
     wrapping("AdcCrcErrors", Field::kAdcCrcErrors, 16, 16, "", kCumulative,
@@ -402,6 +403,8 @@ inline constexpr std::array<SignalDef, 6> kHealthAdcSignals{{
              "ADC resets detected and recovered, mod 2^8"),
     unsigned_int("StuckMask", Field::kStuckMask, 0, 40, 6, 63.0, kNotMultiplexed, {}, kAtSample,
                  "Bit c set: ADC channel c+1 judged stuck"),
+    wrapping("LogDropped", Field::kLogDropped, 46, 6, "", kCumulative,
+             "Log records the firmware's log queue lost (queue full), mod 2^6"),
     counter_signal(),
     crc_signal(),
 }};
@@ -594,7 +597,7 @@ inline constexpr std::array<MessageDef, kMessageCount> kMessages{{
     {"GfinsPositionD", MessageId::kPositionD, 0x190, MessageKind::kData, 10, kPositionDSignals,
      "GFINS", "Position from the alignment point, down"},
     {"GfinsHealthAdc", MessageId::kHealthAdc, 0x1A0, MessageKind::kData, 1000, kHealthAdcSignals,
-     "GFINS", "ADC health counters"},
+     "GFINS", "ADC and log health counters"},
     {"GfinsHealthSystem", MessageId::kHealthSystem, 0x1B0, MessageKind::kData, 1000,
      kHealthSystemSignals, "GFINS", "Loop and bus health counters"},
     {"GfinsSensorsA", MessageId::kSensorsA, 0x1C0, MessageKind::kData, 0, kSensorsASignals, "GFINS",
