@@ -187,7 +187,7 @@ struct StepModel {
 };
 
 struct Worst {
-  double ratio = 0;  // largest |core − baseline| / bound over the steps
+  double ratio = -1;  // largest |core − baseline| / bound over the steps (-1: none seen yet)
   double diff = 0;
   double bound = 0;
   std::size_t step = 0;
