@@ -278,6 +278,29 @@ TEST(CalibrateCli, SettingsAreCheckedBeforeSolvingWithReadableBounds) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "c.toml"));
 }
 
+TEST(CalibrateCli, AnOutputThatCannotBeWrittenIsRefusedBeforeSolving) {
+  // Exit 4 is "could not write" (--help); before this check it came after the whole report.
+  const TempDir dir;
+  const std::string inputs =
+      "--means " + kGolden + " --gravity 9.80665 --device-id b --adc-lsb " + kAdcLsb;
+  RunResult r = run_cli(dir, inputs + " -o " + (dir.path() / "no-such-folder" / "c.toml").string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_THAT(r.output, HasSubstr("does not exist (checked before solving)"));
+  EXPECT_THAT(r.output, Not(HasSubstr("verdict")));  // nothing was solved
+  r = run_cli(dir, inputs + " -o " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_THAT(r.output, HasSubstr("it is a directory"));
+  EXPECT_THAT(r.output, Not(HasSubstr("verdict")));
+  // The check leaves nothing behind and does not refuse a writable folder.
+  r = run_cli(dir, inputs + " -o " + (dir.path() / "c.toml").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(e.path().filename().string().rfind(".gfins-calibrate-probe-", 0), std::string::npos)
+        << e.path();
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "c.toml"));
+}
+
 TEST(CalibrateCli, TheLatitudeGivesWgs84NormalGravityInTheFile) {
   // Given a calibration at 24.8° latitude, 100 m: Somigliana's formula (WGS-84, written here)
   // minus the free-air gradient 3.086e-6 m/s² per m.

@@ -215,6 +215,10 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   namespace fs = std::filesystem;
   // Checked before the decode: a figure that cannot be written is a one-line error naming it,
   // not a traceback of the plot script after the work.
+  if (png.empty()) {
+    std::fprintf(stderr, "gfins-can plot: -o is empty: give the PNG file to write\n");
+    return kExitInput;
+  }
   if (const std::string why = output_unwritable(png); !why.empty()) {
     std::fprintf(stderr, "gfins-can plot: cannot write the figure '%s': %s\n", png.c_str(),
                  why.c_str());

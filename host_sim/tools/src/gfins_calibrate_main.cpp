@@ -6,12 +6,16 @@
 // be written.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -35,6 +39,28 @@ constexpr int kExitWrite = 4;
 int fail(int code, const std::string& message) {
   std::cerr << "gfins-calibrate: error: " << message << "\n";
   return code;
+}
+
+/// Why the calibration file `output` could not be written, or "" when it can. The file is
+/// replaced atomically (a temporary file in the same folder, then a rename), so what must be
+/// writable is its folder, not the file: probed with a temporary file that is removed at once.
+/// Checked before the work, so that a long solve does not end in "could not write".
+std::string output_unwritable(const std::string& output) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(output, ec)) return "it is a directory";
+  fs::path dir = fs::path(output).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec)) return "its folder '" + dir.string() + "' does not exist";
+  std::random_device rd;
+  const fs::path probe = dir / (".gfins-calibrate-probe-" + std::to_string(rd()));
+  std::FILE* f = std::fopen(probe.c_str(), "wbx");
+  if (f == nullptr) {
+    return "cannot create a file in its folder '" + dir.string() + "': " + std::strerror(errno);
+  }
+  static_cast<void>(std::fclose(f));
+  fs::remove(probe, ec);
+  return {};
 }
 
 struct Options {
@@ -441,6 +467,11 @@ int calibrate_main(int argc, char** argv) {
     return fail(kExitInput, "--output is required (or --dry-run)");
   }
   if (const int rc = check_numbers(o); rc != kExitOk) return rc;
+  if (!o.dry_run) {
+    if (const std::string why = output_unwritable(o.output); !why.empty()) {
+      return fail(kExitWrite, "--output " + o.output + ": " + why + " (checked before solving)");
+    }
+  }
   return run(o);
 }
 
