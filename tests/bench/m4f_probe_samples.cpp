@@ -7,8 +7,11 @@
 //   gfins_m4f_probe_samples > nav_core/baremetal/probe_samples.hpp     regenerate
 //   gfins_m4f_probe_samples --check nav_core/baremetal/probe_samples.hpp
 //       exit 0 when the file is what this program writes, 1 (naming the first differing line)
-//       when it is stale, 2 on a usage or file error (ctest m4f_probe_samples_current)
+//       when it is stale, 2 on a usage or file error (ctest m4f_probe_samples_current); the
+//       expected final state may differ by float rounding (kExpectedTolerance)
 #include <bit>
+#include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -16,6 +19,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "../../nav_core/baremetal/probe_config.hpp"
 #include "bench_scenario.hpp"
@@ -128,6 +132,49 @@ std::string header(const Workload& w) {
   return o.str();
 }
 
+// The expected final state is computed by this host's compiler: another compiler or flags may sum
+// in another order and move it by float rounding over 999 steps (the x86 float and double
+// pipelines differ by 4.8e-5 m/s on these samples), which does not make the header stale; a
+// change of the samples, the configuration or the core's equations moves it by far more.
+constexpr double kExpectedTolerance = 2e-4;  // m, m/s, quaternion units
+constexpr const char* kExpectedLine =
+    "inline constexpr std::array<std::uint32_t, 10> kExpectedOutBits";
+
+std::vector<float> expected_floats(const std::string& line) {
+  std::vector<float> v;
+  std::size_t pos = line.find('{');
+  while (pos != std::string::npos) {
+    const std::size_t x = line.find("0x", pos);
+    if (x == std::string::npos) break;
+    v.push_back(
+        std::bit_cast<float>(static_cast<std::uint32_t>(std::stoul(line.substr(x), nullptr, 16))));
+    pos = x + 2;
+  }
+  return v;
+}
+
+bool same_line(const std::string& have, const std::string& want) {
+  if (have == want) return true;
+  if (want.rfind(kExpectedLine, 0) == 0 && have.rfind(kExpectedLine, 0) == 0) {
+    const std::vector<float> a = expected_floats(have);
+    const std::vector<float> b = expected_floats(want);
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!(std::abs(static_cast<double>(a[i]) - static_cast<double>(b[i])) <=
+            kExpectedTolerance)) {
+        return false;
+      }
+    }
+    return true;
+  }
+  // The comment that spells the expected values out in decimal follows the bit patterns' fate.
+  const auto is_values_comment = [](const std::string& l) {
+    return l.size() > 3 && l.rfind("// ", 0) == 0 &&
+           (std::isdigit(static_cast<unsigned char>(l[3])) != 0 || l[3] == '-');
+  };
+  return is_values_comment(have) && is_values_comment(want);
+}
+
 int check(const std::string& path, const std::string& want) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
@@ -136,7 +183,6 @@ int check(const std::string& path, const std::string& want) {
   }
   std::stringstream have;
   have << in.rdbuf();
-  if (have.str() == want) return 0;
   std::istringstream a(have.str());
   std::istringstream b(want);
   std::string la;
@@ -144,7 +190,8 @@ int check(const std::string& path, const std::string& want) {
   for (int line = 1;; ++line) {
     const bool ga = static_cast<bool>(std::getline(a, la));
     const bool gb = static_cast<bool>(std::getline(b, lb));
-    if (!ga || !gb || la != lb) {
+    if (!ga && !gb) return 0;
+    if (ga != gb || !same_line(la, lb)) {
       std::cerr << "gfins_m4f_probe_samples: '" << path << "' is stale from line " << line
                 << ": regenerate it with gfins_m4f_probe_samples > " << path << "\n";
       return 1;
