@@ -51,7 +51,8 @@ step "host-debug (ASan + UBSan): unit tests"
 ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 
 # Every unit test ran above under the sanitizers; the release build adds what needs optimised
-# code: the hour-long simulations, the heap checks with NDEBUG defined, the applications and
+# code: the hour-long simulations, the heap checks with NDEBUG defined, the resource figures of
+# gfins-sim montecarlo and covariance (label optimised, tests/CMakeLists.txt), the applications and
 # the benchmarks (built and run briefly so they cannot rot). The full release suite is
 # `ctest --preset host-release` after a full release build.
 step "host-release: build (applications, benchmarks, long and heap tests)"
@@ -59,7 +60,8 @@ cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
-  can_publisher_no_malloc_check gfins-can gfins_can_decode_bench gfins_package_programs
+  can_publisher_no_malloc_check gfins-can gfins_can_decode_bench gfins_package_programs \
+  host_sim_montecarlo_cli
 
 # clang-tidy reads only the release tree's compile database, so from here it runs in the
 # background at the lowest CPU priority (nice 19: it gets a core only when the steps below leave
@@ -74,8 +76,8 @@ nice -n 19 ./scripts/check-tidy.sh build/host-release >"$log_dir/tidy.log" 2>&1 
 tidy_pid=$!
 set +m
 
-step "host-release: hour-long runs (label long) and heap checks (label heap)"
-ctest --preset host-release -j "$jobs" -L 'long|heap' | tee "$log_dir/ctest-release.log"
+step "host-release: hour-long runs (label long), heap checks (label heap), resource figures (label optimised)"
+ctest --preset host-release -j "$jobs" -L 'long|heap|optimised' | tee "$log_dir/ctest-release.log"
 
 step "host-release: main job and benchmarks, smoke run"
 ./build/host-release/host_sim/app/gfins-sim --duration 1 >/dev/null

@@ -80,16 +80,23 @@ if [ -n "$deb" ]; then
   # (the ADC chip model inside the process, paced by the gpio-sim line's falling edges, output
   # on a vcan named can0, the interface the package's unit waits for) through a unit drop-in.
   # Default: gfins-fw-vboard.toml at this rate with the systemd watchdog, on can0, the chip
-  # found by its gpio-sim label. The scenario is not in the firmware
+  # found by its gpio-sim label, with the package's real-time settings (SCHED_FIFO 80, mlockall). The scenario is not in the firmware
   # package (scenarios ship with gfins-tools): it goes to /etc/gfins/vboard-scenarios, named
   # with --scenario-dir.
   if [ -z "$fw_config" ]; then
     fw_config=$vboard_cache/service-fw.toml
     sed -e "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/" -e 's/^gpio_chip = .*/gpio_chip = "gfins-vboard"/' \
       -e '/^\[watchdog\]/,/^kind/ s/^kind = .*/kind = "systemd"/' \
-      -e '/^\[can\]/,/^interface/ s/^interface = .*/interface = "can0"/' "$here/gfins-fw-vboard.toml" >"$fw_config"
+      -e '/^\[can\]/,/^interface/ s/^interface = .*/interface = "can0"/' \
+      -e '/^\[realtime\]/,/^lock_memory/ s/^priority = .*/priority = 80/' \
+      -e '/^\[realtime\]/,/^lock_memory/ s/^lock_memory = .*/lock_memory = true/' \
+      "$here/gfins-fw-vboard.toml" >"$fw_config"
     grep -q '^kind = "systemd"' "$fw_config" || vb_die "could not set [watchdog] kind = systemd in $fw_config"
     grep -q '^interface = "can0"' "$fw_config" || vb_die "could not set [can] interface = can0 in $fw_config"
+    # The package's real-time defaults (firmware/app/gfins-fw.toml): under the unit's LimitRTPRIO
+    # and LimitMEMLOCK the gfins user may take them (check fw-realtime).
+    grep -q '^priority = 80' "$fw_config" && grep -q '^lock_memory = true' "$fw_config" ||
+      vb_die "could not set [realtime] priority = 80, lock_memory = true in $fw_config"
   fi
   cp "$fw_config" "$out/etc/gfins/vboard.toml"
   mkdir -p "$out/etc/gfins/vboard-scenarios"

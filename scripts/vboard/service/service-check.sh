@@ -73,7 +73,7 @@ if [ "$WANT_FW" = 1 ]; then
     fi
     if ! active; then
       # Nothing below can happen without a running service: say so instead of waiting.
-      for c in fw-waits-for-can0 fw-runs-as-gfins fw-frames fw-status-text fw-watchdog-pings fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
+      for c in fw-waits-for-can0 fw-runs-as-gfins fw-realtime fw-frames fw-status-text fw-watchdog-pings fw-hang-restart fw-watchdog-journal fw-frames-after-restart; do
         fail "$c: not reached, gfins-fw.service is $(prop gfins-fw ActiveState) (NRestarts $(prop gfins-fw NRestarts))"
       done
     else
@@ -83,8 +83,24 @@ if [ "$WANT_FW" = 1 ]; then
     want_uid=$(id -u gfins)
     [ "$uids" = "$want_uid $want_uid" ] && pass "fw-runs-as-gfins: MainPID $pid runs as uid $want_uid (gfins)" ||
       fail "fw-runs-as-gfins: MainPID $pid runs as uid(s) '${uids:-?}', gfins is $want_uid"
-    policy=$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *//p' | head -n 1)
-    say "VBOARD-INFO fw scheduling: $policy"
+    # Real-time scheduling permitted by the unit (LimitRTPRIO, LimitMEMLOCK) and taken by the
+    # firmware as a non-root user: its sample-loop thread under SCHED_FIFO at [realtime] priority
+    # 80, its memory locked by mlockall. proc(5): in /proc/PID/task/TID/stat, after "(comm) ",
+    # rt_priority is field 40 and policy field 41 (SCHED_FIFO = 1), i.e. the 38th and 39th of
+    # what follows the comm; VmLck in /proc/PID/status is the locked memory.
+    fifo=""
+    for st in /proc/$pid/task/*/stat; do
+      f=$(sed 's/^.*) //' "$st" | cut -d' ' -f38,39)
+      tid=${st%/stat}
+      [ "$f" = "80 1" ] && fifo="$fifo ${tid##*/}"
+    done
+    lck=$(sed -n 's/^VmLck:[[:space:]]*\([0-9]*\) kB/\1/p' "/proc/$pid/status")
+    if [ -n "$fifo" ] && [ "${lck:-0}" -gt 0 ]; then
+      pass "fw-realtime: thread(s)$fifo of $pid under SCHED_FIFO priority 80, VmLck ${lck} kB"
+    else
+      fail "fw-realtime: no thread of $pid under SCHED_FIFO 80 (policy/priority per thread: $(for st in /proc/$pid/task/*/stat; do sed 's/^.*) //' "$st" | cut -d' ' -f38,39; done | tr '\n' ';')), VmLck ${lck:-?} kB"
+      journalctl -u gfins-fw --no-pager | grep -i 'realtime\|SCHED_FIFO\|mlockall' | tail -n 4 | sed 's/^/VBOARD-LOG fw: /' | tee -a $out
+    fi
     frames=$(timeout 5 candump -n 20 can0 | wc -l)
     [ "$frames" -eq 20 ] && pass "fw-frames: 20 frames on can0 from the service" ||
       fail "fw-frames: $frames of 20 frames on can0 within 5 s"
