@@ -95,9 +95,12 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;
   }
+  // Every helper thread (log drain, reload worker, status reporter) starts before the loop's
+  // thread takes SCHED_FIFO: a thread inherits its creator's policy, and none of them may
+  // compete with the loop at its priority (the virtual board's check fw-realtime asserts it).
+  if (status_reporter) status_reporter->start();
   if (const std::string warn = board.enter_realtime(cfg); !warn.empty()) spdlog::warn("{}", warn);
   if (board.watchdog) (void)board.watchdog->notify_ready();
-  if (status_reporter) status_reporter->start();
   spdlog::info("sample loop running (alignment: keep the board still for {} s)", cfg.alignment_s);
 
   std::signal(SIGINT, on_signal);

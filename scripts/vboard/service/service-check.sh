@@ -64,7 +64,7 @@ if [ "$WANT_FW" = 1 ]; then
       nr0=$(sed -n 's/^NRestarts=//p' /tmp/start)
       can_up=$(cat /run/vboard-can0 2>/dev/null)
       late=$(awk -v s="${start_us:-0}" -v c="${can_up:-1e9}" 'BEGIN { print (s / 1e6 > c) ? 1 : 0 }')
-      [ "$late" = 1 -a "$nr0" = 0 ] &&
+      [ "$late" = 1 ] && [ "$nr0" = 0 ] &&
         pass "fw-waits-for-can0: started at ${start_us}us, after can0 appeared (uptime ${can_up}s), NRestarts 0" ||
         fail "fw-waits-for-can0: started at ${start_us:-?}us, can0 appeared at uptime ${can_up:-never}s, NRestarts ${nr0:-?} (expected a start after can0 and no restart)"
     else
@@ -84,21 +84,26 @@ if [ "$WANT_FW" = 1 ]; then
     [ "$uids" = "$want_uid $want_uid" ] && pass "fw-runs-as-gfins: MainPID $pid runs as uid $want_uid (gfins)" ||
       fail "fw-runs-as-gfins: MainPID $pid runs as uid(s) '${uids:-?}', gfins is $want_uid"
     # Real-time scheduling permitted by the unit (LimitRTPRIO, LimitMEMLOCK) and taken by the
-    # firmware as a non-root user: its sample-loop thread under SCHED_FIFO at [realtime] priority
-    # 80, its memory locked by mlockall. proc(5): in /proc/PID/task/TID/stat, after "(comm) ",
-    # rt_priority is field 40 and policy field 41 (SCHED_FIFO = 1), i.e. the 38th and 39th of
-    # what follows the comm; VmLck in /proc/PID/status is the locked memory.
-    fifo=""
+    # firmware as a non-root user: the sample loop (the main thread, TID = PID) under SCHED_FIFO
+    # at [realtime] priority 80, no other thread of the process under a real-time policy (they
+    # would compete with the loop), its memory locked by mlockall. proc(5): in
+    # /proc/PID/task/TID/stat, after "(comm) ", rt_priority is field 40 and policy field 41
+    # (SCHED_OTHER 0, SCHED_FIFO 1, SCHED_RR 2), i.e. the 38th and 39th of what follows the comm;
+    # VmLck in /proc/PID/status is the locked memory.
+    sched=""
+    others_rt=""
     for st in /proc/$pid/task/*/stat; do
-      f=$(sed 's/^.*) //' "$st" | cut -d' ' -f38,39)
       tid=${st%/stat}
-      [ "$f" = "80 1" ] && fifo="$fifo ${tid##*/}"
+      tid=${tid##*/}
+      f=$(sed 's/^.*) //' "$st" | cut -d' ' -f38,39)
+      sched="$sched $tid:$(echo "$f" | tr " " /)"
+      if [ "$tid" = "$pid" ]; then main=$f; else case ${f#* } in 1 | 2) others_rt="$others_rt $tid" ;; esac; fi
     done
     lck=$(sed -n 's/^VmLck:[[:space:]]*\([0-9]*\) kB/\1/p' "/proc/$pid/status")
-    if [ -n "$fifo" ] && [ "${lck:-0}" -gt 0 ]; then
-      pass "fw-realtime: thread(s)$fifo of $pid under SCHED_FIFO priority 80, VmLck ${lck} kB"
+    if [ "${main:-}" = "80 1" ] && [ -z "$others_rt" ] && [ "${lck:-0}" -gt 0 ]; then
+      pass "fw-realtime: loop thread $pid under SCHED_FIFO priority 80, the other threads not real-time (tid:priority/policy$sched), VmLck ${lck} kB"
     else
-      fail "fw-realtime: no thread of $pid under SCHED_FIFO 80 (policy/priority per thread: $(for st in /proc/$pid/task/*/stat; do sed 's/^.*) //' "$st" | cut -d' ' -f38,39; done | tr '\n' ';')), VmLck ${lck:-?} kB"
+      fail "fw-realtime: expected thread $pid at SCHED_FIFO 80 alone and VmLck > 0; tid:priority/policy$sched, VmLck ${lck:-?} kB"
       journalctl -u gfins-fw --no-pager | grep -i 'realtime\|SCHED_FIFO\|mlockall' | tail -n 4 | sed 's/^/VBOARD-LOG fw: /' | tee -a $out
     fi
     frames=$(timeout 5 candump -n 20 can0 | wc -l)
