@@ -83,7 +83,7 @@ wait $flood_pid 2>/dev/null
 # receive" (docs/can-interface.md) and a log line with the running total (the CAN health frame
 # carries no receive counter). CanRxDropped below is that total from the log's last such line.
 sleep 0.2  # the logger thread writes every 10 ms: the last line reaches the file meanwhile
-rx_lost=$(sed -n 's/.*received CAN frame(s) lost before the loop read them (lost: \([0-9]*\)).*/\1/p' /tmp/faults-fw.log | tail -n 1)
+rx_lost=$(sed -n 's/.*received CAN frame(s) lost before the loop read them (lost: \([0-9]*\)[;)].*/\1/p' /tmp/faults-fw.log | tail -n 1)
 check faults-flood-reported "during a 2 s cangen flood: $w_epochs epochs, status bit 18 (CAN frames lost on receive) $rx_bit_before -> $(bitname $w_flags 18), log reports ${rx_lost:-no} lost frame(s) (lines before the flood: $rx_lines_before)" \
   [ "$rx_bit_before" = clear -a "$rx_lines_before" -eq 0 -a "$(bitname $w_flags 18)" = set -a "${rx_lost:-0}" -gt 0 ]
 window flood-after 2

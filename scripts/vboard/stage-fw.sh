@@ -4,7 +4,8 @@
 # data-ready edges of the gpio-sim line through libgpiod, output on the REAL vcan0 through
 # SocketCAN) for a fixed number of edges while candump records; then assertions on the decoded
 # recording: the epoch count, continuous counters and valid CRCs (gfins-can decode exit 0 and the
-# sample counter's spacing), values within one quantisation step of the host-only run of the
+# sample counter's spacing), the waits before the first and after the last edge published as
+# no-sample epochs, values within one quantisation step of the host-only run of the
 # same configuration (run.sh), epoch by epoch keyed by the sample counter, and zero faults in
 # the health frames.
 # needs: build:firmware/app/gfins-fw
@@ -46,15 +47,53 @@ echo "VBOARD-INFO fw decode: $summary"
 check fw-decode-clean "gfins-can decode exit $dec_rc (0: every frame's CRC valid, counters continuous, no issue)" \
   [ $dec_rc -eq 0 ]
 
-epochs=$(($(wc -l </tmp/fw.csv) - 1))
-expect=$(((edges + divider - 1) / divider))
-check fw-epochs "$epochs epochs decoded, expected $expect ($edges edges at $rate Hz, divider $divider, toggler skipped ${skipped:-?})" \
-  [ "$epochs" -eq $expect -a "${skipped:-1}" -eq 0 ]
-
-# Counters continuous, checked on the decoded sample counter itself: 0, 10, 20, ...
+# The firmware publishes from its start, before the toggler's first edge, and until SIGTERM, a
+# second after the last edge: the periods without a conversion go out as no-sample epochs
+# (docs/faults.md, "While the ADC delivers nothing": StatusFlags bits 2 InputInvalid, 5 "a value
+# not available", 13 HealthDegraded and 15 DataReadyLost, navigation values not available). The
+# ones before the first conversion count the loop's periods from its start; the first conversion
+# is sample 0 (the counter restarts once, a note for gfins-can). Split the decoded epochs: those
+# with a sample (bits 2 and 5 clear in this fault-free run) must be the 2000 edges' epochs, whole
+# and in order; the no-sample ones may only lead or trail them, never fall between.
+fl=$(csv_col /tmp/fw.csv StatusFlags)
 sc=$(csv_col /tmp/fw.csv SampleCount)
-gaps=$(awk -F, -v c="$sc" -v d=$divider 'NR > 1 { if ($c != (NR - 2) * d) ++bad } END { print bad + 0 }' /tmp/fw.csv)
-check fw-sample-counter "$gaps epochs whose sample counter is not 10 x their index (first 0)" [ "$gaps" -eq 0 ]
+set -- $(awk -F, -v f="$fl" -v c="$sc" -v d=$divider '
+  # bit(v, 2^b): busybox awk has no "^" (no math support)
+  function bit(v, p) { return int(v / p) % 2 }
+  NR == 1 { print > "/tmp/fw-samples.csv"; next }
+  {
+    nosample = bit($f, 4) && bit($f, 32)
+    if (!nosample) {
+      print > "/tmp/fw-samples.csv"
+      if (n && trail) inner += trail  # no-sample epochs between two with a sample
+      trail = 0
+      if ($c != n * d) ++bad
+      ++n
+      last = $c
+      next
+    }
+    if (!bit($f, 8192) || !bit($f, 32768)) ++badbits
+    if (!n) { if (lead && $c != prev + d) ++leadgap; ++lead; prev = $c; next }
+    if (!trail && $c != last + d) ++trailgap
+    if (trail && $c != prev + d) ++trailgap
+    ++trail
+    prev = $c
+  }
+  END { print n + 0, lead + 0, trail + 0, inner + 0, bad + 0, leadgap + 0, trailgap + 0, badbits + 0 }' /tmp/fw.csv)
+epochs=$1 lead=$2 trail=$3 inner=$4 gaps=$5 leadgap=$6 trailgap=$7 badbits=$8
+expect=$(((edges + divider - 1) / divider))
+check fw-epochs "$epochs epochs with a sample decoded, expected $expect ($edges edges at $rate Hz, divider $divider, toggler skipped ${skipped:-?}); no-sample epochs: $lead before the first edge, $trail after the last, $inner between (expected 0)" \
+  [ "$epochs" -eq $expect -a "${skipped:-1}" -eq 0 -a "$inner" -eq 0 ]
+
+# Counters continuous, checked on the decoded sample counter itself: the epochs with a sample
+# 0, 10, 20, ...; the no-sample epochs after the last edge continue it (2000, 2010, ...), those
+# before the first edge are consecutive among themselves.
+check fw-sample-counter "$gaps epochs with a sample whose counter is not 10 x their index (first 0); $trailgap breaks after the last edge, $leadgap before the first" \
+  [ "$gaps" -eq 0 -a "$trailgap" -eq 0 -a "$leadgap" -eq 0 ]
+# The waits are published, not silent: the toggler starts after the firmware and stops a second
+# before SIGTERM, so both kinds exist, each with its fault bits.
+check fw-nosample-epochs "$lead + $trail no-sample epochs (bits 2 and 5), $badbits of them without bits 13/15" \
+  [ "$lead" -gt 0 -a "$trail" -gt 0 -a "$badbits" -eq 0 ]
 
 # Equal to the host-only run epoch by epoch, keyed by the sample counter, every field within ONE
 # quantisation step of its signal in docs/can/gfins.dbc (fw-compare.awk says why one step, and
@@ -69,7 +108,7 @@ check fw-sample-counter "$gaps epochs whose sample counter is not 10 x their ind
 # before the first edge (held 1 s); they are asserted to clear within the first 2 s of edges,
 # and never to reappear.
 echo "VBOARD-INFO fw guest CPU $(grep -m1 '^flags' /proc/cpuinfo | tr -s ' \t' ' ')"
-set -- $(awk -F, -v rate="$rate" -f /vboard/fw-compare.awk /vboard/gfins.dbc /vboard/fw-ref.csv /tmp/fw.csv)
+set -- $(awk -F, -v rate="$rate" -f /vboard/fw-compare.awk /vboard/gfins.dbc /vboard/fw-ref.csv /tmp/fw-samples.csv)
 check fw-compare-inputs "DBC, reference and VM CSV read (problem: ${10:-none})" [ "${10:-?}" = - ]
 check fw-equals-host "$1 of $epochs epochs equal the host-only run within one quantisation step per field, $2 differ, $3 not in it ($6 fields compared, $4 exactly one step apart, largest difference $5 step(s); first out of tolerance: $7)" \
   [ "$1" -eq "$epochs" -a "$2" -eq 0 -a "$3" -eq 0 -a "$epochs" -gt 0 ]

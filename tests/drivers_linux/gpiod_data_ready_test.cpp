@@ -73,6 +73,13 @@ class FakeGpiod : public GpiodApi {
   int line_event_wait(gpiod_line*, const timespec* t) override {
     ++waits;
     last_timeout = *t;
+    timeouts.push_back(*t);
+    if (eintr_waits > 0) {  // a signal arrives during the wait, after wait_ns_per_eintr
+      --eintr_waits;
+      now_ns += wait_ns_per_eintr;
+      errno = EINTR;
+      return -1;
+    }
     if (wait_errno != 0) {
       errno = wait_errno;
       return -1;
@@ -94,7 +101,13 @@ class FakeGpiod : public GpiodApi {
     return static_cast<int>(i);
   }
 
+  std::int64_t monotonic_now_ns() override { return now_ns; }
+
   bool chip_exists = true;
+  int eintr_waits = 0;                 // how many waits a signal interrupts
+  std::int64_t wait_ns_per_eintr = 0;  // time each interrupted wait lasted
+  std::int64_t now_ns = 5000000000;    // the fake CLOCK_MONOTONIC
+  std::vector<timespec> timeouts;      // every timeout passed to the kernel
   unsigned num_lines = 8;
   int request_errno = 0;
   int wait_errno = 0;
@@ -186,10 +199,36 @@ TEST(GpiodDataReady, TheTimeoutIsPassedToTheKernelAndAQuietLineTimesOut) {
   EXPECT_EQ(r.status().code(), ErrorCode::kTimeout);
   EXPECT_EQ(api.last_timeout.tv_sec, 2);
   EXPECT_EQ(api.last_timeout.tv_nsec, 500000000);
-  api.wait_errno = EINTR;
+  api.wait_errno = EIO;
   const auto e = d.value()->wait_edge(0);
   EXPECT_EQ(e.status().code(), ErrorCode::kIoError);
-  EXPECT_EQ(e.status().os_error(), EINTR);
+  EXPECT_EQ(e.status().os_error(), EIO);
+}
+
+TEST(GpiodDataReady, ASignalDuringTheWaitIsNotAnErrorAndTheWaitGoesOnForWhatIsLeft) {
+  // Given a 3 ms wait that two signals interrupt after 1 ms each (SIGTERM to the firmware: the
+  // kernel returns EINTR, poll-style waits are never restarted), then an edge,
+  FakeGpiod api;
+  auto d = GpiodDataReady::open(by_offset(0), api);
+  ASSERT_TRUE(d.is_ok());
+  api.eintr_waits = 2;
+  api.wait_ns_per_eintr = 1000000;
+  api.batches.push_back({7000000});
+  // the edge is returned, no error, and each wait asked the kernel for the time left: 3, 2, 1 ms.
+  const auto r = d.value()->wait_edge(3000000);
+  ASSERT_TRUE(r.is_ok()) << r.status().message();
+  EXPECT_EQ(r.value().t_ns, 7000000);
+  ASSERT_EQ(api.timeouts.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(api.timeouts[i].tv_sec, 0);
+    EXPECT_EQ(api.timeouts[i].tv_nsec, static_cast<long>(3000000 - 1000000 * i)) << i;
+  }
+  EXPECT_EQ(d.value()->counters().interrupted_waits, 2u);
+  // When the signals take the whole timeout, it is a timeout, not an I/O error.
+  api.eintr_waits = 3;
+  const auto t = d.value()->wait_edge(3000000);
+  EXPECT_EQ(t.status().code(), ErrorCode::kTimeout);
+  EXPECT_EQ(api.timeouts.size(), 6u);
 }
 
 TEST(GpiodDataReady, ABurstQueuedDuringAStallIsReadAtOnceAndHandedOutEdgeByEdge) {

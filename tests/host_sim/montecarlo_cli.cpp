@@ -15,7 +15,6 @@
 #include <regex>
 #include <sstream>
 #include <string>
-#include <thread>
 
 #include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/scenario.hpp"
@@ -149,14 +148,15 @@ TEST_F(MontecarloCli, ProgressReachesALogAndSigintKeepsTheFinishedRuns) {
   ASSERT_GT(t.child.pid, 0);
   // when a progress line says at least 2 runs are done (bounded wait), SIGINT is sent;
   const std::regex done("progress: montecarlo: [0-9]+ % \\(([0-9]+) of 200 runs\\)");
-  bool seen = false;
-  for (int i = 0; i < 6000 && !seen; ++i) {
-    const std::string err = test::slurp(t.stderr_path());
-    for (std::sregex_iterator it(err.begin(), err.end(), done), end; it != end; ++it) {
-      seen = seen || std::stoi((*it)[1].str()) >= 2;
-    }
-    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const bool seen = test::wait_for_stderr(
+      t,
+      [&](const std::string& err) {
+        for (std::sregex_iterator it(err.begin(), err.end(), done), end; it != end; ++it) {
+          if (std::stoi((*it)[1].str()) >= 2) return true;
+        }
+        return false;
+      },
+      std::chrono::seconds(60));
   ASSERT_EQ(unsetenv("GFINS_PROGRESS_INTERVAL_S"), 0);
   EXPECT_TRUE(seen) << "no progress line with 2 runs done within 60 s";
   ASSERT_TRUE(drivers::lnx::signal_program(t.child, SIGINT).is_ok());
@@ -195,11 +195,8 @@ TEST_F(MontecarloCli, CovarianceShowsProgressInALogAndStopsBetweenPhasesOnSigint
       test::start_tool(GFINS_SIM_BIN, {"covariance", toml, "--no-plot", "-o", out.string()}, log);
   ASSERT_GT(t.child.pid, 0);
   // when SIGINT comes after the reference run's first progress line,
-  bool seen = false;
-  for (int i = 0; i < 12000 && !seen; ++i) {
-    seen = test::slurp(t.stderr_path()).find("progress: reference run: ") != std::string::npos;
-    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const bool seen =
+      test::wait_for_stderr(t, "progress: reference run: ", std::chrono::seconds(120));
   ASSERT_EQ(unsetenv("GFINS_PROGRESS_INTERVAL_S"), 0);
   EXPECT_TRUE(seen) << "no progress line within 120 s";
   ASSERT_TRUE(drivers::lnx::signal_program(t.child, SIGINT).is_ok());

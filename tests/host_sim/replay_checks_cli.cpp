@@ -15,7 +15,6 @@
 #include <filesystem>
 #include <regex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "gfins/host_sim/recording.hpp"
@@ -121,11 +120,7 @@ TEST_F(ReplayChecksCli, SigintStopsBetweenTwoSamplesWithWholeFiles) {
       test::start_tool(GFINS_REPLAY_BIN, {gfr, "--no-plot", "-o", out.string()}, log);
   ASSERT_GT(t.child.pid, 0);
   // when SIGINT comes after the first progress line (a log, not a terminal, gets them too),
-  bool seen = false;
-  for (int i = 0; i < 6000 && !seen; ++i) {
-    seen = test::slurp(t.stderr_path()).find("progress: replay: ") != std::string::npos;
-    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const bool seen = test::wait_for_stderr(t, "progress: replay: ", std::chrono::seconds(60));
   ASSERT_EQ(unsetenv("GFINS_PROGRESS_INTERVAL_S"), 0);
   EXPECT_TRUE(seen) << "no progress line within 60 s";
   ASSERT_TRUE(drivers::lnx::signal_program(t.child, SIGINT).is_ok());

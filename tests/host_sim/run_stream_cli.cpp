@@ -17,7 +17,6 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "gfins/host_sim/recording.hpp"
@@ -159,11 +158,7 @@ TEST_F(RunStreamCli, SigintStopsCleanlyWithAPrefixOfTheRun) {
       {"run", toml.string(), "-o", cut.string(), "--no-plot", "--record", gfr.string()}, log);
   ASSERT_GT(t.child.pid, 0);
   // Wait (bounded) for the first progress line on stderr, then interrupt.
-  bool seen = false;
-  for (int i = 0; i < 6000 && !seen; ++i) {
-    seen = test::slurp(t.stderr_path()).find("progress: ") != std::string::npos;
-    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  const bool seen = test::wait_for_stderr(t, "progress: ", std::chrono::seconds(60));
   EXPECT_TRUE(seen) << "no progress line within 60 s";
   ASSERT_TRUE(drivers::lnx::signal_program(t.child, SIGINT).is_ok());
   const CliResult r = test::finish_tool(t);

@@ -6,9 +6,12 @@
 // deliberately bad device id "a b") goes through the vector overload, byte for byte.
 #pragma once
 
+#include <chrono>
+#include <concepts>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gfins/drivers/linux/spawn.hpp"
@@ -60,6 +63,26 @@ inline StartedTool start_tool(const std::string& exe, const std::vector<std::str
   o.stderr_path = t.stderr_path().string();
   if (auto c = drivers::lnx::start_program(argv, o); c.is_ok()) t.child = c.value();
   return t;
+}
+
+/// Polls a started tool's stderr every 10 ms until `found(stderr text)` holds or `limit` has
+/// passed; true when it held. For tests that act (SIGINT) once the tool has reached a point.
+template <typename Found>
+requires std::predicate<Found, const std::string&>
+bool wait_for_stderr(const StartedTool& t, Found found, std::chrono::milliseconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  for (;;) {
+    if (found(slurp(t.stderr_path()))) return true;
+    if (std::chrono::steady_clock::now() >= end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+/// wait_for_stderr for a fixed piece of text.
+inline bool wait_for_stderr(const StartedTool& t, const std::string& text,
+                            std::chrono::milliseconds limit) {
+  return wait_for_stderr(
+      t, [&](const std::string& err) { return err.find(text) != std::string::npos; }, limit);
 }
 
 /// Waits for a started tool: exit code (-1 when killed by a signal or never started), output.

@@ -25,6 +25,11 @@ int GpiodApi::line_request_falling_edge_events(gpiod_line* line, const char* con
   return ::gpiod_line_request_falling_edge_events(line, consumer);
 }
 void GpiodApi::line_release(gpiod_line* line) { ::gpiod_line_release(line); }
+std::int64_t GpiodApi::monotonic_now_ns() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);  // cannot fail for CLOCK_MONOTONIC with a valid pointer
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
 int GpiodApi::line_event_wait(gpiod_line* line, const timespec* timeout) {
   return ::gpiod_line_event_wait(line, timeout);
 }
@@ -115,10 +120,26 @@ hal::DataReadyEdge GpiodDataReady::next_buffered() {
 
 Result<hal::DataReadyEdge> GpiodDataReady::do_wait_edge(std::int64_t timeout_ns) {
   if (next_ < buffered_) return next_buffered();
-  timespec timeout{};
-  timeout.tv_sec = static_cast<time_t>(timeout_ns / 1000000000);
-  timeout.tv_nsec = static_cast<long>(timeout_ns % 1000000000);
-  const int w = api_.line_event_wait(line_, &timeout);
+  // A signal handled by the process (SIGTERM asking the firmware to stop) ends the kernel's wait
+  // with EINTR: not a fault of the line. Wait again for what is left of the timeout (signal(7):
+  // poll-style waits are never restarted, SA_RESTART or not); the caller sees its stop flag after
+  // this edge or timeout, at most the timeout later.
+  const std::int64_t deadline_ns = api_.monotonic_now_ns() + timeout_ns;
+  std::int64_t left_ns = timeout_ns;
+  int w = 0;
+  for (;;) {
+    timespec timeout{};
+    timeout.tv_sec = static_cast<time_t>(left_ns / 1000000000);
+    timeout.tv_nsec = static_cast<long>(left_ns % 1000000000);
+    w = api_.line_event_wait(line_, &timeout);
+    if (w >= 0 || errno != EINTR) break;
+    ++counters_.interrupted_waits;
+    left_ns = deadline_ns - api_.monotonic_now_ns();
+    if (left_ns <= 0) {
+      w = 0;
+      break;
+    }
+  }
   if (w < 0) {
     return Status(ErrorCode::kIoError, "gpiod: waiting for a data-ready edge failed", errno);
   }

@@ -50,6 +50,8 @@ class GpiodApi {
   virtual void line_release(gpiod_line* line);
   virtual int line_event_wait(gpiod_line* line, const timespec* timeout);
   virtual int line_event_read_multiple(gpiod_line* line, gpiod_line_event* events, unsigned n);
+  /// CLOCK_MONOTONIC in ns: what is left of a wait that a signal interrupted.
+  virtual std::int64_t monotonic_now_ns();
 };
 GpiodApi& real_gpiod();
 
@@ -70,10 +72,11 @@ struct GpiodDataReadyConfig {
 
 /// Counters only grow.
 struct DataReadyCounters {
-  std::uint32_t edges = 0;         // data-ready edges read from the kernel
-  std::uint32_t missed_edges = 0;  // inferred from timestamp gaps (see the file comment)
-  std::uint32_t early_edges = 0;   // closer than half a period to the previous one
-  std::uint32_t full_reads = 0;    // reads that filled the whole buffer (more may have waited)
+  std::uint32_t edges = 0;              // data-ready edges read from the kernel
+  std::uint32_t missed_edges = 0;       // inferred from timestamp gaps (see the file comment)
+  std::uint32_t early_edges = 0;        // closer than half a period to the previous one
+  std::uint32_t full_reads = 0;         // reads that filled the whole buffer (more may have waited)
+  std::uint32_t interrupted_waits = 0;  // waits a signal ended (EINTR), resumed for the time left
 };
 
 class GpiodDataReady final : public hal::DataReadyLine {
