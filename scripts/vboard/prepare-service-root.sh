@@ -80,9 +80,9 @@ if [ -n "$deb" ]; then
   # (the ADC chip model inside the process, paced by the gpio-sim line's falling edges, output
   # on a vcan named can0, the interface the package's unit waits for) through a unit drop-in.
   # Default: gfins-fw-vboard.toml at this rate with the systemd watchdog, on can0, the chip
-  # found by its gpio-sim label, with the package's real-time settings (SCHED_FIFO 80, mlockall). The scenario is not in the firmware
-  # package (scenarios ship with gfins-tools): it goes to /etc/gfins/vboard-scenarios, named
-  # with --scenario-dir.
+  # found by its gpio-sim label, with the package's real-time settings (SCHED_FIFO 80,
+  # mlockall). The scenario is not in the firmware package (scenarios ship with gfins-tools): it
+  # goes to /etc/gfins/vboard-scenarios, named with --scenario-dir.
   if [ -z "$fw_config" ]; then
     fw_config=$vboard_cache/service-fw.toml
     sed -e "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/" -e 's/^gpio_chip = .*/gpio_chip = "gfins-vboard"/' \

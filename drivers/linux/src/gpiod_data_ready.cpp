@@ -1,5 +1,7 @@
 #include "gfins/drivers/lnx/gpiod_data_ready.hpp"
 
+#include "gfins/drivers/lnx/os.hpp"
+
 #include <gpiod.h>
 #include <time.h>
 
@@ -25,11 +27,7 @@ int GpiodApi::line_request_falling_edge_events(gpiod_line* line, const char* con
   return ::gpiod_line_request_falling_edge_events(line, consumer);
 }
 void GpiodApi::line_release(gpiod_line* line) { ::gpiod_line_release(line); }
-std::int64_t GpiodApi::monotonic_now_ns() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);  // cannot fail for CLOCK_MONOTONIC with a valid pointer
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
+std::int64_t GpiodApi::monotonic_now_ns() { return monotonic_ns(real_os()); }
 int GpiodApi::line_event_wait(gpiod_line* line, const timespec* timeout) {
   return ::gpiod_line_event_wait(line, timeout);
 }

@@ -1,6 +1,7 @@
 // Hardware-in-the-loop replay link over TCP (docs/hil.md). POSIX sockets, non-blocking, poll(2)
 // for every wait, so a silent host costs the loop one read timeout and never blocks it.
 #include "gfins/drivers/lnx/hil_link.hpp"
+#include "gfins/drivers/lnx/os.hpp"
 #include "gfins/recording/codec.hpp"
 
 #include <arpa/inet.h>
@@ -178,11 +179,7 @@ ParseResult parse(std::span<const std::uint8_t> b) {
 
 namespace {
 
-std::int64_t now_ns() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
+std::int64_t now_ns() { return monotonic_ns(real_os()); }
 
 // poll(2) for `events` until `deadline_ns` (CLOCK_MONOTONIC); true when ready.
 bool wait_fd(int fd, short events, std::int64_t deadline_ns) {

@@ -59,6 +59,12 @@ int Os::set_fifo_priority(int priority) {
 }
 int Os::mlockall(int flags) { return ::mlockall(flags); }
 
+std::int64_t monotonic_ns(Os& os) {
+  timespec ts{};
+  (void)os.clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
 Os& real_os() {
   static Os os;
   return os;

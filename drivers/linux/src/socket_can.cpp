@@ -30,12 +30,6 @@ constexpr int kMaxReadsPerDrain = 128;
 bool would_block(int err) { return err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS; }
 bool interface_gone(int err) { return err == ENETDOWN || err == ENODEV || err == ENXIO; }
 
-std::int64_t monotonic_ns(Os& os) {
-  timespec ts{};
-  (void)os.clock_gettime(CLOCK_MONOTONIC, &ts);  // cannot fail for CLOCK_MONOTONIC
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-
 }  // namespace
 
 Result<std::unique_ptr<SocketCan>> SocketCan::open(const SocketCanConfig& config, Os& os) {

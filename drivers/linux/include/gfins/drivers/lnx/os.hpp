@@ -55,4 +55,9 @@ class Os {
 /// The process-wide real implementation (stateless, never destroyed).
 Os& real_os();
 
+/// CLOCK_MONOTONIC through `os`, in ns: the time base of every deadline the backends compute
+/// (what is left of a wait after a signal or a partial read). clock_gettime cannot fail for
+/// CLOCK_MONOTONIC with a valid pointer (clock_gettime(2)).
+std::int64_t monotonic_ns(Os& os);
+
 }  // namespace gfins::drivers::lnx
