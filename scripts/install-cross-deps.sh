@@ -5,6 +5,8 @@
 # qemu-user-static to run the cross-built unit tests. Idempotent; run as root on Debian 12.
 # Fails naming the package apt cannot install.
 set -euo pipefail
+apt_tag=install-cross-deps
+source "$(dirname "$0")/lib/apt.sh"
 
 archs=(arm64 armhf)
 target_dev=(libgpiod-dev libsystemd-dev libgtest-dev libgmock-dev libtomlplusplus-dev
@@ -51,10 +53,7 @@ for a in "${archs[@]}"; do
 done
 policy=$(apt-cache policy "libgpiod-dev:${archs[0]}" "libgpiod-dev:${archs[1]}")
 if [ $added -eq 1 ] || [ "$(grep -c 'Candidate: [0-9]' <<<"$policy")" -ne 2 ]; then
-  # A mirror in mid-sync makes one index fail: retry once, then let the install name what is
-  # missing.
-  apt-get update -qq || { sleep 5; apt-get update -qq; } ||
-    echo "install-cross-deps: apt-get update reported errors (continuing with the indexes it has)" >&2
+  apt_update
 fi
 echo "install-cross-deps: installing ${#missing[@]} package(s): ${missing[*]}"
 # A Multi-Arch: same library must have one version on every architecture; when the mirror's
@@ -63,22 +62,17 @@ echo "install-cross-deps: installing ${#missing[@]} package(s): ${missing[*]}"
 # the foreign architectures have, then install.
 align_multiarch() {
   local sim lib v specs
-  sim=$(apt-get install -s --no-install-recommends "${missing[@]}" 2>&1 || true)
+  sim=$("${apt_get_cmd[@]}" install -s --no-install-recommends "${missing[@]}" 2>&1 || true)
   for lib in $(sed -n 's/.*Depends: \([a-z0-9.+-]*\):\(arm64\|armhf\) .*not going to be installed.*/\1/p' <<<"$sim" | sort -u); do
     v=$(apt-cache policy "$lib:${archs[0]}" | sed -n 's/^ *Candidate: //p')
     specs=("$lib:amd64=$v")
     for a in "${archs[@]}"; do specs+=("$lib:$a=$v"); done
     echo "install-cross-deps: aligning $lib on $v for amd64 and ${archs[*]}"
-    apt-get install -y -qq --no-install-recommends --allow-downgrades "${specs[@]}" >/dev/null ||
+    "${apt_get_cmd[@]}" install -y -qq --no-install-recommends --allow-downgrades "${specs[@]}" >/dev/null ||
       { echo "install-cross-deps: cannot align $lib on version $v across architectures" >&2; exit 1; }
   done
 }
 align_multiarch
-if ! apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; then
-  for p in "${missing[@]}"; do
-    apt-get install -y -qq --no-install-recommends "$p" >/dev/null ||
-      { echo "install-cross-deps: apt-get install $p failed" >&2; exit 1; }
-  done
-fi
+apt_install "${missing[@]}"
 echo "install-cross-deps: done"
 enable_binfmt

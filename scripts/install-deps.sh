@@ -3,6 +3,8 @@
 # Idempotent and non-interactive; run as root on Debian 12. Skips apt entirely when all
 # packages are present already.
 set -euo pipefail
+apt_tag=install-deps
+source "$(dirname "$0")/lib/apt.sh"
 
 packages=(
   build-essential cmake ninja-build git pkg-config
@@ -35,7 +37,6 @@ if [ "$(id -u)" -ne 0 ]; then
   echo "install-deps: must run as root to install packages (try: sudo $0)" >&2
   exit 1
 fi
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}"
+apt_update
+apt_install "${missing[@]}"
 echo "install-deps: done"

@@ -4,6 +4,8 @@
 # cannot install a package the script fails naming it.
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
+apt_tag=vboard
+source "$(dirname "$0")/../lib/apt.sh"
 
 packages=(
   qemu-system-x86 busybox-static cpio gzip kmod
@@ -22,12 +24,5 @@ if [ ${#missing[@]} -eq 0 ]; then
 fi
 [ "$(id -u)" -eq 0 ] || vb_die "must run as root to install: ${missing[*]}"
 vb_log "installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq || vb_die "apt-get update failed (Debian mirror unreachable?)"
-if ! apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; then
-  # Name the package that cannot be installed.
-  for p in "${missing[@]}"; do
-    apt-get install -y -qq --no-install-recommends "$p" >/dev/null ||
-      vb_die "apt-get install $p failed"
-  done
-fi
+apt_update
+apt_install "${missing[@]}" || vb_die "host packages could not be installed (the package is named above)"

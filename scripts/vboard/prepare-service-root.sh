@@ -40,7 +40,10 @@ if [ -n "$deb" ]; then
     [ "${GFINS_VBOARD_OFFLINE:-0}" != 1 ] ||
       vb_die "GFINS_VBOARD_OFFLINE=1 but the dependencies of $(basename "$deb") are not in the cached root"
     vb_log "installing the dependencies of $(basename "$deb") in the cached root: $deps"
-    { chroot "$pristine" apt-get update -qq && \
+    # shellcheck source=../lib/apt.sh
+    apt_tag=vboard apt_get_cmd=(chroot "$pristine" apt-get)
+    source "$here/../lib/apt.sh"
+    { apt_update && \
       DEBIAN_FRONTEND=noninteractive chroot "$pristine" apt-get satisfy -y -qq --no-install-recommends "$deps" && \
       chroot "$pristine" apt-get clean; } >"$vboard_cache/service-apt.log" 2>&1 ||
       { tail -n 20 "$vboard_cache/service-apt.log" >&2; vb_die "cannot install the dependencies of $(basename "$deb") ($deps) from the mirror"; }

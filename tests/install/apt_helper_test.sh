@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# The three package scripts against a Debian mirror in mid-sync, with fake apt tools first on PATH
+# (apt-get, apt-cache, dpkg-query, dpkg, mount, update-binfmts: nothing is installed or changed
+# on the machine). Each script must
+#   - retry `apt-get update`, then go on with the lists apt has and exit 0 when the install works;
+#   - fail when the install itself fails, naming the package apt cannot install.
+# The fake apt-get fails every `update` the way a mirror in mid-sync does (an index of unexpected
+# size, exit 100) and refuses to install the packages listed in FAKE_APT_BROKEN.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/../.." && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+bin=$work/bin
+mkdir -p "$bin"
+
+cat >"$bin/apt-get" <<'EOF'
+#!/usr/bin/env bash
+echo "apt-get $*" >>"$FAKE_APT_LOG"
+case " $* " in
+  *" update "*)
+    echo "E: Failed to fetch http://deb.debian.org/debian-security/dists/bookworm-security/main/binary-armhf/Packages.xz  File has unexpected size (290544 != 290504). Mirror sync in progress? [IP: 151.101.2.132 80]" >&2
+    exit 100 ;;
+  *" install "*)
+    [[ " $* " == *" -s "* ]] && exit 0  # the simulation of install-cross-deps.sh
+    for a in "$@"; do
+      for b in ${FAKE_APT_BROKEN:-}; do
+        if [ "$a" = "$b" ]; then
+          echo "E: Unable to locate package $b" >&2
+          exit 100
+        fi
+      done
+    done
+    exit 0 ;;
+esac
+exit 0
+EOF
+cat >"$bin/dpkg-query" <<'EOF'
+#!/usr/bin/env bash
+# dpkg-query -W -f='${Status}' PKG: "installed" unless PKG (without :arch) is in FAKE_MISSING.
+p=${!#}
+for m in ${FAKE_MISSING:-}; do
+  if [ "${p%%:*}" = "$m" ]; then exit 1; fi
+done
+printf 'install ok installed'
+EOF
+cat >"$bin/dpkg" <<'EOF'
+#!/usr/bin/env bash
+case "$1" in
+  --print-foreign-architectures) printf 'arm64\narmhf\n' ;;
+esac
+exit 0
+EOF
+# No candidate: install-cross-deps.sh then runs apt-get update (the step that met the mid-sync).
+printf '#!/bin/sh\necho "  Candidate: (none)"\n' >"$bin/apt-cache"
+printf '#!/bin/sh\nexit 0\n' >"$bin/mount"
+printf '#!/bin/sh\nexit 0\n' >"$bin/update-binfmts"
+chmod +x "$bin"/*
+
+failures=0
+# run_case NAME SCRIPT MISSING BROKEN EXPECT_RC EXPECT_TEXT
+run_case() {
+  local name=$1 script=$2 missing=$3 broken=$4 want_rc=$5 want_text=$6 rc=0 updates
+  : >"$work/apt.log"
+  FAKE_APT_LOG=$work/apt.log FAKE_MISSING=$missing FAKE_APT_BROKEN=$broken \
+    GFINS_APT_RETRY_PAUSE_S=0 PATH="$bin:$PATH" "$repo/$script" >"$work/out" 2>&1 || rc=$?
+  updates=$(grep -c ' update' "$work/apt.log" || true)
+  if [ "$rc" -ne "$want_rc" ] || ! grep -qF -- "$want_text" "$work/out" || [ "$updates" -ne 3 ]; then
+    echo "FAIL $name: exit $rc (want $want_rc), $updates apt-get update calls (want 3), output:"
+    sed 's/^/    /' "$work/out"
+    failures=$((failures + 1))
+  else
+    echo "ok   $name"
+  fi
+}
+
+run_case "install-deps: update errors, install works" scripts/install-deps.sh \
+  "cmake" "" 0 "going on with the package lists apt has"
+run_case "install-deps: a package apt cannot install is named" scripts/install-deps.sh \
+  "cmake valgrind" "valgrind" 1 "cannot install package valgrind"
+run_case "vboard/install-deps: update errors, install works" scripts/vboard/install-deps.sh \
+  "cpio" "" 0 "going on with the package lists apt has"
+run_case "vboard/install-deps: a package apt cannot install is named" \
+  scripts/vboard/install-deps.sh "cpio kmod" "kmod" 1 "cannot install package kmod"
+run_case "install-cross-deps: update errors, install works" scripts/install-cross-deps.sh \
+  "qemu-user-static" "" 0 "going on with the package lists apt has"
+run_case "install-cross-deps: a package apt cannot install is named" \
+  scripts/install-cross-deps.sh "qemu-user-static libgpiod-dev" "libgpiod-dev:armhf" 1 \
+  "cannot install package libgpiod-dev:armhf"
+
+[ "$failures" -eq 0 ] || { echo "$failures case(s) failed"; exit 1; }
+echo "all cases passed"
