@@ -34,8 +34,8 @@ using test_oracle::place_of;
 
 // The calibration-board scenario's truth (host_sim/scenarios/calibration-board.toml) and its
 // 24.8° site (WGS-84 normal gravity at 50 m).
-constexpr double kRho = 0.1;  // m, cube half-size
-constexpr double kG = 9.78913;
+constexpr double kRho = 0.1;     // m, cube half-size
+constexpr double kG = 9.789262;  // WGS-84 normal gravity at 24.8°, 50 m (Somigliana + free air)
 constexpr std::array<double, 6> kScale{1.31, 1.35, 1.29, 1.37, 1.33, 1.30};  // V/g
 constexpr std::array<double, 6> kBiasG{0.002, -0.0015, 0.003, -0.0025, 0.001, -0.0005};
 constexpr std::array<double, 6> kBetaDeg{0.8, -1.2, 0.5, 1.5, -0.7, 0.9};
