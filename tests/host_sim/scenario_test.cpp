@@ -207,5 +207,26 @@ TEST(ScenarioParse, MissingFileOrNameIsReported) {
   EXPECT_NE(p.error().message.find("no-such-scenario"), std::string::npos) << p.error().message;
 }
 
+// The aiding scenarios: stop-and-go trajectories of the lengths their descriptions promise
+// (the urban drive at least 10 min, stops long enough for the 1 s static alignment).
+TEST(ScenarioFiles, AidingScenariosAreStopAndGoOfTheirStatedLengths) {
+  const std::string dir = std::string(GFINS_TEST_DATA_DIR) + "/../../host_sim/scenarios";
+  struct Want {
+    const char* name;
+    double min_duration_s;
+    double speed_mps;
+  };
+  for (const Want w : {Want{"urban-stop-and-go", 600.0, 12.0}, Want{"highway", 600.0, 30.0},
+                       Want{"walk", 300.0, 1.4}}) {
+    const HostResult<Scenario> p = load_scenario(w.name, dir);
+    ASSERT_TRUE(p.is_ok()) << w.name << ": " << p.error().message;
+    const Scenario& s = p.value();
+    EXPECT_EQ(s.trajectory.kind, "stop_and_go") << w.name;
+    EXPECT_GE(s.duration_s, w.min_duration_s) << w.name;
+    EXPECT_EQ(s.trajectory.stop_and_go.speed_mps, w.speed_mps) << w.name;
+    EXPECT_GE(s.trajectory.stop_and_go.initial_stop_s, 1.0) << w.name;
+  }
+}
+
 }  // namespace
 }  // namespace gfins::sim

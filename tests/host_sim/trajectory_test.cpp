@@ -51,6 +51,18 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
 
 Quatd some_attitude() { return nav::quat_from_euler(0.3, -0.7, 2.1); }
 
+StopAndGoSpec short_stop_and_go() {
+  StopAndGoSpec g;
+  g.speed_mps = 10.0;
+  g.accel_s = 2.0;
+  g.cruise_s = 3.0;
+  g.stop_s = 1.0;
+  g.initial_stop_s = 0.5;
+  g.weave_amplitude_m = 20.0;
+  g.weave_length_m = 120.0;
+  return g;
+}
+
 std::vector<Case> all_cases() {
   return {
       {"rest", [] { return make_rest(some_attitude(), Vec3d(1, -2, 3)); }},
@@ -62,6 +74,9 @@ std::vector<Case> all_cases() {
       {"coning", [] { return make_coning(0.4, 3.0, some_attitude()); }},
       {"maneuver", [] { return make_maneuver(1.0); }},
       {"maneuver_x2", [] { return make_maneuver(2.0); }},
+      // Segments chosen so that kTimesS falls in each: initial stop, stop, speed-up, cruise,
+      // slow-down, the next cycle's speed-up (peak jerk V·5.77/t_acc² = 14 m/s³).
+      {"stop_and_go", [] { return make_stop_and_go(short_stop_and_go()); }},
   };
 }
 
@@ -250,6 +265,44 @@ TEST(TrajectoryTest, ManeuverAtScaleZeroIsRestAtTheOrigin) {
   EXPECT_EQ(x.v_n, Vec3d::Zero());
   EXPECT_EQ(x.w_b, Vec3d::Zero());
   EXPECT_NEAR(x.q_nb.angularDistance(Quatd::Identity()), 0.0, kRounding);
+}
+
+}  // namespace
+}  // namespace gfins::sim
+
+namespace gfins::sim {
+namespace {
+
+// Stop and go: still during every stop, V(t_acc + t_cruise) metres north per cycle, cruising
+// north at V, and a coordinated turn everywhere (no lateral specific force in the body frame: the
+// normal acceleration of a planar path is |ṗ| ψ̇, which the bank tan φ = |ṗ| ψ̇ / g cancels).
+TEST(TrajectoryTest, StopAndGoStopsCyclesAndTurnsCoordinated) {
+  const StopAndGoSpec g = short_stop_and_go();
+  const auto traj = make_stop_and_go(g);
+  EXPECT_EQ(traj->name(), "stop_and_go");
+  const double cycle_s = g.stop_s + 2.0 * g.accel_s + g.cruise_s;
+  const double cycle_m = g.speed_mps * (g.accel_s + g.cruise_s);
+  for (int n = 0; n < 3; ++n) {
+    const double t0 = g.initial_stop_s + n * cycle_s;
+    for (const double dt : {0.01, 0.5, 0.99}) {  // inside the stop of cycle n
+      const TruthState x = traj->at(t0 + dt * g.stop_s);
+      EXPECT_EQ(x.v_n.norm(), 0.0) << "cycle " << n;
+      EXPECT_EQ(x.w_b.norm(), 0.0) << "cycle " << n;
+      // The road's x coordinate at the stop: n whole cycles.
+      EXPECT_NEAR(x.r_n.x(), n * cycle_m, kRounding * cycle_m * 4) << "cycle " << n;
+    }
+    // Mid-cruise: progress north at V, ground speed V √(1 + (A k sin k x)²) along the road.
+    const TruthState c = traj->at(t0 + g.stop_s + g.accel_s + g.cruise_s / 2);
+    const double k = 2.0 * M_PI / g.weave_length_m;
+    const double slope = g.weave_amplitude_m * k * std::sin(k * c.r_n.x());
+    EXPECT_NEAR(c.v_n.x(), g.speed_mps, kRounding * 100);
+    EXPECT_NEAR(c.v_n.norm(), g.speed_mps * std::sqrt(1.0 + slope * slope), kRounding * 100);
+  }
+  for (double t = 0.0; t < 3 * cycle_s; t += 0.013) {
+    const TruthState x = traj->at(t);
+    const Vec3d f_b = x.q_nb.conjugate() * (x.a_n - Vec3d(0, 0, kG));
+    EXPECT_NEAR(f_b.y(), 0.0, 1e-12 * kG) << "t = " << t;
+  }
 }
 
 }  // namespace

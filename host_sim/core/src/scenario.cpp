@@ -196,6 +196,10 @@ std::vector<std::string> trajectory_keys_of(const std::string& kind) {
   if (kind == "coning") return {"kind", "euler_deg", "half_angle_deg", "cone_rate_hz"};
   if (kind == "maneuver") return {"kind", "scale"};
   if (kind == "drive") return {"kind", "speed_mps", "turn_amplitude_m", "turn_period_s"};
+  if (kind == "stop_and_go") {
+    return {"kind",   "speed_mps",      "accel_s",           "cruise_s",
+            "stop_s", "initial_stop_s", "weave_amplitude_m", "weave_length_m"};
+  }
   if (kind == "calibration_poses")
     return {"kind", "poses", "dwell_s", "transition_s", "extra_poses_g"};
   return {"kind"};
@@ -271,13 +275,15 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   const toml::table& tr = *rd.table(root, "trajectory", true);
   const std::string p = "trajectory.";
   rd.only(tr, p,
-          {"kind", "euler_deg", "accel_mps2", "axis_b", "rate_dps", "half_angle_deg",
-           "cone_rate_hz", "scale", "speed_mps", "turn_amplitude_m", "turn_period_s", "poses",
-           "dwell_s", "transition_s", "extra_poses_g"});
+          {"kind",           "euler_deg",    "accel_mps2", "axis_b",         "rate_dps",
+           "half_angle_deg", "cone_rate_hz", "scale",      "speed_mps",      "turn_amplitude_m",
+           "turn_period_s",  "poses",        "dwell_s",    "transition_s",   "extra_poses_g",
+           "accel_s",        "cruise_s",     "stop_s",     "initial_stop_s", "weave_amplitude_m",
+           "weave_length_m"});
   TrajectorySpec& t = s.trajectory;
   t.kind = rd.string(tr, p, "kind", std::nullopt,
                      {"rest", "constant_acceleration", "spin", "rate_table", "coning", "maneuver",
-                      "drive", "calibration_poses"});
+                      "drive", "stop_and_go", "calibration_poses"});
   check_trajectory_keys(tr, rd, t.kind);
   if (const auto e = rd.numbers(tr, p, "euler_deg", 3, -360.0, 360.0, false); !e.empty()) {
     t.euler0_rad = vec3(e) * kDegToRad;
@@ -301,6 +307,16 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     t.speed_mps = rd.number(tr, p, "speed_mps", 10.0, 0.1, 100.0);
     t.turn_amplitude_m = rd.number(tr, p, "turn_amplitude_m", 20.0, 0.0, 1e4);
     t.turn_period_s = rd.number(tr, p, "turn_period_s", 20.0, 1.0, 1e5);
+  }
+  if (t.kind == "stop_and_go") {
+    StopAndGoSpec& g = t.stop_and_go;
+    g.speed_mps = rd.number(tr, p, "speed_mps", g.speed_mps, 0.1, 100.0);
+    g.accel_s = rd.number(tr, p, "accel_s", g.accel_s, 0.1, 1e3);
+    g.cruise_s = rd.number(tr, p, "cruise_s", g.cruise_s, 0.0, 1e5);
+    g.stop_s = rd.number(tr, p, "stop_s", g.stop_s, 0.0, 1e5);
+    g.initial_stop_s = rd.number(tr, p, "initial_stop_s", g.initial_stop_s, 0.0, 1e5);
+    g.weave_amplitude_m = rd.number(tr, p, "weave_amplitude_m", g.weave_amplitude_m, 0.0, 1e4);
+    g.weave_length_m = rd.number(tr, p, "weave_length_m", g.weave_length_m, 1.0, 1e6);
   }
   if (t.kind == "calibration_poses") {
     t.poses = rd.string(tr, p, "poses", std::string("both"), {"table2", "table3", "both"});
@@ -399,12 +415,6 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   return s;
 }
 
-/// atan on jets: atan' = 1/(1+x²), atan'' = −2x/(1+x²)².
-JetD jet_atan(const JetD& x) {
-  const double d = 1.0 + x.val * x.val;
-  return chain(x, std::atan(x.val), 1.0 / d, -2.0 * x.val / (d * d));
-}
-
 class DriveTrajectory final : public JetTrajectory {
  public:
   DriveTrajectory(double v, double a, double period) : v_(v), a_(a), w_(2.0 * M_PI / period) {}
@@ -415,11 +425,11 @@ class DriveTrajectory final : public JetTrajectory {
     r_n = {v_ * t, a_ * (1.0 - c), JetD(0.0)};
     // Heading along the velocity: tan ψ = ẏ/ẋ = A Ω sin Ωt / v, written over jets so that ψ̇
     // and ψ̈ follow exactly. Bank of a coordinated turn: tan φ = v ψ̇ / g.
-    const JetD psi = jet_atan(s * (a_ * w_ / v_));
+    const JetD psi = atan(s * (a_ * w_ / v_));
     const double k = a_ * w_ / v_;
     // ψ̇ = k Ω cos Ωt / (1 + k² sin² Ωt), written over jets as well.
     const JetD psi_dot = (k * w_) * c / (1.0 + (k * k) * s * s);
-    const JetD phi = jet_atan(psi_dot * (v_ / nav::kStandardGravity));
+    const JetD phi = atan(psi_dot * (v_ / nav::kStandardGravity));
     q_nb = jet_rot_z(psi) * jet_rot_x(phi);
   }
   std::string name() const override { return "drive"; }
@@ -518,6 +528,7 @@ HostResult<std::unique_ptr<Trajectory>> make_trajectory(const TrajectorySpec& t)
   if (t.kind == "coning") return make_coning(t.half_angle_rad, t.cone_rate_rps, q0);
   if (t.kind == "maneuver") return make_maneuver(t.scale);
   if (t.kind == "drive") return make_drive(t.speed_mps, t.turn_amplitude_m, t.turn_period_s);
+  if (t.kind == "stop_and_go") return make_stop_and_go(t.stop_and_go);
   return HostError{ErrorCode::kInvalidArgument, "unknown trajectory kind '" + t.kind + "'"};
 }
 

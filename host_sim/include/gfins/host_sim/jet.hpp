@@ -105,6 +105,13 @@ Jet<T> sqrt(const Jet<T>& x) {
   return chain(x, r, f1, -f1 / (T(2) * x.val));
 }
 
+/// atan'(x) = 1/(1+x²), atan''(x) = −2x/(1+x²)².
+template <typename T>
+Jet<T> atan(const Jet<T>& x) {
+  const T d = T(1) + x.val * x.val;
+  return chain(x, std::atan(x.val), T(1) / d, T(-2) * x.val / (d * d));
+}
+
 template <typename T>
 Jet<T> exp(const Jet<T>& x) {
   const T e = std::exp(x.val);

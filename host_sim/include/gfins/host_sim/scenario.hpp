@@ -32,7 +32,7 @@ namespace gfins::sim {
 /// The motion. Which fields matter depends on `kind` (docs/simulation.md lists them).
 struct TrajectorySpec {
   std::string kind = "rest";         // rest | constant_acceleration | spin | rate_table | coning |
-                                     // maneuver | drive | calibration_poses
+                                     // maneuver | drive | stop_and_go | calibration_poses
   Vec3d euler0_rad = Vec3d::Zero();  // initial roll, pitch, yaw (file: degrees)
   Vec3d accel_n_mps2 = Vec3d::Zero();  // constant_acceleration
   Vec3d axis_b = Vec3d::UnitZ();       // spin, rate_table
@@ -43,6 +43,7 @@ struct TrajectorySpec {
   double speed_mps = 10.0;             // drive: forward speed
   double turn_amplitude_m = 20.0;      // drive: lateral amplitude of the weave
   double turn_period_s = 20.0;         // drive: period of one left-right weave
+  StopAndGoSpec stop_and_go{};         // stop_and_go (speed_mps above is its cruise speed)
   std::string poses = "both";          // calibration_poses: "table2" | "table3" | "both"
   double dwell_s = 10.0;               // calibration_poses: time at rest in each pose
   double transition_s = 2.0;           // calibration_poses: time to turn to the next pose

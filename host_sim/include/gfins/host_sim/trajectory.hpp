@@ -148,6 +148,24 @@ std::unique_ptr<Trajectory> make_coning(double half_angle_rad, double cone_rate_
 /// (spin, coning) and 0.7 µs (manoeuvre: 17 sin/cos pairs and one exp).
 std::unique_ptr<Trajectory> make_maneuver(double scale = 1.0);
 
+/// A vehicle (or walker) stopping and going along a weaving road (stop_and_go.cpp gives the
+/// formulas): after initial_stop_s at rest, cycles of stop_s at rest, a minimum-jerk speed-up to
+/// speed_mps over accel_s, cruise_s at that speed and a slow-down over accel_s; the road is
+/// y = A (1 − cos 2πx/L) (A = weave_amplitude_m, L = weave_length_m, NED), heading along it,
+/// banked as a coordinated turn. speed_mps is the progress north (ẋ); the ground speed along the
+/// road is ẋ √(1 + (2πA/L · sin 2πx/L)²), up to √(1 + (2πA/L)²) times more. Starts at the origin
+/// heading north.
+struct StopAndGoSpec {
+  double speed_mps = 10.0;
+  double accel_s = 5.0;
+  double cruise_s = 20.0;
+  double stop_s = 10.0;
+  double initial_stop_s = 10.0;
+  double weave_amplitude_m = 20.0;
+  double weave_length_m = 300.0;
+};
+std::unique_ptr<Trajectory> make_stop_and_go(const StopAndGoSpec& spec);
+
 /// The attitude q_nb of a board at rest that senses the specific force f_b (body axes, any
 /// length; at rest f = −g, i.e. "up": (0, 0, −1) g is the face "z down"). Heading: that of the
 /// shortest rotation taking f̂_b to −ẑ_n (fixed, otherwise arbitrary).
