@@ -50,16 +50,16 @@ int sim_main(int argc, char** argv) {
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   cli.add_option("-d,--duration", o.duration_s, "simulated time, s")
-      ->check(CLI::Range(1e-3, 1e6))
+      ->check(app::finite_range(1e-3, 1e6))
       ->capture_default_str();
   cli.add_option("-r,--rate", o.rate_hz, "sample rate, Hz")
-      ->check(CLI::Range(1.0, 1e5))
+      ->check(app::finite_range(1.0, 1e5))
       ->capture_default_str();
   cli.add_option("--rho", o.rho_m, "cube half-size rho, m (Table 1)")
-      ->check(CLI::Range(1e-3, 10.0))
+      ->check(app::finite_range(1e-3, 10.0))
       ->capture_default_str();
   cli.add_option("--noise-mg", o.noise_mg, "white noise per sensor for the noisy run, milli-g")
-      ->check(CLI::Range(0.0, 1e3))
+      ->check(app::finite_range(0.0, 1e3))
       ->capture_default_str();
   cli.add_option("--seed", o.seed, "noise seed")->capture_default_str();
   cli.add_option("--scalar", o.scalar, "navigation core scalar")
@@ -89,13 +89,21 @@ int sim_main(int argc, char** argv) {
   auto* cov = cli.add_subcommand("covariance", "predicted 1-sigma envelopes and error budget");
   cov->add_option("scenario", scenario_name, "file, or built-in name")
       ->default_val("rest-calibrated");
-  cov->add_option("--bias-ug", cov_opts.bias_ug, "random-constant bias 1 sigma per sensor, ug");
-  cov->add_option("--bias-rw", cov_opts.bias_rw_ug_sqrt_s, "bias random walk, ug/sqrt(s)");
-  cov->add_option("--scale-ppm", cov_opts.scale_ppm, "residual scale-factor error 1 sigma, ppm");
+  // Upper limits: 1 g of bias (1e6 ug), 1 g/sqrt(s) of walk, a 100 % scale error, 1 rad of
+  // axis error, 1 m of location error; beyond them the linear error model means nothing and
+  // the products overflow.
+  cov->add_option("--bias-ug", cov_opts.bias_ug, "random-constant bias 1 sigma per sensor, ug")
+      ->check(app::finite_range(0.0, 1e6));
+  cov->add_option("--bias-rw", cov_opts.bias_rw_ug_sqrt_s, "bias random walk, ug/sqrt(s)")
+      ->check(app::finite_range(0.0, 1e6));
+  cov->add_option("--scale-ppm", cov_opts.scale_ppm, "residual scale-factor error 1 sigma, ppm")
+      ->check(app::finite_range(0.0, 1e6));
   cov->add_option("--orientation-urad", cov_opts.orientation_urad,
-                  "residual axis orientation error 1 sigma per axis, urad");
+                  "residual axis orientation error 1 sigma per axis, urad")
+      ->check(app::finite_range(0.0, 1e6));
   cov->add_option("--location-mm", cov_opts.location_mm,
-                  "residual location error 1 sigma per axis, mm");
+                  "residual location error 1 sigma per axis, mm")
+      ->check(app::finite_range(0.0, 1e3));
   cov->add_option("--at", cov_opts.times_s, "budget times, s (default T/4, T/2, T)");
   auto* record_opt =
       run_cmd->add_option("--record", out.record,

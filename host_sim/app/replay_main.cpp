@@ -572,7 +572,7 @@ int replay_main(int argc, char** argv) {
         ->required();
     cli.add_option("--up", m.up_b, "body axis pointing up (x y z)")->expected(3)->required();
     cli.add_option("--rate-rad-s", m.rate_rad_s, "table rate, rad/s")
-        ->check(CLI::Range(0.1, 100.0))
+        ->check(app::finite_range(0.1, 100.0))
         ->required();
     cli.add_flag("--header", m.header, "print the CSV header line first");
     try {
@@ -604,17 +604,19 @@ int replay_main(int argc, char** argv) {
   cli.add_option("--decimate", o.out.decimate, "write every N-th state to navigation.csv")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
-  cli.add_option("--align-s", o.align_s, "static alignment at the start, s")->capture_default_str();
+  cli.add_option("--align-s", o.align_s, "static alignment at the start, s")
+      ->check(app::finite_range(1e-3, 3600.0))
+      ->capture_default_str();
   bool no_still_check = false;
   cli.add_flag("--no-still-check", no_still_check,
                "navigate even when the alignment window is not still (channel standard deviation "
                "above 5 mg)");
   cli.add_option("--heading-deg", o.heading_deg,
                  "initial heading (nothing on board senses it), deg")
-      ->check(CLI::Range(-360.0, 360.0))
+      ->check(app::finite_range(-360.0, 360.0))
       ->capture_default_str();
   cli.add_option("--gravity", o.gravity_mps2, "local gravity of the navigation model, m/s^2")
-      ->check(CLI::Range(9.7, 9.9))
+      ->check(app::finite_range(9.7, 9.9))
       ->capture_default_str();
   try {
     cli.parse(argc, argv);

@@ -1,0 +1,55 @@
+// Numbers on the command lines of gfins-sim and gfins-replay that are not numbers (NaN, inf) or
+// are absurd (1e300 µg of bias, a 1e308 s alignment) are refused at the command line, naming the
+// option, before any work: they used to reach the arithmetic and end in NaN results with exit 0.
+// The tools are the real binaries, started without a shell; the oracle is the documented exit
+// code 2 (bad input) and the option's name in the message.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "support/cli_fixture.hpp"
+
+namespace gfins::sim {
+namespace {
+
+using test::CliResult;
+
+constexpr int kExitBadInput = 2;  // gfins-sim and gfins-replay --help
+
+struct Case {
+  const char* exe;
+  std::vector<std::string> args;
+  const char* option;
+};
+
+class AbsurdArgsCli : public test::CliTest {};
+
+TEST_F(AbsurdArgsCli, NonFiniteAndAbsurdNumbersAreRefusedNamingTheOption) {
+  const std::string gfr = path("none.gfr");  // never read: the command line fails first
+  const std::vector<Case> cases = {
+      {GFINS_REPLAY_BIN, {gfr, "--heading-deg", "nan"}, "--heading-deg"},
+      {GFINS_REPLAY_BIN, {gfr, "--heading-deg", "inf"}, "--heading-deg"},
+      {GFINS_REPLAY_BIN, {gfr, "--gravity", "nan"}, "--gravity"},
+      {GFINS_REPLAY_BIN, {gfr, "--align-s", "1e308"}, "--align-s"},
+      {GFINS_REPLAY_BIN, {gfr, "--align-s", "nan"}, "--align-s"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--bias-ug", "1e300"}, "--bias-ug"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--bias-ug", "nan"}, "--bias-ug"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--bias-rw", "inf"}, "--bias-rw"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--scale-ppm", "1e300"}, "--scale-ppm"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--orientation-urad", "nan"}, "--orientation-urad"},
+      {GFINS_SIM_BIN, {"covariance", "rest", "--location-mm", "1e300"}, "--location-mm"},
+      {GFINS_SIM_BIN, {"--duration", "nan"}, "--duration"},
+      {GFINS_SIM_BIN, {"--noise-mg", "inf"}, "--noise-mg"},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = run(c.exe, c.args);
+    const std::string what = std::string(c.exe) + " " + c.args.back();
+    EXPECT_EQ(r.exit_code, kExitBadInput) << what << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.option), std::string::npos) << what << "\n" << r.output;
+    EXPECT_EQ(r.output.find("nan\n"), std::string::npos) << what << "\n" << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace gfins::sim
