@@ -51,5 +51,18 @@ TEST_F(AbsurdArgsCli, NonFiniteAndAbsurdNumbersAreRefusedNamingTheOption) {
   }
 }
 
+// Inputs that never end (/dev/zero) are refused after their size limit, quickly and naming the
+// limit, where they used to be read until gigabytes of memory were gone.
+TEST_F(AbsurdArgsCli, EndlessInputsAreRefusedAfterTheirLimit) {
+  const CliResult sim = run(GFINS_SIM_BIN, {"run", "/dev/zero", "-o", path("o")});
+  EXPECT_EQ(sim.exit_code, kExitBadInput) << sim.output;
+  EXPECT_NE(sim.output.find("larger than 1048576 bytes"), std::string::npos) << sim.output;
+  const CliResult cal =
+      run(GFINS_CALIBRATE_BIN, {"--means", "/dev/zero", "--adc-lsb", "1e-6", "--device-id", "b1",
+                                "--gravity", "9.8", "-o", path("cal.toml")});
+  EXPECT_NE(cal.exit_code, 0) << cal.output;
+  EXPECT_NE(cal.output.find("larger than 16777216 bytes"), std::string::npos) << cal.output;
+}
+
 }  // namespace
 }  // namespace gfins::sim

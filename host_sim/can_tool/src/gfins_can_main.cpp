@@ -25,6 +25,7 @@
 #include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
+#include "gfins/drivers/lnx/text_file.hpp"
 #include "gfins/host_sim/version.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
@@ -397,15 +398,18 @@ int run_rate_table_sequence(const SequenceCliOptions& o, const SequenceOptions& 
                  "--poses-out and --layout are for the orientation poses\n");
     return kExitUsage;
   }
-  std::ifstream f(o.rate_table, std::ios::binary);
-  std::stringstream text;
-  text << f.rdbuf();
-  if (!f) {
-    std::fprintf(stderr, "gfins-can calibrate: cannot read '%s'\n", o.rate_table.c_str());
+  std::string text;
+  const Status read =
+      drivers::lnx::read_text_file(o.rate_table.c_str(), drivers::lnx::kMaxTableBytes, text);
+  if (!read.is_ok()) {
+    std::fprintf(stderr, "gfins-can calibrate: %s\n",
+                 drivers::lnx::text_file_error(o.rate_table, read, drivers::lnx::kMaxTableBytes,
+                                               "a rate-table plan")
+                     .c_str());
     return kExitInput;
   }
   std::string error;
-  const std::vector<RateTableRun> plan = rate_table_plan(text.str(), error);
+  const std::vector<RateTableRun> plan = rate_table_plan(text, error);
   if (plan.empty()) {
     std::fprintf(stderr, "gfins-can calibrate: %s: %s\n", o.rate_table.c_str(), error.c_str());
     return kExitUsage;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "gfins/drivers/lnx/text_file.hpp"
 #include "gfins/host_sim/data_paths.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
@@ -43,11 +44,16 @@ HostResult<Scenario> load_file(const fs::path& path) {
     return HostError{ErrorCode::kInvalidArgument,
                      path.string() + ": is a folder, not a scenario file (*.toml)"};
   }
-  std::ifstream in(path);
-  if (!in) return HostError{ErrorCode::kIoError, path.string() + ": cannot read the file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scenario(text.str(), path.string());
+  std::string text;
+  const Status read =
+      drivers::lnx::read_text_file(path.c_str(), drivers::lnx::kMaxConfigBytes, text);
+  if (!read.is_ok()) {
+    return HostError{
+        read.code() == ErrorCode::kOutOfRange ? ErrorCode::kInvalidArgument : ErrorCode::kIoError,
+        drivers::lnx::text_file_error(path.string(), read, drivers::lnx::kMaxConfigBytes,
+                                      "a scenario")};
+  }
+  return parse_scenario(text, path.string());
 }
 
 std::string unknown_name_message(const std::string& name, const std::string& builtin_dir) {

@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <utility>
 
+#include "gfins/drivers/lnx/text_file.hpp"
 #include "gfins/host_sim/recording.hpp"
 
 namespace gfins::tools {
@@ -112,8 +114,16 @@ HostResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int6
 HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
   CsvTable t;
   t.file = path.string();
-  std::ifstream in(path);
-  if (!in) return HostError{ErrorCode::kIoError, t.file + ": cannot open", 0};
+  std::string text;
+  const Status read =
+      drivers::lnx::read_text_file(path.c_str(), drivers::lnx::kMaxTableBytes, text);
+  if (!read.is_ok()) {
+    return HostError{
+        ErrorCode::kIoError,
+        drivers::lnx::text_file_error(t.file, read, drivers::lnx::kMaxTableBytes, "a CSV table"),
+        0};
+  }
+  std::istringstream in(text);
   std::string line;
   int n = 0;
   while (std::getline(in, line)) {
