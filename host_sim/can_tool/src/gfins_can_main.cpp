@@ -25,7 +25,7 @@
 #include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
-#include "gfins/host_sim/version.hpp"
+#include "gfins/version/version.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL
