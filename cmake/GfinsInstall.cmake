@@ -62,9 +62,12 @@ include([[${PROJECT_SOURCE_DIR}/cmake/GfinsInstallBoardFiles.cmake]])"
   install(FILES docs/deploy.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-fw COMPONENT board)
   # gfins-fw --sim NAME needs the scenarios without the host tools: the package carries its own
   # copy in share/gfins-fw/scenarios (gfins-tools has share/gfins/scenarios; two folders, so the
-  # two packages never own the same file). The program looks in share/gfins first.
-  install(DIRECTORY host_sim/scenarios/ DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins-fw/scenarios
-          COMPONENT board FILES_MATCHING PATTERN "*.toml")
+  # two packages never own the same file). The program looks in share/gfins first. A gfins-fw
+  # without the simulated board (GFINS_SIM_BOARD=OFF: the Linux board presets) needs none.
+  if(GFINS_SIM_BOARD)
+    install(DIRECTORY host_sim/scenarios/ DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins-fw/scenarios
+            COMPONENT board FILES_MATCHING PATTERN "*.toml")
+  endif()
 endif()
 
 # --- tools: host programs, scenarios, plot scripts, documentation ----------------------------

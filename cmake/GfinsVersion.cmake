@@ -13,4 +13,5 @@ add_custom_target(gfins_version_stamp
 add_library(gfins_version STATIC ${gfins_version_cpp})
 add_library(gfins::version ALIAS gfins_version)
 add_dependencies(gfins_version gfins_version_stamp)
-target_include_directories(gfins_version PUBLIC ${PROJECT_SOURCE_DIR}/host_sim/include)
+# The header is a std-only vocabulary header beside status/ and sample/ (nav_core/include).
+target_include_directories(gfins_version PUBLIC ${PROJECT_SOURCE_DIR}/nav_core/include)

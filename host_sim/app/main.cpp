@@ -20,7 +20,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "gfins/host_sim/version.hpp"
+#include "gfins/version/version.hpp"
 
 namespace {
 

@@ -25,8 +25,8 @@
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/replay.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
-#include "gfins/host_sim/version.hpp"
 #include "gfins/nav_core/pipeline.hpp"
+#include "gfins/version/version.hpp"
 #include "run_options.hpp"
 
 namespace {

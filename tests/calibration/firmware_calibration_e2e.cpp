@@ -44,9 +44,9 @@
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/gravity.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 #include "support/run_cli.hpp"
 #include "support/sim_chain.hpp"
 
@@ -244,7 +244,7 @@ struct Board {
   Wire wire;
   std::unique_ptr<sim_board::SensorStream> stream;
   std::unique_ptr<sim_board::ChipAdc> adc;
-  sim_board::SampleClock clock;
+  app::SampleClock clock;
   std::unique_ptr<sim_board::SimSampleSource> source;
   std::unique_ptr<TraceSource> tap;
   std::unique_ptr<BoardEnd> board_bus;

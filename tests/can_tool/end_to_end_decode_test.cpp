@@ -10,8 +10,8 @@
 
 #include "bench/bench_scenario.hpp"
 #include "decoder.hpp"
-#include "gfins/can/candump.hpp"
 #include "gfins/can/publisher.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
 namespace gfins::can_tool {
 namespace {
@@ -25,8 +25,8 @@ class LineBus final : public hal::CanBus {
 
  private:
   Status do_send(const hal::CanFrame& f) override {
-    char buf[can::kMaxCandumpLine];
-    const std::size_t n = can::format_candump_line(
+    char buf[drivers::lnx::kMaxCandumpLine];
+    const std::size_t n = drivers::lnx::format_candump_line(
         buf, t_us / 1000000, static_cast<std::uint32_t>(t_us % 1000000), "can0", f);
     lines.emplace_back(buf, n);
     return Status::ok();

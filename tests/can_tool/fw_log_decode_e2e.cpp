@@ -26,9 +26,9 @@
 
 #include "gfins/app/config.hpp"
 #include "gfins/app/startup.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/pipeline.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 #include "support/cli_fixture.hpp"
 
 namespace gfins {

@@ -6,7 +6,9 @@
 #include <fstream>
 #include <vector>
 
+#include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 
 namespace gfins::app {
 namespace {
@@ -346,40 +348,67 @@ TEST(Cli, ValuesTheRunWouldRefuseAreRefusedUpFront) {
   }
 }
 
+// The boards of the host build of gfins-fw: the firmware's and the simulated one.
+BoardTable host_boards() {
+  BoardTable t;
+  add_firmware_boards(t);
+  sim_board::add_to(t);
+  return t;
+}
+
 TEST(Cli, PreflightFindsWhatOnlyTheRunFoundBefore) {
+  const BoardTable boards = host_boards();
   const std::string dir = GFINS_SCENARIO_DIR;
   FwConfig c;
   c.board = BoardKind::kSim;
   c.sim_scenario_dir = dir;
   c.sim_scenario = "rest";
-  EXPECT_EQ(preflight(c, "o"), "");
+  EXPECT_EQ(preflight(c, boards, "o"), "");
   c.sim_scenario = "nosuchscenario";
-  const std::string missing = preflight(c, "o");
+  const std::string missing = preflight(c, boards, "o");
   EXPECT_EQ(missing.rfind("o: sim.scenario = \"nosuchscenario\": ", 0), 0u) << missing;
   // The scenario's rate must be the ADC's.
   c.sim_scenario = "rest";
   c.sample_rate_hz = 2000;
-  EXPECT_EQ(preflight(c, "o"),
+  EXPECT_EQ(preflight(c, boards, "o"),
             "o: sim.scenario = \"rest\": runs at 1000 Hz: adc.sample_rate_hz must be the same");
   c.sample_rate_hz = 1000;
   // Output files: the folder must exist; a folder is not a file.
   c.can_log = "/nonexistent-gfins/x.log";
-  EXPECT_EQ(preflight(c, "o"),
+  EXPECT_EQ(preflight(c, boards, "o"),
             "o: can.log_file = \"/nonexistent-gfins/x.log\": its folder \"/nonexistent-gfins\" "
             "does not exist");
   c.can_log = "/tmp";
-  EXPECT_EQ(preflight(c, "o"), "o: can.log_file = \"/tmp\": is a folder, not a file");
+  EXPECT_EQ(preflight(c, boards, "o"), "o: can.log_file = \"/tmp\": is a folder, not a file");
   c.can_log = "out.log";  // the working folder
-  EXPECT_EQ(preflight(c, "o"), "");
-  EXPECT_EQ(preflight(c, "o", "/nonexistent-gfins/x.csv"),
+  EXPECT_EQ(preflight(c, boards, "o"), "");
+  EXPECT_EQ(preflight(c, boards, "o", "/nonexistent-gfins/x.csv"),
             "o: --latency-csv = \"/nonexistent-gfins/x.csv\": its folder \"/nonexistent-gfins\" "
             "does not exist");
   FwConfig h;
   h.board = BoardKind::kHil;
   h.hil_port_file = "/nonexistent-gfins/port";
-  EXPECT_EQ(preflight(h, "o"),
+  EXPECT_EQ(preflight(h, boards, "o"),
             "o: hil.port_file = \"/nonexistent-gfins/port\": its folder \"/nonexistent-gfins\" "
             "does not exist");
+}
+
+TEST(Cli, PreflightRefusesABoardThisBuildDoesNotHave) {
+  // The board's own build of gfins-fw (GFINS_SIM_BOARD=OFF) registers only the firmware's boards.
+  BoardTable board_only;
+  add_firmware_boards(board_only);
+  FwConfig c;
+  c.board = BoardKind::kSim;
+  c.sim_scenario_dir = GFINS_SCENARIO_DIR;
+  c.sim_scenario = "rest";
+  EXPECT_EQ(preflight(c, board_only, "o"),
+            "o: board.kind = \"sim\": this gfins-fw is built without that board (the simulated "
+            "board is host code: GFINS_SIM_BOARD=OFF)");
+  EXPECT_EQ(make_board(board_only, c).error,
+            "board.kind = \"sim\": this gfins-fw is built without that board (the simulated "
+            "board is host code: GFINS_SIM_BOARD=OFF)");
+  c.board = BoardKind::kLinux;
+  EXPECT_EQ(preflight(c, board_only, "o"), "");
 }
 
 TEST(Cli, OriginSaysWhatTheConfigurationIsMadeOf) {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "gfins/drivers/lnx/gpiod_data_ready.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 
 namespace gfins {
 namespace {
@@ -89,7 +89,7 @@ std::vector<RawSample> reference_samples(const sim::Scenario& s, std::uint32_t n
   auto stream = std::move(made).value();
   sim_board::ChipAdc adc(s.rate_hz);
   EXPECT_TRUE(adc.start().is_ok());
-  sim_board::SampleClock clock;
+  app::SampleClock clock;
   sim_board::SimSampleSource src(*stream, adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz,
                                  n);
   std::vector<RawSample> out;

@@ -13,8 +13,8 @@
 #include "gfins/app/logger.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 #include "support/sim_chain.hpp"
 
 namespace gfins::testing {
@@ -91,7 +91,7 @@ class FaultySource final : public app::SampleSource {
 /// (sample) clock to `stall_ns` after the epoch's edge, as a cycle that overran would.
 class StallingSink final : public app::EpochSink {
  public:
-  StallingSink(app::EpochSink& next, sim_board::SampleClock& clock) : next_(next), clock_(clock) {}
+  StallingSink(app::EpochSink& next, app::SampleClock& clock) : next_(next), clock_(clock) {}
   void stall(std::uint32_t epochs, std::int64_t stall_ns) { left_ = epochs, stall_ns_ = stall_ns; }
   std::uint32_t publish(const app::Epoch& e) override {
     const std::uint32_t n = next_.publish(e);
@@ -105,7 +105,7 @@ class StallingSink final : public app::EpochSink {
 
  private:
   app::EpochSink& next_;
-  sim_board::SampleClock& clock_;
+  app::SampleClock& clock_;
   std::uint32_t left_ = 0;
   std::int64_t stall_ns_ = 0;
 };
@@ -168,7 +168,7 @@ struct SimRig {
   std::unique_ptr<sim_board::SensorStream> stream;
   static constexpr std::uint8_t kNode = 1;
   std::unique_ptr<sim_board::ChipAdc> adc;
-  sim_board::SampleClock clock;
+  app::SampleClock clock;
   std::unique_ptr<sim_board::SimSampleSource> source;
   std::unique_ptr<FaultySource> faulty;
   std::unique_ptr<TapSource> tap;

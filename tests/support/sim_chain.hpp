@@ -7,8 +7,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 
 namespace gfins::test {
 
@@ -19,7 +19,7 @@ struct SimChain {
 };
 
 /// `samples` conversions of scenario `s`, paced by `clock` (kFast), with `faults` injected.
-inline SimChain make_sim_chain(const sim::Scenario& s, sim_board::SampleClock& clock,
+inline SimChain make_sim_chain(const sim::Scenario& s, app::SampleClock& clock,
                                std::uint32_t samples, const sim_board::FaultPlan& faults) {
   SimChain c;
   auto made = sim_board::make_scenario_stream(s);

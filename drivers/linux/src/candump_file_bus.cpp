@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 
-#include "gfins/can/candump.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
 namespace gfins::drivers::lnx {
 
@@ -13,8 +13,8 @@ Result<std::unique_ptr<CandumpFileBus>> CandumpFileBus::open(const CandumpFileBu
                                                              hal::Clock& clock, Os& os) {
   if (config.path.empty()) return Status(ErrorCode::kInvalidArgument, "candump file: empty path");
   hal::CanFrame probe;
-  char line[can::kMaxCandumpLine];
-  if (can::format_candump_line(line, 0, 0, config.interface, probe) == 0) {
+  char line[kMaxCandumpLine];
+  if (format_candump_line(line, 0, 0, config.interface, probe) == 0) {
     return Status(ErrorCode::kInvalidArgument,
                   "candump file: interface name must be 1..15 characters without spaces");
   }
@@ -169,9 +169,9 @@ Status CandumpFileBus::do_send(const hal::CanFrame& f) {
   char* buffer = buffers_[active_].get();
   // candump prints the kernel's struct timeval: whole microseconds, the rest truncated.
   const std::int64_t t_ns = std::max<std::int64_t>(clock_.now_ns(), 0);
-  const std::size_t n = can::format_candump_line(
-      std::span<char>(buffer + used_, capacity_ - used_ - 1), t_ns / 1000000000,
-      static_cast<std::uint32_t>(t_ns % 1000000000 / 1000), interface_, f);
+  const std::size_t n =
+      format_candump_line(std::span<char>(buffer + used_, capacity_ - used_ - 1), t_ns / 1000000000,
+                          static_cast<std::uint32_t>(t_ns % 1000000000 / 1000), interface_, f);
   if (n == 0) {
     ++counters_.tx_dropped;
     return Status(ErrorCode::kInvalidArgument, "candump file: frame cannot be formatted");

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "gfins/app/config.hpp"
-#include "gfins/host_sim/version.hpp"
+#include "gfins/version/version.hpp"
 
 namespace gfins::app {
 namespace {

@@ -13,7 +13,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "board.hpp"
+#include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
 #include "gfins/app/sample_loop.hpp"
@@ -37,7 +37,8 @@ struct FileCloser {
   void operator()(std::FILE* f) const { (void)std::fclose(f); }
 };
 
-int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
+int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
+        const std::string& latency_csv) {
   using namespace gfins::app;
   gfins::app::init_spdlog(cfg.log_level);
   spdlog::info("gfins-fw: board {}, {} Hz, node {}, compensator {}", to_string(cfg.board),
@@ -55,7 +56,7 @@ int run(const gfins::app::FwConfig& cfg, const std::string& latency_csv) {
     }
   }
 
-  BoardResult made = make_board(cfg);
+  BoardResult made = make_board(boards, cfg);
   if (!made.board) {
     spdlog::critical("board set-up failed: {}", printable_text(made.error));
     return 1;
@@ -178,8 +179,13 @@ int main(int argc, char** argv) {
       print(cli.exit_code == 0 ? stdout : stderr, cli.message);
       return cli.exit_code;
     }
+    // The boards this build runs on: the firmware's own and the plug-ins linked in.
+    gfins::app::BoardTable boards;
+    gfins::app::add_firmware_boards(boards);
+    gfins::app::add_plugin_boards(boards);
     // The same checks before a run and for --check-config: what one accepts the other does.
-    if (std::string problem = gfins::app::preflight(*cli.config, cli.origin, cli.latency_csv);
+    if (std::string problem =
+            gfins::app::preflight(*cli.config, boards, cli.origin, cli.latency_csv);
         !problem.empty()) {
       print(stderr, "gfins-fw: " + problem + "\n");
       return 2;
@@ -191,7 +197,7 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    return run(*cli.config, cli.latency_csv);
+    return run(boards, *cli.config, cli.latency_csv);
   } catch (const std::exception& e) {
     print(stderr, std::string("gfins-fw: ") + e.what() + "\n");
     return 1;

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <system_error>
 
+#include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
-#include "gfins/host_sim/scenario.hpp"
 
 namespace gfins::app {
 namespace {
@@ -29,25 +29,16 @@ std::string output_path_problem(const std::string& path) {
 
 }  // namespace
 
-std::string preflight(const FwConfig& c, const std::string& origin,
+std::string preflight(const FwConfig& c, const BoardTable& boards, const std::string& origin,
                       const std::string& latency_csv) {
   const auto bad = [&](const std::string& key, const std::string& value, const std::string& why) {
     return origin + ": " + key + " = " + quote_text(value) + ": " + why;
   };
-  if (c.board == BoardKind::kSim) {
-    const auto s = c.sim_scenario_dir.empty()
-                       ? sim::load_scenario(c.sim_scenario)
-                       : sim::load_scenario(c.sim_scenario, c.sim_scenario_dir);
-    if (!s.is_ok()) return bad("sim.scenario", c.sim_scenario, s.error().message);
-    // The simulated ADC runs at the scenario's rate; the loop and the front end at the
-    // configured one: they must agree (make_sim_board refuses the mismatch too).
-    if (s.value().rate_hz != c.sample_rate_hz) {
-      std::string rates = std::to_string(s.value().rate_hz);
-      rates.erase(rates.find_last_not_of('0') + 1);
-      if (!rates.empty() && rates.back() == '.') rates.pop_back();
-      return bad("sim.scenario", c.sim_scenario,
-                 "runs at " + rates + " Hz: adc.sample_rate_hz must be the same");
-    }
+  // The board's own checks first (the simulated board: its scenario and its rate).
+  const BoardEntry* board = boards.find(c.board);
+  if (board == nullptr) return origin + ": " + board_not_built(c.board);
+  if (board->check != nullptr) {
+    if (std::string problem = board->check(c, origin); !problem.empty()) return problem;
   }
   if (!c.can_log.empty()) {
     if (std::string why = output_path_problem(c.can_log); !why.empty()) {

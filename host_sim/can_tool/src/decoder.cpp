@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "gfins/can/candump.hpp"
 #include "gfins/can/signal_codec.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
 namespace gfins::can_tool {
 namespace {
@@ -174,11 +174,11 @@ void StreamDecoder::notice(std::uint64_t line, std::string text) {
 
 void StreamDecoder::feed_line(std::uint64_t line_no, std::string_view line) {
   ++summary_.lines;
-  if (can::is_candump_comment(line)) {
+  if (drivers::lnx::is_candump_comment(line)) {
     ++summary_.comment_lines;
     return;
   }
-  const Result<can::CandumpRecord> r = can::parse_candump_line(line);
+  const Result<drivers::lnx::CandumpRecord> r = drivers::lnx::parse_candump_line(line);
   if (!r.is_ok()) {
     issue(IssueKind::kMalformedLine, line_no, r.status().message());
     return;

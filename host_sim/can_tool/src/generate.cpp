@@ -177,8 +177,8 @@ std::string generate_budget_table(double sample_rate_hz, std::uint32_t bit_rate)
 
 #include <cmath>
 
-#include "gfins/can/candump.hpp"
 #include "gfins/can/publisher.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
 namespace gfins::can_tool {
 namespace {
@@ -192,10 +192,10 @@ class LogBus final : public hal::CanBus {
 
  private:
   Status do_send(const hal::CanFrame& f) override {
-    char line[can::kMaxCandumpLine + 1];
-    const std::size_t n =
-        can::format_candump_line(std::span<char>(line, can::kMaxCandumpLine), t_us / 1000000,
-                                 static_cast<std::uint32_t>(t_us % 1000000), "can0", f);
+    char line[drivers::lnx::kMaxCandumpLine + 1];
+    const std::size_t n = drivers::lnx::format_candump_line(
+        std::span<char>(line, drivers::lnx::kMaxCandumpLine), t_us / 1000000,
+        static_cast<std::uint32_t>(t_us % 1000000), "can0", f);
     line[n] = '\n';
     if (n == 0 || std::fwrite(line, 1, n + 1, out_) != n + 1) ok = false;
     return Status::ok();

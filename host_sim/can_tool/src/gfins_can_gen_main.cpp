@@ -12,7 +12,7 @@
 
 #include "generate.hpp"
 #include "gfins/can/message_table.hpp"
-#include "gfins/host_sim/version.hpp"
+#include "gfins/version/version.hpp"
 
 namespace {
 

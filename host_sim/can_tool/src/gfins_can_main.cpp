@@ -26,7 +26,7 @@
 #include "decoder.hpp"
 #include "generate.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
-#include "gfins/host_sim/version.hpp"
+#include "gfins/version/version.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL

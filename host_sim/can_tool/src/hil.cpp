@@ -13,10 +13,10 @@
 #include "gfins/drivers/ads131m06.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
 #include "gfins/drivers/qa1100_front_end.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/pipeline.hpp"
-#include "gfins/sim_board/sim_board.hpp"
 
 namespace gfins::can_tool {
 namespace {

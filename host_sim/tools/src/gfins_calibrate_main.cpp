@@ -22,8 +22,8 @@
 #include "calibrate.hpp"
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
-#include "gfins/host_sim/version.hpp"
 #include "gfins/nav_core/gravity.hpp"
+#include "gfins/version/version.hpp"
 
 namespace {
 

@@ -128,13 +128,15 @@ std::optional<ConfigProblem> check(const FwConfig& c);
 /// from. Returns "" when all are valid.
 std::string validate(const FwConfig& c, const std::string& origin);
 
+class BoardTable;  // board.hpp
+
 /// Checks against the file system what the run would otherwise find only when it gets there:
-/// the scenario of the simulated board (it loads, and runs at adc.sample_rate_hz) and the output
-/// files (can.log_file, hil.port_file on the hil board, `latency_csv` when not empty: the folder
-/// exists and the path is not a folder). Devices (SPI, GPIO, CAN interface, watchdog) are not
-/// opened: the run reports those at start-up, before the loop starts. Returns "" or
-/// "ORIGIN: key = value: problem".
-std::string preflight(const FwConfig& c, const std::string& origin,
+/// that `boards` has c.board, that board's own checks (BoardEntry::check: the simulated board's
+/// scenario loads and runs at adc.sample_rate_hz) and the output files (can.log_file,
+/// hil.port_file on the hil board, `latency_csv` when not empty: the folder exists and the path
+/// is not a folder). Devices (SPI, GPIO, CAN interface, watchdog) are not opened: the run reports
+/// those at start-up, before the loop starts. Returns "" or "ORIGIN: key = value: problem".
+std::string preflight(const FwConfig& c, const BoardTable& boards, const std::string& origin,
                       const std::string& latency_csv = {});
 
 /// For --check-config: "" when the run would navigate with a calibration (calibration.file

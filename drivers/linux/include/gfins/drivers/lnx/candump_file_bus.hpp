@@ -1,5 +1,5 @@
 // hal::CanBus that writes every sent frame to a candump log file, one line per frame as
-// can-utils' `candump -L` writes it (formatted by gfins::can::format_candump_line), for the
+// can-utils' `candump -L` writes it (formatted by format_candump_line, candump.hpp), for the
 // simulated board: `gfins-fw --sim` output that canplayer can replay onto a real bus and that
 // log2asc converts for other tools.
 //
@@ -47,7 +47,7 @@ struct CandumpFileBusConfig {
 
 class CandumpFileBus final : public hal::CanBus {
  public:
-  /// Room one line needs in the buffer: gfins::can::kMaxCandumpLine plus the '\n'.
+  /// Room one line needs in the buffer: kMaxCandumpLine plus the '\n'.
   static constexpr std::size_t kLineMax = 97;
 
   /// Errors: kInvalidArgument (empty path, bad interface name, buffer smaller than one line);

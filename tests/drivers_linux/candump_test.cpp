@@ -1,11 +1,11 @@
 // candump lines as can-utils writes them (candump -L) and the forms its readers accept.
-#include "gfins/can/candump.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace gfins::can {
+namespace gfins::drivers::lnx {
 namespace {
 
 std::string format(std::int64_t s, std::uint32_t us, std::string_view iface,
@@ -162,4 +162,4 @@ TEST(Candump, FormatThenParseIsIdentity) {
 }
 
 }  // namespace
-}  // namespace gfins::can
+}  // namespace gfins::drivers::lnx

@@ -1,6 +1,6 @@
-#include "gfins/can/candump.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 
-namespace gfins::can {
+namespace gfins::drivers::lnx {
 namespace {
 
 int hex_digit(char c) {
@@ -199,4 +199,4 @@ std::size_t format_candump_line(std::span<char> out, std::int64_t seconds, std::
   return n;
 }
 
-}  // namespace gfins::can
+}  // namespace gfins::drivers::lnx

@@ -22,7 +22,10 @@
 #include <string>
 #include <vector>
 
+#include "gfins/app/board.hpp"
+#include "gfins/app/config.hpp"
 #include "gfins/app/ports.hpp"
+#include "gfins/app/sample_clock.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
@@ -36,21 +39,6 @@ class SteadyClock final : public hal::Clock {
  private:
   std::int64_t do_now_ns() override;
   Status do_sleep_until_ns(std::int64_t t_ns) override;
-};
-
-/// Clock of the fast pacing: reads the time of the edge being processed (no wall clock at all,
-/// so a fast run never sees overruns and is reproducible).
-class SampleClock final : public hal::Clock {
- public:
-  void set(std::int64_t t_ns) { t_ns_ = t_ns; }
-
- private:
-  std::int64_t do_now_ns() override { return t_ns_; }
-  Status do_sleep_until_ns(std::int64_t t_ns) override {
-    if (t_ns > t_ns_) t_ns_ = t_ns;
-    return Status::ok();
-  }
-  std::int64_t t_ns_ = 0;
 };
 
 /// Scenario → six sensor voltages per sample (the analog side of the board).
@@ -114,8 +102,9 @@ enum class Pacing : std::uint8_t { kFast, kRealTime, kGpio };
 /// The data-ready line and the ADC of the simulated board, as the loop sees them.
 class SimSampleSource final : public app::SampleSource {
  public:
-  SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock, SampleClock* sample_clock,
-                  Pacing pacing, double sample_rate_hz, std::uint32_t samples);
+  SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock,
+                  app::SampleClock* sample_clock, Pacing pacing, double sample_rate_hz,
+                  std::uint32_t samples);
   /// kGpio pacing: conversion k happens at the edge whose sequence is the first edge's + k, at
   /// that edge's timestamp. Edges the line reports missing (a sequence step > 1) cost their
   /// conversions, as on the board: the sensor stream advances over them and the ADC driver
@@ -141,7 +130,7 @@ class SimSampleSource final : public app::SampleSource {
   SensorStream& stream_;
   ChipAdc& adc_;
   hal::Clock& clock_;
-  SampleClock* sample_clock_;
+  app::SampleClock* sample_clock_;
   Pacing pacing_;
   std::int64_t period_ns_;
   double period_s_;
@@ -198,5 +187,17 @@ sim::HostResult<std::unique_ptr<SensorStream>> make_scenario_stream(const sim::S
 /// The factory calibration of the simulated array: its true scale factors, biases and
 /// misalignment (the scenario's), the ADC chain's LSB, the scenario's compensator.
 calib_file::CalibrationData scenario_calibration(const sim::Scenario& s, double volts_per_count);
+
+// ---- gfins-fw on the simulated board (fw_board.cpp) -----------------------------------------
+
+/// The simulated board of `c` (sim.scenario, sim.pacing, sim.duration_s; the CAN output and the
+/// watchdog as the firmware opens them for every board).
+app::BoardResult make_board(const app::FwConfig& c);
+
+/// preflight()'s checks for this board: the scenario loads and runs at adc.sample_rate_hz.
+std::string check_config(const app::FwConfig& c, const std::string& origin);
+
+/// Registers the simulated board (board.kind = "sim") in the firmware's board table.
+void add_to(app::BoardTable& t);
 
 }  // namespace gfins::sim_board

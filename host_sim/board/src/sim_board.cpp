@@ -1,4 +1,4 @@
-#include "gfins/sim_board/sim_board.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -28,8 +28,8 @@ Status SteadyClock::do_sleep_until_ns(std::int64_t t_ns) {
 // ---- Sample source ----------------------------------------------------------------------------
 
 SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock& clock,
-                                 SampleClock* sample_clock, Pacing pacing, double sample_rate_hz,
-                                 std::uint32_t samples)
+                                 app::SampleClock* sample_clock, Pacing pacing,
+                                 double sample_rate_hz, std::uint32_t samples)
     : stream_(stream),
       adc_(adc),
       clock_(clock),

@@ -20,7 +20,7 @@
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/status/status.hpp"
 
-namespace gfins::can {
+namespace gfins::drivers::lnx {
 
 inline constexpr std::uint32_t kCanErrFlag = 0x20000000u;  // linux/can.h CAN_ERR_FLAG
 inline constexpr std::size_t kMaxCandumpLine = 96;         // enough for any classic frame line
@@ -54,4 +54,4 @@ Result<CandumpRecord> parse_candump_line(std::string_view line);
 std::size_t format_candump_line(std::span<char> out, std::int64_t seconds, std::uint32_t micros,
                                 std::string_view interface, const hal::CanFrame& f);
 
-}  // namespace gfins::can
+}  // namespace gfins::drivers::lnx

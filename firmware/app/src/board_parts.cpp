@@ -1,0 +1,122 @@
+#include <cmath>
+
+#include "boards.hpp"
+#include "gfins/app/board.hpp"
+#include "gfins/app/can_adapters.hpp"
+#include "gfins/drivers/lnx/candump_file_bus.hpp"
+#include "gfins/drivers/lnx/dev_watchdog.hpp"
+#include "gfins/drivers/lnx/error_text.hpp"
+#include "gfins/drivers/lnx/gpiod_data_ready.hpp"
+#include "gfins/drivers/lnx/realtime.hpp"
+#include "gfins/drivers/lnx/socket_can.hpp"
+#include "gfins/drivers/lnx/systemd_watchdog.hpp"
+
+namespace gfins::app {
+namespace lnx = drivers::lnx;
+namespace {
+
+// /dev/watchdog timeout: long enough for a loaded start-up, short enough to restart a hung loop
+// within a minute.
+constexpr int kDevWatchdogTimeoutS = 10;
+
+}  // namespace
+
+void add_firmware_boards(BoardTable& t) {
+  t.add(BoardEntry{BoardKind::kLinux, nullptr, make_linux_board});
+  t.add(BoardEntry{BoardKind::kHil, nullptr, make_hil_board});
+}
+
+std::string enter_realtime(const FwConfig& c) {
+  std::string warn;
+  if (c.rt_priority > 0) {
+    if (const Status s = lnx::set_fifo_priority(c.rt_priority); !s.is_ok()) {
+      warn += lnx::describe("SCHED_FIFO priority " + std::to_string(c.rt_priority), s) +
+              " — running at normal priority, expect more latency (grant CAP_SYS_NICE or "
+              "LimitRTPRIO in the service unit). ";
+    }
+  }
+  if (c.lock_memory) {
+    if (const Status s = lnx::lock_memory(); !s.is_ok()) {
+      warn += lnx::describe("mlockall", s) +
+              " — memory not locked, page faults may delay the loop (grant CAP_IPC_LOCK or "
+              "LimitMEMLOCK=infinity).";
+    }
+  }
+  return warn;
+}
+
+std::string open_can_output(const FwConfig& c, hal::Clock& clock, Board& b) {
+  if (!c.can_log.empty()) {
+    lnx::CandumpFileBusConfig bc;
+    bc.path = c.can_log;
+    bc.interface = c.can_interface;
+    // File writes off the loop thread, except in fast pacing, whose output must be the same on
+    // every run (a writer thread that falls behind drops frames: a matter of scheduling).
+    bc.background_writer = !(c.board == BoardKind::kSim && c.pacing == Pacing::kFast);
+    auto bus = lnx::CandumpFileBus::open(bc, clock);
+    if (!bus.is_ok()) return lnx::describe(c.can_log, bus.status());
+    lnx::CandumpFileBus* file = bus.value().get();
+    b.bus = std::move(bus).value();
+    b.finish_output = [file, path = c.can_log] {
+      (void)file->flush();  // a failure is counted in write_errors() and reported below
+      if (file->write_errors() == 0) return std::string();
+      const hal::CanCounters k = file->counters();
+      return lnx::describe("can.log_file = " + quote_text(path), file->last_error()) + "; " +
+             std::to_string(k.tx_dropped) + " of " + std::to_string(k.tx_frames + k.tx_dropped) +
+             " frames not written (" + std::to_string(file->write_errors()) + " failed writes)";
+    };
+    return "";
+  }
+  lnx::SocketCanConfig sc;
+  sc.interface = c.can_interface;
+  auto bus = lnx::SocketCan::open(sc);
+  if (!bus.is_ok()) return lnx::describe(c.can_interface, bus.status());
+  b.bus = std::move(bus).value();
+  return "";
+}
+
+std::string open_watchdog(const FwConfig& c, hal::Clock& clock, Board& b) {
+  if (c.watchdog == WatchdogKind::kSystemd) {
+    auto wd = lnx::SystemdWatchdog::open(clock);
+    if (!wd.is_ok()) return lnx::describe("systemd watchdog", wd.status());
+    b.watchdog = std::move(wd).value();
+  } else if (c.watchdog == WatchdogKind::kDevice) {
+    auto wd = lnx::DevWatchdog::open(c.watchdog_device, kDevWatchdogTimeoutS);
+    if (!wd.is_ok()) return lnx::describe(c.watchdog_device, wd.status());
+    b.watchdog = std::move(wd).value();
+  }
+  return "";
+}
+
+void add_can_protocol(const FwConfig& c, Board& b) {
+  const auto node = static_cast<std::uint8_t>(c.node_id);
+  b.sink = std::make_unique<CanEpochSink>(*b.bus, node, to_can_dividers(c));
+  b.codec = std::make_unique<CanCommandCodec>(node);
+}
+
+DataReadyResult open_data_ready(const FwConfig& c) {
+  // Falling edges (ADS131M06 DRDY is active low), sequence inferred from the kernel timestamps
+  // against the nominal period; adc.drdy_line is an offset when all digits, else a name.
+  lnx::GpiodDataReadyConfig dr;
+  dr.chip = c.gpio_chip;
+  if (c.drdy_line.find_first_not_of("0123456789") == std::string::npos) {
+    dr.line_offset = std::stoi(c.drdy_line);
+  } else {
+    dr.line_name = c.drdy_line;
+  }
+  dr.nominal_period_ns = static_cast<std::int64_t>(std::llround(1e9 / c.sample_rate_hz));
+  DataReadyResult out;
+  auto line = lnx::GpiodDataReady::open(dr);
+  if (!line.is_ok()) {
+    out.error = lnx::describe(c.gpio_chip + " line " + c.drdy_line, line.status());
+    return out;
+  }
+  out.line = std::move(line).value();
+  return out;
+}
+
+std::string describe_status(const std::string& what, const Status& s) {
+  return lnx::describe(what, s);
+}
+
+}  // namespace gfins::app
