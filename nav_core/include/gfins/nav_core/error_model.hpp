@@ -84,6 +84,8 @@ class ErrorModel {
   using StateVec = Eigen::Matrix<T, kStates, 1>;
   using StateMat = Eigen::Matrix<T, kStates, kStates>;
   using InputMat = Eigen::Matrix<T, kStates, N>;
+  using NavMat = Eigen::Matrix<T, err_idx::kNav, err_idx::kNav>;
+  using NavInputMat = Eigen::Matrix<T, err_idx::kNav, 6>;
 
   ErrorModel() = default;
   /// `solver` is the one the navigation uses (nominal or calibrated geometry); `gravity` gives
@@ -103,10 +105,19 @@ class ErrorModel {
     return g;
   }
 
-  /// Continuous F at the point x (the truth, or the navigation solution in a filter).
-  StateMat continuous(const NavState<T>& x) const {
+  /// ∂ẋ_nav/∂δ[ω̇; f]: how an error of the array's solution [ω̇; f] (rad/s², m/s², body) drives
+  /// the twelve navigation errors; input_matrix() is this times M (δ[ω̇; f] = M δs).
+  NavInputMat array_input_matrix(const NavState<T>& x) const {
+    NavInputMat g = NavInputMat::Zero();
+    g.template block<3, 3>(err_idx::kVel, 3) = x.q_nb.toRotationMatrix();  // eq. (12): C_b^n δf
+    g.template block<3, 3>(err_idx::kRate, 0) = Mat3<T>::Identity();       // eq. (13): δω̇
+    return g;
+  }
+
+  /// The navigation block of F (12×12: φ, δr, δv, δω) at the point x.
+  NavMat navigation_continuous(const NavState<T>& x) const {
     using namespace err_idx;
-    StateMat f = StateMat::Zero();
+    NavMat f = NavMat::Zero();
     const Mat3<T> c_nb = x.q_nb.toRotationMatrix();
     const Eigen::Matrix<T, 6, 3> kj = solver_.k() * centripetal_jacobian(x.w_b);
     f.template block<3, 3>(kPhi, kRate) = -c_nb;                                // eq. (8)
@@ -115,7 +126,27 @@ class ErrorModel {
     f(kVel + 2, kPos + 2) = dgz_drz_;                                           // gravity gradient
     f.template block<3, 3>(kVel, kRate) = -c_nb * kj.template bottomRows<3>();  // eq. (12) ρδω²
     f.template block<3, 3>(kRate, kRate) = -kj.template topRows<3>();           // eq. (13)
-    f.template block<kStates, N>(0, kBias) = input_matrix(x);                   // δs = b
+    return f;
+  }
+
+  /// Covariance (per second of PSD) of the white output noise seen through the array's solve:
+  /// Cov(M n) = M diag(σ_j²) Mᵀ for independent per-sensor noise n_j of σ_j. 6×6 and correlated
+  /// in general; with `scale` = h (the sample interval) it is the PSD σ² h of continuous_noise.
+  Mat6<T> array_noise(const std::array<T, N>& sigma, T scale) const {
+    Outputs q;
+    for (int j = 0; j < N; ++j) {
+      const T s = sigma[static_cast<std::size_t>(j)];
+      q(j) = s * s * scale;
+    }
+    const typename Solver::MapMatrix m = solver_.m();
+    return m * q.asDiagonal() * m.transpose();
+  }
+
+  /// Continuous F at the point x (the truth, or the navigation solution in a filter).
+  StateMat continuous(const NavState<T>& x) const {
+    StateMat f = StateMat::Zero();
+    f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = navigation_continuous(x);
+    f.template block<kStates, N>(0, err_idx::kBias) = input_matrix(x);  // δs = b
     return f;
   }
 

@@ -71,6 +71,8 @@ class Strapdown {
     state_.status |= nav_status::kAligned;
     state_.q_nb.normalize();
     solver_.solve(s0, state_.w_b, state_.wdot_b, state_.f_b);
+    state_.wdot_b -= bias_.template head<3>();
+    state_.f_b -= bias_.template segment<3>(kP);
     state_.a_n = state_.q_nb * state_.f_b + gravity_.g_n(state_.r_n);
     q_ = state_.q_nb;
     w_ = pad(state_.w_b);
@@ -92,6 +94,10 @@ class Strapdown {
   /// (q_, w_, wdot_, a_, v_, r_) and copied to the NavState once per step.
   void step_linear(const typename Solver::PaddedVec& u, T dt_s, std::int64_t t_ns,
                    std::uint32_t seq) {
+    // The estimated bias of [ω̇; f] (set_bias), removed before anything else: one padded
+    // subtract per half of u (a SIMD packet each for floats), zero by default.
+    const PVec u_wdot = u.template head<kP>() - bias_.template head<kP>();
+    const PVec u_f = u.template tail<kP>() - bias_.template tail<kP>();
     const T h = dt_s;
     const PVec w0 = w_;
     const PVec wdot0 = wdot_;
@@ -101,7 +107,7 @@ class Strapdown {
     // When K's top rows are zero (a symmetric array such as Table 1, where ω̇ = S s/(2ρ) of
     // eq. (4)/(6) has no centripetal term) the predictor is exact and ω̇ needs no product: same
     // values as the general case, which would subtract exact zeros, for a third fewer operations.
-    PVec wdot_pred = u.template head<kP>();
+    PVec wdot_pred = u_wdot;
     if (!wdot_free_of_w_) {
       const PVec w_pred = w0 + h * wdot0;
       // The whole padded product (whole SIMD packets) is cheaper than its three top rows.
@@ -113,12 +119,12 @@ class Strapdown {
     PVec wdot1;
     PVec f1;
     if (wdot_free_of_w_) {
-      wdot1 = u.template head<kP>();
-      f1 = u.template tail<kP>() - solver_.padded_k_force().lazyProduct(m1);
+      wdot1 = u_wdot;
+      f1 = u_f - solver_.padded_k_force().lazyProduct(m1);
     } else {
-      const typename Solver::PaddedVec full = u - solver_.padded_k().lazyProduct(m1);
-      wdot1 = full.template head<kP>();
-      f1 = full.template tail<kP>();
+      const typename Solver::PaddedVec km = solver_.padded_k().lazyProduct(m1);
+      wdot1 = u_wdot - km.template head<kP>();
+      f1 = u_f - km.template tail<kP>();
     }
 
     const PVec phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * cross_padded(w0, w1);
@@ -145,6 +151,49 @@ class Strapdown {
     state_.r_n = r_.sum.template head<3>();
   }
 
+  /// The estimated bias of the array's solution [ω̇; f] (rad/s², m/s², body), subtracted from
+  /// u = M s before every step (the aided filter's 6-D bias, error_state_filter.hpp). The values
+  /// of the current sample (ω̇, f, a) are re-derived with the new bias, so the next step's
+  /// trapezoids start from corrected values.
+  void set_bias(const Vec3<T>& b_wdot, const Vec3<T>& b_f) {
+    const Vec3<T> d_wdot = b_wdot - bias_.template head<3>();
+    const Vec3<T> d_f = b_f - bias_.template segment<3>(kP);
+    bias_.template head<3>() = b_wdot;
+    bias_.template segment<3>(kP) = b_f;
+    wdot_.template head<3>() -= d_wdot;
+    state_.wdot_b = wdot_.template head<3>();
+    state_.f_b -= d_f;
+    refresh_acceleration();
+  }
+  Vec3<T> bias_wdot() const { return bias_.template head<3>(); }
+  Vec3<T> bias_f() const { return bias_.template segment<3>(kP); }
+
+  /// Closed-loop feedback of an estimated error x = estimate − truth (docs/math.md, "Aided
+  /// navigation"): attitude error φ_n (rad, n frame, eq. (7): Ĉ Cᵀ = exp(−[φ×]), so the
+  /// corrected attitude is q ← exp(φ) ⊗ q̂), position δr_n (m), velocity δv_n (m/s) and angular
+  /// rate δω_b (rad/s) are removed from the integration state itself (the padded copies and the
+  /// Kahan sums, whose carries are kept). ω̇ and f of the current sample follow the rate
+  /// correction to first order (δ[ω̇; f] = −K J(ω) δω, error_model.hpp) and a_n the new attitude.
+  void apply_correction(const Vec3<T>& phi_n, const Vec3<T>& dr_n, const Vec3<T>& dv_n,
+                        const Vec3<T>& dw_b) {
+    q_ = quat_from_rotation_vector<T>(phi_n) * q_;
+    q_.normalize();
+    v_.add(pad(-dv_n));
+    r_.add(pad(-dr_n));
+    const Vec3<T> w_old = w_.template head<3>();
+    w_.template head<3>() -= dw_b;
+    const Vec6<T> dwf = solver_.k() * (centripetal_monomials(w_old) -
+                                       centripetal_monomials(Vec3<T>(w_.template head<3>())));
+    wdot_.template head<3>() += dwf.template head<3>();
+    state_.f_b += dwf.template tail<3>();
+    state_.q_nb = q_;
+    state_.w_b = w_.template head<3>();
+    state_.wdot_b = wdot_.template head<3>();
+    state_.v_n = v_.sum.template head<3>();
+    state_.r_n = r_.sum.template head<3>();
+    refresh_acceleration();
+  }
+
   const NavState<T>& state() const { return state_; }
   /// For the status bits only: the integration state lives in the padded copies above (set by
   /// initialize()); changing q_nb, w_b, ... here would not change the next step.
@@ -154,6 +203,12 @@ class Strapdown {
   /// True when ω̇ does not depend on ω (the top three rows of K are exactly zero).
   static bool wdot_independent_of_rate(const Solver& solver) {
     return (solver.padded_k().template topRows<3>().array() == T(0)).all();
+  }
+
+  /// a = C f + g_n(r) of the current sample after f, q or r changed outside a step.
+  void refresh_acceleration() {
+    state_.a_n = q_ * state_.f_b + gravity_.g_n(state_.r_n);
+    a_ = pad(state_.a_n);
   }
 
   static PVec pad(const Vec3<T>& v) {
@@ -172,6 +227,7 @@ class Strapdown {
   PVec a_ = PVec::Zero();
   CompensatedVec3<T, PVec> v_{};
   CompensatedVec3<T, PVec> r_{};
+  typename Solver::PaddedVec bias_ = Solver::PaddedVec::Zero();  // [b_ω̇; b_f], padded layout
 };
 
 }  // namespace gfins::nav
