@@ -1,6 +1,7 @@
 #include "gfins/can/publisher.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "gfins/can/signal_codec.hpp"
 
@@ -28,6 +29,29 @@ double euler_angle(const nav::Quat<float>& qf, std::uint8_t axis) {
 }
 
 double vec(const nav::Vec3<float>& v, std::uint8_t i) { return static_cast<double>(v[i]); }
+
+/// False when `field` belongs to a navigation group the epoch marks invalid.
+bool group_valid(const Validity& v, Field field) {
+  switch (field) {
+    case Field::kQuaternion:
+    case Field::kEuler:
+      return v.attitude;
+    case Field::kRate:
+      return v.rate;
+    case Field::kAngularAccel:
+      return v.angular_accel;
+    case Field::kAccel:
+      return v.accel;
+    case Field::kVelocity:
+      return v.velocity;
+    case Field::kPosition:
+      return v.position;
+    default:
+      return true;
+  }
+}
+
+constexpr double kNotAvailable = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 
@@ -58,6 +82,8 @@ Status check_config(const PublisherConfig& c) {
 
 double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
   const nav::NavState<float>& n = e.nav;
+  // An invalid group is "not available" (the signal's N/A code), whatever the state holds.
+  if (!group_valid(e.valid, field)) return kNotAvailable;
   switch (field) {
     case Field::kTimeUs:
       // Floor division keeps the µs of a negative scenario time consistent with its ns.

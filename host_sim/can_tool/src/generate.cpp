@@ -12,6 +12,8 @@ namespace {
 using can::MessageDef;
 using can::SignalDef;
 
+constexpr const char* kNotAvailableName = "NotAvailable";
+
 /// Shortest decimal text that reads back to the same double (DBC tools parse it exactly).
 std::string num(double v) {
   char buf[400];
@@ -92,11 +94,14 @@ std::string generate_dbc(std::uint8_t node_id) {
     const double ms = 1000.0 * m.default_divider / can::kDefaultSampleRateHz;
     o << "BA_ \"GenMsgCycleTime\" BO_ " << m.base_id + node_id << " " << std::lround(ms) << ";\n";
   }
+  // Value descriptions: the enumerations, and the not-available raw code of every signal that has
+  // one, so a DBC tool shows "NotAvailable" instead of a reading (Qw -1.00024).
   for (const MessageDef& m : can::kMessages) {
     for (const SignalDef& s : m.signals) {
-      if (s.values.empty()) continue;
+      if (s.values.empty() && !s.has_na) continue;
       o << "VAL_ " << m.base_id + node_id << " " << s.name;
       for (const can::ValueName& v : s.values) o << " " << v.raw << " \"" << v.name << "\"";
+      if (s.has_na) o << " " << s.na_raw << " \"" << kNotAvailableName << "\"";
       o << " ;\n";
     }
   }

@@ -69,6 +69,23 @@ struct Health {
   std::uint32_t log_dropped = 0;        // log records lost to a full log queue
 };
 
+/// Which navigation groups of an epoch hold a value the board stands behind. A group that is not
+/// valid goes on the bus as the not-available raw code of each of its signals (never a made-up
+/// zero or identity): while aligning, after a reset, or when the filter's 1σ of the group exceeds
+/// its configured horizon. The app sets these from the filter; every group starts valid so that a
+/// caller that does not know about validity publishes what it always did.
+struct Validity {
+  bool attitude = true;       // GfinsQuaternion, GfinsEuler
+  bool rate = true;           // GfinsAngularRate
+  bool angular_accel = true;  // GfinsAngularAccel
+  bool accel = true;          // GfinsAccel
+  bool velocity = true;       // GfinsVelocity (VelN/E/D)
+  bool position = true;       // GfinsPositionNE, GfinsPositionD (PosN/E/D)
+
+  /// Nothing valid (aligning, no filter yet).
+  static constexpr Validity none() { return {false, false, false, false, false, false}; }
+};
+
 /// One sample's worth of what may be published. Every value refers to nav.t_ns, the sampling
 /// instant (data-ready edge) of sample nav.seq.
 struct Epoch {
@@ -78,6 +95,7 @@ struct Epoch {
   std::uint32_t status_bits = 0;      // status_bits (nav.status bits 0..3 are ORed in)
   std::uint32_t cal_id = 0;           // identity of the calibration in use (0 = nominal)
   Health health;
+  Validity valid;  // per navigation group; an invalid group is sent as not available
 };
 
 }  // namespace gfins::can

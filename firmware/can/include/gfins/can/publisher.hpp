@@ -43,6 +43,7 @@ struct PublisherCounters {
 
 /// Values of one epoch as the bus carries them, before quantisation: what the encoder reads for a
 /// (field, index) of the table. Exposed so the host can compare decoded frames with the state.
+/// NaN (sent as the signal's not-available code) for a field of a group `e.valid` marks invalid.
 double epoch_field(const Epoch& e, Field field, std::uint8_t index);
 
 /// The frame of data message `m` for epoch `e` with epoch counter `counter`: encoded, sealed with
