@@ -587,7 +587,13 @@ int main_impl(int argc, char** argv) {
   realign->add_option("--heading-deg", heading_deg, "heading, degrees in [-360, 360]")
       ->required()
       ->check(heading_deg_check());
+  bool realign_force = false;
+  realign->add_flag("--force", realign_force,
+                    "carry it out even while the board moves (refused while moving otherwise)");
   auto* reset = cmd->add_subcommand("reset", "reset navigation");
+  bool reset_force = false;
+  reset->add_flag("--force", reset_force,
+                  "carry it out even while the board moves (refused while moving otherwise)");
   std::string comp;
   auto* compensator = cmd->add_subcommand("compensator", "switch compensator");
   compensator->add_option("kind", comp, "none | paper | exact")
@@ -743,8 +749,10 @@ int main_impl(int argc, char** argv) {
     c.opcode = can::Opcode::kRealign;
     c.heading_rad =
         static_cast<float>(std::remainder(heading_deg, 360.0) * std::numbers::pi / 180.0);
+    c.forced = realign_force;
   } else if (reset->parsed()) {
     c.opcode = can::Opcode::kResetNavigation;
+    c.forced = reset_force;
   } else if (compensator->parsed()) {
     c.opcode = can::Opcode::kSetCompensator;
     c.compensator = comp == "none"    ? nav::CompensatorKind::kNone
