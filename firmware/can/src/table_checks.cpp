@@ -55,7 +55,7 @@ constexpr bool e2e_ok(const MessageDef& m) {
                           s.length == kCounterLength);
     crc = crc || (s.field == Field::kCrc && s.start_bit == kCrcStartBit && s.length == 8);
   }
-  return crc && (counter || m.kind != MessageKind::kData);
+  return crc && (counter || (m.kind != MessageKind::kData && m.kind != MessageKind::kInput));
 }
 
 /// The documented limits are representable and distinct from the not-available raw value.

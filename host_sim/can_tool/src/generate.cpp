@@ -29,7 +29,8 @@ std::string mux_tag(const SignalDef& s) {
 }
 
 std::string receiver(const MessageDef& m) {
-  return m.kind == can::MessageKind::kCommand ? "GFINS" : "HOST";
+  return m.kind == can::MessageKind::kCommand || m.kind == can::MessageKind::kInput ? "GFINS"
+                                                                                    : "HOST";
 }
 
 std::string signal_comment(const SignalDef& s) {
@@ -64,7 +65,7 @@ std::string generate_dbc(std::uint8_t node_id) {
     << int{node_id} << "\"\n\n\n";
   o << "NS_ :\n\tNS_DESC_\n\tCM_\n\tBA_DEF_\n\tBA_\n\tVAL_\n\tBA_DEF_DEF_\n\tSIG_VALTYPE_\n\n";
   o << "BS_:\n\n";
-  o << "BU_: GFINS HOST\n\n\n";
+  o << "BU_: GFINS HOST GNSS\n\n\n";
   for (const MessageDef& m : can::kMessages) {
     const std::uint32_t id = m.base_id + node_id;
     o << "BO_ " << id << " " << m.name << ": " << int{can::kFrameLength} << " " << m.sender << "\n";
@@ -79,6 +80,7 @@ std::string generate_dbc(std::uint8_t node_id) {
   o << "\n";
   o << "CM_ BU_ GFINS \"Gyro-free INS board (six accelerometers)\";\n";
   o << "CM_ BU_ HOST \"Receiver of navigation frames, sender of commands\";\n";
+  o << "CM_ BU_ GNSS \"GNSS receiver or aiding gateway: sender of the aiding input frames\";\n";
   for (const MessageDef& m : can::kMessages) {
     const std::uint32_t id = m.base_id + node_id;
     o << "CM_ BO_ " << id << " \"" << m.comment << ". Identifier 0x" << std::hex << m.base_id
@@ -114,7 +116,9 @@ std::string generate_signal_tables() {
     o << "#### " << m.name << " — 0x" << std::hex << std::uppercase << m.base_id << std::dec
       << " + node\n\n";
     o << m.comment << ". Default divider: ";
-    if (m.kind != can::MessageKind::kData) {
+    if (m.kind == can::MessageKind::kInput) {
+      o << "sent by the GNSS receiver or gateway, one fix at a time (not a board output)";
+    } else if (m.kind != can::MessageKind::kData) {
       o << "on demand";
     } else if (m.default_divider == 0) {
       o << "off";

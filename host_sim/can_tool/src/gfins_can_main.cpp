@@ -100,6 +100,9 @@ int decode(const DecodeOptions& o, View& view) {
         }
         ++n;
       });
+  dec.set_input_sink([&](const DecodedInput& in) {
+    if (o.node < 0 || in.node_id == o.node) view.input(in);
+  });
   dec.set_notice_sink([&](const Notice& nt) {
     if (!o.quiet) {
       std::fprintf(stderr, "%s:%llu: note: %s\n", current.c_str(),

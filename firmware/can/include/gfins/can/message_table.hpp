@@ -76,6 +76,17 @@ enum class Field : std::uint8_t {
   kCmdPose,
   kCmdSamples,
   kCmdForced,
+  // aiding inputs (GNSS receiver / heading source -> board)
+  kInGnssPos,  // index 0 N, 1 E, 2 D
+  kInGnssVel,
+  kInGnssSigmaPosH,
+  kInGnssSigmaPosV,
+  kInGnssSigmaVel,
+  kInGnssAge,
+  kInGnssContent,
+  kInHeading,
+  kInHeadingSigma,
+  kInHeadingAge,
   // response
   kRspOpcode,
   kRspToken,
@@ -147,10 +158,17 @@ enum class MessageId : std::uint8_t {
   // configuration names) keep their values.
   kAccuracy,
   kAidingCounters,
+  kGnssPositionNE,
+  kGnssPositionD,
+  kGnssVelocity,
+  kGnssFixInfo,
+  kHeadingInput,
 };
-inline constexpr std::size_t kMessageCount = 18;
+inline constexpr std::size_t kMessageCount = 23;
 
-enum class MessageKind : std::uint8_t { kData, kCommand, kResponse };
+/// kInput: aiding measurements sent to the board (GNSS, heading), same framing as data frames
+/// (counter in bits 52..55 = the fix's sequence id, CRC in byte 7), decoded by aiding_input.hpp.
+enum class MessageKind : std::uint8_t { kData, kCommand, kResponse, kInput };
 
 struct MessageDef {
   std::string_view name{};
@@ -546,6 +564,113 @@ inline constexpr std::array<SignalDef, 18> kAidingCountersSignals{{
     crc_signal(),
 }};
 
+// Aiding inputs (GNSS receiver or a gateway -> board). Every frame of one fix carries the fix id
+// in the counter bits; GfinsGnssFixInfo, sent last, completes the fix. Reserved bits are zero.
+inline constexpr std::string_view kAtFix =
+    "the fix's time of validity (reception of FixInfo - FixAge)";
+inline constexpr std::string_view kAtHeading =
+    "the heading's time of validity (reception - HeadingAge)";
+
+constexpr SignalDef fix_id_signal() {
+  return wrapping("FixId", Field::kCounter, kCounterStartBit, kCounterLength, "",
+                  "the fix this frame belongs to",
+                  "Fix sequence id (mod 16): equal in every frame of one fix, advances by one "
+                  "per fix; a fix with the id of the last accepted one is rejected as stale");
+}
+
+/// An input σ: like sigma() but zero is not a σ (min = one step), all ones = not stated.
+constexpr SignalDef input_sigma(std::string_view name, Field field, std::uint8_t start,
+                                std::uint8_t length, double factor, std::string_view unit,
+                                std::string_view instant, std::string_view comment) {
+  SignalDef d = sigma(name, field, 0, start, length, factor, unit, comment);
+  d.min = factor;
+  d.instant = instant;
+  return d;
+}
+
+constexpr SignalDef input_age(std::string_view name, Field field, std::uint8_t start,
+                              std::string_view comment) {
+  SignalDef d = sigma(name, field, 0, start, 13, 1e-3, "s", comment);
+  d.round_up = false;
+  d.instant = "the frame's transmission";
+  return d;
+}
+
+constexpr SignalDef at_fix(SignalDef d) {
+  d.instant = kAtFix;
+  return d;
+}
+
+inline constexpr std::array<SignalDef, 4> kGnssPositionNESignals{{
+    at_fix(physical("GnssPosN", Field::kInGnssPos, 0, 0, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin (alignment point), north")),
+    at_fix(physical("GnssPosE", Field::kInGnssPos, 1, 26, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin, east")),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kGnssPositionDSignals{{
+    at_fix(physical("GnssPosD", Field::kInGnssPos, 2, 0, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin, down")),
+    input_sigma("GnssSigmaPosH", Field::kInGnssSigmaPosH, 26, 13, 0.01, "m", kAtFix,
+                "Receiver's 1 sigma of the position, north and east (each)"),
+    input_sigma("GnssSigmaPosV", Field::kInGnssSigmaPosV, 39, 13, 0.01, "m", kAtFix,
+                "Receiver's 1 sigma of the position, down"),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kGnssVelocitySignals{{
+    at_fix(physical("GnssVelN", Field::kInGnssVel, 0, 0, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, north")),
+    at_fix(physical("GnssVelE", Field::kInGnssVel, 1, 16, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, east")),
+    at_fix(physical("GnssVelD", Field::kInGnssVel, 2, 32, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, down")),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<ValueName, 3> kGnssContentValues{
+    {{1, "Position"}, {2, "Velocity"}, {3, "PositionVelocity"}}};
+
+inline constexpr std::array<SignalDef, 5> kGnssFixInfoSignals{{
+    input_sigma("GnssSigmaVel", Field::kInGnssSigmaVel, 0, 12, 0.001, "m/s", kAtFix,
+                "Receiver's 1 sigma of each velocity axis"),
+    input_age("GnssFixAge", Field::kInGnssAge, 12,
+              "Age of the fix when this frame was sent: transmission - time of validity"),
+    unsigned_int("GnssContent", Field::kInGnssContent, 0, 25, 2, 3.0, kNotMultiplexed,
+                 kGnssContentValues, kAtFix,
+                 "What the fix holds: bit 0 position (PositionNE, PositionD), bit 1 velocity", 1.0),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kHeadingInputSignals{{
+    SignalDef{.name = "ExtHeading",
+              .field = Field::kInHeading,
+              .start_bit = 0,
+              .length = 16,
+              .is_signed = true,
+              .factor = 1e-4,
+              .unit = "rad",
+              .min = -3.1416,
+              .max = 3.1416,
+              .has_na = true,
+              .na_raw = -32768,
+              .instant = kAtHeading,
+              .comment = "External heading (yaw of q_nb), e.g. dual-antenna GNSS"},
+    input_sigma("ExtHeadingSigma", Field::kInHeadingSigma, 16, 12, 1e-4, "rad", kAtHeading,
+                "1 sigma of the external heading"),
+    input_age("ExtHeadingAge", Field::kInHeadingAge, 28,
+              "Age of the heading when sent: transmission - time of validity"),
+    wrapping("Sequence", Field::kCounter, kCounterStartBit, kCounterLength, "",
+             "the heading this frame carries",
+             "Heading sequence (mod 16), advances by one per heading; a repeat is rejected"),
+    crc_signal(),
+}};
+
 // Command (host -> board). Opcode is the multiplexor: each opcode's arguments are the signals
 // with its value in `mux`. Bits not used by the opcode must be zero.
 inline constexpr std::uint8_t kOpRealign = 1;
@@ -722,6 +847,18 @@ inline constexpr std::array<MessageDef, kMessageCount> kMessages{{
     {"GfinsAidingCounters", MessageId::kAidingCounters, 0x1F0, MessageKind::kData, 400,
      kAidingCountersSignals, "GFINS",
      "Accepted and rejected aiding updates per kind, one kind per frame in turn"},
+    {"GfinsGnssPositionNE", MessageId::kGnssPositionNE, 0x0C0, MessageKind::kInput, 0,
+     kGnssPositionNESignals, "GNSS", "GNSS fix, frame 1 of 4: antenna position north, east"},
+    {"GfinsGnssPositionD", MessageId::kGnssPositionD, 0x0D0, MessageKind::kInput, 0,
+     kGnssPositionDSignals, "GNSS",
+     "GNSS fix, frame 2 of 4: antenna position down and the receiver's position 1 sigma"},
+    {"GfinsGnssVelocity", MessageId::kGnssVelocity, 0x0E0, MessageKind::kInput, 0,
+     kGnssVelocitySignals, "GNSS", "GNSS fix, frame 3 of 4: antenna velocity"},
+    {"GfinsGnssFixInfo", MessageId::kGnssFixInfo, 0x0F0, MessageKind::kInput, 0,
+     kGnssFixInfoSignals, "GNSS",
+     "GNSS fix, frame 4 of 4 (completes the fix): velocity 1 sigma, age, content"},
+    {"GfinsHeadingInput", MessageId::kHeadingInput, 0x0B0, MessageKind::kInput, 0,
+     kHeadingInputSignals, "GNSS", "External heading for the filter"},
 }};
 
 constexpr const MessageDef& message(MessageId id) {
