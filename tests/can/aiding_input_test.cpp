@@ -85,12 +85,22 @@ TEST(GnssInput, AVelocityOnlyFixNeedsNoPositionFrames) {
   GnssFix v = sample_fix(5);
   v.has_position = false;
   const auto frames = encode_gnss_fix(v, kNode);
+  // The position frames are sent with every value not available: absent, not an error.
+  ASSERT_TRUE(d.add(frames[0]).is_ok());
+  ASSERT_TRUE(d.add(frames[1]).is_ok());
   ASSERT_TRUE(d.add(frames[2]).is_ok());
   const Result<InputEvent> r = d.add(frames[3]);
   ASSERT_TRUE(r.is_ok()) << r.status().message();
   EXPECT_EQ(r->kind, InputEventKind::kGnssFix);
   EXPECT_FALSE(r->gnss.has_position);
   EXPECT_TRUE(r->gnss.has_velocity);
+  EXPECT_EQ(d.counters().total_rejected(), 0u);
+  // A FixInfo claiming a position whose frames said "absent" is incomplete.
+  InputDecoder e(kNode);
+  auto lying = encode_gnss_fix(v, kNode);
+  lying[3] = with_raw(lying[3], "GnssContent", 3);
+  EXPECT_FALSE(feed(e, lying).is_ok());
+  EXPECT_EQ(e.last_reject(), InputReject::kIncomplete);
 }
 
 TEST(GnssInput, ACorruptedFrameIsRejectedCountedAndSpoilsItsFix) {

@@ -30,6 +30,16 @@ double checked(const SignalDef& s, std::uint64_t p) {
   return x;
 }
 
+/// True when every value signal of the frame carries its not-available code: the sender states
+/// that part of the fix is absent (a velocity-only fix sends its position frames so).
+bool all_not_available(const MessageDef& m, std::uint64_t p) {
+  for (const SignalDef& s : m.signals) {
+    if (s.field == Field::kCounter || s.field == Field::kCrc) continue;
+    if (!s.has_na || raw_value(s, extract_bits(p, s)) != s.na_raw) return false;
+  }
+  return true;
+}
+
 std::uint64_t put(std::uint64_t p, const SignalDef& s, double x) {
   return insert_bits(p, s, encode_signal(s, x).bits);
 }
@@ -159,6 +169,9 @@ Result<InputEvent> InputDecoder::add_gnss(const MessageDef& m, std::uint64_t p, 
   };
   InputEvent pending;
   pending.kind = InputEventKind::kPending;
+  // A position or velocity frame with every value not available says "this fix has no such
+  // part": stored as absent, not an error (FixInfo's content then must not claim it).
+  if (m.id != MessageId::kGnssFixInfo && all_not_available(m, p)) return pending;
   switch (m.id) {
     case MessageId::kGnssPositionNE:
       partial_.r_n_m[0] = checked(sig(m, Field::kInGnssPos, 0), p);
