@@ -260,6 +260,25 @@ bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,
       e.accel_mps2[k] = static_cast<float>(9.81 * std::sin(0.1 * t + static_cast<double>(k)));
     }
     e.health.adc_crc_errors = static_cast<std::uint32_t>(i / 100000);
+    // A filter with GNSS and standstill aiding: σ that grow and shrink, counts that grow; no ZARU
+    // update yet (its time since is not available), and a heading σ beyond its range at times
+    // (sent as the maximum).
+    can::Accuracy& a = e.accuracy;
+    a.sigma_roll_rad = static_cast<float>(0.002 + 0.001 * std::sin(0.2 * t));
+    a.sigma_pitch_rad = static_cast<float>(0.0025 + 0.001 * std::cos(0.2 * t));
+    a.sigma_heading_rad = static_cast<float>(1.2 + 1.0 * std::sin(0.1 * t));
+    a.sigma_vel_h_mps = static_cast<float>(0.05 + 0.02 * std::sin(0.3 * t));
+    a.sigma_vel_v_mps = static_cast<float>(0.08 + 0.02 * std::cos(0.3 * t));
+    a.sigma_pos_h_m = static_cast<float>(1.5 + 0.5 * std::sin(0.05 * t));
+    a.sigma_pos_v_m = static_cast<float>(2.5 + 0.5 * std::cos(0.05 * t));
+    a.filter_mode =
+        std::fmod(t, 20.0) < 5.0 ? can::filter_mode::kStandstill : can::filter_mode::kGnss;
+    for (std::size_t k = 0; k < can::kAidKindCount; ++k) {
+      a.aiding[k].accepted = static_cast<std::uint32_t>(i / (100 * (k + 1)));
+      a.aiding[k].rejected = static_cast<std::uint32_t>(i / (10000 * (k + 1)));
+      a.aiding[k].since_accepted_s = static_cast<float>(std::fmod(t, 1.0 + static_cast<double>(k)));
+    }
+    a.aiding[1].since_accepted_s = can::kNoValue;
     bus.t_us = kLogStartUs + static_cast<std::int64_t>(std::llround(t * 1e6));
     pub.publish(e);
     if (!bus.ok) return false;
