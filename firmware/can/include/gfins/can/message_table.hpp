@@ -6,7 +6,8 @@
 // Conventions (docs/can-interface.md): classic CAN 2.0, 11-bit identifiers = base + node id
 // (node id 0..15), 8 data bytes, signals little-endian (Intel, DBC "@1"), bit 0 = LSB of byte 0.
 // Data frames: payload bits 0..51, rolling epoch counter bits 52..55, CRC-8/SAE-J1850 bits 56..63
-// over the two identifier bytes (little-endian) and data bytes 0..6.
+// over the two identifier bytes (little-endian) and data bytes 0..6. Aiding input frames (GNSS,
+// heading; aiding_input.hpp) are framed the same way, their counter being the fix sequence id.
 #pragma once
 
 #include <array>
