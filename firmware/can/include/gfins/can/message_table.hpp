@@ -316,7 +316,9 @@ constexpr SignalDef sigma(std::string_view name, Field field, std::uint8_t index
                    .factor = factor,
                    .unit = unit,
                    .min = 0.0,
-                   .max = static_cast<double>(na - 1) * factor,
+                   // (na - 1) / (1 / factor): the decimal the DBC prints (0.4094, not
+                   // the 0.40940000000000004 of 4094 * 1e-4)
+                   .max = static_cast<double>(na - 1) / (1.0 / factor),
                    .has_na = true,
                    .na_raw = static_cast<std::int64_t>(na),
                    .instant = kAtSample,
