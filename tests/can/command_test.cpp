@@ -75,6 +75,45 @@ TEST(Command, EveryCommandRoundTrips) {
   }
 }
 
+TEST(Command, ForcedFlagOfRealignAndResetRoundTripsAtTheIcdBits) {
+  // ICD: Realign's RealignForced is bit 32 (byte 4, bit 0) after the heading; ResetNavigation's
+  // ResetForced is bit 16 (byte 2, bit 0).
+  for (bool forced : {false, true}) {
+    SCOPED_TRACE(forced);
+    Command c;
+    c.opcode = Opcode::kRealign;
+    c.heading_rad = 0.5f;
+    c.forced = forced;
+    hal::CanFrame f = encode_command(c, kNode);
+    EXPECT_EQ(f.data[4], forced ? 1 : 0);
+    DecodedCommand d = decode_command(f, kNode);
+    ASSERT_TRUE(d.ok()) << d.error.message;
+    EXPECT_EQ(d.command.forced, forced);
+    c.opcode = Opcode::kResetNavigation;
+    f = encode_command(c, kNode);
+    EXPECT_EQ(f.data[2], forced ? 1 : 0);
+    d = decode_command(f, kNode);
+    ASSERT_TRUE(d.ok()) << d.error.message;
+    EXPECT_EQ(d.command.forced, forced);
+  }
+  // A forced bit on a command that has none is a bit the opcode does not use.
+  EXPECT_EQ(decode_command(raw_command({3, 1, 2, 0, 1, 0, 0}), kNode).error.code,
+            ResultCode::kMalformed);  // SetCompensator with bit 32 set
+  // Bits next to the flag stay reserved.
+  EXPECT_EQ(decode_command(raw_command({2, 1, 2, 0, 0, 0, 0}), kNode).error.code,
+            ResultCode::kMalformed);  // ResetNavigation with bit 17 set
+}
+
+TEST(Command, SetDividerReachesTheAccuracyMessages) {
+  Command c;
+  c.opcode = Opcode::kSetDivider;
+  c.message = MessageId::kAidingCounters;
+  c.divider = 100;
+  const DecodedCommand d = decode_command(encode_command(c, kNode), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_EQ(d.command.message, MessageId::kAidingCounters);
+}
+
 TEST(Command, ByteLayoutAsTheIcdSays) {
   // StartCapture pose 3, N = 1000 = 0x03E8, token 0x42.
   const DecodedCommand d = decode_command(raw_command({6, 0x42, 3, 0xE8, 0x03, 0, 0}), kNode);
@@ -104,7 +143,7 @@ TEST(Command, MalformedFramesDecodeToTypedErrors) {
       {"crc", bad_crc, ResultCode::kBadCrc},
       {"opcode 0", raw_command({0, 9, 0, 0, 0, 0, 0}), ResultCode::kUnknownOpcode},
       {"opcode 99", raw_command({99, 9, 0, 0, 0, 0, 0}), ResultCode::kUnknownOpcode},
-      {"reset with argument", raw_command({2, 9, 1, 0, 0, 0, 0}), ResultCode::kMalformed},
+      {"reset with argument", raw_command({2, 9, 2, 0, 0, 0, 0}), ResultCode::kMalformed},
       {"byte 6 set", raw_command({5, 9, 0, 0, 0, 0, 0x10}), ResultCode::kMalformed},
       // heading 3.2 rad = 32000 > 31416
       {"heading > pi", raw_command({1, 9, 0x00, 0x7D, 0, 0, 0}), ResultCode::kOutOfRange},

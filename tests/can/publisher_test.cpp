@@ -27,8 +27,9 @@ TEST(Publisher, DefaultsSendTheDocumentedFramesPerSecond) {
   Publisher pub(bus, PublisherConfig{});
   ASSERT_TRUE(pub.init_status().is_ok());
   for (std::uint32_t seq = 0; seq < 1000; ++seq) pub.publish(epoch_at(seq));  // one second
-  // 8 messages at 100 Hz, Euler and angular acceleration at 50 Hz, two health frames at 1 Hz.
-  EXPECT_EQ(bus.count, 8u * 100 + 2 * 50 + 2);
+  // 8 messages at 100 Hz, Euler and angular acceleration at 50 Hz, two health frames at 1 Hz,
+  // accuracy at 5 Hz, aiding counters every 400 samples (seq 0, 400, 800).
+  EXPECT_EQ(bus.count, 8u * 100 + 2 * 50 + 2 + 5 + 3);
   EXPECT_EQ(pub.counters().epochs, 100u);
   EXPECT_EQ(pub.counters().frames_sent, bus.count);
 }
@@ -123,7 +124,7 @@ TEST(Publisher, RefusedFramesAreCountedNotRetried) {
   Publisher pub(bus, PublisherConfig{});
   pub.publish(epoch_at(0));
   EXPECT_EQ(pub.counters().frames_sent, 0u);
-  EXPECT_EQ(pub.counters().send_failures, 12u);  // the 12 data messages enabled by default
+  EXPECT_EQ(pub.counters().send_failures, 14u);  // the 14 data messages enabled by default
 }
 
 }  // namespace

@@ -208,6 +208,27 @@ def main():
             check(d.returncode == 0 and len(d.stdout.decode().splitlines()) == 11,
                   f'asc2log output: exit {d.returncode}, {d.stderr.decode()}')
 
+    # gnss: a scenario's simulated receiver as GNSS input frames, decoded back by gfins-can (the
+    # board's codec): one accepted fix per fix time outside the outage, no problem.
+    scenarios = os.path.join(os.path.dirname(os.path.abspath(a.corpus)), '..', '..', 'host_sim',
+                             'scenarios')
+    gnss_log = os.path.join(a.workdir, 'gnss.log')
+    r = run([exe, 'gnss', 'drive-gnss', '--scenario-dir', scenarios, '--node', '2', '-o', gnss_log])
+    check(r.returncode == 0, f'gnss: exit {r.returncode}: {r.stderr.decode()}')
+    if r.returncode == 0:
+        lines = open(gnss_log).read().splitlines()
+        check(len(lines) == 4 * 161, f'gnss: {len(lines)} frames, expected 4 x 161 fixes')
+        check(lines[0].startswith('(0000000000.060000) can0 0C2#'), f'gnss: first line {lines[0]}')
+        d = run([exe, 'decode', gnss_log, '--view', 'json'])
+        recs = [json.loads(l) for l in d.stdout.decode().splitlines()]
+        check(d.returncode == 0, f'gnss decode: exit {d.returncode}: {d.stderr.decode()}')
+        check(len(recs) == 161 and all(x.get('input') == 'GnssFix' and x['node'] == 2
+                                       for x in recs), f'gnss decode: {len(recs)} fixes')
+        check(all(x['GnssFixAge'] == 0.06 for x in recs), 'gnss decode: age is not the latency')
+    r = run([exe, 'gnss', 'drive', '--scenario-dir', scenarios])
+    check(r.returncode == 2 and 'no [gnss] table' in r.stderr.decode(),
+          f'gnss without [gnss]: exit {r.returncode}')
+
     # plot
     png = os.path.join(a.workdir, 'plot.png')
     if os.path.exists(png):

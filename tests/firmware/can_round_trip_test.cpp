@@ -112,11 +112,16 @@ TEST(CanOutput, DecodedFramesEqualTheNavStateWithinQuantisation) {
         double want = std::fmod(std::floor((x - s.offset) / s.factor + 0.5), m2);
         if (want < 0) want += m2;
         EXPECT_EQ(static_cast<double>(bits), want) << m->name << "." << s.name;
+      } else if (std::isnan(x)) {
+        // Not available (a filter σ while no filter runs): the N/A code, decoded as NaN.
+        EXPECT_TRUE(std::isnan(can::decode_signal(s, bits))) << m->name << "." << s.name;
       } else {
         const double got = can::decode_signal(s, bits);
         const double clipped = std::clamp(x, s.min, s.max);
-        // round to nearest: at most half a step, plus the float→double rounding of the value
-        EXPECT_LE(std::abs(got - clipped), 0.5 * s.factor * (1 + 1e-9) + 1e-9 * std::abs(x))
+        // round to nearest: at most half a step (a σ rounds up: less than one step), plus the
+        // float→double rounding of the value
+        const double step = s.round_up ? s.factor : 0.5 * s.factor;
+        EXPECT_LE(std::abs(got - clipped), step * (1 + 1e-9) + 1e-9 * std::abs(x))
             << m->name << "." << s.name << " seq " << current->nav.seq;
       }
       ++compared;

@@ -10,10 +10,12 @@ namespace {
 const MessageDef& cmd_def() { return message(MessageId::kCommand); }
 const MessageDef& rsp_def() { return message(MessageId::kResponse); }
 
-/// The signal of `m` carrying `field` (for per-channel fields, the one with `index`).
-const SignalDef& sig(const MessageDef& m, Field field, std::uint8_t index = 0) {
+/// The signal of `m` carrying `field` (for per-channel fields, the one with `index`; for a field
+/// several opcodes share, the one of opcode `mux`).
+const SignalDef& sig(const MessageDef& m, Field field, std::uint8_t index = 0,
+                     std::int16_t mux = kNotMultiplexed) {
   for (const SignalDef& s : m.signals) {
-    if (s.field == field && s.index == index) return s;
+    if (s.field == field && s.index == index && (mux == kNotMultiplexed || s.mux == mux)) return s;
   }
   return m.signals[0];  // unreachable for the fields used below (checked by the tests)
 }
@@ -98,6 +100,9 @@ DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id) {
       case Field::kCmdSamples:
         c.samples = static_cast<std::uint16_t>(x);
         break;
+      case Field::kCmdForced:
+        c.forced = x != 0.0;
+        break;
       default:
         break;
     }
@@ -121,8 +126,12 @@ hal::CanFrame encode_command(const Command& c, std::uint8_t node_id) {
     case Opcode::kRealign: {
       const SignalDef& s = sig(m, Field::kCmdHeading);
       p = insert_bits(p, s, bits_of(s, raw_of_physical(s, static_cast<double>(c.heading_rad))));
+      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpRealign), c.forced ? 1u : 0u);
       break;
     }
+    case Opcode::kResetNavigation:
+      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpResetNavigation), c.forced ? 1u : 0u);
+      break;
     case Opcode::kSetCompensator:
       p = insert_bits(p, sig(m, Field::kCmdCompensator), static_cast<std::uint8_t>(c.compensator));
       break;

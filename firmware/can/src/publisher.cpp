@@ -1,6 +1,7 @@
 #include "gfins/can/publisher.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "gfins/can/signal_codec.hpp"
 
@@ -28,6 +29,44 @@ double euler_angle(const nav::Quat<float>& qf, std::uint8_t axis) {
 }
 
 double vec(const nav::Vec3<float>& v, std::uint8_t i) { return static_cast<double>(v[i]); }
+
+/// False when `field` belongs to a navigation group the epoch marks invalid.
+bool group_valid(const Validity& v, Field field) {
+  switch (field) {
+    case Field::kQuaternion:
+    case Field::kEuler:
+      return v.attitude;
+    case Field::kRate:
+      return v.rate;
+    case Field::kAngularAccel:
+      return v.angular_accel;
+    case Field::kAccel:
+      return v.accel;
+    case Field::kVelocity:
+      return v.velocity;
+    case Field::kPosition:
+      return v.position;
+    default:
+      return true;
+  }
+}
+
+constexpr double kNotAvailable = std::numeric_limits<double>::quiet_NaN();
+
+/// Whether a clipped or not-available value of `field` flags the epoch (StatusFlags bits 4, 5):
+/// the navigation values and sensor outputs do. A σ does not: without a filter it is not
+/// available by design, and one beyond its range is sent as the maximum, which reads "at least".
+bool flags_epoch(Field field) {
+  switch (field) {
+    case Field::kSigmaAttitude:
+    case Field::kSigmaVelocity:
+    case Field::kSigmaPosition:
+    case Field::kAidSinceAccepted:
+      return false;
+    default:
+      return true;
+  }
+}
 
 }  // namespace
 
@@ -58,6 +97,8 @@ Status check_config(const PublisherConfig& c) {
 
 double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
   const nav::NavState<float>& n = e.nav;
+  // An invalid group is "not available" (the signal's N/A code), whatever the state holds.
+  if (!group_valid(e.valid, field)) return kNotAvailable;
   switch (field) {
     case Field::kTimeUs:
       // Floor division keeps the µs of a negative scenario time consistent with its ns.
@@ -110,14 +151,40 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
       return e.health.loop_overruns;
     case Field::kLogDropped:
       return e.health.log_dropped;
+    case Field::kSigmaAttitude: {
+      const float s[3] = {e.accuracy.sigma_roll_rad, e.accuracy.sigma_pitch_rad,
+                          e.accuracy.sigma_heading_rad};
+      return static_cast<double>(s[index % 3u]);
+    }
+    case Field::kSigmaVelocity:
+      return static_cast<double>(index == 0 ? e.accuracy.sigma_vel_h_mps
+                                            : e.accuracy.sigma_vel_v_mps);
+    case Field::kSigmaPosition:
+      return static_cast<double>(index == 0 ? e.accuracy.sigma_pos_h_m : e.accuracy.sigma_pos_v_m);
+    case Field::kFilterMode:
+      return e.accuracy.filter_mode & 0x0Fu;
+    case Field::kAidKind:
+      return index;
+    case Field::kAidAccepted:
+      return e.accuracy.aiding[index % kAidKindCount].accepted;
+    case Field::kAidRejected:
+      return e.accuracy.aiding[index % kAidKindCount].rejected;
+    case Field::kAidSinceAccepted:
+      return static_cast<double>(e.accuracy.aiding[index % kAidKindCount].since_accepted_s);
     default:
       return 0.0;
   }
 }
 
+std::uint8_t selector_count(const MessageDef& m) {
+  int n = 0;
+  for (const SignalDef& s : m.signals) n = std::max(n, s.mux + 1);
+  return static_cast<std::uint8_t>(n);
+}
+
 hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
                                 std::uint8_t counter, std::uint32_t* saturated,
-                                std::uint32_t* unavailable) {
+                                std::uint32_t* unavailable, std::uint8_t selector) {
   hal::CanFrame f;
   f.id = m.base_id + node_id;
   f.len = kFrameLength;
@@ -128,8 +195,14 @@ hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_
       p = insert_bits(p, s, counter);
       continue;
     }
+    if (s.mux == kMultiplexor) {
+      p = insert_bits(p, s, selector);
+      continue;
+    }
+    if (s.mux >= 0 && s.mux != selector) continue;  // another selector's signal
     const EncodedSignal enc = encode_signal(s, epoch_field(e, s.field, s.index));
     p = insert_bits(p, s, enc.bits);
+    if (!flags_epoch(s.field)) continue;
     if (enc.saturated && saturated != nullptr) ++*saturated;
     if (enc.not_available && unavailable != nullptr) ++*unavailable;
   }
@@ -164,7 +237,11 @@ void Publisher::publish(const Epoch& e) {
     }
     const std::uint16_t d = dividers_[idx(m.id)];
     if (d == 0 || e.nav.seq % d != 0) continue;
-    frames[n++] = encode_data_frame(m, e, node_id_, counter_, &saturated, &unavailable);
+    // A multiplexed message sends its selector values in turn, one per frame.
+    std::uint8_t& sel = selector_[idx(m.id)];
+    frames[n++] = encode_data_frame(m, e, node_id_, counter_, &saturated, &unavailable, sel);
+    const std::uint8_t count = selector_count(m);
+    if (count > 0) sel = static_cast<std::uint8_t>((sel + 1u) % count);
   }
   frames[0] = encode_data_frame(message(MessageId::kEpoch), e, node_id_, counter_, &saturated,
                                 &unavailable);

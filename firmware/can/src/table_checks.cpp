@@ -55,7 +55,7 @@ constexpr bool e2e_ok(const MessageDef& m) {
                           s.length == kCounterLength);
     crc = crc || (s.field == Field::kCrc && s.start_bit == kCrcStartBit && s.length == 8);
   }
-  return crc && (counter || m.kind != MessageKind::kData);
+  return crc && (counter || (m.kind != MessageKind::kData && m.kind != MessageKind::kInput));
 }
 
 /// The documented limits are representable and distinct from the not-available raw value.
@@ -76,6 +76,21 @@ constexpr bool limits_ok(const MessageDef& m) {
   return true;
 }
 
+constexpr bool is_navigation(Field f) {
+  return f == Field::kQuaternion || f == Field::kEuler || f == Field::kRate ||
+         f == Field::kAngularAccel || f == Field::kAccel || f == Field::kVelocity ||
+         f == Field::kPosition;
+}
+
+/// Every navigation signal can say "not available" (an invalid group, a non-finite value): none
+/// may be forced to send a made-up number.
+constexpr bool navigation_has_na(const MessageDef& m) {
+  for (const SignalDef& s : m.signals) {
+    if (is_navigation(s.field) && !s.has_na) return false;
+  }
+  return true;
+}
+
 constexpr bool all(bool (*check)(const MessageDef&)) {
   for (const MessageDef& m : kMessages) {
     if (!check(m)) return false;
@@ -86,6 +101,7 @@ constexpr bool all(bool (*check)(const MessageDef&)) {
 static_assert(ids_unique_and_in_range(), "message identifiers overlap or exceed 11 bits");
 static_assert(all(layout_ok), "signals overlap or leave the 64-bit payload");
 static_assert(all(e2e_ok), "a message lacks its counter or CRC at the standard place");
+static_assert(all(navigation_has_na), "a navigation signal has no not-available code");
 static_assert(all(limits_ok), "a signal's [min, max] is not representable or covers its N/A code");
 static_assert(crc8_sae_j1850(std::array<std::uint8_t, 9>{'1', '2', '3', '4', '5', '6', '7', '8',
                                                          '9'}) == 0x4B,

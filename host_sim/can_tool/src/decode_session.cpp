@@ -91,6 +91,11 @@ void print_summary(const Summary& s, std::FILE* out) {
       static_cast<unsigned long long>(s.frames_ok), static_cast<unsigned long long>(s.epochs),
       static_cast<unsigned long long>(s.commands), static_cast<unsigned long long>(s.responses),
       static_cast<unsigned long long>(s.total_issues()));
+  if (s.inputs != 0) {
+    std::fprintf(out, "  aiding inputs: %llu frames, %llu fixes/headings decoded\n",
+                 static_cast<unsigned long long>(s.inputs),
+                 static_cast<unsigned long long>(s.fixes));
+  }
   for (std::size_t k = 0; k < s.issues.size(); ++k) {
     if (s.issues[k] == 0) continue;
     std::fprintf(out, "  %-20s %llu\n", to_string(static_cast<IssueKind>(k)),

@@ -146,6 +146,8 @@ const char* to_string(IssueKind k) {
       return "reordered";
     case IssueKind::kOrphan:
       return "orphan frame";
+    case IssueKind::kInputRejected:
+      return "rejected input";
     case IssueKind::kCount_:
       break;
   }
@@ -161,6 +163,7 @@ std::uint64_t Summary::total_issues() const {
 StreamDecoder::StreamDecoder(EpochSink on_epoch, IssueSink on_issue)
     : on_epoch_(std::move(on_epoch)), on_issue_(std::move(on_issue)) {
   for (NodeState& n : nodes_) reset_tracks(n, true);
+  for (std::uint8_t node = 0; node <= can::kMaxNodeId; ++node) inputs_.emplace_back(node);
 }
 
 void StreamDecoder::issue(IssueKind k, std::uint64_t line, std::string text) {
@@ -215,6 +218,11 @@ void StreamDecoder::feed_frame(std::uint64_t line_no, std::int64_t time_us,
   }
   ++summary_.frames_ok;
   ++summary_.per_message[msg_index(*m)];
+  if (m->kind == can::MessageKind::kInput) {
+    ++summary_.inputs;
+    on_input(f, node, line_no, time_us);
+    return;
+  }
   if (m->kind != can::MessageKind::kData) {
     ++(m->kind == can::MessageKind::kCommand ? summary_.commands : summary_.responses);
     on_command(f, node, m->kind == can::MessageKind::kResponse);
@@ -253,6 +261,24 @@ void StreamDecoder::on_command(const hal::CanFrame& f, std::uint8_t node, bool r
       t.pending = 0;
     }
   }
+}
+
+void StreamDecoder::on_input(const hal::CanFrame& f, std::uint8_t node, std::uint64_t line,
+                             std::int64_t time_us) {
+  // The board's own codec: what it would accept or reject, and why.
+  const Result<can::InputEvent> r = inputs_[node].add(f);
+  const can::MessageDef* m = can::find_message(f.id, nullptr);
+  if (!r.is_ok()) {
+    issue(IssueKind::kInputRejected, line,
+          std::string(m->name) + ": " + can::to_string(inputs_[node].last_reject()) + " (" +
+              r.status().message() + ")");
+    return;
+  }
+  if (r->kind != can::InputEventKind::kGnssFix && r->kind != can::InputEventKind::kHeadingFix) {
+    return;
+  }
+  ++summary_.fixes;
+  if (on_input_) on_input_(DecodedInput{node, line, time_us, *r});
 }
 
 void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_t line,
@@ -536,8 +562,16 @@ void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::Can
   const std::uint64_t p = can::payload_of(f);
   const auto& cols = columns();
   const ColumnRange r = column_ranges()[mi];
+  // A multiplexed message carries only the signals of the selector value it was sent with.
+  std::int64_t selector = -1;
+  for (const can::SignalDef& s : m.signals) {
+    if (s.mux == can::kMultiplexor) {
+      selector = static_cast<std::int64_t>(can::extract_bits(p, s));
+    }
+  }
   for (std::size_t i = r.first; i < r.end; ++i) {
     const can::SignalDef& s = *cols[i].signal;
+    if (s.mux >= 0 && s.mux != selector) continue;
     n.epoch.values[i] = can::decode_signal(s, can::extract_bits(p, s));
     n.epoch.present[i] = true;
   }

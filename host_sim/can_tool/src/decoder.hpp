@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "gfins/can/aiding_input.hpp"
 #include "gfins/can/message_table.hpp"
 #include "gfins/hal/can_bus.hpp"
 
@@ -46,13 +47,15 @@ enum class IssueKind : std::uint8_t {
   kWrongLength,
   kBadCrc,
   kRemoteOrError,
-  kEpochDrop,  // whole epochs missing (sample count and counter agree on how many)
-  kFrameDrop,  // frames of a message missing where its observed spacing says they were due
-  kDuplicate,  // the same message twice in one epoch, or the same Epoch frame twice
-  kReordered,  // a frame after the next epoch opened or before its own Epoch frame, or a
-               // stale Epoch frame
-  kOrphan,     // data frames whose Epoch frame was lost (one per lost Epoch frame), or a
-               // frame whose counter matches no epoch near the open one
+  kEpochDrop,      // whole epochs missing (sample count and counter agree on how many)
+  kFrameDrop,      // frames of a message missing where its observed spacing says they were due
+  kDuplicate,      // the same message twice in one epoch, or the same Epoch frame twice
+  kReordered,      // a frame after the next epoch opened or before its own Epoch frame, or a
+                   // stale Epoch frame
+  kOrphan,         // data frames whose Epoch frame was lost (one per lost Epoch frame), or a
+                   // frame whose counter matches no epoch near the open one
+  kInputRejected,  // an aiding input frame the board would reject (stale or mixed fix id,
+                   // value out of range, reserved bits, incomplete fix)
   kCount_,
 };
 const char* to_string(IssueKind k);
@@ -70,6 +73,14 @@ struct Notice {
   std::string text;
 };
 
+/// A GNSS fix or heading decoded from the aiding input frames (as the board would accept it).
+struct DecodedInput {
+  std::uint8_t node_id = 0;
+  std::uint64_t line = 0;        // line of the frame that completed it (FixInfo, HeadingInput)
+  std::int64_t log_time_us = 0;  // its log timestamp
+  can::InputEvent event;         // kind kGnssFix or kHeadingFix
+};
+
 struct Summary {
   std::uint64_t lines = 0;
   std::uint64_t comment_lines = 0;   // blank lines and comments (not starting with '('), skipped
@@ -81,6 +92,8 @@ struct Summary {
   std::uint64_t epochs = 0;
   std::uint64_t responses = 0;  // GfinsResponse frames seen
   std::uint64_t commands = 0;   // GfinsCommand frames seen
+  std::uint64_t inputs = 0;     // aiding input frames seen (GNSS, heading)
+  std::uint64_t fixes = 0;      // complete GNSS fixes and headings decoded from them
   std::array<std::uint64_t, static_cast<std::size_t>(IssueKind::kCount_)> issues{};
   std::array<std::uint64_t, can::kMessageCount> per_message{};
   std::uint64_t total_issues() const;
@@ -91,9 +104,11 @@ class StreamDecoder {
   using EpochSink = std::function<void(const DecodedEpoch&)>;
   using IssueSink = std::function<void(const Issue&)>;
   using NoticeSink = std::function<void(const Notice&)>;
+  using InputSink = std::function<void(const DecodedInput&)>;
 
   StreamDecoder(EpochSink on_epoch, IssueSink on_issue);
   void set_notice_sink(NoticeSink on_notice) { on_notice_ = std::move(on_notice); }
+  void set_input_sink(InputSink on_input) { on_input_ = std::move(on_input); }
 
   /// One candump line (parse errors become kMalformedLine issues).
   void feed_line(std::uint64_t line_no, std::string_view line);
@@ -144,6 +159,8 @@ class StreamDecoder {
   void on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
                      std::uint64_t line, const hal::CanFrame& f);
   void on_command(const hal::CanFrame& f, std::uint8_t node, bool response);
+  void on_input(const hal::CanFrame& f, std::uint8_t node, std::uint64_t line,
+                std::int64_t time_us);
   void open_epoch(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us);
   void close_epoch(NodeState& n);
   void store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f);
@@ -157,7 +174,9 @@ class StreamDecoder {
   EpochSink on_epoch_;
   IssueSink on_issue_;
   NoticeSink on_notice_;
+  InputSink on_input_;
   Summary summary_;
+  std::vector<can::InputDecoder> inputs_;  // one per node id
   std::array<NodeState, can::kMaxNodeId + 1> nodes_{};
 };
 

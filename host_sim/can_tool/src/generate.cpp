@@ -12,6 +12,8 @@ namespace {
 using can::MessageDef;
 using can::SignalDef;
 
+constexpr const char* kNotAvailableName = "NotAvailable";
+
 /// Shortest decimal text that reads back to the same double (DBC tools parse it exactly).
 std::string num(double v) {
   char buf[400];
@@ -27,7 +29,8 @@ std::string mux_tag(const SignalDef& s) {
 }
 
 std::string receiver(const MessageDef& m) {
-  return m.kind == can::MessageKind::kCommand ? "GFINS" : "HOST";
+  return m.kind == can::MessageKind::kCommand || m.kind == can::MessageKind::kInput ? "GFINS"
+                                                                                    : "HOST";
 }
 
 std::string signal_comment(const SignalDef& s) {
@@ -62,7 +65,7 @@ std::string generate_dbc(std::uint8_t node_id) {
     << int{node_id} << "\"\n\n\n";
   o << "NS_ :\n\tNS_DESC_\n\tCM_\n\tBA_DEF_\n\tBA_\n\tVAL_\n\tBA_DEF_DEF_\n\tSIG_VALTYPE_\n\n";
   o << "BS_:\n\n";
-  o << "BU_: GFINS HOST\n\n\n";
+  o << "BU_: GFINS HOST GNSS\n\n\n";
   for (const MessageDef& m : can::kMessages) {
     const std::uint32_t id = m.base_id + node_id;
     o << "BO_ " << id << " " << m.name << ": " << int{can::kFrameLength} << " " << m.sender << "\n";
@@ -77,6 +80,7 @@ std::string generate_dbc(std::uint8_t node_id) {
   o << "\n";
   o << "CM_ BU_ GFINS \"Gyro-free INS board (six accelerometers)\";\n";
   o << "CM_ BU_ HOST \"Receiver of navigation frames, sender of commands\";\n";
+  o << "CM_ BU_ GNSS \"GNSS receiver or aiding gateway: sender of the aiding input frames\";\n";
   for (const MessageDef& m : can::kMessages) {
     const std::uint32_t id = m.base_id + node_id;
     o << "CM_ BO_ " << id << " \"" << m.comment << ". Identifier 0x" << std::hex << m.base_id
@@ -92,11 +96,14 @@ std::string generate_dbc(std::uint8_t node_id) {
     const double ms = 1000.0 * m.default_divider / can::kDefaultSampleRateHz;
     o << "BA_ \"GenMsgCycleTime\" BO_ " << m.base_id + node_id << " " << std::lround(ms) << ";\n";
   }
+  // Value descriptions: the enumerations, and the not-available raw code of every signal that has
+  // one, so a DBC tool shows "NotAvailable" instead of a reading (Qw -1.00024).
   for (const MessageDef& m : can::kMessages) {
     for (const SignalDef& s : m.signals) {
-      if (s.values.empty()) continue;
+      if (s.values.empty() && !s.has_na) continue;
       o << "VAL_ " << m.base_id + node_id << " " << s.name;
       for (const can::ValueName& v : s.values) o << " " << v.raw << " \"" << v.name << "\"";
+      if (s.has_na) o << " " << s.na_raw << " \"" << kNotAvailableName << "\"";
       o << " ;\n";
     }
   }
@@ -109,7 +116,9 @@ std::string generate_signal_tables() {
     o << "#### " << m.name << " — 0x" << std::hex << std::uppercase << m.base_id << std::dec
       << " + node\n\n";
     o << m.comment << ". Default divider: ";
-    if (m.kind != can::MessageKind::kData) {
+    if (m.kind == can::MessageKind::kInput) {
+      o << "sent by the GNSS receiver or gateway, one fix at a time (not a board output)";
+    } else if (m.kind != can::MessageKind::kData) {
       o << "on demand";
     } else if (m.default_divider == 0) {
       o << "off";
@@ -251,6 +260,25 @@ bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,
       e.accel_mps2[k] = static_cast<float>(9.81 * std::sin(0.1 * t + static_cast<double>(k)));
     }
     e.health.adc_crc_errors = static_cast<std::uint32_t>(i / 100000);
+    // A filter with GNSS and standstill aiding: σ that grow and shrink, counts that grow; no ZARU
+    // update yet (its time since is not available), and a heading σ beyond its range at times
+    // (sent as the maximum).
+    can::Accuracy& a = e.accuracy;
+    a.sigma_roll_rad = static_cast<float>(0.002 + 0.001 * std::sin(0.2 * t));
+    a.sigma_pitch_rad = static_cast<float>(0.0025 + 0.001 * std::cos(0.2 * t));
+    a.sigma_heading_rad = static_cast<float>(1.2 + 1.0 * std::sin(0.1 * t));
+    a.sigma_vel_h_mps = static_cast<float>(0.05 + 0.02 * std::sin(0.3 * t));
+    a.sigma_vel_v_mps = static_cast<float>(0.08 + 0.02 * std::cos(0.3 * t));
+    a.sigma_pos_h_m = static_cast<float>(1.5 + 0.5 * std::sin(0.05 * t));
+    a.sigma_pos_v_m = static_cast<float>(2.5 + 0.5 * std::cos(0.05 * t));
+    a.filter_mode =
+        std::fmod(t, 20.0) < 5.0 ? can::filter_mode::kStandstill : can::filter_mode::kGnss;
+    for (std::size_t k = 0; k < can::kAidKindCount; ++k) {
+      a.aiding[k].accepted = static_cast<std::uint32_t>(i / (100 * (k + 1)));
+      a.aiding[k].rejected = static_cast<std::uint32_t>(i / (10000 * (k + 1)));
+      a.aiding[k].since_accepted_s = static_cast<float>(std::fmod(t, 1.0 + static_cast<double>(k)));
+    }
+    a.aiding[1].since_accepted_s = can::kNoValue;
     bus.t_us = kLogStartUs + static_cast<std::int64_t>(std::llround(t * 1e6));
     pub.publish(e);
     if (!bus.ok) return false;

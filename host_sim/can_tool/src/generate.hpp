@@ -36,7 +36,8 @@ inline constexpr const char* kBudgetEnd = "<!-- end of generated bus budget -->"
 namespace gfins::can_tool {
 
 /// Writes a candump log of `seconds` of a synthetic, smoothly moving board (closed-form attitude,
-/// velocity and position) published by the real Publisher at the default dividers, sample rate
+/// velocity and position; filter σ, mode and aiding counters, one σ beyond its range at times, one
+/// aiding kind never accepted) published by the real Publisher at the default dividers, sample rate
 /// `sample_rate_hz`, node `node_id`, on interface "can0", log time starting at 1700000000 s.
 /// Returns false when writing failed.
 bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,

@@ -26,7 +26,9 @@
 #include "decoder.hpp"
 #include "generate.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
+#include "gfins/host_sim/scenario.hpp"
 #include "gfins/version/version.hpp"
+#include "gnss_log.hpp"
 #include "host_io.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL
@@ -101,6 +103,9 @@ int decode(const DecodeOptions& o, View& view) {
         }
         ++n;
       });
+  dec.set_input_sink([&](const DecodedInput& in) {
+    if (o.node < 0 || in.node_id == o.node) view.input(in);
+  });
   dec.set_notice_sink([&](const Notice& nt) {
     if (!o.quiet) {
       std::fprintf(stderr, "%s:%llu: note: %s\n", current.c_str(),
@@ -178,6 +183,58 @@ bool close_output(std::FILE* f, const std::string& path) {
     return false;
   }
   return true;
+}
+
+struct GnssOptions {
+  std::string scenario;
+  std::string scenario_dir;
+  std::string output;
+  std::string iface;
+  int node = 0;
+  double duration_s = 0.0;
+  double log_start_s = 0.0;
+};
+
+/// gfins-can gnss: the scenario's [gnss] receiver as input frames.
+int run_gnss(const GnssOptions& o) {
+  const auto sc = o.scenario_dir.empty() ? sim::load_scenario(o.scenario)
+                                         : sim::load_scenario(o.scenario, o.scenario_dir);
+  if (!sc.is_ok()) {
+    std::fprintf(stderr, "gfins-can: %s\n", sc.error().message.c_str());
+    return kExitInput;
+  }
+  if (!sc->gnss) {
+    std::fprintf(stderr, "gfins-can: scenario '%s' has no [gnss] table\n", sc->name.c_str());
+    return kExitInput;
+  }
+  const auto traj = sim::make_trajectory(sc->trajectory);
+  if (!traj.is_ok()) {
+    std::fprintf(stderr, "gfins-can: %s\n", traj.error().message.c_str());
+    return kExitInput;
+  }
+  const sim::GnssModel model(*sc->gnss, *traj.value());
+  const auto fixes = model.fixes(o.duration_s > 0.0 ? o.duration_s : sc->duration_s);
+  const auto node = static_cast<std::uint8_t>(o.node);
+  if (!o.iface.empty()) {
+    auto bus = open_live_bus(o.iface);
+    if (!bus.is_ok()) {
+      std::fprintf(stderr, "gfins-can: cannot open CAN interface '%s': %s\n", o.iface.c_str(),
+                   bus.status().message());
+      return kExitInput;
+    }
+    const std::uint64_t refused = send_gnss_live(**bus, fixes, *sc->gnss, node);
+    std::fprintf(stderr, "gfins-can: %zu fixes sent, %llu frames refused by the bus\n",
+                 fixes.size(), static_cast<unsigned long long>(refused));
+    return refused == 0 ? kExitOk : kExitInput;
+  }
+  std::FILE* out = open_output(o.output);
+  if (out == nullptr) {
+    std::fprintf(stderr, "gfins-can: cannot create '%s': %s\n", o.output.c_str(),
+                 std::strerror(errno));
+    return kExitInput;
+  }
+  const bool written = write_gnss_log(out, fixes, *sc->gnss, node, o.log_start_s);
+  return close_output(out, o.output) && written ? kExitOk : kExitInput;
 }
 
 int run_decode(const DecodeOptions& o) {
@@ -591,7 +648,13 @@ int main_impl(int argc, char** argv) {
   realign->add_option("--heading-deg", heading_deg, "heading, degrees in [-360, 360]")
       ->required()
       ->check(heading_deg_check());
+  bool realign_force = false;
+  realign->add_flag("--force", realign_force,
+                    "carry it out even while the board moves (refused while moving otherwise)");
   auto* reset = cmd->add_subcommand("reset", "reset navigation");
+  bool reset_force = false;
+  reset->add_flag("--force", reset_force,
+                  "carry it out even while the board moves (refused while moving otherwise)");
   std::string comp;
   auto* compensator = cmd->add_subcommand("compensator", "switch compensator");
   compensator->add_option("kind", comp, "none | paper | exact")
@@ -713,6 +776,23 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
 #endif
 
+  GnssOptions go;
+  auto* gnss = app.add_subcommand(
+      "gnss",
+      "play a scenario's simulated GNSS receiver ([gnss] table) as GNSS input frames: a candump "
+      "log, or onto a live bus at the fixes' times");
+  gnss->add_option("scenario", go.scenario, "a scenario name or .toml with a [gnss] table")
+      ->required();
+  gnss->add_option("--scenario-dir", go.scenario_dir, "folder of the named scenarios");
+  gnss->add_option("-o,--output", go.output, "candump log to write (default stdout)");
+  gnss->add_option("--iface", go.iface, "send on this SocketCAN interface instead, in real time");
+  gnss->add_option("--node", go.node, "node id of the board to aid")->check(CLI::Range(0, 15));
+  gnss->add_option("--duration", go.duration_s, "seconds of fixes (0 = the scenario's duration)")
+      ->check(CLI::Range(0.0, 86400.0));
+  gnss->add_option("--log-start", go.log_start_s,
+                   "log time of scenario time 0, s (default 0: log time = scenario time)")
+      ->check(CLI::Range(0.0, 4.0e9));
+
   std::uint8_t dbc_node = 0;
   std::string dbc_out;
   auto* dbc = app.add_subcommand("dbc", "print the DBC generated from the message table");
@@ -732,6 +812,7 @@ int main_impl(int argc, char** argv) {
   if (hil->parsed()) return run_hil(ho, std::cout, std::cerr);
 #endif
   if (plot->parsed()) return run_plot(plot_log, plot_png, plot_node, plot_script);
+  if (gnss->parsed()) return run_gnss(go);
   if (dbc->parsed()) {
     std::FILE* out = open_output(dbc_out);
     if (out == nullptr) {
@@ -747,8 +828,10 @@ int main_impl(int argc, char** argv) {
     c.opcode = can::Opcode::kRealign;
     c.heading_rad =
         static_cast<float>(std::remainder(heading_deg, 360.0) * std::numbers::pi / 180.0);
+    c.forced = realign_force;
   } else if (reset->parsed()) {
     c.opcode = can::Opcode::kResetNavigation;
+    c.forced = reset_force;
   } else if (compensator->parsed()) {
     c.opcode = can::Opcode::kSetCompensator;
     c.compensator = comp == "none"    ? nav::CompensatorKind::kNone

@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "gfins/can/message_table.hpp"
 
@@ -53,10 +54,50 @@ std::string group(const DecodedEpoch& e, std::initializer_list<const char*> name
   return names.size() == 1 ? out : out + ")";
 }
 
+/// The values of a decoded input by the names of its signals (message_table.hpp), in table
+/// order: what the line and json views print.
+std::vector<std::pair<const char*, double>> input_values(const DecodedInput& in) {
+  std::vector<std::pair<const char*, double>> v;
+  if (in.event.kind == can::InputEventKind::kGnssFix) {
+    const can::GnssFix& g = in.event.gnss;
+    const double na = std::nan("");
+    v.emplace_back("FixId", g.fix_id);
+    v.emplace_back("GnssPosN", g.has_position ? g.r_n_m[0] : na);
+    v.emplace_back("GnssPosE", g.has_position ? g.r_n_m[1] : na);
+    v.emplace_back("GnssPosD", g.has_position ? g.r_n_m[2] : na);
+    v.emplace_back("GnssSigmaPosH", g.has_position ? g.sigma_pos_h_m : na);
+    v.emplace_back("GnssSigmaPosV", g.has_position ? g.sigma_pos_v_m : na);
+    v.emplace_back("GnssVelN", g.has_velocity ? g.v_n_mps[0] : na);
+    v.emplace_back("GnssVelE", g.has_velocity ? g.v_n_mps[1] : na);
+    v.emplace_back("GnssVelD", g.has_velocity ? g.v_n_mps[2] : na);
+    v.emplace_back("GnssSigmaVel", g.has_velocity ? g.sigma_vel_mps : na);
+    v.emplace_back("GnssFixAge", g.age_s);
+    v.emplace_back("GnssContent", (g.has_position ? 1 : 0) + (g.has_velocity ? 2 : 0));
+  } else {
+    const can::HeadingFix& h = in.event.heading;
+    v.emplace_back("Sequence", h.sequence);
+    v.emplace_back("ExtHeading", h.heading_rad);
+    v.emplace_back("ExtHeadingSigma", h.sigma_rad);
+    v.emplace_back("ExtHeadingAge", h.age_s);
+  }
+  return v;
+}
+
+const char* input_name(const DecodedInput& in) {
+  return in.event.kind == can::InputEventKind::kGnssFix ? "GnssFix" : "Heading";
+}
+
 /// One line per epoch; a message not sent in the epoch (its divider skipped it) shows as "-".
 class LineView final : public View {
  public:
   explicit LineView(std::FILE* out) : out_(out) {}
+  void input(const DecodedInput& in) override {
+    std::fprintf(out_, "node %u input %s", in.node_id, input_name(in));
+    for (const auto& [name, v] : input_values(in)) {
+      std::fprintf(out_, " %s=%s", name, std::isnan(v) ? "n/a" : format_value(v).c_str());
+    }
+    std::putc('\n', out_);
+  }
   void epoch(const DecodedEpoch& e) override {
     const double flags = col(e, "StatusFlags");
     std::fprintf(out_, "node %u t=%s s seq=%s %s rpy=%s deg w=%s rad/s v=%s m/s r=%s m flags=%s\n",
@@ -102,6 +143,19 @@ class CsvView final : public View {
 class JsonView final : public View {
  public:
   explicit JsonView(std::FILE* out) : out_(out) {}
+  void input(const DecodedInput& in) override {
+    std::fprintf(out_, "{\"node\":%u,\"line\":%llu,\"log_time_s\":%.6f,\"input\":\"%s\"",
+                 in.node_id, static_cast<unsigned long long>(in.line),
+                 static_cast<double>(in.log_time_us) * 1e-6, input_name(in));
+    for (const auto& [name, v] : input_values(in)) {
+      if (std::isnan(v)) {
+        std::fprintf(out_, ",\"%s\":null", name);
+      } else {
+        std::fprintf(out_, ",\"%s\":%.10g", name, v);
+      }
+    }
+    std::fprintf(out_, "}\n");
+  }
   void epoch(const DecodedEpoch& e) override {
     std::fprintf(out_, "{\"node\":%u,\"line\":%llu,\"log_time_s\":%.6f", e.node_id,
                  static_cast<unsigned long long>(e.line),

@@ -15,6 +15,9 @@ class View {
  public:
   virtual ~View() = default;
   virtual void epoch(const DecodedEpoch& e) = 0;
+  /// A GNSS fix or heading from the aiding input frames (line and json views print them; csv
+  /// and table keep to the epochs' columns).
+  virtual void input(const DecodedInput&) {}
   virtual void finish() {}
 };
 

@@ -233,11 +233,53 @@ void check_name(const toml::table& sc, const Reader& rd, const std::string& name
           problem + " (the name is the file's stem when [scenario] has no name key: set one)");
 }
 
+/// [gnss]: the simulated receiver (GnssSpec). Outages are [[start_s, end_s], ...].
+GnssSpec parse_gnss(const toml::table& g, const Reader& rd) {
+  const std::string p = "gnss.";
+  rd.only(
+      g, p,
+      {"rate_hz", "sigma_pos_m", "sigma_vel_mps", "latency_s", "lever_arm_m", "outages", "seed"});
+  GnssSpec spec;
+  spec.rate_hz = rd.number(g, p, "rate_hz", spec.rate_hz, 0.01, 100.0);
+  if (const auto sp = rd.numbers(g, p, "sigma_pos_m", 2, 0.0, 1e4, false); !sp.empty()) {
+    spec.sigma_pos_h_m = sp[0];
+    spec.sigma_pos_v_m = sp[1];
+  }
+  spec.sigma_vel_mps = rd.number(g, p, "sigma_vel_mps", spec.sigma_vel_mps, 0.0, 100.0);
+  spec.latency_s = rd.number(g, p, "latency_s", spec.latency_s, 0.0, 8.0);
+  if (const auto l = rd.numbers(g, p, "lever_arm_m", 3, -100.0, 100.0, false); !l.empty()) {
+    spec.lever_arm_b_m = Vec3d(l[0], l[1], l[2]);
+  }
+  if (const toml::node* n = g.get("outages"); n != nullptr) {
+    const auto* a = n->as_array();
+    if (a == nullptr) rd.fail(n, p + "outages", "expected [[start_s, end_s], ...]");
+    for (const toml::node& e : *a) {
+      const auto* pair = e.as_array();
+      const auto num = [&](std::size_t i) -> std::optional<double> {
+        if (pair == nullptr || pair->size() != 2) return std::nullopt;
+        if (const auto* f = (*pair)[i].as_floating_point()) return f->get();
+        if (const auto* k = (*pair)[i].as_integer()) return static_cast<double>(k->get());
+        return std::nullopt;
+      };
+      const auto start = num(0);
+      const auto end = num(1);
+      if (!start || !end || !std::isfinite(*start) || !std::isfinite(*end) || *start < 0.0 ||
+          *end <= *start) {
+        rd.fail(&e, p + "outages", "each outage is [start_s, end_s] with 0 <= start_s < end_s");
+      }
+      spec.outages.emplace_back(*start, *end);
+    }
+  }
+  spec.seed = rd.integer(g, p, "seed", spec.seed);
+  return spec;
+}
+
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
   Scenario s;
   s.source = source;
   s.name = std::filesystem::path(source).stem().string();
-  rd.only(root, "", {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration"});
+  rd.only(root, "",
+          {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration", "gnss"});
 
   // [scenario]
   const toml::table& sc = *rd.table(root, "scenario", true);
@@ -412,6 +454,8 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     s.calibration.scale_v_per_g = rd.number(*c, "calibration.", "scale_v_per_g", 1.0, 1e-3, 1e3);
     s.calibration.seed = rd.integer(*c, "calibration.", "seed", 7);
   }
+
+  if (const toml::table* g = rd.table(root, "gnss", false)) s.gnss = parse_gnss(*g, rd);
   return s;
 }
 

@@ -10,14 +10,25 @@ value is compared with what `gfins-can decode --view json` printed for the same 
 Two logs: the synthetic one of `gfins-can-gen log`, and an extended one this script builds from
 it with frames encoded here from the ICD's byte layout: the optional compensated-accelerometer
 frames (GfinsSensorsA/B) in every epoch, values at the documented saturation limits and at the
-not-available raw value, and every frame copied to node 3 (identifier + 3, CRC recomputed).
+not-available raw value, GNSS fixes and external headings (the aiding input frames, packed by a
+generic encoder written from the ICD's signal tables), and every frame copied to node 3
+(identifier + 3, CRC recomputed).
+
+The signal tables of docs/can-interface.md (the ICD) give this script each signal's bits, type,
+factor, multiplexor value and not-available code. A value gfins-can shows as not available must
+be that code, and the DBC must name it "NotAvailable" (its VAL_, as candied reads it); a
+multiplexed message's signals are compared only for the selector value its frame carries; an
+input fix is compared with the record gfins-can prints for it.
 
 Usage: independent_decode_test.py --gfins-can EXE --gen EXE --dbc FILE --workdir DIR [--log LOG]
+                                  [--icd docs/can-interface.md]
 Exit 0 when every value agrees; 1 with a list of disagreements otherwise.
 """
 import argparse
 import json
+import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -42,6 +53,51 @@ def crc8_sae_j1850(data):
             if bit_in != top:
                 reg ^= 0x1D
     return reg ^ 0xFF
+
+
+def read_icd(path):
+    """{message: {'id': base id, 'signals': {name: {start, length, signed, factor, na, mux}}}}
+    from the generated signal tables of the ICD (one '#### Name — 0xID + node' per message)."""
+    icd = {}
+    cur = None
+    text = open(path, encoding='utf-8').read()
+    begin = text.index('<!-- generated: signal tables')
+    end = text.index('<!-- end of generated signal tables -->')
+    for line in text[begin:end].splitlines():
+        m = re.match(r'#### (\w+) — 0x([0-9A-F]+) \+ node', line)
+        if m:
+            cur = {'id': int(m.group(2), 16), 'signals': {}}
+            icd[m.group(1)] = cur
+            continue
+        if cur is None or not line.startswith('| ') or line.startswith('| signal') or \
+                line.startswith('|---'):
+            continue
+        cells = [c.strip() for c in line.strip().strip('|').split('|')]
+        name, mux, bits, typ, factor, _offset, _unit, _rng, na = cells[:9]
+        lo, hi = (int(x) for x in bits.split('–'))
+        cur['signals'][name] = {
+            'start': lo, 'length': hi - lo + 1, 'signed': typ.startswith('int'),
+            'factor': float(factor), 'na': None if na == '—' else int(na),
+            'mux': 'selector' if mux == 'selector' else (int(mux[2:]) if mux.startswith('=')
+                                                         else None)}
+    return icd
+
+
+def pack(icd_msg, raws, counter):
+    """Bytes 0..6 of a frame from raw signal values (name -> int), the counter in bits 52..55:
+    little-endian bit numbering as the ICD states (bit k = bit k%8 of byte k//8)."""
+    p = 0
+    for name, raw in raws.items():
+        s = icd_msg['signals'][name]
+        p |= (raw & ((1 << s['length']) - 1)) << s['start']
+    p |= (counter & 0xF) << 52
+    return [(p >> (8 * i)) & 0xFF for i in range(7)]
+
+
+def raw_of(icd_msg, name, x):
+    """Raw value of a physical value (None = the signal's not-available code)."""
+    s = icd_msg['signals'][name]
+    return s['na'] if x is None else int(round(x / s['factor']))
 
 
 def ensure_candied():
@@ -75,7 +131,40 @@ def three_signals(a, b, c, counter):
     return le16(a) + le16(b) + le16(c) + [counter << 4]
 
 
-def build_extended(src, dst):
+def gnss_frames(icd, k, node):
+    """The four frames of GNSS fix k (fix id k mod 16) and a heading for node `node`, from the
+    ICD; every 4th fix is velocity-only (its position signals not available)."""
+    pos = None if k % 4 == 3 else (12.34 * k - 500, -0.07 * k * k, -1.5 + 0.01 * k)
+    vel = (1.25 + 0.01 * k, -3.5, 0.02 * (k % 7))
+    out = []
+
+    def frame(name, values):
+        m = icd[name]
+        raws = {n: raw_of(m, n, v) for n, v in values.items()}
+        return (name, m['id'] + node, pack(m, raws, k))
+
+    out.append(frame('GfinsGnssPositionNE', {'GnssPosN': pos and pos[0],
+                                             'GnssPosE': pos and pos[1]}))
+    out.append(frame('GfinsGnssPositionD', {'GnssPosD': pos and pos[2],
+                                            'GnssSigmaPosH': pos and 1.25,
+                                            'GnssSigmaPosV': pos and 2.5}))
+    out.append(frame('GfinsGnssVelocity', {'GnssVelN': vel[0], 'GnssVelE': vel[1],
+                                           'GnssVelD': vel[2]}))
+    content = 2 if pos is None else 3
+    m = icd['GfinsGnssFixInfo']
+    out.append(('GfinsGnssFixInfo', m['id'] + node,
+                pack(m, {'GnssSigmaVel': raw_of(m, 'GnssSigmaVel', 0.05),
+                         'GnssFixAge': raw_of(m, 'GnssFixAge', 0.065),
+                         'GnssContent': content}, k)))
+    h = icd['GfinsHeadingInput']
+    out.append(('GfinsHeadingInput', h['id'] + node,
+                pack(h, {'ExtHeading': raw_of(h, 'ExtHeading', -3.0 + 0.25 * (k % 24)),
+                         'ExtHeadingSigma': raw_of(h, 'ExtHeadingSigma', 0.0123),
+                         'ExtHeadingAge': raw_of(h, 'ExtHeadingAge', 0.02)}, k)))
+    return out
+
+
+def build_extended(src, dst, icd):
     """Writes the extended log; returns {(line, signal)} of the values written as not available."""
     lines = [l.rstrip('\n') for l in open(src) if l.strip()]
     out = []
@@ -105,6 +194,15 @@ def build_extended(src, dst):
         line = emit(ts, copy, sealed(copy, data[:7]))
         if cid == 0x140 and k % 7 == 3:
             na.add((line, 'RateX'))
+        if cid == 0x100 and k % 10 == 5:  # a GNSS fix and a heading before this epoch's frames
+            for node in (0, NODE_COPY):
+                for name, fid, data7 in gnss_frames(icd, k // 10, node):
+                    line = emit(ts, fid, sealed(fid, data7))
+                    if name in ('GfinsGnssPositionNE', 'GfinsGnssPositionD') and \
+                            (k // 10) % 4 == 3:
+                        for sig in icd[name]['signals']:
+                            if sig.startswith('Gnss'):
+                                na.add((line, sig))
         if cid == 0x190:  # after the last default frame of the epoch: the optional sensors
             for base, names in ((0x1C0, ('Sensor1', 'Sensor2', 'Sensor3')),
                                 (0x1D0, ('Sensor4', 'Sensor5', 'Sensor6'))):
@@ -122,7 +220,7 @@ def build_extended(src, dst):
     return na
 
 
-def check_log(a, log, na_expected, dbc_for_node):
+def check_log(a, log, na_expected, dbc_for_node, icd):
     """Returns (frames, epochs, values compared, failures) for one log."""
     import can  # python3-can
 
@@ -143,8 +241,8 @@ def check_log(a, log, na_expected, dbc_for_node):
         cid = m.arbitration_id
         if crc8_sae_j1850([cid & 0xFF, cid >> 8] + list(d[:7])) != d[7]:
             failures.append(f'frame {i + 1}: CRC mismatch')
-        if 0x600 <= cid < 0x700:
-            continue  # commands/responses carry no epoch counter
+        if 0x600 <= cid < 0x700 or 0x0B0 <= cid < 0x100:
+            continue  # commands/responses carry no epoch counter; input frames their fix id
         node = cid & 0xF
         counter = d[6] >> 4
         if 0x100 <= cid < 0x110:
@@ -169,53 +267,94 @@ def check_log(a, log, na_expected, dbc_for_node):
         decoded += [json.loads(l) for l in res.stdout.decode().splitlines() if l.strip()]
     decoded.sort(key=lambda d: d['i'])
 
-    # 4. gfins-can's values per epoch (keyed by the line of its GfinsEpoch frame).
+    # 4. gfins-can's values per epoch (keyed by the line of its GfinsEpoch frame) and its input
+    #    records (keyed by the line of the frame that completed the fix or heading).
     res = subprocess.run([a.gfins_can, 'decode', log, '--view', 'json', '--quiet'],
                          stdout=subprocess.PIPE, check=False)
     if res.returncode != 0:
         failures.append(f'gfins-can decode exited {res.returncode} on a clean log')
     epochs = {}
+    inputs = {}
     for l in res.stdout.decode().splitlines():
         e = json.loads(l)
-        epochs[e['line']] = e
+        (inputs if 'input' in e else epochs)[e['line']] = e
 
-    # 5. Compare: every decoded signal (except the end-to-end fields) of every frame. A value
-    #    gfins-can shows as not available (null) must be one this script wrote as such, and
-    #    candied must see the not-available raw value there.
+    def not_available_ok(d, msg, name, v):
+        """gfins-can shows no value: it must be the ICD's N/A code, named so by the DBC."""
+        na_code = icd[msg]['signals'][name]['na']
+        if na_code is not None and v['raw'] == na_code and v.get('desc') == 'NotAvailable':
+            na_seen.add((d['i'], name))
+            return True
+        failures.append(f"frame {d['i']}: {msg}.{name}: gfins-can has no value, candied "
+                        f"{v['value']} (raw {v['raw']}, {v.get('desc')})")
+        return False
+
+    def compare(d, msg, name, mine, v):
+        theirs = v['value']
+        if mine is None:
+            not_available_ok(d, msg, name, v)
+        elif abs(mine - theirs) > ABS_TOL + REL_TOL * max(abs(mine), abs(theirs)):
+            failures.append(f"frame {d['i']}: {msg}.{name}: gfins-can {mine}, candied {theirs}")
+
+    # 5. Compare: every decoded signal (except the end-to-end fields) of every frame; of a
+    #    multiplexed message, the signals of the selector value the frame carries.
     compared = 0
     na_seen = set()
     current = {}
+    pending_fix = {}  # node -> [(decoded frame, message)] of the fix being sent
     for d in decoded:
         if d['msg'] is None:
             failures.append(f"frame {d['i']}: candied does not know the identifier")
             continue
         node = frames[d['i'] - 1].arbitration_id & 0xF
-        if d['msg'] == 'GfinsEpoch':
+        msg = d['msg']
+        if msg.startswith('GfinsGnss') or msg == 'GfinsHeadingInput':
+            if msg == 'GfinsHeadingInput':
+                parts = [d]  # a heading is one frame
+            else:
+                pending_fix.setdefault(node, []).append(d)
+                if msg != 'GfinsGnssFixInfo':
+                    continue  # held until the FixInfo frame completes the fix
+                parts = pending_fix.pop(node)
+            rec = inputs.get(d['i'])
+            if rec is None:
+                failures.append(f"frame {d['i']}: gfins-can printed no input record here")
+                continue
+            if rec['node'] != node:
+                failures.append(f"frame {d['i']}: gfins-can's input is of node {rec['node']}")
+            for part in parts:
+                for name, v in part['values'].items():
+                    if name == 'Crc':
+                        continue
+                    compare(part, part['msg'], name, rec.get(name), v)
+                    compared += 1
+            continue
+        if msg == 'GfinsEpoch':
             current[node] = epochs.get(d['i'])
             if current[node] is None:
                 failures.append(f"frame {d['i']}: gfins-can reported no epoch at this line")
             elif current[node]['node'] != node:
                 failures.append(f"frame {d['i']}: gfins-can says node {current[node]['node']}")
         cur = current.get(node)
-        if cur is None or d['msg'] in ('GfinsCommand', 'GfinsResponse'):
+        if cur is None or msg in ('GfinsCommand', 'GfinsResponse'):
             continue
+        sigs = icd[msg]['signals']
+        selector = None
+        for name, sd in sigs.items():
+            if sd['mux'] == 'selector':
+                selector = d['values'][name]['raw']
         for name, v in d['values'].items():
             if name in ('Counter', 'Crc'):
                 continue
-            mine = cur.get(name)
-            theirs = v['value']
-            if mine is None:
-                if (d['i'], name) in na_expected and v['raw'] == NA_RAW16:
-                    na_seen.add((d['i'], name))
-                else:
-                    failures.append(f"frame {d['i']}: {d['msg']}.{name}: gfins-can has no "
-                                    f"value, candied {theirs} (raw {v['raw']})")
-            elif abs(mine - theirs) > ABS_TOL + REL_TOL * max(abs(mine), abs(theirs)):
-                failures.append(f"frame {d['i']}: {d['msg']}.{name}: gfins-can {mine}, "
-                                f"candied {theirs}")
+            mux = sigs[name]['mux']
+            if isinstance(mux, int) and mux != selector:
+                continue  # another kind's signal: not in this frame
+            compare(d, msg, name, cur.get(name), v)
             compared += 1
     for miss in sorted(na_expected - na_seen):
         failures.append(f'frame {miss[0]}: {miss[1]} written as not available, not shown so')
+    if pending_fix and any(pending_fix.values()):
+        failures.append(f'input frames of an unfinished fix at the end: {pending_fix}')
     return len(frames), len(epochs), compared, failures
 
 
@@ -226,10 +365,17 @@ def main():
     ap.add_argument('--dbc', required=True)
     ap.add_argument('--workdir', required=True)
     ap.add_argument('--log')
+    ap.add_argument('--icd', help='docs/can-interface.md (default: next to the DBC\'s folder)')
     ap.add_argument('--seconds', type=float, default=20.0)
     a = ap.parse_args()
 
     os.makedirs(a.workdir, exist_ok=True)
+    icd = read_icd(a.icd or os.path.join(os.path.dirname(os.path.abspath(a.dbc)), '..',
+                                         'can-interface.md'))
+    for need in ('GfinsEpoch', 'GfinsAccuracy', 'GfinsAidingCounters', 'GfinsGnssFixInfo',
+                 'GfinsHeadingInput'):
+        if need not in icd:
+            sys.exit(f'independent decode: the ICD has no table of {need}')
     log = a.log
     if log is None:
         log = os.path.join(a.workdir, 'independent.log')
@@ -246,10 +392,11 @@ def main():
         return dbcs[node]
 
     extended = os.path.join(a.workdir, 'independent_extended.log')
-    na = build_extended(log, extended)
+    na = build_extended(log, extended, icd)
     status = 0
     for name, path, na_expected in (('synthetic', log, set()), ('extended', extended, na)):
-        n_frames, n_epochs, compared, failures = check_log(a, path, na_expected, dbc_for_node)
+        n_frames, n_epochs, compared, failures = check_log(a, path, na_expected, dbc_for_node,
+                                                          icd)
         print(f'independent decode ({name}): {n_frames} frames, {n_epochs} epochs, '
               f'{compared} values compared, {len(failures)} disagreements')
         for f in failures[:50]:

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "gfins/host_sim/error.hpp"
+#include "gfins/host_sim/gnss_model.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/host_sim/trajectory.hpp"
@@ -117,6 +118,10 @@ struct Scenario {
   // noise stated in m/s² and no converter, enter the pipeline after its front end
   // (nav::NavPipeline::process_specific_force), unit-gain sensors.
   bool adc = true;
+
+  // [gnss] (optional): a simulated GNSS receiver on the board's CAN bus (gnss_model.hpp,
+  // `gfins-can gnss`). Absent: no GNSS.
+  std::optional<GnssSpec> gnss;
 };
 
 /// Parses TOML text; `source` names it in messages. Errors name the file, the key and the line.

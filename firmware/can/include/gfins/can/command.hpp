@@ -50,6 +50,7 @@ struct Command {
   std::uint16_t divider = 0;                                       // kSetDivider, 0 = off
   std::uint8_t pose = 0;                                           // kStartCapture: k
   std::uint16_t samples = 0;                                       // kStartCapture: N >= 1
+  bool forced = false;  // kRealign, kResetNavigation: carry it out even while moving
 };
 
 struct CommandError {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "gfins/nav_core/nav_state.hpp"
 
@@ -69,6 +70,60 @@ struct Health {
   std::uint32_t log_dropped = 0;        // log records lost to a full log queue
 };
 
+/// Which navigation groups of an epoch hold a value the board stands behind. A group that is not
+/// valid goes on the bus as the not-available raw code of each of its signals (never a made-up
+/// zero or identity): while aligning, after a reset, or when the filter's 1σ of the group exceeds
+/// its configured horizon. The app sets these from the filter; every group starts valid so that a
+/// caller that does not know about validity publishes what it always did.
+struct Validity {
+  bool attitude = true;       // GfinsQuaternion, GfinsEuler
+  bool rate = true;           // GfinsAngularRate
+  bool angular_accel = true;  // GfinsAngularAccel
+  bool accel = true;          // GfinsAccel
+  bool velocity = true;       // GfinsVelocity (VelN/E/D)
+  bool position = true;       // GfinsPositionNE, GfinsPositionD (PosN/E/D)
+
+  /// Nothing valid (aligning, no filter yet).
+  static constexpr Validity none() { return {false, false, false, false, false, false}; }
+};
+
+/// Bits of Accuracy::filter_mode (GfinsVelocity.FilterMode): which aiding the filter used within
+/// its aiding window. 0 = no filter running (aligning, stopped).
+namespace filter_mode {
+inline constexpr std::uint8_t kUnaided = 1u << 0;     // propagating on the inertial data only
+inline constexpr std::uint8_t kStandstill = 1u << 1;  // zero-velocity / zero-rate updates
+inline constexpr std::uint8_t kGnss = 1u << 2;        // GNSS position and/or velocity
+inline constexpr std::uint8_t kHeading = 1u << 3;     // external heading
+}  // namespace filter_mode
+
+/// Kinds of aiding update: GfinsAidingCounters.AidKind and the index of Accuracy::aiding.
+enum class AidKind : std::uint8_t { kZupt, kZaru, kGnssPosition, kGnssVelocity, kHeading };
+inline constexpr std::size_t kAidKindCount = 5;
+
+inline constexpr float kNoValue = std::numeric_limits<float>::quiet_NaN();
+
+/// Updates of one kind. The counts only grow (sent modulo 2^16).
+struct AidCounter {
+  std::uint32_t accepted = 0;
+  std::uint32_t rejected = 0;         // by the filter's innovation test or the input checks
+  float since_accepted_s = kNoValue;  // time since the last accepted one; NaN = none yet
+};
+
+/// The filter's 1σ (square roots of its covariance's diagonal, combined as the signals say) and
+/// its aiding. NaN = not available (no filter running): sent as the signal's not-available code.
+/// A σ beyond its signal's range goes out as the range's maximum, flagged as saturated.
+struct Accuracy {
+  float sigma_roll_rad = kNoValue;
+  float sigma_pitch_rad = kNoValue;
+  float sigma_heading_rad = kNoValue;
+  float sigma_vel_h_mps = kNoValue;                // sqrt(σ_vN² + σ_vE²)
+  float sigma_vel_v_mps = kNoValue;                // σ_vD
+  float sigma_pos_h_m = kNoValue;                  // sqrt(σ_N² + σ_E²)
+  float sigma_pos_v_m = kNoValue;                  // σ_D
+  std::uint8_t filter_mode = 0;                    // filter_mode bits
+  std::array<AidCounter, kAidKindCount> aiding{};  // index = AidKind
+};
+
 /// One sample's worth of what may be published. Every value refers to nav.t_ns, the sampling
 /// instant (data-ready edge) of sample nav.seq.
 struct Epoch {
@@ -78,6 +133,8 @@ struct Epoch {
   std::uint32_t status_bits = 0;      // status_bits (nav.status bits 0..3 are ORed in)
   std::uint32_t cal_id = 0;           // identity of the calibration in use (0 = nominal)
   Health health;
+  Validity valid;  // per navigation group; an invalid group is sent as not available
+  Accuracy accuracy;
 };
 
 }  // namespace gfins::can

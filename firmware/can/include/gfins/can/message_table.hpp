@@ -6,7 +6,8 @@
 // Conventions (docs/can-interface.md): classic CAN 2.0, 11-bit identifiers = base + node id
 // (node id 0..15), 8 data bytes, signals little-endian (Intel, DBC "@1"), bit 0 = LSB of byte 0.
 // Data frames: payload bits 0..51, rolling epoch counter bits 52..55, CRC-8/SAE-J1850 bits 56..63
-// over the two identifier bytes (little-endian) and data bytes 0..6.
+// over the two identifier bytes (little-endian) and data bytes 0..6. Aiding input frames (GNSS,
+// heading; aiding_input.hpp) are framed the same way, their counter being the fix sequence id.
 #pragma once
 
 #include <array>
@@ -47,6 +48,15 @@ enum class Field : std::uint8_t {
   kVelocity,
   kPosition,
   kSensorAccel,  // index = sensor 0..5
+  // accuracy (filter covariance, 1σ) and aiding
+  kSigmaAttitude,  // index 0 roll, 1 pitch, 2 heading
+  kSigmaVelocity,  // 0 horizontal, 1 vertical
+  kSigmaPosition,  // 0 horizontal, 1 vertical
+  kFilterMode,
+  kAidKind,      // the multiplexor of GfinsAidingCounters
+  kAidAccepted,  // index = AidKind
+  kAidRejected,
+  kAidSinceAccepted,
   // health
   kMissedEdges,
   kAdcCrcErrors,
@@ -66,6 +76,18 @@ enum class Field : std::uint8_t {
   kCmdDivider,
   kCmdPose,
   kCmdSamples,
+  kCmdForced,
+  // aiding inputs (GNSS receiver / heading source -> board)
+  kInGnssPos,  // index 0 N, 1 E, 2 D
+  kInGnssVel,
+  kInGnssSigmaPosH,
+  kInGnssSigmaPosV,
+  kInGnssSigmaVel,
+  kInGnssAge,
+  kInGnssContent,
+  kInHeading,
+  kInHeadingSigma,
+  kInHeadingAge,
   // response
   kRspOpcode,
   kRspToken,
@@ -113,6 +135,7 @@ struct SignalDef {
   std::span<const ValueName> values{};  // enumeration (DBC VAL_)
   std::string_view instant{};           // which instant the value refers to
   std::string_view comment{};
+  bool round_up = false;  // quantise upwards (σ: never shown smaller than it is)
 };
 
 enum class MessageId : std::uint8_t {
@@ -132,10 +155,21 @@ enum class MessageId : std::uint8_t {
   kSensorsB,
   kCommand,
   kResponse,
+  // Appended after the command/response pair, so the first 14 ids (and every divider index a
+  // configuration names) keep their values.
+  kAccuracy,
+  kAidingCounters,
+  kGnssPositionNE,
+  kGnssPositionD,
+  kGnssVelocity,
+  kGnssFixInfo,
+  kHeadingInput,
 };
-inline constexpr std::size_t kMessageCount = 16;
+inline constexpr std::size_t kMessageCount = 23;
 
-enum class MessageKind : std::uint8_t { kData, kCommand, kResponse };
+/// kInput: aiding measurements sent to the board (GNSS, heading), same framing as data frames
+/// (counter in bits 52..55 = the fix's sequence id, CRC in byte 7), decoded by aiding_input.hpp.
+enum class MessageKind : std::uint8_t { kData, kCommand, kResponse, kInput };
 
 struct MessageDef {
   std::string_view name{};
@@ -178,7 +212,7 @@ inline constexpr std::array<ValueName, 8> kResultValues{{{0, "Ok"},
                                                          {6, "Busy"},
                                                          {7, "Failed"}}};
 
-inline constexpr std::array<ValueName, 16> kMessageIdValues{{{0, "Epoch"},
+inline constexpr std::array<ValueName, 18> kMessageIdValues{{{0, "Epoch"},
                                                              {1, "Status"},
                                                              {2, "Quaternion"},
                                                              {3, "Euler"},
@@ -193,7 +227,13 @@ inline constexpr std::array<ValueName, 16> kMessageIdValues{{{0, "Epoch"},
                                                              {12, "SensorsA"},
                                                              {13, "SensorsB"},
                                                              {14, "Command"},
-                                                             {15, "Response"}}};
+                                                             {15, "Response"},
+                                                             {16, "Accuracy"},
+                                                             {17, "AidingCounters"}}};
+
+/// Kinds of aiding update (GfinsAidingCounters.AidKind and the index of Accuracy::aiding).
+inline constexpr std::array<ValueName, 5> kAidKindValues{
+    {{0, "Zupt"}, {1, "Zaru"}, {2, "GnssPosition"}, {3, "GnssVelocity"}, {4, "Heading"}}};
 
 // ---------------------------------------------------------------------------------------------
 // Signal builders (keep the table one row per signal)
@@ -260,6 +300,30 @@ constexpr SignalDef unsigned_int(std::string_view name, Field field, std::uint8_
                    .values = values,
                    .instant = instant,
                    .comment = comment};
+}
+
+/// A 1σ: unsigned, all ones reserved for "not available", rounded up to the next step and
+/// saturating at max (a σ beyond the range is sent as max, which then reads "at least max").
+constexpr SignalDef sigma(std::string_view name, Field field, std::uint8_t index,
+                          std::uint8_t start, std::uint8_t length, double factor,
+                          std::string_view unit, std::string_view comment) {
+  const std::uint64_t na = (std::uint64_t{1} << length) - 1;
+  return SignalDef{.name = name,
+                   .field = field,
+                   .index = index,
+                   .start_bit = start,
+                   .length = length,
+                   .factor = factor,
+                   .unit = unit,
+                   .min = 0.0,
+                   // (na - 1) / (1 / factor): the decimal the DBC prints (0.4094, not
+                   // the 0.40940000000000004 of 4094 * 1e-4)
+                   .max = static_cast<double>(na - 1) / (1.0 / factor),
+                   .has_na = true,
+                   .na_raw = static_cast<std::int64_t>(na),
+                   .instant = kAtSample,
+                   .comment = comment,
+                   .round_up = true};
 }
 
 constexpr SignalDef counter_signal() {
@@ -370,10 +434,13 @@ inline constexpr std::array<SignalDef, 5> kAccelSignals{{
     crc_signal(),
 }};
 
-inline constexpr std::array<SignalDef, 5> kVelocitySignals{{
+inline constexpr std::array<SignalDef, 6> kVelocitySignals{{
     physical("VelN", Field::kVelocity, 0, 0, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, north"),
     physical("VelE", Field::kVelocity, 1, 16, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, east"),
     physical("VelD", Field::kVelocity, 2, 32, 16, 0.01, "m/s", -320.0, 320.0, "Velocity v_n, down"),
+    unsigned_int("FilterMode", Field::kFilterMode, 0, 48, 4, 15.0, kNotMultiplexed, {}, kAtSample,
+                 "Aiding the filter used within its aiding window, bits: 0 unaided (inertial "
+                 "only), 1 standstill (ZUPT/ZARU), 2 GNSS, 3 heading; 0 = no filter running"),
     counter_signal(),
     crc_signal(),
 }};
@@ -387,9 +454,13 @@ inline constexpr std::array<SignalDef, 4> kPositionNESignals{{
     crc_signal(),
 }};
 
-inline constexpr std::array<SignalDef, 3> kPositionDSignals{{
+inline constexpr std::array<SignalDef, 5> kPositionDSignals{{
     physical("PosD", Field::kPosition, 2, 0, 26, 0.01, "m", -335000.0, 335000.0,
              "Position r_n from the alignment point, down"),
+    sigma("SigmaPosH", Field::kSigmaPosition, 0, 26, 13, 0.02, "m",
+          "1 sigma of the horizontal position, sqrt(sigma_N^2 + sigma_E^2), from the filter"),
+    sigma("SigmaPosV", Field::kSigmaPosition, 1, 39, 13, 0.02, "m",
+          "1 sigma of the vertical position (down), from the filter"),
     counter_signal(),
     crc_signal(),
 }};
@@ -444,6 +515,165 @@ inline constexpr std::array<SignalDef, 5> kSensorsBSignals{{
     crc_signal(),
 }};
 
+inline constexpr std::array<SignalDef, 7> kAccuracySignals{{
+    sigma("SigmaRoll", Field::kSigmaAttitude, 0, 0, 10, 1e-4, "rad", "1 sigma of roll"),
+    sigma("SigmaPitch", Field::kSigmaAttitude, 1, 10, 10, 1e-4, "rad", "1 sigma of pitch"),
+    sigma("SigmaHeading", Field::kSigmaAttitude, 2, 20, 11, 1e-3, "rad",
+          "1 sigma of heading (yaw)"),
+    sigma("SigmaVelH", Field::kSigmaVelocity, 0, 31, 10, 0.01, "m/s",
+          "1 sigma of the horizontal velocity, sqrt(sigma_N^2 + sigma_E^2)"),
+    sigma("SigmaVelV", Field::kSigmaVelocity, 1, 41, 11, 0.01, "m/s",
+          "1 sigma of the vertical velocity (down)"),
+    counter_signal(),
+    crc_signal(),
+}};
+
+// Aiding counters: one kind per frame, the kinds in turn (AidKind = the multiplexor).
+inline constexpr std::uint8_t kAidKinds = 5;
+constexpr SignalDef with_mux(SignalDef s, std::uint8_t index, std::int16_t mux) {
+  s.index = index;
+  s.mux = mux;
+  return s;
+}
+
+inline constexpr std::array<SignalDef, 18> kAidingCountersSignals{{
+    SignalDef{.name = "AidKind",
+              .field = Field::kAidKind,
+              .start_bit = 0,
+              .length = 4,
+              .max = 4.0,
+              .mux = kMultiplexor,
+              .values = kAidKindValues,
+              .instant = kAtSample,
+              .comment = "Which kind of aiding update this frame counts; the kinds take turns"},
+#define GFINS_CAN_AID_ROW(NAME, K)                                                          \
+  with_mux(wrapping(NAME "Accepted", Field::kAidAccepted, 4, 16, "", kCumulative,           \
+                    NAME " updates the filter accepted, mod 2^16"),                         \
+           K, K),                                                                           \
+      with_mux(wrapping(NAME "Rejected", Field::kAidRejected, 20, 16, "", kCumulative,      \
+                        NAME " updates the filter rejected (innovation test), mod 2^16"),   \
+               K, K),                                                                       \
+      with_mux(sigma(NAME "Since", Field::kAidSinceAccepted, K, 36, 16, 0.01, "s",          \
+                     "Time since the last accepted " NAME " update (saturates; N/A = none " \
+                     "yet)"),                                                               \
+               K, K)
+    GFINS_CAN_AID_ROW("Zupt", 0),
+    GFINS_CAN_AID_ROW("Zaru", 1),
+    GFINS_CAN_AID_ROW("GnssPos", 2),
+    GFINS_CAN_AID_ROW("GnssVel", 3),
+    GFINS_CAN_AID_ROW("Heading", 4),
+#undef GFINS_CAN_AID_ROW
+    counter_signal(),
+    crc_signal(),
+}};
+
+// Aiding inputs (GNSS receiver or a gateway -> board). Every frame of one fix carries the fix id
+// in the counter bits; GfinsGnssFixInfo, sent last, completes the fix. Reserved bits are zero.
+inline constexpr std::string_view kAtFix =
+    "the fix's time of validity (reception of FixInfo - FixAge)";
+inline constexpr std::string_view kAtHeading =
+    "the heading's time of validity (reception - HeadingAge)";
+
+constexpr SignalDef fix_id_signal() {
+  return wrapping("FixId", Field::kCounter, kCounterStartBit, kCounterLength, "",
+                  "the fix this frame belongs to",
+                  "Fix sequence id (mod 16): equal in every frame of one fix, advances by one "
+                  "per fix; a fix with the id of the last accepted one is rejected as stale");
+}
+
+/// An input σ: like sigma() but zero is not a σ (min = one step), all ones = not stated.
+constexpr SignalDef input_sigma(std::string_view name, Field field, std::uint8_t start,
+                                std::uint8_t length, double factor, std::string_view unit,
+                                std::string_view instant, std::string_view comment) {
+  SignalDef d = sigma(name, field, 0, start, length, factor, unit, comment);
+  d.min = factor;
+  d.instant = instant;
+  return d;
+}
+
+constexpr SignalDef input_age(std::string_view name, Field field, std::uint8_t start,
+                              std::string_view comment) {
+  SignalDef d = sigma(name, field, 0, start, 13, 1e-3, "s", comment);
+  d.round_up = false;
+  d.instant = "the frame's transmission";
+  return d;
+}
+
+constexpr SignalDef at_fix(SignalDef d) {
+  d.instant = kAtFix;
+  return d;
+}
+
+inline constexpr std::array<SignalDef, 4> kGnssPositionNESignals{{
+    at_fix(physical("GnssPosN", Field::kInGnssPos, 0, 0, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin (alignment point), north")),
+    at_fix(physical("GnssPosE", Field::kInGnssPos, 1, 26, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin, east")),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kGnssPositionDSignals{{
+    at_fix(physical("GnssPosD", Field::kInGnssPos, 2, 0, 26, 0.01, "m", -335000.0, 335000.0,
+                    "GNSS antenna position from the navigation origin, down")),
+    input_sigma("GnssSigmaPosH", Field::kInGnssSigmaPosH, 26, 13, 0.01, "m", kAtFix,
+                "Receiver's 1 sigma of the position, north and east (each)"),
+    input_sigma("GnssSigmaPosV", Field::kInGnssSigmaPosV, 39, 13, 0.01, "m", kAtFix,
+                "Receiver's 1 sigma of the position, down"),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kGnssVelocitySignals{{
+    at_fix(physical("GnssVelN", Field::kInGnssVel, 0, 0, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, north")),
+    at_fix(physical("GnssVelE", Field::kInGnssVel, 1, 16, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, east")),
+    at_fix(physical("GnssVelD", Field::kInGnssVel, 2, 32, 16, 0.01, "m/s", -320.0, 320.0,
+                    "GNSS antenna velocity, down")),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<ValueName, 3> kGnssContentValues{
+    {{1, "Position"}, {2, "Velocity"}, {3, "PositionVelocity"}}};
+
+inline constexpr std::array<SignalDef, 5> kGnssFixInfoSignals{{
+    input_sigma("GnssSigmaVel", Field::kInGnssSigmaVel, 0, 12, 0.001, "m/s", kAtFix,
+                "Receiver's 1 sigma of each velocity axis"),
+    input_age("GnssFixAge", Field::kInGnssAge, 12,
+              "Age of the fix when this frame was sent: transmission - time of validity"),
+    unsigned_int("GnssContent", Field::kInGnssContent, 0, 25, 2, 3.0, kNotMultiplexed,
+                 kGnssContentValues, kAtFix,
+                 "What the fix holds: bit 0 position (PositionNE, PositionD), bit 1 velocity", 1.0),
+    fix_id_signal(),
+    crc_signal(),
+}};
+
+inline constexpr std::array<SignalDef, 5> kHeadingInputSignals{{
+    SignalDef{.name = "ExtHeading",
+              .field = Field::kInHeading,
+              .start_bit = 0,
+              .length = 16,
+              .is_signed = true,
+              .factor = 1e-4,
+              .unit = "rad",
+              .min = -3.1416,
+              .max = 3.1416,
+              .has_na = true,
+              .na_raw = -32768,
+              .instant = kAtHeading,
+              .comment = "External heading (yaw of q_nb), e.g. dual-antenna GNSS"},
+    input_sigma("ExtHeadingSigma", Field::kInHeadingSigma, 16, 12, 1e-4, "rad", kAtHeading,
+                "1 sigma of the external heading"),
+    input_age("ExtHeadingAge", Field::kInHeadingAge, 28,
+              "Age of the heading when sent: transmission - time of validity"),
+    wrapping("Sequence", Field::kCounter, kCounterStartBit, kCounterLength, "",
+             "the heading this frame carries",
+             "Heading sequence (mod 16), advances by one per heading; a repeat is rejected"),
+    crc_signal(),
+}};
+
 // Command (host -> board). Opcode is the multiplexor: each opcode's arguments are the signals
 // with its value in `mux`. Bits not used by the opcode must be zero.
 inline constexpr std::uint8_t kOpRealign = 1;
@@ -455,7 +685,7 @@ inline constexpr std::uint8_t kOpStartCapture = 6;
 inline constexpr std::uint8_t kOpReloadCalibration = 7;
 inline constexpr std::uint8_t kMaxCapturePose = 63;
 
-inline constexpr std::array<SignalDef, 9> kCommandSignals{{
+inline constexpr std::array<SignalDef, 11> kCommandSignals{{
     SignalDef{.name = "Opcode",
               .field = Field::kCmdOpcode,
               .start_bit = 0,
@@ -481,9 +711,16 @@ inline constexpr std::array<SignalDef, 9> kCommandSignals{{
               .instant = kAtCommand,
               .comment = "Realign: heading (yaw of q_nb) to align to; roll and pitch from "
                          "static leveling"},
+    unsigned_int("RealignForced", Field::kCmdForced, 0, 32, 1, 1.0, kOpRealign, {}, kAtCommand,
+                 "Realign: 1 = carry it out even while the board moves (else refused while "
+                 "moving)"),
+    unsigned_int("ResetForced", Field::kCmdForced, 0, 16, 1, 1.0, kOpResetNavigation, {},
+                 kAtCommand,
+                 "ResetNavigation: 1 = carry it out even while the board moves (else refused "
+                 "while moving)"),
     unsigned_int("Compensator", Field::kCmdCompensator, 0, 16, 8, 2.0, kOpSetCompensator,
                  kCompensatorValues, kAtCommand, "SetCompensator: compensator to use"),
-    unsigned_int("DividerMessage", Field::kCmdMessage, 0, 16, 8, 13.0, kOpSetDivider,
+    unsigned_int("DividerMessage", Field::kCmdMessage, 0, 16, 8, 17.0, kOpSetDivider,
                  kMessageIdValues, kAtCommand, "SetDivider: the data message"),
     unsigned_int("Divider", Field::kCmdDivider, 0, 24, 16, 65535.0, kOpSetDivider, {}, kAtCommand,
                  "SetDivider: new divider of the sample rate (0 = off); a multiple of the "
@@ -608,6 +845,23 @@ inline constexpr std::array<MessageDef, kMessageCount> kMessages{{
      "Command to the board; answered by GfinsResponse with the same Opcode and Token"},
     {"GfinsResponse", MessageId::kResponse, 0x680, MessageKind::kResponse, 0, kResponseSignals,
      "GFINS", "Response to a GfinsCommand"},
+    {"GfinsAccuracy", MessageId::kAccuracy, 0x1E0, MessageKind::kData, 200, kAccuracySignals,
+     "GFINS", "1 sigma of attitude and velocity from the filter's covariance"},
+    {"GfinsAidingCounters", MessageId::kAidingCounters, 0x1F0, MessageKind::kData, 400,
+     kAidingCountersSignals, "GFINS",
+     "Accepted and rejected aiding updates per kind, one kind per frame in turn"},
+    {"GfinsGnssPositionNE", MessageId::kGnssPositionNE, 0x0C0, MessageKind::kInput, 0,
+     kGnssPositionNESignals, "GNSS", "GNSS fix, frame 1 of 4: antenna position north, east"},
+    {"GfinsGnssPositionD", MessageId::kGnssPositionD, 0x0D0, MessageKind::kInput, 0,
+     kGnssPositionDSignals, "GNSS",
+     "GNSS fix, frame 2 of 4: antenna position down and the receiver's position 1 sigma"},
+    {"GfinsGnssVelocity", MessageId::kGnssVelocity, 0x0E0, MessageKind::kInput, 0,
+     kGnssVelocitySignals, "GNSS", "GNSS fix, frame 3 of 4: antenna velocity"},
+    {"GfinsGnssFixInfo", MessageId::kGnssFixInfo, 0x0F0, MessageKind::kInput, 0,
+     kGnssFixInfoSignals, "GNSS",
+     "GNSS fix, frame 4 of 4 (completes the fix): velocity 1 sigma, age, content"},
+    {"GfinsHeadingInput", MessageId::kHeadingInput, 0x0B0, MessageKind::kInput, 0,
+     kHeadingInputSignals, "GNSS", "External heading for the filter"},
 }};
 
 constexpr const MessageDef& message(MessageId id) {

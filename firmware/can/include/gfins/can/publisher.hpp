@@ -43,13 +43,20 @@ struct PublisherCounters {
 
 /// Values of one epoch as the bus carries them, before quantisation: what the encoder reads for a
 /// (field, index) of the table. Exposed so the host can compare decoded frames with the state.
+/// NaN (sent as the signal's not-available code) for a field of a group `e.valid` marks invalid.
 double epoch_field(const Epoch& e, Field field, std::uint8_t index);
 
 /// The frame of data message `m` for epoch `e` with epoch counter `counter`: encoded, sealed with
-/// its CRC. `saturated`/`unavailable` are incremented per clipped / not-available value.
+/// its CRC. `saturated`/`unavailable` are incremented per clipped / not-available value (of a
+/// navigation value or sensor output; a σ does not count: it is N/A without a filter and reads
+/// "at least max" when saturated). A
+/// multiplexed message carries the signals of selector value `selector` (ignored otherwise).
 hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
                                 std::uint8_t counter, std::uint32_t* saturated,
-                                std::uint32_t* unavailable);
+                                std::uint32_t* unavailable, std::uint8_t selector = 0);
+
+/// Selector values of a multiplexed data message (0..n-1 in turn); 0 when not multiplexed.
+std::uint8_t selector_count(const MessageDef& m);
 
 class Publisher {
  public:
@@ -76,7 +83,8 @@ class Publisher {
   hal::CanBus* bus_;
   std::uint8_t node_id_ = 0;
   Dividers dividers_{};
-  std::uint8_t counter_ = 0;  // epoch counter, mod 16
+  std::uint8_t counter_ = 0;                            // epoch counter, mod 16
+  std::array<std::uint8_t, kMessageCount> selector_{};  // next selector of multiplexed messages
   Status init_status_{};
   PublisherCounters counters_{};
 };

@@ -52,9 +52,13 @@ constexpr std::uint64_t bits_of(const SignalDef& s, std::int64_t raw) {
   return static_cast<std::uint64_t>(raw) & low_mask(s.length);
 }
 
-/// Raw value of a physical value without limits: round((x - offset) / factor).
+/// Raw value of a physical value without limits: round((x - offset) / factor), or rounded up
+/// for a signal that must never show less than the value (σ). The 1e-9 of a step absorbs the
+/// division's rounding, so an exact multiple is not pushed one step up.
 inline std::int64_t raw_of_physical(const SignalDef& s, double x) {
-  return static_cast<std::int64_t>(std::llround((x - s.offset) / s.factor));
+  const double r = (x - s.offset) / s.factor;
+  if (s.round_up) return static_cast<std::int64_t>(std::ceil(r - 1e-9));
+  return static_cast<std::int64_t>(std::llround(r));
 }
 
 constexpr double physical_of_raw(const SignalDef& s, std::int64_t raw) {
