@@ -4,6 +4,8 @@
 // Neither check is active while GoogleTest itself runs; only the windows marked below count.
 #include <gtest/gtest.h>
 
+#include "gfins/nav_core/filter/error_state_filter.hpp"
+#include "gfins/nav_core/filter/standstill_detector.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -45,6 +47,55 @@ TEST(NoMallocTest, ConfigureAlignAndStepNeverAllocateFloat) {
 
 TEST(NoMallocTest, ConfigureAlignAndStepNeverAllocateDouble) {
   EXPECT_EQ(allocations_for_full_run<double>(CompensatorKind::kPaper), 0);
+}
+
+// The aided filter: configure, start, propagate and every kind of update (accepted, rejected,
+// reset before heading alignment), the accuracy outputs and the standstill detector.
+template <typename T>
+long allocations_for_filter() {
+  static ErrorStateFilter<T> filter;
+  static StandstillDetector<T> detector;
+  const auto solver = ArraySolver<T, 6>::create(table1_geometry(T(0.1))).value();
+  const auto gravity = GravityModel<T>::constant(T(9.80665));
+  static Strapdown<T, 6> nav;
+  nav = Strapdown<T, 6>(solver, gravity);
+  Vec6<T> s = solver.predict(Vec3<T>::Zero(), Vec3<T>(T(0), T(0), T(-9.80665)), Vec3<T>::Zero());
+  NavState<T> init;
+  init.status = nav_status::kAligned;
+  FilterConfig<T> config;
+  config.heading_known = false;
+  config.gnss_lever_arm_b = Vec3<T>(T(0.5), T(0), T(-0.3));
+  NoAllocWindow window;
+  nav.initialize(init, s);
+  if (!filter.configure(config).is_ok()) return -1;
+  if (!detector.configure(solver, StandstillConfig<T>{}).is_ok()) return -1;
+  filter.start(nav);
+  GnssFix<T> fix;
+  fix.sigma = Vec3<T>::Constant(T(1));
+  std::uint32_t outcomes = 0;
+  for (std::uint32_t k = 1; k <= 400; ++k) {
+    nav.step(s, T(0.001), static_cast<std::int64_t>(k) * 1000000, k);
+    const Vec6<T> u = solver.linear_part(s);
+    detector.add(u.template head<3>(), u.template tail<3>());
+    if (k % 10 != 0) continue;
+    if (!filter.propagate(nav, T(0.01)).is_ok()) return -2;
+    outcomes += static_cast<std::uint32_t>(filter.update_zupt(nav).status);
+    outcomes += static_cast<std::uint32_t>(filter.update_zaru(nav).status);
+    fix.t_valid_ns = nav.state().t_ns - 5000000;  // latency: interpolated in the history
+    fix.value_n = Vec3<T>(T(0), T(0), T(0.3)) + Vec3<T>::Constant(k == 200 ? T(100) : T(0));
+    outcomes += static_cast<std::uint32_t>(filter.update_gnss_position(nav, fix).status);
+    fix.value_n = k == 100 ? Vec3<T>(T(5), T(0), T(0)) : Vec3<T>::Zero();
+    outcomes += static_cast<std::uint32_t>(filter.update_gnss_velocity(nav, fix).status);
+    outcomes += static_cast<std::uint32_t>(filter.update_heading(nav, T(0), T(0.1)).status);
+    if (filter.accuracy(nav.state()).valid == 0xff) return -3;
+  }
+  if (!filter.heading_aligned() || outcomes == 0) return -4;
+  return window.allocations();
+}
+
+TEST(NoMallocTest, FilterPropagationAndEveryUpdateNeverAllocate) {
+  EXPECT_EQ(allocations_for_filter<float>(), 0);
+  EXPECT_EQ(allocations_for_filter<double>(), 0);
 }
 
 // The detector itself must be able to fail: an Eigen dynamic matrix inside a window is caught.

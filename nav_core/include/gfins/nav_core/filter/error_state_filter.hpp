@@ -1,0 +1,516 @@
+// Error-state (indirect) Kalman filter of the aided gyro-free strapdown (docs/math.md, "Aided
+// navigation: the error-state filter").
+//
+// State (measurement.hpp): x = [φ, δr, δv, δω, δβ_ω̇, δβ_f], 18 errors. The navigation block of
+// the process model is the linear error model of paper §3 (eqs. (7)-(13)) as error_model.hpp
+// derives it (ErrorModel::navigation_continuous: eq. (8) φ̇ = −C δω, eq. (10), eq. (12) with the
+// K J(ω) centripetal coupling and the gravity gradient, eq. (13)); the bias is the fixed 6-D bias
+// of the array's solution [ω̇; f] (Carlsson, Skog, Hendeby, Jaldén 2022) instead of N
+// per-sensor biases, which are not observable: only β = M b reaches the navigation.
+//   ẋ_nav = F_nav x_nav + G_u (δβ + M n),  G_u = ∂ẋ_nav/∂δ[ω̇; f] (ErrorModel::array_input_matrix)
+//   δβ̇ = w_β,  Cov(M n) = M diag(σ² h) Mᵀ,  Cov(w_β) = M diag(q_rw) Mᵀ   (correlated 6×6)
+// Propagation runs at a decimated rate (every D samples, dt = D/rate): Φ = I + F h + F² h²/2 from
+// F at the current navigation state, Q_d by Van Loan's series to h³ (as ErrorModel does).
+// Updates: generic linearised update with a χ² innovation gate (NIS against the configured
+// quantile for the measurement's dimension), Joseph form, symmetrisation, a floor and a check on
+// the diagonal (non-finite or negative → covariance reset to the initial one, counted), and
+// closed-loop feedback into the Strapdown (apply_correction, set_bias), after which x = 0.
+//
+// Static allocation (P, 18×18, is 1.3 kB in float; the history 64 × 60 B), no heap, no
+// exceptions; float on the board, double as the reference (explicit instantiations in
+// src/error_state_filter.cpp).
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "gfins/nav_core/error_model.hpp"
+#include "gfins/nav_core/filter/chi_square.hpp"
+#include "gfins/nav_core/filter/euler_error.hpp"
+#include "gfins/nav_core/filter/gnss_update.hpp"
+#include "gfins/nav_core/filter/measurement.hpp"
+#include "gfins/nav_core/filter/nav_history.hpp"
+#include "gfins/nav_core/filter/zero_update.hpp"
+#include "gfins/nav_core/integrator.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::nav {
+
+template <typename T>
+struct FilterConfig {
+  T sample_rate_hz = T(1000);  // rate of the samples the noise σ refers to
+  // Per-sensor white noise σ (per sample), bias random walk (m/s²/√s) and random-constant bias σ
+  // (m/s²): mapped through M into the 6-D bias and noise of [ω̇; f].
+  SensorNoiseSpec<T, kNumSensors> noise{};
+  // Initial 1σ of the navigation errors (after static alignment).
+  T init_sigma_tilt_rad = T(0.01);     // φ_N, φ_E
+  T init_sigma_heading_rad = T(0.05);  // φ_D when the heading is given
+  bool heading_known = true;           // false: φ_D variance π² until the GNSS track aligns it
+  T init_sigma_pos_m = T(1);
+  T init_sigma_vel_mps = T(0.05);
+  T init_sigma_rate_rps = T(1e-3);
+  // Covariance hygiene: every diagonal element is kept at or above this (SI units squared).
+  T variance_floor = T(1e-14);
+  // Innovation gate: probability of the χ² quantile (per measurement dimension).
+  T gate_probability = T(0.999);
+  bool innovation_gate = true;  // false: every finite innovation is applied (tests only)
+  // Standstill pseudo-measurements, 1σ.
+  T zupt_sigma_mps = T(0.01);
+  T zaru_sigma_rps = T(1e-3);
+  // GNSS antenna lever arm, m, body FRD from the array centre.
+  Vec3<T> gnss_lever_arm_b = Vec3<T>::Zero();
+  // Heading from the GNSS track once the horizontal speed exceeds this (heading_known = false).
+  T track_min_speed_mps = T(3);
+  // An aiding kind counts in mode() for this long after its last accepted update.
+  T aiding_timeout_s = T(2);
+  // Validity horizons: a quantity is valid while aligned and its 1σ is at or below these.
+  T valid_sigma_tilt_rad = T(0.0175);     // 1°
+  T valid_sigma_heading_rad = T(0.0524);  // 3°
+  T valid_sigma_vel_mps = T(0.5);
+  T valid_sigma_pos_m = T(10);
+};
+
+/// Bits of NavAccuracy::mode: which aiding was accepted within FilterConfig::aiding_timeout_s
+/// (none set: unaided).
+namespace filter_mode {
+inline constexpr std::uint8_t kStandstill = 1u << 0;  // ZUPT or ZARU
+inline constexpr std::uint8_t kGnss = 1u << 1;        // GNSS position or velocity
+inline constexpr std::uint8_t kHeading = 1u << 2;     // external heading
+}  // namespace filter_mode
+
+/// Bits of NavAccuracy::valid.
+namespace filter_valid {
+inline constexpr std::uint8_t kRollPitch = 1u << 0;
+inline constexpr std::uint8_t kHeading = 1u << 1;
+inline constexpr std::uint8_t kVelocity = 1u << 2;
+inline constexpr std::uint8_t kPosition = 1u << 3;
+}  // namespace filter_valid
+
+/// 1σ of the published quantities, from the filter covariance (never an optimistic guess).
+template <typename T>
+struct NavAccuracy {
+  Vec3<T> euler_sigma_rad = Vec3<T>::Zero();  // roll, pitch, heading
+  Vec3<T> vel_sigma_mps = Vec3<T>::Zero();    // N, E, D
+  Vec3<T> pos_sigma_m = Vec3<T>::Zero();      // N, E, D
+  std::uint8_t mode = 0;                      // filter_mode bits
+  std::uint8_t valid = 0;                     // filter_valid bits
+};
+
+enum class UpdateStatus : std::uint8_t {
+  kAccepted,  // applied and fed back
+  kRejected,  // innovation outside the χ² gate: not applied
+  kInvalid,   // bad input (σ ≤ 0, non-finite, outside the history) or not started: not applied
+  kReset,     // before heading alignment: the fix reset the quantity instead of an update
+};
+
+struct UpdateOutcome {
+  UpdateStatus status = UpdateStatus::kInvalid;
+  float nis = 0;  // νᵀ S⁻¹ ν (0 when not computed); float whatever T (no double on the board)
+};
+
+struct FilterCounters {
+  std::array<std::uint32_t, kAidingKinds> accepted{};
+  std::array<std::uint32_t, kAidingKinds> rejected{};
+  std::array<std::uint32_t, kAidingKinds> invalid{};
+  std::uint32_t propagations = 0;
+  std::uint32_t covariance_resets = 0;  // non-finite or negative diagonal found and reset
+};
+
+template <typename T, int HistoryCapacity = 32>
+class ErrorStateFilter {
+ public:
+  static constexpr int kStates = filt_idx::kStates;
+  using StateVec = Eigen::Matrix<T, kStates, 1>;
+  using StateMat = Eigen::Matrix<T, kStates, kStates>;
+  using Model = ErrorModel<T, kNumSensors>;
+  using Nav = Strapdown<T, kNumSensors>;
+
+  /// Checks and takes the configuration, and zeroes the counters (they only grow between
+  /// configurations). On failure nothing changes. The process model is built at each propagation
+  /// from the strapdown's own array solver and gravity (a new calibration is followed at once).
+  [[nodiscard]] Status configure(const FilterConfig<T>& config) {
+    if (!(config.sample_rate_hz > T(0)) || !std::isfinite(config.sample_rate_hz)) {
+      return Status(ErrorCode::kInvalidArgument, "filter: sample rate must be positive");
+    }
+    if (!(config.gate_probability > T(0) && config.gate_probability < T(1))) {
+      return Status(ErrorCode::kInvalidArgument, "filter: gate probability must be in (0, 1)");
+    }
+    if (!(config.zupt_sigma_mps > T(0)) || !(config.zaru_sigma_rps > T(0)) ||
+        !(config.init_sigma_tilt_rad > T(0)) || !(config.init_sigma_heading_rad > T(0)) ||
+        !(config.init_sigma_pos_m > T(0)) || !(config.init_sigma_vel_mps > T(0)) ||
+        !(config.init_sigma_rate_rps > T(0)) || !(config.variance_floor > T(0))) {
+      return Status(ErrorCode::kInvalidArgument, "filter: every sigma must be positive");
+    }
+    config_ = config;
+    gate_1_ = chi_square_quantile(config.gate_probability, 1);
+    gate_3_ = chi_square_quantile(config.gate_probability, 3);
+    counters_ = FilterCounters{};  // a new configuration is a new filter
+    configured_ = true;
+    started_ = false;
+    return Status::ok();
+  }
+
+  /// Starts estimating at the strapdown's current (aligned) solution: P ← P0, the bias estimate
+  /// of the strapdown to zero, history cleared, heading aligned when the configuration gives it.
+  void start(Nav& nav) {
+    // Random-constant per-sensor biases seen through the solve: M diag(σ_b²) Mᵀ.
+    p0_bias_ = Model(nav.solver(), nav.gravity()).array_noise(config_.noise.bias_sigma_mps2, T(1));
+    p_ = initial_covariance();
+    nav.set_bias(Vec3<T>::Zero(), Vec3<T>::Zero());
+    history_.clear();
+    history_.push(nav.state());
+    heading_aligned_ = config_.heading_known;
+    last_accepted_ns_.fill(kNever);
+    started_ = configured_;
+  }
+
+  /// The covariance the filter starts from and resets to.
+  StateMat initial_covariance() const {
+    using namespace filt_idx;
+    StateMat p = StateMat::Zero();
+    const T tilt2 = config_.init_sigma_tilt_rad * config_.init_sigma_tilt_rad;
+    constexpr T kPi = T(3.14159265358979323846);
+    p(kPhi, kPhi) = tilt2;
+    p(kPhi + 1, kPhi + 1) = tilt2;
+    p(kPhi + 2, kPhi + 2) = config_.heading_known
+                                ? config_.init_sigma_heading_rad * config_.init_sigma_heading_rad
+                                : kPi * kPi;
+    for (int i = 0; i < 3; ++i) {
+      p(kPos + i, kPos + i) = config_.init_sigma_pos_m * config_.init_sigma_pos_m;
+      p(kVel + i, kVel + i) = config_.init_sigma_vel_mps * config_.init_sigma_vel_mps;
+      p(kRate + i, kRate + i) = config_.init_sigma_rate_rps * config_.init_sigma_rate_rps;
+    }
+    p.template block<6, 6>(kBiasWdot, kBiasWdot) = p0_bias_;
+    return p;
+  }
+
+  /// One covariance step over dt_s (the D samples since the previous call) at the strapdown's
+  /// current state, which is also stored in the history. F, the noise through M and the gravity
+  /// gradient come from ErrorModel on the strapdown's own solver and gravity.
+  Status propagate(const Nav& strapdown, T dt_s) {
+    if (!started_) return Status(ErrorCode::kFailedPrecondition, "filter: not started");
+    if (!(dt_s > T(0)) || !std::isfinite(dt_s)) {
+      return Status(ErrorCode::kInvalidArgument, "filter: dt_s must be positive");
+    }
+    using namespace filt_idx;
+    const NavState<T>& nav = strapdown.state();
+    const Model model(strapdown.solver(), strapdown.gravity());
+    const T h = dt_s;
+    // Continuous model: F = [F_nav G_u; 0 0], Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)].
+    // The 18×18 products are coefficient-based (lazyProduct): small code on the M4F, no GEMM.
+    StateMat f = StateMat::Zero();
+    f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = model.navigation_continuous(nav);
+    const typename Model::NavInputMat g = model.array_input_matrix(nav);
+    f.template block<err_idx::kNav, 6>(0, kBiasWdot) = g;
+    StateMat qc = StateMat::Zero();
+    const Mat6<T> noise_u =
+        model.array_noise(config_.noise.white_sigma_mps2, T(1) / config_.sample_rate_hz);
+    qc.template topLeftCorner<err_idx::kNav, err_idx::kNav>() =
+        g.lazyProduct(noise_u).lazyProduct(g.transpose());
+    qc.template block<6, 6>(kBiasWdot, kBiasWdot) =
+        model.array_noise(config_.noise.bias_rw_mps2_sqrt_s, T(1));
+    // Van Loan's series to h³ (error_model.hpp): Q_d = Q_c h + (F Q_c + Q_c Fᵀ) h²/2 +
+    // F Q_c Fᵀ h³/3; Φ = I + F h + F² h²/2; P ← Φ P Φᵀ + Q_d.
+    StateMat tmp = f.lazyProduct(qc);  // F Q_c
+    StateMat qd = qc * h + (tmp + tmp.transpose()) * (h * h / T(2));
+    qd.noalias() += tmp.lazyProduct(f.transpose()) * (h * h * h / T(3));
+    tmp = f * h;
+    StateMat phi = StateMat::Identity() + tmp;
+    phi.noalias() += tmp.lazyProduct(tmp) / T(2);
+    tmp.noalias() = phi.lazyProduct(p_);
+    p_.noalias() = tmp.lazyProduct(phi.transpose());
+    p_ += qd;
+    if (!heading_aligned_) decouple_heading();
+    condition_covariance();
+    history_.push(nav);
+    ++counters_.propagations;
+    return Status::ok();
+  }
+
+  // ---- Updates: each returns what became of it; only kAccepted (and kReset) change the state --
+
+  /// Zero velocity at standstill (3-D).
+  UpdateOutcome update_zupt(Nav& nav) {
+    if (!started_) return invalid(AidingKind::kZupt);
+    return apply(zupt_measurement(nav.state(), config_.zupt_sigma_mps), AidingKind::kZupt, gate_3_,
+                 nav);
+  }
+
+  /// Zero angular rate at standstill (3-D).
+  UpdateOutcome update_zaru(Nav& nav) {
+    if (!started_) return invalid(AidingKind::kZaru);
+    return apply(zaru_measurement(nav.state(), config_.zaru_sigma_rps), AidingKind::kZaru, gate_3_,
+                 nav);
+  }
+
+  /// GNSS antenna position valid at fix.t_valid_ns (≤ now, within the history).
+  UpdateOutcome update_gnss_position(Nav& nav, const GnssFix<T>& fix) {
+    HistoryEntry<T> at;
+    if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssPosition);
+    if (!heading_aligned_) return reset_position(nav, fix, at);
+    return apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
+                 AidingKind::kGnssPosition, gate_3_, nav);
+  }
+
+  /// GNSS antenna velocity valid at fix.t_valid_ns. Before heading alignment it sets the velocity
+  /// and, above track_min_speed_mps, the heading from the track.
+  UpdateOutcome update_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
+    HistoryEntry<T> at;
+    if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
+    if (!heading_aligned_) return reset_velocity_and_track(nav, fix, at);
+    return apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
+                 AidingKind::kGnssVelocity, gate_3_, nav);
+  }
+
+  /// External heading (yaw from north, rad) with its 1σ, valid now. Before heading alignment it
+  /// sets the heading.
+  UpdateOutcome update_heading(Nav& nav, T yaw_rad, T sigma_rad) {
+    if (!started_ || !std::isfinite(yaw_rad) || !(sigma_rad > T(0))) {
+      return invalid(AidingKind::kHeading);
+    }
+    const Measurement<T, 1> m = heading_measurement(nav.state().q_nb, yaw_rad, sigma_rad);
+    if (!heading_aligned_) {
+      set_heading(nav, m.y(0), sigma_rad);
+      return accepted_reset(AidingKind::kHeading, nav);
+    }
+    return apply(m, AidingKind::kHeading, gate_1_, nav);
+  }
+
+  // ---- Outputs --------------------------------------------------------------------------------
+
+  /// 1σ, mode and validity at the navigation state `nav` (the strapdown's current one).
+  NavAccuracy<T> accuracy(const NavState<T>& nav) const {
+    using namespace filt_idx;
+    NavAccuracy<T> a;
+    const Mat3<T> j = euler_error_jacobian(nav.q_nb);
+    const Mat3<T> ce = j * p_.template block<3, 3>(kPhi, kPhi) * j.transpose();
+    for (int i = 0; i < 3; ++i) {
+      a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
+      a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i));
+      a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
+    }
+    const bool aligned = started_ && (nav.status & nav_status::kAligned) != 0;
+    const bool located = aligned && heading_aligned_;
+    if (aligned &&
+        a.euler_sigma_rad.template head<2>().maxCoeff() <= config_.valid_sigma_tilt_rad) {
+      a.valid |= filter_valid::kRollPitch;
+    }
+    if (located && a.euler_sigma_rad(2) <= config_.valid_sigma_heading_rad) {
+      a.valid |= filter_valid::kHeading;
+    }
+    if (located && a.vel_sigma_mps.maxCoeff() <= config_.valid_sigma_vel_mps) {
+      a.valid |= filter_valid::kVelocity;
+    }
+    if (located && a.pos_sigma_m.maxCoeff() <= config_.valid_sigma_pos_m) {
+      a.valid |= filter_valid::kPosition;
+    }
+    if (recent(AidingKind::kZupt, nav.t_ns) || recent(AidingKind::kZaru, nav.t_ns)) {
+      a.mode |= filter_mode::kStandstill;
+    }
+    if (recent(AidingKind::kGnssPosition, nav.t_ns) ||
+        recent(AidingKind::kGnssVelocity, nav.t_ns)) {
+      a.mode |= filter_mode::kGnss;
+    }
+    if (recent(AidingKind::kHeading, nav.t_ns)) a.mode |= filter_mode::kHeading;
+    return a;
+  }
+
+  const StateMat& covariance() const { return p_; }
+  const FilterCounters& counters() const { return counters_; }
+  const FilterConfig<T>& config() const { return config_; }
+  bool started() const { return started_; }
+  bool heading_aligned() const { return heading_aligned_; }
+  /// Instant of the last accepted update of `kind` (INT64_MIN when none).
+  std::int64_t last_accepted_ns(AidingKind kind) const {
+    return last_accepted_ns_[static_cast<std::size_t>(kind)];
+  }
+  /// Instant of the last accepted aiding update of any kind (INT64_MIN when none).
+  std::int64_t last_aiding_ns() const {
+    std::int64_t t = kNever;
+    for (const std::int64_t v : last_accepted_ns_) t = v > t ? v : t;
+    return t;
+  }
+  /// The χ² thresholds the gates use (dimension 1 and 3).
+  T gate_threshold(int dim) const { return dim == 1 ? gate_1_ : gate_3_; }
+
+ private:
+  static constexpr std::int64_t kNever = INT64_MIN;
+
+  bool recent(AidingKind kind, std::int64_t now_ns) const {
+    const std::int64_t t = last_accepted_ns(kind);
+    if (t == kNever) return false;
+    return static_cast<T>(now_ns - t) * T(1e-9) <= config_.aiding_timeout_s;
+  }
+
+  UpdateOutcome invalid(AidingKind kind) {
+    ++counters_.invalid[static_cast<std::size_t>(kind)];
+    return UpdateOutcome{UpdateStatus::kInvalid, 0.0F};
+  }
+
+  bool fix_usable(const Nav& nav, const GnssFix<T>& fix, HistoryEntry<T>& at) const {
+    return started_ && fix.value_n.allFinite() && (fix.sigma.array() > T(0)).all() &&
+           fix.sigma.allFinite() && history_.at(fix.t_valid_ns, nav.state(), at);
+  }
+
+  /// The linearised update: gate, gain, Joseph form, feedback.
+  template <int M>
+  UpdateOutcome apply(const Measurement<T, M>& m, AidingKind kind, T gate, Nav& nav) {
+    const auto k_idx = static_cast<std::size_t>(kind);
+    if (!m.y.allFinite()) return invalid(kind);
+    const Eigen::Matrix<T, kStates, M> pht = p_.lazyProduct(m.h.transpose());
+    Eigen::Matrix<T, M, M> s = m.h.lazyProduct(pht) + m.r;
+    s = (s + s.transpose()) / T(2);
+    // S must be positive definite (Cholesky as the test); M ≤ 3, so its inverse is closed-form.
+    const Eigen::LLT<Eigen::Matrix<T, M, M>> llt(s);
+    if (llt.info() != Eigen::Success) return invalid(kind);
+    const Eigen::Matrix<T, M, M> s_inv = s.inverse();
+    const T nis = m.y.dot(s_inv * m.y);
+    if (!std::isfinite(nis)) return invalid(kind);
+    if (config_.innovation_gate && nis > gate) {
+      ++counters_.rejected[k_idx];
+      return UpdateOutcome{UpdateStatus::kRejected, static_cast<float>(nis)};
+    }
+    const Eigen::Matrix<T, kStates, M> k = pht.lazyProduct(s_inv);
+    StateVec dx = k * m.y;
+    if (!heading_aligned_) dx(filt_idx::kPhi + 2) = T(0);  // heading is not estimated yet
+    // Joseph form: P = (I − KH) P (I − KH)ᵀ + K R Kᵀ, symmetric and positive for any K.
+    StateMat a = StateMat::Identity();
+    a.noalias() -= k.lazyProduct(m.h);
+    const StateMat ap = a.lazyProduct(p_);
+    p_.noalias() = ap.lazyProduct(a.transpose());
+    p_.noalias() += k.lazyProduct(m.r).lazyProduct(k.transpose());
+    if (!heading_aligned_) decouple_heading();
+    condition_covariance();
+    feed_back(dx, nav);
+    ++counters_.accepted[k_idx];
+    last_accepted_ns_[k_idx] = nav.state().t_ns;
+    return UpdateOutcome{UpdateStatus::kAccepted, static_cast<float>(nis)};
+  }
+
+  /// Closed loop: the estimated errors leave the strapdown (and the history), x returns to 0.
+  void feed_back(const StateVec& dx, Nav& nav) {
+    using namespace filt_idx;
+    const Vec3<T> phi = dx.template segment<3>(kPhi);
+    const Vec3<T> dr = dx.template segment<3>(kPos);
+    const Vec3<T> dv = dx.template segment<3>(kVel);
+    const Vec3<T> dw = dx.template segment<3>(kRate);
+    nav.apply_correction(phi, dr, dv, dw);
+    nav.set_bias(nav.bias_wdot() + dx.template segment<3>(kBiasWdot),
+                 nav.bias_f() + dx.template segment<3>(kBiasF));
+    history_.shift(phi, dr, dv);
+  }
+
+  UpdateOutcome accepted_reset(AidingKind kind, const Nav& nav) {
+    const auto k_idx = static_cast<std::size_t>(kind);
+    ++counters_.accepted[k_idx];
+    last_accepted_ns_[k_idx] = nav.state().t_ns;
+    condition_covariance();
+    return UpdateOutcome{UpdateStatus::kReset, 0.0F};
+  }
+
+  /// Replaces rows/columns [i, i+3) of P by diag(var) (the quantity was just set from a fix).
+  void reset_block(int i, const Vec3<T>& var) {
+    p_.template middleRows<3>(i).setZero();
+    p_.template middleCols<3>(i).setZero();
+    p_.template block<3, 3>(i, i).diagonal() = var;
+  }
+
+  /// Before heading alignment: position set from the fix. The lever arm is rotated with an
+  /// unknown heading, so its length is added to the variance of each axis.
+  UpdateOutcome reset_position(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
+    const Vec3<T> dr = at.r_n + at.q_nb * config_.gnss_lever_arm_b - fix.value_n;
+    nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
+    history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
+    const T l2 = config_.gnss_lever_arm_b.squaredNorm();
+    reset_block(filt_idx::kPos, fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(l2));
+    return accepted_reset(AidingKind::kGnssPosition, nav);
+  }
+
+  /// Before heading alignment: velocity set from the fix; above the speed threshold the heading
+  /// is the track atan2(v_E, v_N) (the vehicle moves along its x axis: no side slip; the body x
+  /// axis projects on the horizontal at the yaw angle whatever roll and pitch), with
+  /// σ_ψ = σ_v,horizontal / speed.
+  UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix,
+                                         const HistoryEntry<T>& at) {
+    const T speed = fix.value_n.template head<2>().norm();
+    Vec3<T> phi = Vec3<T>::Zero();
+    if (speed >= config_.track_min_speed_mps) {
+      const T track = std::atan2(fix.value_n.y(), fix.value_n.x());
+      // A rotation about the down axis changes the yaw by its angle whatever roll and pitch, and
+      // the yaw error is −φ_D there (euler_error.hpp): φ_D = track − ψ̂ at the fix instant.
+      phi.z() = wrap_pi(track - euler_from_quat(at.q_nb).z());
+    }
+    // The velocity error at the fix instant, then rotated with the heading correction.
+    const Vec3<T> dv = at.v_n - fix.value_n;
+    nav.apply_correction(phi, Vec3<T>::Zero(), dv, Vec3<T>::Zero());
+    history_.shift(phi, Vec3<T>::Zero(), dv);
+    reset_block(filt_idx::kVel, fix.sigma.cwiseProduct(fix.sigma));
+    if (speed >= config_.track_min_speed_mps) {
+      const T sigma_h = fix.sigma.template head<2>().maxCoeff() / speed;
+      set_heading_variance(sigma_h);
+    }
+    return accepted_reset(AidingKind::kGnssVelocity, nav);
+  }
+
+  /// Heading set directly (before alignment): dyaw = ψ̂ − ψ removed by the rotation about the
+  /// down axis φ = [0, 0, −dyaw] (the yaw error is −φ_D, euler_error.hpp).
+  void set_heading(Nav& nav, T dyaw, T sigma_rad) {
+    const Vec3<T> phi(T(0), T(0), -dyaw);
+    nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
+    history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
+    set_heading_variance(sigma_rad);
+  }
+
+  void set_heading_variance(T sigma_rad) {
+    constexpr int kD = filt_idx::kPhi + 2;
+    p_.row(kD).setZero();
+    p_.col(kD).setZero();
+    p_(kD, kD) = sigma_rad * sigma_rad;
+    heading_aligned_ = true;
+  }
+
+  /// While the heading is unknown its error is a nuisance of variance π² outside the linear
+  /// model: its correlations are dropped so no update moves it or is moved by it.
+  void decouple_heading() {
+    constexpr int kD = filt_idx::kPhi + 2;
+    const T var = p_(kD, kD);
+    p_.row(kD).setZero();
+    p_.col(kD).setZero();
+    p_(kD, kD) = var;
+  }
+
+  /// Symmetrise, floor the diagonal, and reset to P0 on a non-finite value or a negative
+  /// diagonal (counted): the filter never NaNs out.
+  void condition_covariance() {
+    p_ = ((p_ + p_.transpose()) / T(2)).eval();
+    bool bad = !p_.allFinite();
+    for (int i = 0; i < kStates && !bad; ++i) {
+      if (p_(i, i) < T(0)) bad = true;
+      if (p_(i, i) < config_.variance_floor) p_(i, i) = config_.variance_floor;
+    }
+    if (bad) {
+      p_ = initial_covariance();
+      ++counters_.covariance_resets;
+    }
+  }
+
+  FilterConfig<T> config_{};
+  StateMat p_ = StateMat::Zero();
+  Mat6<T> p0_bias_ = Mat6<T>::Zero();  // initial covariance of the 6-D bias, M diag(σ_b²) Mᵀ
+  NavHistory<T, HistoryCapacity> history_{};
+  FilterCounters counters_{};
+  std::array<std::int64_t, kAidingKinds> last_accepted_ns_{};
+  T gate_1_ = T(0);
+  T gate_3_ = T(0);
+  bool configured_ = false;
+  bool started_ = false;
+  bool heading_aligned_ = true;
+};
+
+extern template class ErrorStateFilter<float>;
+extern template class ErrorStateFilter<double>;
+
+}  // namespace gfins::nav

@@ -1,0 +1,54 @@
+// Euler angles (Z-Y-X: roll φ_r, pitch θ, yaw ψ) against the attitude error φ_n of eq. (7), for
+// the published 1σ of roll, pitch and heading and for the heading update.
+//
+// The navigation-frame rate of a Z-Y-X attitude is ω_n = E [φ̇_r θ̇ ψ̇]ᵀ with
+//   E = [cψcθ  −sψ  0;  sψcθ  cψ  0;  −sθ  0  1],
+// so a small rotation ε applied in the n frame (C ← exp([ε×]) C) changes the angles by E⁻¹ ε:
+//   E⁻¹ = [cψ/cθ  sψ/cθ  0;  −sψ  cψ  0;  cψ tθ  sψ tθ  1].
+// The computed attitude is Ĉ = exp(−[φ×]) C (eq. (7)), so
+//   [δφ_r δθ δψ]ᵀ = (euler(Ĉ) − euler(C)) = J φ,   J = −E⁻¹(ψ̂, θ̂),
+// and Cov(Euler error) = J P_φφ Jᵀ. J is singular at θ = ±90° (gimbal lock): the roll and yaw
+// σ grow without bound there, which is the truth about those angles.
+#pragma once
+
+#include <cmath>
+
+#include "gfins/nav_core/filter/measurement.hpp"
+
+namespace gfins::nav {
+
+/// J = ∂(Euler error)/∂φ at the attitude q_nb (rows roll, pitch, yaw).
+template <typename T>
+Mat3<T> euler_error_jacobian(const Quat<T>& q_nb) {
+  const Vec3<T> e = euler_from_quat(q_nb);
+  const T cp = std::cos(e.y());
+  const T tp = std::tan(e.y());
+  const T cy = std::cos(e.z());
+  const T sy = std::sin(e.z());
+  Mat3<T> j;
+  j << -cy / cp, -sy / cp, T(0),  //
+      sy, -cy, T(0),              //
+      -cy * tp, -sy * tp, T(-1);
+  return j;
+}
+
+/// Wraps an angle difference into (−π, π].
+template <typename T>
+T wrap_pi(T a) {
+  constexpr T kPi = T(3.14159265358979323846);
+  while (a > kPi) a -= T(2) * kPi;
+  while (a <= -kPi) a += T(2) * kPi;
+  return a;
+}
+
+/// External heading (yaw, rad from north, 1σ sigma_rad): y = ψ̂ − ψ = J_yaw φ − n, 1-D.
+template <typename T>
+Measurement<T, 1> heading_measurement(const Quat<T>& q_nb, T yaw_rad, T sigma_rad) {
+  Measurement<T, 1> m;
+  m.y(0) = wrap_pi(euler_from_quat(q_nb).z() - yaw_rad);
+  m.h.template block<1, 3>(0, filt_idx::kPhi) = euler_error_jacobian(q_nb).row(2);
+  m.r(0, 0) = sigma_rad * sigma_rad;
+  return m;
+}
+
+}  // namespace gfins::nav

@@ -1,0 +1,6 @@
+#include "gfins/nav_core/filter/error_state_filter.hpp"
+
+namespace gfins::nav {
+template class ErrorStateFilter<float>;
+template class ErrorStateFilter<double>;
+}  // namespace gfins::nav
