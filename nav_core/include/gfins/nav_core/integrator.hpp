@@ -122,9 +122,10 @@ class Strapdown {
       wdot1 = u_wdot;
       f1 = u_f - solver_.padded_k_force().lazyProduct(m1);
     } else {
-      const typename Solver::PaddedVec km = solver_.padded_k().lazyProduct(m1);
-      wdot1 = u_wdot - km.template head<kP>();
-      f1 = u_f - km.template tail<kP>();
+      // One fused expression, as without the bias: (u − β̂) − K m(ω), element by element.
+      const typename Solver::PaddedVec full = u - bias_ - solver_.padded_k().lazyProduct(m1);
+      wdot1 = full.template head<kP>();
+      f1 = full.template tail<kP>();
     }
 
     const PVec phi = (h / T(2)) * (w0 + w1) + (h * h / T(12)) * cross_padded(w0, w1);
