@@ -17,8 +17,6 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "gfins/nav_core/filter/error_state_filter.hpp"
-#include "gfins/nav_core/filter/standstill_detector.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 #include "probe_config.hpp"
 #include "probe_samples.hpp"
@@ -37,13 +35,9 @@ volatile float g_out[10];
 
 nav::NavPipeline<float> g_pipeline;
 
-// The aided filter (float), in static storage like the pipeline. Until the pipeline owns it, a
-// second Strapdown stands for the pipeline's own (the filter feeds corrections back into it); it
-// costs the size of one integrator, which the wiring will remove.
-nav::ErrorStateFilter<float> g_filter;
-nav::StandstillDetector<float> g_detector;
-nav::Strapdown<float, nav::kNumSensors> g_aided;
-
+// The pipeline owns the aided filter and the standstill detector (nav_core/filter/aiding.hpp):
+// its aiding is off in the probe's configuration, so the per-sample results stay those of the
+// x86 reference (probe_samples.hpp), while every filter routine is linked and measured.
 // What the CAN side would receive: GNSS fixes and a heading, written by "DMA" like the ADC frame.
 volatile float g_gnss[7];  // position N E D, velocity N E D, heading
 volatile float g_acc_out[7];
@@ -93,22 +87,15 @@ static nav::Vec3<float> read_gnss(int first) {
 // The filter's work at the decimated rate: propagation, the standstill decision and every kind of
 // update, then the accuracy outputs. Out of line so the size script can walk its call graph too.
 extern "C" [[gnu::noinline]] void gfins_filter_step() {
-  const nav::NavState<float>& s = g_pipeline.state();
-  g_detector.add(s.wdot_b, s.f_b);
-  (void)g_filter.propagate(g_aided, 0.01F);
-  if (g_detector.at_rest()) {
-    (void)g_filter.update_zupt(g_aided);
-    (void)g_filter.update_zaru(g_aided);
-  }
   nav::GnssFix<float> fix;
-  fix.t_valid_ns = g_aided.state().t_ns;
+  fix.t_valid_ns = g_pipeline.state().t_ns;
   fix.value_n = read_gnss(0);
-  (void)g_filter.update_gnss_position(g_aided, fix);
+  (void)g_pipeline.offer_gnss_position(fix);
   fix.value_n = read_gnss(3);
-  (void)g_filter.update_gnss_velocity(g_aided, fix);
+  (void)g_pipeline.offer_gnss_velocity(fix);
   const float heading = g_gnss[6];
-  (void)g_filter.update_heading(g_aided, heading, 0.05F);
-  const nav::NavAccuracy<float> a = g_filter.accuracy(g_aided.state());
+  (void)g_pipeline.offer_heading(heading, 0.05F);
+  const nav::NavAccuracy<float> a = g_pipeline.accuracy();
   for (int i = 0; i < 3; ++i) {
     g_acc_out[i] = a.euler_sigma_rad(i);
     g_acc_out[3 + i] = a.pos_sigma_m(i);
@@ -137,14 +124,6 @@ int main() {
   dma_sample(0);
 #endif
   g_pipeline.start_at(initial_state(), read_adc());
-  g_aided =
-      nav::Strapdown<float, nav::kNumSensors>(g_pipeline.solver(), g_pipeline.config().gravity);
-  g_aided.initialize(g_pipeline.state(), nav::Vec6<float>::Zero());
-  if (!g_filter.configure(nav::FilterConfig<float>{}).is_ok() ||
-      !g_detector.configure(g_pipeline.solver(), nav::StandstillConfig<float>{}).is_ok()) {
-    return 1;
-  }
-  g_filter.start(g_aided);
 #ifdef GFINS_PROBE_STEPS
   for (int i = 1; i <= GFINS_PROBE_STEPS; ++i) {
     dma_sample(i);

@@ -1,5 +1,7 @@
 #include "gfins/app/can_adapters.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "gfins/app/sample_loop.hpp"
@@ -33,11 +35,11 @@ static_assert(static_cast<int>(CommandKind::kRealign) == can::kOpRealign &&
                   static_cast<int>(CommandKind::kCaptureCalibration) == can::kOpStartCapture &&
                   static_cast<int>(CommandKind::kReloadCalibration) == can::kOpReloadCalibration,
               "command kinds are the CAN opcodes");
-static_assert(static_cast<int>(CommandResult::kFailed) ==
-                      static_cast<int>(can::ResultCode::kFailed) &&
-                  static_cast<int>(CommandResult::kBusy) ==
-                      static_cast<int>(can::ResultCode::kBusy),
-              "command results are the CAN result codes");
+static_assert(
+    static_cast<int>(CommandResult::kFailed) == static_cast<int>(can::ResultCode::kFailed) &&
+        static_cast<int>(CommandResult::kBusy) == static_cast<int>(can::ResultCode::kBusy) &&
+        static_cast<int>(CommandResult::kMoving) == static_cast<int>(can::ResultCode::kMoving),
+    "command results are the CAN result codes");
 static_assert(kMaxPose == can::kMaxCapturePose, "one pose range");
 static_assert(kMaxNodeId == can::kMaxNodeId, "one node id range");
 
@@ -71,12 +73,24 @@ can::Epoch to_can_epoch(const Epoch& e) {
   c.health.bus_off_events = e.health.bus_off_events;
   c.health.loop_overruns = e.health.loop_overruns;
   c.health.log_dropped = e.health.log_dropped;
+  c.valid = e.valid;
+  c.accuracy = e.accuracy;
   return c;
 }
 
 can::Dividers to_can_dividers(const FwConfig& c) {
   can::Dividers d{};
   for (std::size_t m = 0; m < kNumMessages; ++m) d[m] = c.dividers[m];
+  // With aiding on, the filter's accuracy and aiding counters go out at the table's rates
+  // (GfinsAccuracy 5 Hz, GfinsAidingCounters 2.5 Hz at 1 kHz), rounded up to a multiple of the
+  // epoch divider as every message must be; without a filter they have nothing to say.
+  const std::uint32_t epoch = std::max<std::uint32_t>(c.dividers[0], 1);
+  for (const can::MessageId id : {can::MessageId::kAccuracy, can::MessageId::kAidingCounters}) {
+    const std::uint32_t table = can::message(id).default_divider;
+    const std::uint32_t div = (table + epoch - 1) / epoch * epoch;
+    d[static_cast<std::size_t>(id)] =
+        c.aiding ? static_cast<std::uint16_t>(std::min<std::uint32_t>(div, kMaxDivider)) : 0;
+  }
   return d;
 }
 
@@ -113,6 +127,7 @@ DecodedFrame CanCommandCodec::decode(const hal::CanFrame& f) const {
   out.command.kind = static_cast<CommandKind>(c.opcode);
   out.command.token = c.token;
   out.command.heading_rad = c.heading_rad;
+  out.command.forced = c.forced;
   out.command.compensator = c.compensator;
   out.command.message = static_cast<std::uint8_t>(c.message);
   out.command.divider = c.divider;

@@ -34,7 +34,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   std::vector<double> position;
   std::vector<std::string> dividers;
   int node = 0, prio = 0;
-  bool no_mlock = false, print_default = false;
+  bool no_mlock = false, print_default = false, aiding = false;
 
   auto* o_config =
       app.add_option("-c,--config", config_file, "configuration file (TOML); default: built-in")
@@ -76,6 +76,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   auto* o_align = app.add_option("--alignment-s", align, "navigation.alignment_s");
   auto* o_prio = app.add_option("--rt-priority", prio, "realtime.priority (0 = no SCHED_FIFO)");
   app.add_flag("--no-mlock", no_mlock, "realtime.lock_memory = false");
+  app.add_flag("--aiding", aiding, "aiding.enabled = true (standstill updates, filter accuracy)");
   auto* o_wd = app.add_option("--watchdog", watchdog, "watchdog.kind")
                    ->check(CLI::IsMember({"none", "systemd", "device"}));
   auto* o_wdd = app.add_option("--watchdog-device", wd_device, "watchdog.device");
@@ -187,6 +188,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_align->count()) c.alignment_s = align;
   if (o_prio->count()) c.rt_priority = prio;
   if (no_mlock) c.lock_memory = false;
+  if (aiding) c.aiding = true;
   if (o_wd->count()) {
     c.watchdog = pick(watchdog, std::array<const char*, 3>{"none", "systemd", "device"},
                       std::array<WatchdogKind, 3>{WatchdogKind::kNone, WatchdogKind::kSystemd,

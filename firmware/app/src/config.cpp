@@ -176,8 +176,8 @@ class Reader {
 };
 
 void read_all(Reader& r, FwConfig& c) {
-  for (const char* t : {"board", "adc", "can", "output", "navigation", "calibration", "realtime",
-                        "watchdog", "log", "sim", "hil"}) {
+  for (const char* t : {"board", "adc", "can", "output", "navigation", "aiding", "calibration",
+                        "realtime", "watchdog", "log", "sim", "hil"}) {
     r.table(t);
   }
   r.choice("board.kind", c.board, std::array<const char*, 3>{"linux", "sim", "hil"},
@@ -209,6 +209,14 @@ void read_all(Reader& r, FwConfig& c) {
   r.number("navigation.heading_deg", c.heading_deg);
   r.vec3("navigation.position_m", c.position_m);
   r.number("navigation.alignment_s", c.alignment_s);
+  r.boolean("aiding.enabled", c.aiding);
+  r.boolean("aiding.standstill", c.aiding_standstill);
+  r.integer("aiding.decimation", c.aiding_decimation, 1, 10000);
+  r.number("aiding.noise_ug", c.aiding_noise_ug);
+  r.number("aiding.bias_sigma_ug", c.aiding_bias_sigma_ug);
+  r.number("aiding.bias_rw_ug_sqrt_s", c.aiding_bias_rw_ug_sqrt_s);
+  r.number("aiding.zupt_sigma_mps", c.aiding_zupt_sigma_mps);
+  r.number("aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps);
   r.text("calibration.file", c.calibration_file);
   r.integer("realtime.priority", c.rt_priority, 0, kMaxRtPriority);
   r.boolean("realtime.lock_memory", c.lock_memory);

@@ -147,6 +147,25 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
   if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
     return P{"navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s"};
   }
+  // [aiding]: σ that are positive, finite and physically sensible (a σ of 0 would make the
+  // filter certain of a value it never measured).
+  struct Sigma {
+    const char* key;
+    double value;
+    double lo;
+    double hi;
+    const char* unit;
+  };
+  for (const Sigma& g :
+       {Sigma{"aiding.noise_ug", c.aiding_noise_ug, 0.1, 1e5, "µg"},
+        Sigma{"aiding.bias_sigma_ug", c.aiding_bias_sigma_ug, 0.1, 1e6, "µg"},
+        Sigma{"aiding.bias_rw_ug_sqrt_s", c.aiding_bias_rw_ug_sqrt_s, 0.0, 1e5, "µg/√s"},
+        Sigma{"aiding.zupt_sigma_mps", c.aiding_zupt_sigma_mps, 1e-4, 10.0, "m/s"},
+        Sigma{"aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps, 1e-6, 10.0, "rad/s"}}) {
+    if (!(g.value >= g.lo && g.value <= g.hi)) {
+      return P{g.key, num(g.value), "must be " + num(g.lo) + ".." + num(g.hi) + " " + g.unit};
+    }
+  }
   if (!c.calibration_file.empty() && !valid_path(c.calibration_file)) {
     return P{"calibration.file", quote_text(c.calibration_file),
              std::string(kPathRule) + " (or empty for none)"};

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "gfins/app/config.hpp"
+#include "gfins/app/nav_accuracy.hpp"
 
 namespace gfins::app {
 
@@ -185,6 +186,8 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
   epoch_.health = health_;
+  epoch_.valid = can::Validity::none();  // no sample behind this epoch
+  epoch_.accuracy = epoch_accuracy(pipeline_, t_ns);
 }
 
 void SampleLoop::update_adc_counters(std::uint32_t sample) {
@@ -357,6 +360,8 @@ void SampleLoop::build_epoch(const RawSample& s) {
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
   epoch_.health = health_;
+  epoch_.valid = epoch_validity(pipeline_);
+  epoch_.accuracy = epoch_accuracy(pipeline_, s.t_ns);
 }
 
 // ---- Commands -------------------------------------------------------------------------------
@@ -421,6 +426,12 @@ void SampleLoop::execute(const Command& c, Response& r) {
       const bool realign = c.kind == CommandKind::kRealign;
       if (realign && !(std::abs(c.heading_rad) <= 2.0f * std::numbers::pi_v<float>)) {
         return reject(CommandResult::kOutOfRange);
+      }
+      // A new alignment while the vehicle moves would navigate from a wrong attitude: with the
+      // aiding's standstill detector running, only a board it judges at rest (or a forced
+      // command) starts over.
+      if (!c.forced && pipeline_.aiding().started() && !pipeline_.aiding().at_rest()) {
+        return reject(CommandResult::kMoving);
       }
       nav::PipelineConfig<float> cfg = cal_.config;
       cfg.heading_rad = realign ? c.heading_rad : options_.initial_heading_rad;
@@ -539,6 +550,7 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
     cfg.r0_n = cal_.config.r0_n;
     cfg.gravity = cal_.config.gravity;
     cfg.alignment_samples = cal_.config.alignment_samples;
+    cfg.aiding = cal_.config.aiding;  // the filter restarts from its initial covariance
     if (reconfigure_keep_navigation(cfg).is_ok()) {
       cal_.config = cfg;
       cal_.cal_id = fresh.cal_id;

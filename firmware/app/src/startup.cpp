@@ -16,6 +16,23 @@ std::uint32_t calibration_id(const calib_file::CalibrationData& d) {
   return calib_file::cal_id_of(d);  // one rule, shared with gfins-calibrate's report
 }
 
+nav::AidingConfig<float> aiding_config(const FwConfig& c, const nav::PipelineConfig<float>& p) {
+  constexpr double kUg = 1e-6 * nav::kStandardGravity;  // m/s² per µg
+  nav::AidingConfig<float> a;
+  a.enabled = c.aiding;
+  a.standstill_updates = c.aiding_standstill;
+  a.decimation = static_cast<std::uint32_t>(c.aiding_decimation);
+  a.filter.sample_rate_hz = static_cast<float>(c.sample_rate_hz);
+  a.filter.noise.white_sigma_mps2.fill(static_cast<float>(c.aiding_noise_ug * kUg));
+  a.filter.noise.bias_sigma_mps2.fill(static_cast<float>(c.aiding_bias_sigma_ug * kUg));
+  a.filter.noise.bias_rw_mps2_sqrt_s.fill(static_cast<float>(c.aiding_bias_rw_ug_sqrt_s * kUg));
+  a.filter.zupt_sigma_mps = static_cast<float>(c.aiding_zupt_sigma_mps);
+  a.filter.zaru_sigma_rps = static_cast<float>(c.aiding_zaru_sigma_rps);
+  a.standstill.white_sigma_mps2 = static_cast<float>(c.aiding_noise_ug * kUg);
+  a.standstill.gravity_mps2 = p.gravity.magnitude_at_origin();
+  return a;
+}
+
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
                                            const calib_file::CalibrationData& d) {
   nav::PipelineConfig<float> p;
@@ -36,6 +53,7 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
   p.alignment_samples =
       static_cast<std::uint32_t>(std::llround(std::max(1.0, c.alignment_s * c.sample_rate_hz)));
   p.heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
+  p.aiding = aiding_config(c, p);
   p.r0_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
                        static_cast<float>(c.position_m[2]));

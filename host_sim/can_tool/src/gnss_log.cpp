@@ -31,9 +31,9 @@ bool write_gnss_log(std::FILE* out, const std::vector<sim::GnssSample>& fixes,
     const auto t_us = static_cast<std::int64_t>(std::llround((log_start_s + s.t_send_s) * 1e6));
     for (const hal::CanFrame& f : can::encode_gnss_fix(to_gnss_fix(s, spec), node_id)) {
       char line[drivers::lnx::kMaxCandumpLine + 1];
-      const std::size_t n =
-          drivers::lnx::format_candump_line(std::span<char>(line, drivers::lnx::kMaxCandumpLine), t_us / 1000000,
-                                   static_cast<std::uint32_t>(t_us % 1000000), iface.c_str(), f);
+      const std::size_t n = drivers::lnx::format_candump_line(
+          std::span<char>(line, drivers::lnx::kMaxCandumpLine), t_us / 1000000,
+          static_cast<std::uint32_t>(t_us % 1000000), iface.c_str(), f);
       if (n == 0) return false;
       line[n] = '\n';
       if (std::fwrite(line, 1, n + 1, out) != n + 1) return false;

@@ -274,12 +274,32 @@ GnssSpec parse_gnss(const toml::table& g, const Reader& rd) {
   return spec;
 }
 
+// [aiding] (AidingSpec).
+void parse_aiding(const toml::table& root, const Reader& rd, AidingSpec& a) {
+  const toml::table* t = rd.table(root, "aiding", false);
+  if (t == nullptr) return;
+  const std::string p = "aiding.";
+  rd.only(*t, p,
+          {"enabled", "decimation", "standstill", "window", "false_alarm", "zupt_sigma_mps",
+           "zaru_sigma_rps", "bias_sigma_ug", "bias_rw_ug_sqrt_s"});
+  a.enabled = rd.boolean(*t, p, "enabled", true);
+  a.decimation = static_cast<std::uint32_t>(rd.number(*t, p, "decimation", 10.0, 1.0, 10000.0));
+  a.standstill = rd.boolean(*t, p, "standstill", a.standstill);
+  a.window = static_cast<std::uint32_t>(rd.number(*t, p, "window", 100.0, 2.0, 100000.0));
+  a.false_alarm = rd.number(*t, p, "false_alarm", a.false_alarm, 1e-9, 0.5);
+  a.zupt_sigma_mps = rd.number(*t, p, "zupt_sigma_mps", a.zupt_sigma_mps, 1e-6, 10.0);
+  a.zaru_sigma_rps = rd.number(*t, p, "zaru_sigma_rps", a.zaru_sigma_rps, 1e-9, 10.0);
+  a.bias_sigma_ug = rd.number(*t, p, "bias_sigma_ug", a.bias_sigma_ug, 1e-3, 1e6);
+  a.bias_rw_ug_sqrt_s = rd.number(*t, p, "bias_rw_ug_sqrt_s", a.bias_rw_ug_sqrt_s, 0.0, 1e6);
+}
+
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
   Scenario s;
   s.source = source;
   s.name = std::filesystem::path(source).stem().string();
   rd.only(root, "",
-          {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration", "gnss"});
+          {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration", "gnss",
+           "aiding"});
 
   // [scenario]
   const toml::table& sc = *rd.table(root, "scenario", true);
@@ -456,6 +476,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   }
 
   if (const toml::table* g = rd.table(root, "gnss", false)) s.gnss = parse_gnss(*g, rd);
+  parse_aiding(root, rd, s.aiding);
   return s;
 }
 

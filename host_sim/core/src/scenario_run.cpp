@@ -33,10 +33,50 @@ struct Stream {
   std::vector<Vec6d> outputs_mps2;  // the paper's §6.3 only (!scenario.adc): m/s², no converter
   double volts_per_count = 0.0;     // of the converter, V at the sensor
   std::array<double, 6> scale_v_per_g{};  // nominal SF of each sensor, what the front end is told
+  std::vector<GnssSample> gnss;           // [gnss] fixes for an aided run, in sending order
+};
+
+/// The fixes of [gnss] the navigation is aided with: none without [aiding] enabled (the
+/// receiver then only feeds `gfins-can gnss`).
+std::vector<GnssSample> aiding_fixes(const Scenario& s, const Trajectory& traj) {
+  if (!s.gnss || !s.aiding.enabled) return {};
+  return GnssModel(*s.gnss, traj).fixes(s.duration_s);
+}
+
+/// Offers the fixes sent by t_s (t_send ≤ t_s) to the pipeline, each with its time of validity
+/// and the receiver's stated σ: what the board does with the frames of `gfins-can gnss`.
+class GnssFeeder {
+ public:
+  GnssFeeder(const std::vector<GnssSample>& fixes, const std::optional<GnssSpec>& spec)
+      : fixes_(fixes), spec_(spec) {}
+
+  template <typename T>
+  void offer_due(nav::NavPipeline<T>& p, double t_s) {
+    for (; next_ < fixes_.size() && fixes_[next_].t_send_s <= t_s; ++next_) {
+      const GnssSample& g = fixes_[next_];
+      nav::GnssFix<T> pos;
+      pos.t_valid_ns = static_cast<std::int64_t>(std::llround(g.t_valid_s * 1e9));
+      pos.value_n = g.r_n_m.template cast<T>();
+      pos.sigma =
+          nav::Vec3<T>(static_cast<T>(spec_->sigma_pos_h_m), static_cast<T>(spec_->sigma_pos_h_m),
+                       static_cast<T>(spec_->sigma_pos_v_m));
+      nav::GnssFix<T> vel = pos;
+      vel.value_n = g.v_n_mps.template cast<T>();
+      vel.sigma.setConstant(static_cast<T>(spec_->sigma_vel_mps));
+      (void)p.offer_gnss_position(pos);
+      (void)p.offer_gnss_velocity(vel);
+    }
+  }
+
+ private:
+  const std::vector<GnssSample>& fixes_;
+  const std::optional<GnssSpec>& spec_;
+  std::size_t next_ = 0;
 };
 
 HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
   const ArrayErrors errors = array_errors(s);
+  std::vector<GnssSample> gnss = aiding_fixes(s, traj);
   SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
                          s.seed);
   AdcConfig adc_config;
@@ -46,6 +86,7 @@ HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
   if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   const auto steps = static_cast<std::size_t>(sample_count(s) - 1);
   Stream st;
+  st.gnss = std::move(gnss);
   st.volts_per_count = source.volts_per_count();
   for (std::size_t j = 0; j < 6; ++j) st.scale_v_per_g[j] = errors.sensors[j].scale_v_per_g;
   st.truth.reserve(steps + 1);
@@ -92,6 +133,34 @@ SampleRecord record_of(const TruthState& truth, const nav::NavState<double>& e) 
   return rec;
 }
 
+/// The filter and standstill detector of [aiding], with the noise the scenario's sensors have
+/// (white σ per sample: the stated noise, else the QA-1100 model's 70 µg, never below the
+/// converter's 1 µg class quantisation) and the bias prior and walk [aiding] states.
+template <typename T>
+nav::AidingConfig<T> aiding_config(const Scenario& s, const nav::GravityModel<T>& gravity) {
+  const double g = nav::kStandardGravity;
+  double white = s.noise_mps2 > 0 ? s.noise_mps2 : (s.qa1100 ? 70e-6 * g : 0.0);
+  white = std::max(white, 1e-6 * g);
+  const AidingSpec& a = s.aiding;
+  nav::AidingConfig<T> c;
+  c.enabled = a.enabled;
+  c.decimation = a.decimation;
+  c.standstill_updates = a.standstill;
+  c.filter.sample_rate_hz = static_cast<T>(s.rate_hz);
+  c.filter.noise.white_sigma_mps2.fill(static_cast<T>(white));
+  c.filter.noise.bias_sigma_mps2.fill(static_cast<T>(a.bias_sigma_ug * 1e-6 * g));
+  c.filter.noise.bias_rw_mps2_sqrt_s.fill(static_cast<T>(a.bias_rw_ug_sqrt_s * 1e-6 * g));
+  c.filter.zupt_sigma_mps = static_cast<T>(a.zupt_sigma_mps);
+  c.filter.zaru_sigma_rps = static_cast<T>(a.zaru_sigma_rps);
+  c.standstill.window = a.window;
+  c.standstill.false_alarm_probability = static_cast<T>(a.false_alarm);
+  c.standstill.white_sigma_mps2 = static_cast<T>(white);
+  c.standstill.gravity_mps2 = gravity.magnitude_at_origin();
+  // The board knows where its antenna is mounted: the receiver's lever arm.
+  if (s.gnss) c.filter.gnss_lever_arm_b = s.gnss->lever_arm_b_m.template cast<T>();
+  return c;
+}
+
 /// The navigation core of one run, configured: the real front end (the converter's LSB, the
 /// sensors' scale factors, the biases the compensator is told, true or calibrated; unused by the
 /// §6.3 m/s² entry), the compensator and its misalignment, gravity, the rate.
@@ -115,6 +184,7 @@ HostResult<std::unique_ptr<nav::NavPipeline<T>>> make_pipeline(
   cfg_t.compensator = kind;
   cfg_t.gravity = gravity_model<T>(s);
   cfg_t.sample_rate_hz = static_cast<T>(cfg.sample_rate_hz);
+  cfg_t.aiding = aiding_config<T>(s, cfg_t.gravity);
   // Heap-allocated: the pipeline is a large object (on the board it lives in static storage).
   auto pipeline = std::make_unique<nav::NavPipeline<T>>();
   if (const auto status = pipeline->configure(cfg_t); !status.is_ok()) {
@@ -150,7 +220,9 @@ HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::Compens
   NavLoop<T> loop(*pipeline, [&](std::uint64_t, const nav::NavState<T>& e) {
     r.samples.push_back(record_of(st.truth[e.seq], e.template cast<double>()));
   });
+  GnssFeeder gnss(st.gnss, s.gnss);
   for (std::size_t k = 1; k < n; ++k) {
+    gnss.offer_due(*pipeline, st.truth[k - 1].t_s);
     if (s.adc) {
       loop.step(st.raw[k]);
     } else {
@@ -560,6 +632,7 @@ struct StreamedSeries {
   SeriesStats* stats = nullptr;
   std::array<double, 6> bias_mps2{};
   HostStatus sink_status = Done{};
+  std::unique_ptr<GnssFeeder> gnss;
 
   HostStatus take(const SampleRecord& rec) {
     stats->add(rec);
@@ -573,7 +646,8 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
                        const ProgressFn& progress,
                        const nav::Misalignment<double>& comp_misalignment,
                        const std::array<double, 6>& bias_comp, const std::array<double, 6>& sf,
-                       std::optional<RecordingWriter>& rec, StreamedOutcome& out) {
+                       std::optional<RecordingWriter>& rec,
+                       const std::vector<GnssSample>& gnss_fixes, StreamedOutcome& out) {
   const bool navigate_runs = s.trajectory.kind != "calibration_poses";
   const std::uint64_t steps = sample_count(s) - 1;
   out.samples_planned = steps + 1;
@@ -598,6 +672,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
       r->pipeline = std::move(p);
       r->stats = sp.stats;
       r->bias_mps2 = sp.bias;
+      r->gnss = std::make_unique<GnssFeeder>(gnss_fixes, s.gnss);
       if (!sp.csv->empty()) {
         GFINS_TRY(auto w, SeriesCsvWriter::open(*sp.csv, targets.decimate));
         r->csv.emplace(std::move(w));
@@ -622,6 +697,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
     return o;
   };
   const std::uint64_t every = std::max<std::uint64_t>(out.samples_planned / 1000, 1);
+  double t_prev_s = 0.0;  // fixes sent by the previous sample are offered before this one
   for (std::uint64_t k = 0; k <= steps; ++k) {
     if (k > 0 && targets.stop != nullptr && *targets.stop != 0) {
       out.interrupted = true;
@@ -645,6 +721,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
             r->take(record_of(x->truth, r->pipeline->state().template cast<double>())));
         continue;
       }
+      r->gnss->offer_due(*r->pipeline, t_prev_s);
       if (s.adc) {
         r->loop->step(x->raw);
       } else {
@@ -656,6 +733,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
     }
     out.samples_done = k + 1;
     out.t_stop_s = x->truth.t_s;
+    t_prev_s = x->truth.t_s;
     if (progress && k % every == 0) {
       progress(static_cast<double>(k) / static_cast<double>(out.samples_planned));
     }
@@ -701,6 +779,7 @@ HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const Strea
   if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   std::array<double, 6> sf{};
   for (std::size_t j = 0; j < 6; ++j) sf[j] = errors.sensors[j].scale_v_per_g;
+  const std::vector<GnssSample> gnss = aiding_fixes(s, *traj);
   std::optional<RecordingWriter> rec;
   if (!targets.recording.empty()) {
     if (!s.adc || !(source.volts_per_count() > 0.0)) {
@@ -719,8 +798,9 @@ HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const Strea
   }
   const HostStatus st =
       scalar == NavScalar::kFloat
-          ? stream_runs<float>(s, source, targets, progress, comp_m, bias_comp, sf, rec, out)
-          : stream_runs<double>(s, source, targets, progress, comp_m, bias_comp, sf, rec, out);
+          ? stream_runs<float>(s, source, targets, progress, comp_m, bias_comp, sf, rec, gnss, out)
+          : stream_runs<double>(s, source, targets, progress, comp_m, bias_comp, sf, rec, gnss,
+                                out);
   if (rec) {
     out.recorded = rec->records_written();
     // Closed even after an error, so that what was written stays a valid recording.

@@ -72,6 +72,21 @@ struct CalibrationSpec {
   std::uint64_t seed = 7;
 };
 
+/// [aiding]: the navigation core's error-state filter and standstill updates
+/// (nav/filter/aiding.hpp). The filter's noise model comes from the scenario's sensors (white σ per
+/// sample); the bias prior and walk are stated here because the filter cannot know the truth.
+struct AidingSpec {
+  bool enabled = false;
+  std::uint32_t decimation = 10;    // filter propagation every D samples
+  bool standstill = true;           // ZUPT + ZARU when the detector says "at rest"
+  std::uint32_t window = 100;       // standstill detector window, samples
+  double false_alarm = 0.01;        // P(a rest window declared moving)
+  double zupt_sigma_mps = 0.01;     // 1σ of the zero-velocity pseudo-measurement
+  double zaru_sigma_rps = 1e-3;     // 1σ of the zero-rate pseudo-measurement
+  double bias_sigma_ug = 500.0;     // random-constant bias 1σ per sensor (prior), µg
+  double bias_rw_ug_sqrt_s = 10.0;  // bias random walk per sensor, µg/√s
+};
+
 struct Scenario {
   std::string name;         // file stem or [scenario] name
   std::string description;  // one line
@@ -122,6 +137,7 @@ struct Scenario {
   // [gnss] (optional): a simulated GNSS receiver on the board's CAN bus (gnss_model.hpp,
   // `gfins-can gnss`). Absent: no GNSS.
   std::optional<GnssSpec> gnss;
+  AidingSpec aiding{};
 };
 
 /// Parses TOML text; `source` names it in messages. Errors name the file, the key and the line.

@@ -9,6 +9,7 @@
 
 #include "gfins/nav_core/alignment.hpp"
 #include "gfins/nav_core/compensator.hpp"
+#include "gfins/nav_core/filter/aiding.hpp"
 #include "gfins/nav_core/front_end.hpp"
 #include "gfins/nav_core/geometry.hpp"
 #include "gfins/nav_core/gravity.hpp"
@@ -33,17 +34,35 @@ struct PipelineConfig {
   std::uint32_t alignment_samples = 1000;  // samples at rest averaged before navigating
   T heading_rad = T(0);                    // given: nothing on board senses heading
   Vec3<T> r0_n = Vec3<T>::Zero();          // given initial position, m, NED
+  AidingConfig<T> aiding{};                // error-state filter and standstill updates (off)
+  // With aiding on, the static alignment refuses a window that moved (and starts over):
+  // RMS deviation of f from its mean, RMS of ω̇, and | |f̄| − g | beyond these. Defaults: 5 mg,
+  // 0.5 rad/s² and 10 mg, several times the QA-1100 array's noise (docs/math.md).
+  T align_max_f_noise_mps2 = T(0.05);
+  T align_max_wdot_rms_rps2 = T(0.5);
+  T align_gravity_tolerance_mps2 = T(0.1);
+};
+
+/// Why the last alignment window was refused (PipelineCounters::alignment_restarts counts them).
+enum class AlignmentRefusal : std::uint8_t {
+  kNone,
+  kNotGravity,        // |f̄| < 1 m/s²: not a gravity vector (board not at rest, wrong units)
+  kSpecificForce,     // f scattered beyond align_max_f_noise_mps2: the board moved
+  kAngularAccel,      // ω̇ beyond align_max_wdot_rms_rps2: the board turned
+  kGravityMagnitude,  // |f̄| differs from the gravity model: accelerating, or a wrong calibration
 };
 
 enum class PipelinePhase : std::uint8_t { kAligning, kNavigating };
 
 /// Counters a pipeline keeps; they only grow (the firmware publishes them).
 struct PipelineCounters {
-  std::uint32_t samples = 0;         // samples offered
-  std::uint32_t gaps = 0;            // jumps of the sample counter (counted here only)
-  std::uint32_t missed_samples = 0;  // samples lost in those jumps
-  std::uint32_t saturated = 0;       // samples with a channel at ADC full scale
-  std::uint32_t rejected = 0;        // samples not integrated (saturated or kCrcError)
+  std::uint32_t samples = 0;             // samples offered
+  std::uint32_t gaps = 0;                // jumps of the sample counter (counted here only)
+  std::uint32_t missed_samples = 0;      // samples lost in those jumps
+  std::uint32_t saturated = 0;           // samples with a channel at ADC full scale
+  std::uint32_t rejected = 0;            // samples not integrated (saturated or kCrcError)
+  std::uint32_t alignment_restarts = 0;  // alignment windows refused (last_refusal says why)
+  AlignmentRefusal last_refusal = AlignmentRefusal::kNone;
 };
 
 template <typename T>
@@ -69,11 +88,15 @@ class NavPipeline {
       return Status(ErrorCode::kInvalidArgument,
                     "pipeline: sample rate must be positive and finite");
     }
+    Aiding<T> aiding;
+    const Status as = aiding.configure(solver.value(), config.aiding);
+    if (!as.is_ok()) return as;
     config_ = config;
     front_end_ = fe.value();
     compensator_ = comp.value();
     compensator_.fold_into(solver.value());
     strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
+    aiding_ = aiding;
     aligner_.reset();
     have_seen_ = false;
     period_s_ = T(1) / config.sample_rate_hz;
@@ -130,6 +153,7 @@ class NavPipeline {
     Outputs s;
     compensator_.apply(s_raw, initial.w_b, initial.wdot_b, s);
     strapdown_.initialize(initial, s);
+    aiding_.start(strapdown_);
     mark_compensated();
     last_seq_ = initial.seq;
     last_seen_seq_ = initial.seq;
@@ -143,6 +167,24 @@ class NavPipeline {
     count_gap(seq);
     return integrate(s_raw, t_ns, seq);
   }
+
+  // ---- Aiding (PipelineConfig::aiding) -------------------------------------------------------
+  // External measurements with their own time of validity (GnssFix::t_valid_ns, on the samples'
+  // clock); each goes through the filter's χ² gate. Not aligned or aiding off: kInvalid.
+
+  UpdateOutcome offer_gnss_position(const GnssFix<T>& fix) {
+    return aiding_.offer_gnss_position(strapdown_, fix);
+  }
+  UpdateOutcome offer_gnss_velocity(const GnssFix<T>& fix) {
+    return aiding_.offer_gnss_velocity(strapdown_, fix);
+  }
+  UpdateOutcome offer_heading(T yaw_rad, T sigma_rad) {
+    return aiding_.offer_heading(strapdown_, yaw_rad, sigma_rad);
+  }
+  /// The filter, the detector and the accuracy of state(); aiding().started() says whether the
+  /// σ mean anything (aiding on and aligned).
+  const Aiding<T>& aiding() const { return aiding_; }
+  NavAccuracy<T> accuracy() const { return aiding_.accuracy(strapdown_.state()); }
 
   PipelinePhase phase() const { return phase_; }
   bool configured() const { return configured_; }
@@ -177,10 +219,12 @@ class NavPipeline {
     if (dseq != 1) status |= nav_status::kSampleGap;  // lost or rejected samples in between
     last_seq_ = seq;
     const NavState<T>& st = strapdown_.state();
+    const T dt_s = period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq);
     // u = M s with the compensator folded in (Compensator::fold_into): one product per sample.
     strapdown_.step_linear(
-        compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b),
-        period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq), t_ns, seq);
+        compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b), dt_s, t_ns,
+        seq);
+    if (aiding_.started()) aiding_.after_step(strapdown_, dt_s);
     strapdown_.mutable_state().status = status;
     mark_compensated();
     return phase_;
@@ -192,8 +236,12 @@ class NavPipeline {
     aligner_.add(strapdown_.solver(), s);
     if (aligner_.count() < config_.alignment_samples) return;
     const auto result = aligner_.finish(config_.alignment_samples);
-    if (!result.is_ok()) {
-      aligner_.reset();  // not a gravity vector: start over (board moving or not connected)
+    const AlignmentRefusal why =
+        result.is_ok() ? refusal(result.value()) : AlignmentRefusal::kNotGravity;
+    if (why != AlignmentRefusal::kNone) {
+      aligner_.reset();  // start over (board moving, not connected, or the wrong calibration)
+      ++counters_.alignment_restarts;
+      counters_.last_refusal = why;
       return;
     }
     alignment_ = result.value();
@@ -201,6 +249,21 @@ class NavPipeline {
         StaticAligner<T, 6>::initial_state(alignment_, config_.heading_rad, config_.r0_n, t_ns);
     init.seq = seq;
     start_at_specific_force(init, s_raw);
+  }
+
+  /// The motion checks of an aided alignment (PipelineConfig); unaided, only the gravity-vector
+  /// check of StaticAligner::finish applies.
+  AlignmentRefusal refusal(const AlignmentResult<T>& a) const {
+    if (!config_.aiding.enabled) return AlignmentRefusal::kNone;
+    if (!(a.f_noise_mps2 <= config_.align_max_f_noise_mps2))
+      return AlignmentRefusal::kSpecificForce;
+    if (!(a.wdot_rms_rps2 <= config_.align_max_wdot_rms_rps2))
+      return AlignmentRefusal::kAngularAccel;
+    const T g = config_.gravity.magnitude_at_origin();
+    if (!(std::abs(a.gravity_mps2 - g) <= config_.align_gravity_tolerance_mps2)) {
+      return AlignmentRefusal::kGravityMagnitude;
+    }
+    return AlignmentRefusal::kNone;
   }
 
   void mark_compensated() {
@@ -213,6 +276,7 @@ class NavPipeline {
   FrontEnd<T, 6> front_end_{};
   Compensator<T> compensator_{};
   Strapdown<T, 6> strapdown_{};
+  Aiding<T> aiding_{};
   StaticAligner<T, 6> aligner_{};
   AlignmentResult<T> alignment_{};
   PipelineCounters counters_{};

@@ -70,6 +70,16 @@ struct FwConfig {
   std::array<double, 3> position_m{};  // initial position, NED from the alignment point
   double alignment_s = 1.0;            // time at rest averaged by the static alignment
 
+  // [aiding] the error-state filter with standstill updates (docs/firmware.md, "Aiding")
+  bool aiding = false;
+  bool aiding_standstill = true;           // ZUPT + ZARU while the array says "at rest"
+  int aiding_decimation = 10;              // filter propagation every N samples
+  double aiding_noise_ug = 70.0;           // white noise per sensor and sample (QA-1100: 70 µg)
+  double aiding_bias_sigma_ug = 500.0;     // per-sensor bias prior, 1σ
+  double aiding_bias_rw_ug_sqrt_s = 10.0;  // per-sensor bias random walk
+  double aiding_zupt_sigma_mps = 0.01;     // 1σ of the zero-velocity update
+  double aiding_zaru_sigma_rps = 0.001;    // 1σ of the zero-rate update
+
   // [calibration]
   std::string calibration_file = "/var/lib/gfins/calibration.toml";
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "gfins/app/health.hpp"
+#include "gfins/can/epoch.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/nav_core/compensator.hpp"
 #include "gfins/nav_core/nav_state.hpp"
@@ -34,6 +35,8 @@ struct Epoch {
   std::uint32_t status_bits = 0;  // status_bits::
   std::uint32_t cal_id = 0;       // calibration identity (0 = uncalibrated defaults)
   HealthCounters health{};
+  can::Validity valid = can::Validity::none();  // per navigation group (nav_accuracy.hpp)
+  can::Accuracy accuracy{};                     // the filter's 1σ, mode, aiding counters
 };
 
 /// What the ADC driver counts (cumulative).
@@ -89,6 +92,7 @@ struct Command {
   CommandKind kind = CommandKind::kReportCalibration;
   std::uint8_t token = 0;  // echoed in the response so the host matches it
   float heading_rad = 0;   // kRealign
+  bool forced = false;     // kRealign, kResetNavigation: even while the board moves
   nav::CompensatorKind compensator = nav::CompensatorKind::kNone;  // kSetCompensator
   std::uint8_t message = 0;                                        // kSetDivider
   std::uint16_t divider = 0;                                       // kSetDivider
@@ -106,6 +110,7 @@ enum class CommandResult : std::uint8_t {
   kMalformed = 5,   // frame could not be decoded
   kBusy = 6,        // a capture or reload is already running
   kFailed = 7,      // executed but failed (reload: bad file; the previous calibration stays)
+  kMoving = 9,      // re-align or reset refused while the board moves (not forced)
 };
 
 /// Calibration capture statistics of one channel, in ADC codes.

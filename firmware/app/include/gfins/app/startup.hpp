@@ -17,6 +17,9 @@ namespace gfins::app {
 /// tool prints); 0 is reserved for "uncalibrated defaults".
 std::uint32_t calibration_id(const calib_file::CalibrationData& d);
 
+/// The [aiding] section as the navigation core takes it (gravity and rate from `p`).
+nav::AidingConfig<float> aiding_config(const FwConfig& c, const nav::PipelineConfig<float>& p);
+
 /// Pipeline configuration from the firmware configuration and a calibration.
 nav::PipelineConfig<float> pipeline_config(const FwConfig& c, const calib_file::CalibrationData& d);
 

@@ -3,15 +3,18 @@
 // force about its window mean and of the angular acceleration.
 //
 // Over a window of W samples of [ω̇_k; f_k] (ω = 0 assumed: the linear part M s),
-//   T = (1/W) Σ_k [ ‖f_k − f̄‖² / σ_f² + ‖ω̇_k‖² / σ_ω̇² ],   f̄ = (1/W) Σ f_k,
+//   T = (1/W) Σ_k [ ‖f_k − f̄‖² / σ_f² + ‖ω̇_k − ω̇̄‖² / σ_ω̇² ],   f̄, ω̇̄ the window means,
 // with σ_f², σ_ω̇² the per-axis variances of the white sensor noise mapped through M
 // (σ² M Mᵀ; for Table 1 it is diag(σ_ω̇² I, σ_f² I) exactly, so the components are independent
-// with those variances). Under H0 (at rest: ω̇ = 0, f constant, unknown) W·T is χ² with
-// 3W + 3(W − 1) = 6W − 3 degrees of freedom (the mean of f takes 3), so the threshold for a false
-// alarm probability p_fa (a window at rest declared moving) is
-//   γ = χ²_{1−p_fa}(6W − 3) / W   (chi_square.hpp: Wilson–Hilferty, < 0.01 % off for 6W−3 ≥ 100).
-// A window is "at rest" when T ≤ γ and | ‖f̄‖ − g | ≤ gravity_tolerance.
-//
+// with those variances). Under H0 (at rest: f and ω̇ constant) W·T is χ² with 6(W − 1) degrees
+// of freedom (each mean takes 3), so the threshold for a false alarm probability p_fa (a window
+// at rest declared moving) is
+//   γ = χ²_{1−p_fa}(6W − 6) / W   (chi_square.hpp: Wilson–Hilferty, < 0.01 % off for 6W−6 ≥ 100).
+// A window is "at rest" when T ≤ γ, | ‖f̄‖ − g | ≤ gravity_tolerance and ‖ω̇̄‖ ≤ the ω̇
+// tolerance. The ω̇ mean is tested against a tolerance, not inside T: at rest it is the array's
+// ω̇ bias (0.45 mg of sensor drift makes ~0.03 rad/s², about 6 σ_ω̇ per sample for the QA-1100
+// array), which no statistic of the window can tell from a real constant angular acceleration;
+// the aiding sets the tolerance from what its bias estimate leaves unknown (aiding.hpp).
 // Windows are consecutive and disjoint (a decision every W samples), so no W-sized buffer is
 // needed: running sums only. The f sums are taken about the window's first sample (f_k − f_ref),
 // so float32 does not cancel g² against g²: Σ‖f_k − f̄‖² = Σ‖d_k‖² − W ‖d̄‖², d = f − f_ref.
@@ -33,6 +36,10 @@ struct StandstillConfig {
   T white_sigma_mps2 = T(1e-3);         // per-sensor white noise σ per sample (m/s²)
   T gravity_mps2 = T(kStandardGravity);
   T gravity_tolerance_mps2 = T(0.05);  // | ‖f̄‖ − g | allowed at rest
+  // ‖mean ω̇‖ allowed at rest, rad/s²: at rest the mean is the array's ω̇ bias, which the
+  // statistic cannot tell from a real angular acceleration; the aiding narrows this to what the
+  // filter's bias estimate leaves unknown (set_wdot_tolerance).
+  T wdot_mean_tolerance_rps2 = T(0.02);
 };
 
 template <typename T>
@@ -54,9 +61,11 @@ class StandstillDetector {
     var_wdot_ = mmt.template topLeftCorner<3, 3>().trace() / T(3);
     var_f_ = mmt.template bottomRightCorner<3, 3>().trace() / T(3);
     const auto w = static_cast<int>(config.window);
+    // Two scatters about their window means (f and ω̇): 6W − 6 degrees of freedom under H0.
     threshold_ =
-        chi_square_quantile(T(1) - config.false_alarm_probability, 6 * w - 3) / static_cast<T>(w);
+        chi_square_quantile(T(1) - config.false_alarm_probability, 6 * w - 6) / static_cast<T>(w);
     config_ = config;
+    wdot_tolerance_ = config.wdot_mean_tolerance_rps2;
     reset();
     return Status::ok();
   }
@@ -66,8 +75,15 @@ class StandstillDetector {
     n_ = 0;
     sum_d_.setZero();
     sum_d2_ = T(0);
+    sum_w_.setZero();
     sum_wdot2_ = T(0);
   }
+
+  /// The ‖mean ω̇‖ allowed at rest from now on (rad/s², positive).
+  void set_wdot_tolerance(T tolerance_rps2) {
+    if (tolerance_rps2 > T(0)) wdot_tolerance_ = tolerance_rps2;
+  }
+  T wdot_tolerance() const { return wdot_tolerance_; }
 
   /// One sample of the array's solution with ω = 0 (ω̇ rad/s², f m/s², body). Returns true when
   /// it completed a window (a new decision in at_rest() and statistic()).
@@ -76,14 +92,18 @@ class StandstillDetector {
     const Vec3<T> d = f_b - f_ref_;
     sum_d_ += d;
     sum_d2_ += d.squaredNorm();
+    sum_w_ += wdot_b;
     sum_wdot2_ += wdot_b.squaredNorm();
     if (++n_ < config_.window) return false;
     const T w = static_cast<T>(n_);
     const Vec3<T> mean_d = sum_d_ / w;
     const T scatter = sum_d2_ - w * mean_d.squaredNorm();  // Σ‖f_k − f̄‖²
-    statistic_ = (scatter / var_f_ + sum_wdot2_ / var_wdot_) / w;
+    const Vec3<T> mean_w = sum_w_ / w;
+    const T scatter_w = sum_wdot2_ - w * mean_w.squaredNorm();  // Σ‖ω̇_k − mean ω̇‖²
+    statistic_ = (scatter / var_f_ + scatter_w / var_wdot_) / w;
     const T g_err = std::abs((f_ref_ + mean_d).norm() - config_.gravity_mps2);
-    at_rest_ = statistic_ <= threshold_ && g_err <= config_.gravity_tolerance_mps2;
+    at_rest_ = statistic_ <= threshold_ && g_err <= config_.gravity_tolerance_mps2 &&
+               mean_w.norm() <= wdot_tolerance_;
     ++windows_;
     if (at_rest_) ++rest_windows_;
     reset();
@@ -106,7 +126,9 @@ class StandstillDetector {
   Vec3<T> f_ref_ = Vec3<T>::Zero();
   Vec3<T> sum_d_ = Vec3<T>::Zero();
   T sum_d2_ = T(0);
+  Vec3<T> sum_w_ = Vec3<T>::Zero();
   T sum_wdot2_ = T(0);
+  T wdot_tolerance_ = T(0.02);
   std::uint32_t n_ = 0;
   T statistic_ = T(0);
   bool at_rest_ = false;

@@ -15,8 +15,8 @@
 namespace gfins::drivers::lnx {
 
 /// Limits of the project's text inputs (each far above any real file of its kind).
-inline constexpr std::size_t kMaxConfigBytes = 1u << 20;    // firmware configuration, scenarios
-inline constexpr std::size_t kMaxTableBytes = 16u << 20;    // CSV tables (means, rate-table plans)
+inline constexpr std::size_t kMaxConfigBytes = 1u << 20;  // firmware configuration, scenarios
+inline constexpr std::size_t kMaxTableBytes = 16u << 20;  // CSV tables (means, rate-table plans)
 
 /// Reads the file at `path` into `out` (replaced). Errors: kIoError with errno when it cannot be
 /// opened or read (a folder reads as EISDIR), kOutOfRange "larger than the limit" when it holds

@@ -1,0 +1,154 @@
+// Aided navigation inside the pipeline: the error-state filter, the standstill detector and the
+// decimation between them (docs/math.md, "Aided navigation: the error-state filter").
+//
+// Per integrated sample the pipeline calls after_step():
+//   - the standstill detector takes the sample's [ω̇; f] (a decision every W samples);
+//   - every D samples (FilterConfig's propagation interval, AidingConfig::decimation) the filter
+//     propagates its covariance over the time since the previous propagation, and while the
+//     last detector decision says "at rest" it applies the zero-velocity and zero-rate updates
+//     (ZUPT, ZARU), each through its χ² gate.
+// External aiding (GNSS position and velocity, heading) enters through the offer_*() calls with
+// the measurement's own time of validity.
+//
+// Disabled (the default), nothing here runs and the per-sample path of the pipeline is the
+// unaided one (one branch).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "gfins/nav_core/filter/error_state_filter.hpp"
+#include "gfins/nav_core/filter/standstill_detector.hpp"
+#include "gfins/nav_core/geometry.hpp"
+#include "gfins/nav_core/integrator.hpp"
+#include "gfins/status/status.hpp"
+
+namespace gfins::nav {
+
+template <typename T>
+struct AidingConfig {
+  bool enabled = false;
+  std::uint32_t decimation = 10;  // filter propagation every D integrated samples (100 Hz at 1 kHz)
+  bool standstill_updates = true;  // ZUPT + ZARU while the detector says "at rest"
+  FilterConfig<T> filter{};
+  StandstillConfig<T> standstill{};
+};
+
+template <typename T>
+class Aiding {
+ public:
+  using Nav = Strapdown<T, kNumSensors>;
+
+  /// Builds the filter and the detector for `solver` (the one the strapdown uses; the filter
+  /// takes its process model from the strapdown at each propagation). Disabled: only remembers
+  /// that. On failure nothing changes.
+  [[nodiscard]] Status configure(const ArraySolver<T, kNumSensors>& solver,
+                                 const AidingConfig<T>& config) {
+    if (!config.enabled) {
+      config_ = config;
+      started_ = false;
+      return Status::ok();
+    }
+    if (config.decimation < 1 || config.decimation > 10000) {
+      return Status(ErrorCode::kInvalidArgument, "aiding: decimation must be 1..10000 samples");
+    }
+    ErrorStateFilter<T> filter;
+    const Status fs = filter.configure(config.filter);
+    if (!fs.is_ok()) return fs;
+    StandstillDetector<T> detector;
+    const Status ds = detector.configure(solver, config.standstill);
+    if (!ds.is_ok()) return ds;
+    config_ = config;
+    filter_ = filter;
+    detector_ = detector;
+    started_ = false;
+    return Status::ok();
+  }
+
+  bool enabled() const { return config_.enabled; }
+  bool started() const { return started_; }
+
+  /// At the end of alignment: the filter starts at the strapdown's solution.
+  void start(Nav& nav) {
+    if (!config_.enabled) return;
+    filter_.start(nav);
+    detector_.reset();
+    detector_.set_wdot_tolerance(wdot_tolerance());
+    pending_ = 0;
+    pending_dt_s_ = T(0);
+    still_ = false;
+    started_ = true;
+  }
+
+  /// After each integrated sample (dt_s: the step it integrated, gaps included).
+  void after_step(Nav& nav, T dt_s) {
+    if (!started_) return;
+    const NavState<T>& st = nav.state();
+    if (detector_.add(st.wdot_b, st.f_b)) {
+      still_ = detector_.at_rest();
+      detector_.set_wdot_tolerance(wdot_tolerance());
+    }
+    pending_dt_s_ += dt_s;
+    if (++pending_ < config_.decimation) return;
+    const Status s = filter_.propagate(nav, pending_dt_s_);
+    pending_ = 0;
+    pending_dt_s_ = T(0);
+    if (!s.is_ok()) {
+      ++propagation_errors_;
+      return;
+    }
+    if (still_ && config_.standstill_updates) {
+      (void)filter_.update_zupt(nav);
+      (void)filter_.update_zaru(nav);
+    }
+  }
+
+  UpdateOutcome offer_gnss_position(Nav& nav, const GnssFix<T>& fix) {
+    if (!started_) return not_started();
+    return filter_.update_gnss_position(nav, fix);
+  }
+  UpdateOutcome offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
+    if (!started_) return not_started();
+    return filter_.update_gnss_velocity(nav, fix);
+  }
+  UpdateOutcome offer_heading(Nav& nav, T yaw_rad, T sigma_rad) {
+    if (!started_) return not_started();
+    return filter_.update_heading(nav, yaw_rad, sigma_rad);
+  }
+
+  /// 1σ, mode and validity; only meaningful when started().
+  NavAccuracy<T> accuracy(const NavState<T>& nav) const { return filter_.accuracy(nav); }
+  /// The last standstill decision (false before the first window).
+  bool at_rest() const { return still_; }
+  const ErrorStateFilter<T>& filter() const { return filter_; }
+  const StandstillDetector<T>& detector() const { return detector_; }
+  const AidingConfig<T>& config() const { return config_; }
+  std::uint32_t propagation_errors() const { return propagation_errors_; }
+
+ private:
+  /// ‖mean ω̇‖ the detector allows at rest: 3σ of what the filter does not know of the ω̇ bias
+  /// (the strapdown's ω̇ has the estimate removed) plus the window mean's own noise, per axis
+  /// at its largest, times √3 for the norm of three axes.
+  T wdot_tolerance() const {
+    using namespace filt_idx;
+    const auto& p = filter_.covariance();
+    T var = T(0);
+    for (int i = 0; i < 3; ++i) var = std::max(var, p(kBiasWdot + i, kBiasWdot + i));
+    var += detector_.sigma2_wdot() / static_cast<T>(config_.standstill.window);
+    return T(3) * std::sqrt(T(3) * var);
+  }
+
+  static UpdateOutcome not_started() { return UpdateOutcome{UpdateStatus::kInvalid, 0.0f}; }
+
+  AidingConfig<T> config_{};
+  ErrorStateFilter<T> filter_{};
+  StandstillDetector<T> detector_{};
+  std::uint32_t pending_ = 0;
+  T pending_dt_s_ = T(0);
+  bool still_ = false;
+  bool started_ = false;
+  std::uint32_t propagation_errors_ = 0;
+};
+
+}  // namespace gfins::nav
