@@ -59,6 +59,7 @@ step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
+  nav_core_error_state_filter_long \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
   can_publisher_no_malloc_check gfins-can gfins_can_decode_bench gfins_package_programs \
   host_sim_montecarlo_cli

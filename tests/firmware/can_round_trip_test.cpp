@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
@@ -26,6 +27,31 @@ using testing::SimRig;
 double expected_value(const Epoch& e, const can::SignalDef& s) {
   const auto& n = e.nav;
   const int i = s.index;
+  // A navigation group the epoch does not stand behind (aligning) goes out as not available.
+  constexpr double kNa = std::numeric_limits<double>::quiet_NaN();
+  switch (s.field) {
+    case can::Field::kQuaternion:
+    case can::Field::kEuler:
+      if (!e.valid.attitude) return kNa;
+      break;
+    case can::Field::kRate:
+      if (!e.valid.rate) return kNa;
+      break;
+    case can::Field::kAngularAccel:
+      if (!e.valid.angular_accel) return kNa;
+      break;
+    case can::Field::kAccel:
+      if (!e.valid.accel) return kNa;
+      break;
+    case can::Field::kVelocity:
+      if (!e.valid.velocity) return kNa;
+      break;
+    case can::Field::kPosition:
+      if (!e.valid.position) return kNa;
+      break;
+    default:
+      break;
+  }
   switch (s.field) {
     case can::Field::kVelocity:
       return static_cast<double>(n.v_n(i));
@@ -60,7 +86,16 @@ double expected_value(const Epoch& e, const can::SignalDef& s) {
       return e.health.bus_off_events;
     case can::Field::kLoopOverruns:
       return e.health.loop_overruns;
-    default:  // Euler angles, mode, flags, time: the protocol's own mapping
+    case can::Field::kStatusFlags: {
+      // The publisher flags an epoch whose navigation values went out as not available
+      // (docs/can-interface.md, StatusFlags bit 5): every group while aligning.
+      const can::Validity& v = e.valid;
+      const bool any_na =
+          !(v.attitude && v.rate && v.angular_accel && v.accel && v.velocity && v.position);
+      return can::epoch_field(to_can_epoch(e), s.field, s.index) +
+             (any_na ? static_cast<double>(can::status_bits::kCanNotAvailable) : 0.0);
+    }
+    default:  // Euler angles, mode, time: the protocol's own mapping
       return can::epoch_field(to_can_epoch(e), s.field, s.index);
   }
 }

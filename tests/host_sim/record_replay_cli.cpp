@@ -514,7 +514,7 @@ rate_dps = 90
        {"trajectory.rate_dps", "does not apply to trajectory kind \"rest\"", "kind, euler_deg"}},
       {{"covariance", rest, "--at", "7", "--no-plot"}, {"--at 7", "outside the run", "(0, 5]"}},
       {{"covariance", rest, "--at", "-1", "--no-plot"}, {"--at -1", "outside the run"}},
-      {{"covariance", rest, "--bias-ug", "-3", "--no-plot"}, {"--bias-ug -3", ">= 0"}},
+      {{"covariance", rest, "--bias-ug", "-3", "--no-plot"}, {"--bias-ug", "'-3'", "outside [0,"}},
       {{"run", rest, "-o", "", "--no-plot"}, {"-o/--out is empty"}},
       {{"run", "paper-6.3", "--record", path("p.gfr"), "--no-plot", "-o", path("p63")},
        {"--record", "sensors.adc = false"}},

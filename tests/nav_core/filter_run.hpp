@@ -197,4 +197,27 @@ RunResult<T> run_aided(const RunSpec& spec, FilterConfig<double> config_d) {
   return out;
 }
 
+/// The largest |error| / bound of a block over the epochs after t0.
+inline double max_abs(const std::vector<Epoch>& e, int first, int n, double t0 = 0) {
+  double m = 0;
+  for (const Epoch& x : e) {
+    if (x.t < t0) continue;
+    m = std::max(m, x.err.segment(first, n).cwiseAbs().maxCoeff());
+  }
+  return m;
+}
+
+/// Fraction of (epoch, axis) pairs after t0 whose |error| is within k σ of the filter.
+inline double fraction_within(const std::vector<Epoch>& e, int first, int n, double k, double t0) {
+  int in = 0, all = 0;
+  for (const Epoch& x : e) {
+    if (x.t < t0) continue;
+    for (int i = first; i < first + n; ++i) {
+      ++all;
+      if (std::abs(x.err(i)) <= k * std::sqrt(x.p(i, i))) ++in;
+    }
+  }
+  return all > 0 ? static_cast<double>(in) / all : 0.0;
+}
+
 }  // namespace gfins::nav::testing
