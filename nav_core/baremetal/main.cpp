@@ -2,12 +2,12 @@
 //
 // One nav::NavPipeline<float> lives in static storage (.bss); main() configures it once with the
 // paper's Table 6 calibration and the exact compensator (the solver of the calibrated geometry:
-// one geometry, the configuration issue 13 sizes), then runs the per-sample step on counts read
-// from a volatile buffer that stands for the ADC's DMA target, and writes the navigation state to a
-// volatile sink, so the compiler can neither fold the inputs nor drop the outputs. In the QEMU
-// build (GFINS_PROBE_STEPS) main() fills that buffer before each step with the next of the
-// benchmarks' 1 kHz samples of the manoeuvre (probe_samples.hpp): the traced steps see real,
-// varying codes and navigate the trajectory they came from.
+// one geometry, the configuration whose flash and RAM are budgeted), then runs the per-sample step
+// on counts read from a volatile buffer that stands for the ADC's DMA target, and writes the
+// navigation state to a volatile sink, so the compiler can neither fold the inputs nor drop the
+// outputs. In the QEMU build (GFINS_PROBE_STEPS) main() fills that buffer before each step with the
+// next of the benchmarks' 1 kHz samples of the manoeuvre (probe_samples.hpp): the traced steps see
+// real, varying codes and navigate the trajectory they came from.
 //
 // The per-sample work is the out-of-line function gfins_nav_step(): scripts/embedded_size.sh
 // walks the call graph from it in the disassembly and reports any soft-float double routine

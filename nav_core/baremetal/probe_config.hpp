@@ -32,8 +32,8 @@ using Vec3f = std::array<float, 3>;
 
 /// Paper Table 6 (SF in V/g, bias in g, orientation errors in radians), sensors 1..6 in Table 1
 /// order, a cube of half-size 0.1 m, 1 kHz, the exact compensator (the solver of the calibrated
-/// geometry: one geometry, the configuration issue 13 sizes), with the converter's LSB (V per
-/// count) and each sensor's location error Δρ_j (m, body) given.
+/// geometry: one geometry, the configuration whose flash and RAM are budgeted), with the
+/// converter's LSB (V per count) and each sensor's location error Δρ_j (m, body) given.
 inline nav::PipelineConfig<float> make_probe_config(float volts_per_count,
                                                     const std::array<Vec3f, 6>& drho_m) {
   nav::PipelineConfig<float> c;

@@ -1,6 +1,6 @@
 // Text rules of the configuration (gfins/app/config.hpp): UTF-8 paths without control
 // characters, and values shown in messages escaped so that no NUL cuts a message and no control
-// sequence reaches the terminal (issue 8 review, items 2 and 3).
+// sequence reaches the terminal.
 #include <cstdio>
 #include <string>
 #include <string_view>

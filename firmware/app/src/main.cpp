@@ -161,8 +161,8 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
     }
   }
   board.close();
-  // A CAN log that lost frames is a failed run: its file is not the run's output (15a of the
-  // issue 8 review: /dev/full used to exit 0 with every frame dropped).
+  // A CAN log that lost frames is a failed run: its file is not the run's output (a log on a
+  // full disk, /dev/full, must not end with exit 0 and every frame dropped).
   if (const std::string lost = board.finish_output(); !lost.empty()) {
     spdlog::error("{}", lost);
     status = 1;
