@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Second command of the README, and what CI runs (.ci/run): install packages, check formatting,
-# build every preset, run the whole test suite, then clang-tidy. Exits non-zero on the first
-# failure. GFINS_JOBS sets the build parallelism (default: all cores).
+# build every preset, run the whole test suite, with clang-tidy in the background from the
+# start. Exits non-zero on the first failure. GFINS_JOBS sets the build parallelism (default: all
+# cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${GFINS_JOBS:-$(nproc)}
@@ -43,6 +44,21 @@ step "install packages"
 step "clang-format check"
 ./scripts/check-format.sh
 
+# clang-tidy needs only the release tree's compile database, which configuring writes (the files
+# it checks include no generated header), so it starts here, in the background at the lowest CPU
+# priority (nice 19: it gets a core only when the steps below leave one idle: link and test
+# phases, the serial install and documentation steps, apt downloads, the tests under qemu-user,
+# lintian, the virtual machine's one TCG thread), in its own process group, stopped if the script
+# ends early; its result is collected at the end. The virtual board's data-ready stages run on
+# instruction-counted guest time, so this load does not move their timing (docs/deploy.md).
+# Own process group through job control (set -m), not setsid: a new session is a new scheduler
+# autogroup, in which nice 19 would count only against itself and tidy would take half the CPU.
+cmake --preset host-release >/dev/null
+set -m
+nice -n 19 ./scripts/check-tidy.sh build/host-release >"$log_dir/tidy.log" 2>&1 &
+tidy_pid=$!
+set +m
+
 step "host-debug (ASan + UBSan): build"
 cmake --preset host-debug >/dev/null
 cmake --build --preset host-debug -j "$jobs"
@@ -59,23 +75,10 @@ step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_replay_bench nav_core_integrator_stability_long \
-  nav_core_error_state_filter_long \
+  nav_core_error_state_filter_long nav_core_filter_nees_long host_sim_aided_run_long \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
   can_publisher_no_malloc_check gfins-can gfins_can_decode_bench gfins_package_programs \
   host_sim_montecarlo_cli
-
-# clang-tidy reads only the release tree's compile database, so from here it runs in the
-# background at the lowest CPU priority (nice 19: it gets a core only when the steps below leave
-# one idle: the serial test and install steps, the single-threaded LTO link, the tests under
-# qemu-user, apt, lintian, the VM's one TCG thread), in its own process group, stopped if the
-# script ends early; its result is collected at the end. The virtual board's data-ready stages run
-# on instruction-counted guest time, so this load does not move their timing (docs/deploy.md).
-# Own process group through job control (set -m), not setsid: a new session is a new scheduler
-# autogroup, in which nice 19 would count only against itself and tidy would take half the CPU.
-set -m
-nice -n 19 ./scripts/check-tidy.sh build/host-release >"$log_dir/tidy.log" 2>&1 &
-tidy_pid=$!
-set +m
 
 step "host-release: hour-long runs (label long), heap checks (label heap), resource figures (label optimised)"
 ctest --preset host-release -j "$jobs" -L 'long|heap|optimised' | tee "$log_dir/ctest-release.log"
@@ -145,7 +148,7 @@ fw_deb=${fw_debs[0]}
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
   --deb "$fw_deb"
 
-step "clang-tidy (started after the release build, at the lowest priority)"
+step "clang-tidy (started after the format check, at the lowest priority)"
 tidy_rc=0
 wait "$tidy_pid" || tidy_rc=$?
 tidy_pid=""

@@ -17,6 +17,7 @@
 #include <optional>
 #include <set>
 
+#include "gfins/can/aiding_input.hpp"
 #include "gfins/can/command.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "sim_rig.hpp"
@@ -666,6 +667,41 @@ TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {
   for (std::uint32_t r : bus.response_results) EXPECT_EQ(r, 3u);  // Result 3 = BadCrc
   EXPECT_EQ(lines_with(lines_, "rejected").size(), 1u);
   expect_status_rate(bus, 1000, rig.samples);
+}
+
+// GNSS input frames with aiding on: a corrupted frame is refused, counted and logged; a whole
+// fix (the board's true position and velocity at rest, zero) reaches the filter, which accepts
+// both of its updates. The oracle is the scenario: the board is at rest at the origin.
+TEST_F(Faults, GnssInputFramesReachTheFilterAndACorruptedOneIsCountedAndLogged) {
+  SimRig rig("rest", 3.0);
+  rig.config.aiding = true;
+  rig.cal = app::load_calibration(rig.config, rig.factory, &rig.factory).set;
+  rig.configure();
+  rig.run_cycles(2000);  // aligned after 1 s
+  can::GnssFix fix;
+  fix.fix_id = 3;
+  fix.has_position = true;
+  fix.has_velocity = true;
+  fix.sigma_pos_h_m = 1.5;
+  fix.sigma_pos_v_m = 3.0;
+  fix.sigma_vel_mps = 0.1;
+  fix.age_s = 0.05;
+  const auto frames = can::encode_gnss_fix(fix, SimRig::kNode);
+  hal::CanFrame bad = frames[0];
+  bad.data[7] ^= 0x5A;  // CRC byte
+  ASSERT_TRUE(rig.bus->inject_rx(bad));
+  rig.run_cycles(1);
+  for (const hal::CanFrame& f : frames) ASSERT_TRUE(rig.bus->inject_rx(f));
+  rig.run_cycles(1);
+  rig.run();
+  lines_ = rig.drain_log();
+  EXPECT_EQ(rig.loop->health().aiding_input_errors, 1u);
+  EXPECT_EQ(rig.loop->health().aiding_inputs, 1u);
+  EXPECT_EQ(rig.loop->health().command_errors, 0u);  // input frames are not commands
+  const auto& c = rig.loop->pipeline().aiding().filter().counters();
+  EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssPosition)], 1u);
+  EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssVelocity)], 1u);
+  EXPECT_EQ(lines_with(lines_, "aiding input frame").size(), 1u);
 }
 
 TEST_F(Faults, FailedCalibrationReloadKeepsTheCalibrationAnswersFailedAndLogs) {

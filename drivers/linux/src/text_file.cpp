@@ -24,7 +24,7 @@ Status read_text_file(const char* path, std::size_t max_bytes, std::string& out)
   // O_NOCTTY: a terminal named as an input never becomes the controlling terminal.
   const ClosingFd fd{::open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY)};
   if (fd.fd < 0) return Status(ErrorCode::kIoError, "cannot open the file", errno);
-  constexpr std::size_t kChunk = 64 * 1024;
+  constexpr std::size_t kChunk = std::size_t{64} * 1024U;
   for (;;) {
     const std::size_t have = out.size();
     // One byte beyond the limit tells "exactly max_bytes" from "more".

@@ -217,6 +217,8 @@ void read_all(Reader& r, FwConfig& c) {
   r.number("aiding.bias_rw_ug_sqrt_s", c.aiding_bias_rw_ug_sqrt_s);
   r.number("aiding.zupt_sigma_mps", c.aiding_zupt_sigma_mps);
   r.number("aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps);
+  r.boolean("aiding.inputs", c.aiding_inputs);
+  r.vec3("aiding.gnss_lever_arm_m", c.aiding_gnss_lever_arm_m);
   r.text("calibration.file", c.calibration_file);
   r.integer("realtime.priority", c.rt_priority, 0, kMaxRtPriority);
   r.boolean("realtime.lock_memory", c.lock_memory);

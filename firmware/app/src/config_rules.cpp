@@ -166,6 +166,12 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
       return P{g.key, num(g.value), "must be " + num(g.lo) + ".." + num(g.hi) + " " + g.unit};
     }
   }
+  // The antenna sits on the vehicle: a lever arm beyond 100 m is a unit mistake (mm for m).
+  for (double l : c.aiding_gnss_lever_arm_m) {
+    if (!std::isfinite(l) || std::abs(l) > 100.0) {
+      return P{"aiding.gnss_lever_arm_m", num(l), "components must be finite, |x| <= 100 m"};
+    }
+  }
   if (!c.calibration_file.empty() && !valid_path(c.calibration_file)) {
     return P{"calibration.file", quote_text(c.calibration_file),
              std::string(kPathRule) + " (or empty for none)"};

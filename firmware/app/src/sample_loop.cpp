@@ -36,6 +36,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_ = cal;
   cal_.config = cfg;
   options_ = options;
+  inputs_ = can::InputDecoder(options.node_id);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
   adc_seen_ = adc_.counters();
   can_seen_ = bus_.counters();
@@ -367,10 +368,12 @@ void SampleLoop::build_epoch(const RawSample& s) {
 // ---- Commands -------------------------------------------------------------------------------
 
 void SampleLoop::handle_commands(std::int64_t t_ns) {
-  if (codec_ == nullptr) return;
+  if (codec_ == nullptr && !options_.aiding_inputs) return;
   for (int i = 0; i < kMaxCommandsPerCycle; ++i) {
     const Result<hal::CanFrame> f = bus_.receive(0);
     if (!f.is_ok()) return;  // kTimeout: nothing waiting
+    if (options_.aiding_inputs && handle_input(f.value(), t_ns)) continue;
+    if (codec_ == nullptr) continue;
     const DecodedFrame d = codec_->decode(f.value());
     if (!d.addressed) continue;
     Response r;
@@ -390,6 +393,57 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
     }
     if (!r.deferred) send_response(r);
   }
+}
+
+bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
+  const Result<can::InputEvent> ev = inputs_.add(f);
+  if (!ev.is_ok()) {
+    ++health_.aiding_input_errors;
+    limited_log(LogKind::kInputRejected, LogLevel::kWarn, t_ns,
+                "aiding input frame id {:#x} rejected: reason {} (refused: {}; {} more since the "
+                "last line)",
+                f.id, static_cast<std::int64_t>(inputs_.last_reject()),
+                health_.aiding_input_errors);
+    return true;
+  }
+  const can::InputEvent& e = ev.value();
+  if (e.kind == can::InputEventKind::kIgnored) return false;
+  if (e.kind == can::InputEventKind::kPending) return true;
+  ++health_.aiding_inputs;
+  // Time of validity on the loop's clock: this cycle's sample time less the age the sender
+  // stated (the bus transit, under a millisecond at 500 kbit/s, is not in it).
+  // The filter counts what it accepts and rejects (published in GfinsAidingCounters); the log
+  // says when a fix was not applied.
+  nav::UpdateStatus worst = nav::UpdateStatus::kAccepted;
+  const auto note = [&worst](const nav::UpdateOutcome& o) {
+    if (o.status == nav::UpdateStatus::kRejected || o.status == nav::UpdateStatus::kInvalid)
+      worst = o.status;
+  };
+  if (e.kind == can::InputEventKind::kGnssFix) {
+    const can::GnssFix& g = e.gnss;
+    nav::GnssFix<float> fix;
+    fix.t_valid_ns = t_ns - static_cast<std::int64_t>(std::llround(g.age_s * 1e9));
+    if (g.has_position) {
+      fix.value_n = nav::Vec3<double>(g.r_n_m[0], g.r_n_m[1], g.r_n_m[2]).cast<float>();
+      fix.sigma =
+          nav::Vec3<double>(g.sigma_pos_h_m, g.sigma_pos_h_m, g.sigma_pos_v_m).cast<float>();
+      note(pipeline_.offer_gnss_position(fix));
+    }
+    if (g.has_velocity) {
+      fix.value_n = nav::Vec3<double>(g.v_n_mps[0], g.v_n_mps[1], g.v_n_mps[2]).cast<float>();
+      fix.sigma.setConstant(static_cast<float>(g.sigma_vel_mps));
+      note(pipeline_.offer_gnss_velocity(fix));
+    }
+  } else {
+    note(pipeline_.offer_heading(static_cast<float>(e.heading.heading_rad),
+                                 static_cast<float>(e.heading.sigma_rad)));
+  }
+  if (worst != nav::UpdateStatus::kAccepted) {
+    limited_log(LogKind::kAidingRejected, LogLevel::kInfo, t_ns,
+                "aiding input not applied: outcome {} ({} more since the last line)",
+                static_cast<std::int64_t>(worst));
+  }
+  return true;
 }
 
 void SampleLoop::send_response(const Response& r) {

@@ -28,6 +28,9 @@ nav::AidingConfig<float> aiding_config(const FwConfig& c, const nav::PipelineCon
   a.filter.noise.bias_rw_mps2_sqrt_s.fill(static_cast<float>(c.aiding_bias_rw_ug_sqrt_s * kUg));
   a.filter.zupt_sigma_mps = static_cast<float>(c.aiding_zupt_sigma_mps);
   a.filter.zaru_sigma_rps = static_cast<float>(c.aiding_zaru_sigma_rps);
+  a.filter.gnss_lever_arm_b = nav::Vec3<float>(static_cast<float>(c.aiding_gnss_lever_arm_m[0]),
+                                               static_cast<float>(c.aiding_gnss_lever_arm_m[1]),
+                                               static_cast<float>(c.aiding_gnss_lever_arm_m[2]));
   a.standstill.white_sigma_mps2 = static_cast<float>(c.aiding_noise_ug * kUg);
   a.standstill.gravity_mps2 = p.gravity.magnitude_at_origin();
   return a;
@@ -63,6 +66,8 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
 LoopOptions loop_options(const FwConfig& c) {
   LoopOptions o;
   o.sample_rate_hz = c.sample_rate_hz;
+  o.node_id = static_cast<std::uint8_t>(c.node_id);
+  o.aiding_inputs = c.aiding && c.aiding_inputs;
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
   o.initial_position_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),

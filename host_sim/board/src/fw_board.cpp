@@ -87,6 +87,22 @@ app::BoardResult make_board(const app::FwConfig& c) {
     return out;
   }
   app::add_can_protocol(c, *b);
+  // The scenario's GNSS receiver ([gnss]) sends its fixes on the board's bus, as a receiver
+  // wired to the board would; gfins-fw uses them when aiding is on (aiding.inputs).
+  if (s.gnss) {
+    auto traj = sim::make_trajectory(s.trajectory);
+    if (!traj.is_ok()) {
+      out.error = traj.error().message;
+      return out;
+    }
+    std::vector<sim::GnssSample> fixes = sim::GnssModel(*s.gnss, *traj.value()).fixes(duration);
+    const double rate = s.rate_hz;
+    b->bus = std::make_unique<GnssReceiverBus>(
+        std::move(b->bus), std::move(fixes), *s.gnss, static_cast<std::uint8_t>(c.node_id),
+        [src, rate] {
+          return src->next_seq() == 0 ? -1.0 : static_cast<double>(src->next_seq() - 1) / rate;
+        });
+  }
   // Uncalibrated defaults: the nominal chain (no misalignment, nominal scale factors, no bias).
   // The factory calibration: the scenario's true parameters.
   b->factory = scenario_calibration(s, parts->adc->volts_per_count());

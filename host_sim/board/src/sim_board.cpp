@@ -166,6 +166,49 @@ void MemoryCanBus::bus_off(bool on) {
   }
 }
 
+can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec) {
+  can::GnssFix f;
+  f.fix_id = static_cast<std::uint8_t>(s.index & 0x0Fu);
+  f.has_position = true;
+  f.has_velocity = true;
+  for (int i = 0; i < 3; ++i) {
+    f.r_n_m[static_cast<std::size_t>(i)] = s.r_n_m[i];
+    f.v_n_mps[static_cast<std::size_t>(i)] = s.v_n_mps[i];
+  }
+  f.sigma_pos_h_m = spec.sigma_pos_h_m;
+  f.sigma_pos_v_m = spec.sigma_pos_v_m;
+  f.sigma_vel_mps = spec.sigma_vel_mps;
+  f.age_s = s.t_send_s - s.t_valid_s;
+  return f;
+}
+
+GnssReceiverBus::GnssReceiverBus(std::unique_ptr<hal::CanBus> inner,
+                                 std::vector<sim::GnssSample> fixes, const sim::GnssSpec& spec,
+                                 std::uint8_t node_id, std::function<double()> now_s)
+    : inner_(std::move(inner)),
+      fixes_(std::move(fixes)),
+      spec_(spec),
+      node_id_(node_id),
+      now_s_(std::move(now_s)) {}
+
+Result<hal::CanFrame> GnssReceiverBus::do_receive(std::int64_t timeout_ns) {
+  if (pending_next_ >= pending_.size() && next_ < fixes_.size()) {
+    const double now = now_s_();
+    const sim::GnssSample& g = fixes_[next_];
+    if (g.t_send_s <= now) {
+      // Handed over after the sample at `now`: the age is counted from that sample, so the
+      // board's time of validity (that sample's time - age) is the fix's own.
+      can::GnssFix fix = to_gnss_fix(g, spec_);
+      fix.age_s = now - g.t_valid_s;
+      pending_ = can::encode_gnss_fix(fix, node_id_);
+      pending_next_ = 0;
+      ++next_;
+    }
+  }
+  if (pending_next_ < pending_.size()) return pending_[pending_next_++];
+  return inner_->receive(timeout_ns);
+}
+
 bool MemoryCanBus::inject_rx(const hal::CanFrame& f) {
   if (rx_count_ == rx_.size()) return false;
   rx_[(rx_head_ + rx_count_) % rx_.size()] = f;

@@ -5,31 +5,16 @@
 #include <thread>
 
 #include "gfins/drivers/lnx/candump.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 
 namespace gfins::can_tool {
-
-can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec) {
-  can::GnssFix f;
-  f.fix_id = static_cast<std::uint8_t>(s.index & 0x0Fu);
-  f.has_position = true;
-  f.has_velocity = true;
-  for (int i = 0; i < 3; ++i) {
-    f.r_n_m[static_cast<std::size_t>(i)] = s.r_n_m[i];
-    f.v_n_mps[static_cast<std::size_t>(i)] = s.v_n_mps[i];
-  }
-  f.sigma_pos_h_m = spec.sigma_pos_h_m;
-  f.sigma_pos_v_m = spec.sigma_pos_v_m;
-  f.sigma_vel_mps = spec.sigma_vel_mps;
-  f.age_s = s.t_send_s - s.t_valid_s;
-  return f;
-}
 
 bool write_gnss_log(std::FILE* out, const std::vector<sim::GnssSample>& fixes,
                     const sim::GnssSpec& spec, std::uint8_t node_id, double log_start_s,
                     const std::string& iface) {
   for (const sim::GnssSample& s : fixes) {
     const auto t_us = static_cast<std::int64_t>(std::llround((log_start_s + s.t_send_s) * 1e6));
-    for (const hal::CanFrame& f : can::encode_gnss_fix(to_gnss_fix(s, spec), node_id)) {
+    for (const hal::CanFrame& f : can::encode_gnss_fix(sim_board::to_gnss_fix(s, spec), node_id)) {
       char line[drivers::lnx::kMaxCandumpLine + 1];
       const std::size_t n = drivers::lnx::format_candump_line(
           std::span<char>(line, drivers::lnx::kMaxCandumpLine), t_us / 1000000,
@@ -49,7 +34,7 @@ std::uint64_t send_gnss_live(hal::CanBus& bus, const std::vector<sim::GnssSample
   for (const sim::GnssSample& s : fixes) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::nanoseconds>(
                                               std::chrono::duration<double>(s.t_send_s)));
-    for (const hal::CanFrame& f : can::encode_gnss_fix(to_gnss_fix(s, spec), node_id)) {
+    for (const hal::CanFrame& f : can::encode_gnss_fix(sim_board::to_gnss_fix(s, spec), node_id)) {
       if (!bus.send(f).is_ok()) ++refused;
     }
   }

@@ -14,10 +14,6 @@
 
 namespace gfins::can_tool {
 
-/// The fix a sample becomes on the bus: position and velocity, the spec's σ, age = the latency,
-/// fix id = index mod 16.
-can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec);
-
 /// Writes every fix's four frames as candump lines on interface `iface`, stamped at the fix's
 /// transmission time + `log_start_s`. False when writing failed.
 bool write_gnss_log(std::FILE* out, const std::vector<sim::GnssSample>& fixes,

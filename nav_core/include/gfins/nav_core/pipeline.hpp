@@ -74,46 +74,13 @@ class NavPipeline {
 
   /// Builds every stage from `config`. On failure nothing changes: a pipeline that was running
   /// keeps its previous (last good) configuration.
-  [[nodiscard]] Status configure(const PipelineConfig<T>& config) {
-    const auto fe = FrontEnd<T, 6>::create(config.front_end);
-    if (!fe.is_ok()) return fe.status();
-    const auto comp =
-        Compensator<T>::create(config.compensator, config.nominal, config.misalignment);
-    if (!comp.is_ok()) return comp.status();
-    const auto solver = ArraySolver<T, 6>::create(
-        Compensator<T>::solver_geometry(config.compensator, config.nominal, config.misalignment),
-        config.max_condition);
-    if (!solver.is_ok()) return solver.status();
-    if (!(config.sample_rate_hz > T(0)) || !std::isfinite(config.sample_rate_hz)) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "pipeline: sample rate must be positive and finite");
-    }
-    Aiding<T> aiding;
-    const Status as = aiding.configure(solver.value(), config.aiding);
-    if (!as.is_ok()) return as;
-    config_ = config;
-    front_end_ = fe.value();
-    compensator_ = comp.value();
-    compensator_.fold_into(solver.value());
-    strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
-    aiding_ = aiding;
-    aligner_.reset();
-    have_seen_ = false;
-    period_s_ = T(1) / config.sample_rate_hz;
-    phase_ = PipelinePhase::kAligning;
-    configured_ = true;
-    return Status::ok();
-  }
+  [[nodiscard]] Status configure(const PipelineConfig<T>& config);
 
   /// Skips alignment: navigation starts at `initial` with this sample (simulation with known
   /// truth, or a warm start). Only the counts of `first` are used: initial.seq and initial.t_ns
   /// say which sample it is, and the next process() counts its gap against initial.seq. The
   /// counts must be a measurement (the caller has the truth, so it starts on a good sample).
-  void start_at(const NavState<T>& initial, const RawSample& first) {
-    Outputs s;
-    front_end_.convert(first.counts, s);
-    start_at_specific_force(initial, s);
-  }
+  void start_at(const NavState<T>& initial, const RawSample& first);
 
   /// One ADC frame: the pipeline's one input (docs/architecture.md, "one path for a sample").
   /// Returns the phase after it; in kNavigating, state() is valid at s.t_ns.
@@ -128,18 +95,7 @@ class NavPipeline {
   ///     both are rejected (counters().rejected; saturated also counts in counters().saturated)
   ///     and leave the state untouched. The next good frame integrates across the hole, over
   ///     the sample periods since the last integrated frame, with nav_status::kSampleGap.
-  PipelinePhase process(const RawSample& s) {
-    ++counters_.samples;
-    count_gap(s.seq);
-    Outputs f;
-    const std::uint32_t saturated = front_end_.convert(s.counts, f);
-    if (saturated != 0) ++counters_.saturated;
-    if ((s.flags & sample_flags::kCrcError) != 0 || saturated != 0) {
-      ++counters_.rejected;
-      return phase_;
-    }
-    return integrate(f, s.t_ns, s.seq);
-  }
+  PipelinePhase process(const RawSample& s);
 
   // ---- m/s² entry: the paper's §6.3 experiment only ------------------------------------------
   // The paper's §6.3 simulation feeds the mechanization with sensor outputs in m/s² (no converter,
@@ -149,42 +105,22 @@ class NavPipeline {
   // only for scenarios with `adc = false`, which only the paper-6.3 files set).
 
   /// start_at() for outputs already in m/s² (§6.3 only, see above).
-  void start_at_specific_force(const NavState<T>& initial, const Outputs& s_raw) {
-    Outputs s;
-    compensator_.apply(s_raw, initial.w_b, initial.wdot_b, s);
-    strapdown_.initialize(initial, s);
-    aiding_.start(strapdown_);
-    mark_compensated();
-    last_seq_ = initial.seq;
-    last_seen_seq_ = initial.seq;
-    have_seen_ = true;
-    phase_ = PipelinePhase::kNavigating;
-  }
+  void start_at_specific_force(const NavState<T>& initial, const Outputs& s_raw);
 
   /// process() for outputs already in m/s² (§6.3 only, see above): same counters, no flags.
-  PipelinePhase process_specific_force(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
-    ++counters_.samples;
-    count_gap(seq);
-    return integrate(s_raw, t_ns, seq);
-  }
+  PipelinePhase process_specific_force(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq);
 
   // ---- Aiding (PipelineConfig::aiding) -------------------------------------------------------
   // External measurements with their own time of validity (GnssFix::t_valid_ns, on the samples'
   // clock); each goes through the filter's χ² gate. Not aligned or aiding off: kInvalid.
 
-  UpdateOutcome offer_gnss_position(const GnssFix<T>& fix) {
-    return aiding_.offer_gnss_position(strapdown_, fix);
-  }
-  UpdateOutcome offer_gnss_velocity(const GnssFix<T>& fix) {
-    return aiding_.offer_gnss_velocity(strapdown_, fix);
-  }
-  UpdateOutcome offer_heading(T yaw_rad, T sigma_rad) {
-    return aiding_.offer_heading(strapdown_, yaw_rad, sigma_rad);
-  }
+  UpdateOutcome offer_gnss_position(const GnssFix<T>& fix);
+  UpdateOutcome offer_gnss_velocity(const GnssFix<T>& fix);
+  UpdateOutcome offer_heading(T yaw_rad, T sigma_rad);
   /// The filter, the detector and the accuracy of state(); aiding().started() says whether the
   /// σ mean anything (aiding on and aligned).
   const Aiding<T>& aiding() const { return aiding_; }
-  NavAccuracy<T> accuracy() const { return aiding_.accuracy(strapdown_.state()); }
+  NavAccuracy<T> accuracy() const;
 
   PipelinePhase phase() const { return phase_; }
   bool configured() const { return configured_; }
@@ -209,62 +145,13 @@ class NavPipeline {
 
   /// A good sample after the front end (m/s²): alignment, or one integration step over the
   /// sample periods since the last integrated sample.
-  PipelinePhase integrate(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
-    if (phase_ == PipelinePhase::kAligning) {
-      align(s_raw, t_ns, seq);
-      return phase_;
-    }
-    const std::uint32_t dseq = seq - last_seq_;  // wraps correctly at 2^32
-    std::uint32_t status = nav_status::kAligned;
-    if (dseq != 1) status |= nav_status::kSampleGap;  // lost or rejected samples in between
-    last_seq_ = seq;
-    const NavState<T>& st = strapdown_.state();
-    const T dt_s = period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq);
-    // u = M s with the compensator folded in (Compensator::fold_into): one product per sample.
-    strapdown_.step_linear(
-        compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b), dt_s, t_ns,
-        seq);
-    if (aiding_.started()) aiding_.after_step(strapdown_, dt_s);
-    strapdown_.mutable_state().status = status;
-    mark_compensated();
-    return phase_;
-  }
+  PipelinePhase integrate(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq);
 
-  void align(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
-    Outputs s;
-    compensator_.apply(s_raw, Vec3<T>::Zero(), Vec3<T>::Zero(), s);
-    aligner_.add(strapdown_.solver(), s);
-    if (aligner_.count() < config_.alignment_samples) return;
-    const auto result = aligner_.finish(config_.alignment_samples);
-    const AlignmentRefusal why =
-        result.is_ok() ? refusal(result.value()) : AlignmentRefusal::kNotGravity;
-    if (why != AlignmentRefusal::kNone) {
-      aligner_.reset();  // start over (board moving, not connected, or the wrong calibration)
-      ++counters_.alignment_restarts;
-      counters_.last_refusal = why;
-      return;
-    }
-    alignment_ = result.value();
-    NavState<T> init =
-        StaticAligner<T, 6>::initial_state(alignment_, config_.heading_rad, config_.r0_n, t_ns);
-    init.seq = seq;
-    start_at_specific_force(init, s_raw);
-  }
+  void align(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq);
 
   /// The motion checks of an aided alignment (PipelineConfig); unaided, only the gravity-vector
   /// check of StaticAligner::finish applies.
-  AlignmentRefusal refusal(const AlignmentResult<T>& a) const {
-    if (!config_.aiding.enabled) return AlignmentRefusal::kNone;
-    if (!(a.f_noise_mps2 <= config_.align_max_f_noise_mps2))
-      return AlignmentRefusal::kSpecificForce;
-    if (!(a.wdot_rms_rps2 <= config_.align_max_wdot_rms_rps2))
-      return AlignmentRefusal::kAngularAccel;
-    const T g = config_.gravity.magnitude_at_origin();
-    if (!(std::abs(a.gravity_mps2 - g) <= config_.align_gravity_tolerance_mps2)) {
-      return AlignmentRefusal::kGravityMagnitude;
-    }
-    return AlignmentRefusal::kNone;
-  }
+  AlignmentRefusal refusal(const AlignmentResult<T>& a) const;
 
   void mark_compensated() {
     if (compensator_.kind() != CompensatorKind::kNone) {
@@ -287,6 +174,159 @@ class NavPipeline {
   PipelinePhase phase_ = PipelinePhase::kAligning;
   bool configured_ = false;
 };
+
+// ---- NavPipeline: member functions defined outside the class, so not inline: a translation unit
+// that uses the extern instantiation below calls them instead of instantiating them again
+// to inline them (nav_core/src instantiates each once per scalar type).
+
+template <typename T>
+Status NavPipeline<T>::configure(const PipelineConfig<T>& config) {
+  const auto fe = FrontEnd<T, 6>::create(config.front_end);
+  if (!fe.is_ok()) return fe.status();
+  const auto comp = Compensator<T>::create(config.compensator, config.nominal, config.misalignment);
+  if (!comp.is_ok()) return comp.status();
+  const auto solver = ArraySolver<T, 6>::create(
+      Compensator<T>::solver_geometry(config.compensator, config.nominal, config.misalignment),
+      config.max_condition);
+  if (!solver.is_ok()) return solver.status();
+  if (!(config.sample_rate_hz > T(0)) || !std::isfinite(config.sample_rate_hz)) {
+    return Status(ErrorCode::kInvalidArgument, "pipeline: sample rate must be positive and finite");
+  }
+  Aiding<T> aiding;
+  const Status as = aiding.configure(solver.value(), config.aiding);
+  if (!as.is_ok()) return as;
+  config_ = config;
+  front_end_ = fe.value();
+  compensator_ = comp.value();
+  compensator_.fold_into(solver.value());
+  strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
+  aiding_ = aiding;
+  aligner_.reset();
+  have_seen_ = false;
+  period_s_ = T(1) / config.sample_rate_hz;
+  phase_ = PipelinePhase::kAligning;
+  configured_ = true;
+  return Status::ok();
+}
+
+template <typename T>
+void NavPipeline<T>::start_at(const NavState<T>& initial, const RawSample& first) {
+  Outputs s;
+  front_end_.convert(first.counts, s);
+  start_at_specific_force(initial, s);
+}
+
+template <typename T>
+PipelinePhase NavPipeline<T>::process(const RawSample& s) {
+  ++counters_.samples;
+  count_gap(s.seq);
+  Outputs f;
+  const std::uint32_t saturated = front_end_.convert(s.counts, f);
+  if (saturated != 0) ++counters_.saturated;
+  if ((s.flags & sample_flags::kCrcError) != 0 || saturated != 0) {
+    ++counters_.rejected;
+    return phase_;
+  }
+  return integrate(f, s.t_ns, s.seq);
+}
+
+template <typename T>
+void NavPipeline<T>::start_at_specific_force(const NavState<T>& initial, const Outputs& s_raw) {
+  Outputs s;
+  compensator_.apply(s_raw, initial.w_b, initial.wdot_b, s);
+  strapdown_.initialize(initial, s);
+  aiding_.start(strapdown_);
+  mark_compensated();
+  last_seq_ = initial.seq;
+  last_seen_seq_ = initial.seq;
+  have_seen_ = true;
+  phase_ = PipelinePhase::kNavigating;
+}
+
+template <typename T>
+PipelinePhase NavPipeline<T>::process_specific_force(const Outputs& s_raw, std::int64_t t_ns,
+                                                     std::uint32_t seq) {
+  ++counters_.samples;
+  count_gap(seq);
+  return integrate(s_raw, t_ns, seq);
+}
+
+template <typename T>
+UpdateOutcome NavPipeline<T>::offer_gnss_position(const GnssFix<T>& fix) {
+  return aiding_.offer_gnss_position(strapdown_, fix);
+}
+
+template <typename T>
+UpdateOutcome NavPipeline<T>::offer_gnss_velocity(const GnssFix<T>& fix) {
+  return aiding_.offer_gnss_velocity(strapdown_, fix);
+}
+
+template <typename T>
+UpdateOutcome NavPipeline<T>::offer_heading(T yaw_rad, T sigma_rad) {
+  return aiding_.offer_heading(strapdown_, yaw_rad, sigma_rad);
+}
+
+template <typename T>
+NavAccuracy<T> NavPipeline<T>::accuracy() const {
+  return aiding_.accuracy(strapdown_.state());
+}
+
+template <typename T>
+PipelinePhase NavPipeline<T>::integrate(const Outputs& s_raw, std::int64_t t_ns,
+                                        std::uint32_t seq) {
+  if (phase_ == PipelinePhase::kAligning) {
+    align(s_raw, t_ns, seq);
+    return phase_;
+  }
+  const std::uint32_t dseq = seq - last_seq_;  // wraps correctly at 2^32
+  std::uint32_t status = nav_status::kAligned;
+  if (dseq != 1) status |= nav_status::kSampleGap;  // lost or rejected samples in between
+  last_seq_ = seq;
+  const NavState<T>& st = strapdown_.state();
+  const T dt_s = period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq);
+  // u = M s with the compensator folded in (Compensator::fold_into): one product per sample.
+  strapdown_.step_linear(
+      compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b), dt_s, t_ns,
+      seq);
+  if (aiding_.started()) aiding_.after_step(strapdown_, dt_s);
+  strapdown_.mutable_state().status = status;
+  mark_compensated();
+  return phase_;
+}
+
+template <typename T>
+void NavPipeline<T>::align(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
+  Outputs s;
+  compensator_.apply(s_raw, Vec3<T>::Zero(), Vec3<T>::Zero(), s);
+  aligner_.add(strapdown_.solver(), s);
+  if (aligner_.count() < config_.alignment_samples) return;
+  const auto result = aligner_.finish(config_.alignment_samples);
+  const AlignmentRefusal why =
+      result.is_ok() ? refusal(result.value()) : AlignmentRefusal::kNotGravity;
+  if (why != AlignmentRefusal::kNone) {
+    aligner_.reset();  // start over (board moving, not connected, or the wrong calibration)
+    ++counters_.alignment_restarts;
+    counters_.last_refusal = why;
+    return;
+  }
+  alignment_ = result.value();
+  NavState<T> init =
+      StaticAligner<T, 6>::initial_state(alignment_, config_.heading_rad, config_.r0_n, t_ns);
+  init.seq = seq;
+  start_at_specific_force(init, s_raw);
+}
+
+template <typename T>
+AlignmentRefusal NavPipeline<T>::refusal(const AlignmentResult<T>& a) const {
+  if (!config_.aiding.enabled) return AlignmentRefusal::kNone;
+  if (!(a.f_noise_mps2 <= config_.align_max_f_noise_mps2)) return AlignmentRefusal::kSpecificForce;
+  if (!(a.wdot_rms_rps2 <= config_.align_max_wdot_rms_rps2)) return AlignmentRefusal::kAngularAccel;
+  const T g = config_.gravity.magnitude_at_origin();
+  if (!(std::abs(a.gravity_mps2 - g) <= config_.align_gravity_tolerance_mps2)) {
+    return AlignmentRefusal::kGravityMagnitude;
+  }
+  return AlignmentRefusal::kNone;
+}
 
 extern template class NavPipeline<float>;
 extern template class NavPipeline<double>;

@@ -79,6 +79,8 @@ struct FwConfig {
   double aiding_bias_rw_ug_sqrt_s = 10.0;  // per-sensor bias random walk
   double aiding_zupt_sigma_mps = 0.01;     // 1σ of the zero-velocity update
   double aiding_zaru_sigma_rps = 0.001;    // 1σ of the zero-rate update
+  bool aiding_inputs = true;  // GNSS / heading input frames of can.node_id feed the filter
+  std::array<double, 3> aiding_gnss_lever_arm_m{};  // GNSS antenna from the array centre, FRD, m
 
   // [calibration]
   std::string calibration_file = "/var/lib/gfins/calibration.toml";

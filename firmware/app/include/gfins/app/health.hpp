@@ -30,8 +30,10 @@ struct HealthCounters {
   std::uint32_t log_dropped = 0;        // log records lost to a full queue
   std::uint32_t commands = 0;           // commands executed
   std::uint32_t command_errors = 0;     // commands rejected (malformed, out of range, busy)
-  std::uint8_t stuck_mask = 0;          // channels stuck now (bit j = channel j)
-  std::uint8_t saturated_mask = 0;      // channels saturated in the last sample
+  std::uint32_t aiding_inputs = 0;      // GNSS fixes and headings decoded from input frames
+  std::uint32_t aiding_input_errors = 0;  // input frames refused (CRC, length, range, stale id)
+  std::uint8_t stuck_mask = 0;            // channels stuck now (bit j = channel j)
+  std::uint8_t saturated_mask = 0;        // channels saturated in the last sample
 };
 
 /// Bits of Epoch::status_bits: the positions of the CAN status frame's StatusFlags

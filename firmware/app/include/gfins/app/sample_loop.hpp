@@ -23,6 +23,7 @@
 #include "gfins/app/ports.hpp"
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/app/status_board.hpp"
+#include "gfins/can/aiding_input.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
 #include "gfins/hal/watchdog.hpp"
@@ -97,6 +98,8 @@ enum class LogKind : std::uint8_t {
   kCanStateBetter,  // back to error-active or warning
   kOverrun,
   kCommandRejected,
+  kInputRejected,   // a GNSS / heading input frame refused by its decoder
+  kAidingRejected,  // a decoded fix refused by the filter (χ² gate, before alignment)
   kCount,
 };
 
@@ -131,6 +134,8 @@ struct LoopOptions {
   double sample_rate_hz = 1000.0;
   float initial_heading_rad = 0;
   nav::Vec3<float> initial_position_n = nav::Vec3<float>::Zero();
+  std::uint8_t node_id = 1;    // the input frames (GNSS, heading) addressed to this node
+  bool aiding_inputs = false;  // decode them and offer them to the filter
 };
 
 class SampleLoop {
@@ -204,6 +209,9 @@ class SampleLoop {
     log(level, t_ns, fmt, a[0], a[1], a[2], a[3]);
   }
   Status reconfigure_keep_navigation(const nav::PipelineConfig<float>& cfg);
+  /// A received frame that is a GNSS or heading input of this node: decoded, offered to the
+  /// filter, counted. False when it is not one (a command frame, another node's input).
+  bool handle_input(const hal::CanFrame& f, std::int64_t t_ns);
   void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
            std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0);
 
@@ -213,6 +221,7 @@ class SampleLoop {
   hal::Clock& clock_;
   FwLogQueue& log_;
   const CommandCodec* codec_ = nullptr;
+  can::InputDecoder inputs_{1};  // GNSS / heading frames of options_.node_id
   hal::Watchdog* watchdog_ = nullptr;
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;

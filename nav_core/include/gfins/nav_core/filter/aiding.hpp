@@ -44,81 +44,23 @@ class Aiding {
   /// takes its process model from the strapdown at each propagation). Disabled: only remembers
   /// that. On failure nothing changes.
   [[nodiscard]] Status configure(const ArraySolver<T, kNumSensors>& solver,
-                                 const AidingConfig<T>& config) {
-    if (!config.enabled) {
-      config_ = config;
-      started_ = false;
-      return Status::ok();
-    }
-    if (config.decimation < 1 || config.decimation > 10000) {
-      return Status(ErrorCode::kInvalidArgument, "aiding: decimation must be 1..10000 samples");
-    }
-    ErrorStateFilter<T> filter;
-    const Status fs = filter.configure(config.filter);
-    if (!fs.is_ok()) return fs;
-    StandstillDetector<T> detector;
-    const Status ds = detector.configure(solver, config.standstill);
-    if (!ds.is_ok()) return ds;
-    config_ = config;
-    filter_ = filter;
-    detector_ = detector;
-    started_ = false;
-    return Status::ok();
-  }
+                                 const AidingConfig<T>& config);
 
   bool enabled() const { return config_.enabled; }
   bool started() const { return started_; }
 
   /// At the end of alignment: the filter starts at the strapdown's solution.
-  void start(Nav& nav) {
-    if (!config_.enabled) return;
-    filter_.start(nav);
-    detector_.reset();
-    detector_.set_wdot_tolerance(wdot_tolerance());
-    pending_ = 0;
-    pending_dt_s_ = T(0);
-    still_ = false;
-    started_ = true;
-  }
+  void start(Nav& nav);
 
   /// After each integrated sample (dt_s: the step it integrated, gaps included).
-  void after_step(Nav& nav, T dt_s) {
-    if (!started_) return;
-    const NavState<T>& st = nav.state();
-    if (detector_.add(st.wdot_b, st.f_b)) {
-      still_ = detector_.at_rest();
-      detector_.set_wdot_tolerance(wdot_tolerance());
-    }
-    pending_dt_s_ += dt_s;
-    if (++pending_ < config_.decimation) return;
-    const Status s = filter_.propagate(nav, pending_dt_s_);
-    pending_ = 0;
-    pending_dt_s_ = T(0);
-    if (!s.is_ok()) {
-      ++propagation_errors_;
-      return;
-    }
-    if (still_ && config_.standstill_updates) {
-      (void)filter_.update_zupt(nav);
-      (void)filter_.update_zaru(nav);
-    }
-  }
+  void after_step(Nav& nav, T dt_s);
 
-  UpdateOutcome offer_gnss_position(Nav& nav, const GnssFix<T>& fix) {
-    if (!started_) return not_started();
-    return filter_.update_gnss_position(nav, fix);
-  }
-  UpdateOutcome offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
-    if (!started_) return not_started();
-    return filter_.update_gnss_velocity(nav, fix);
-  }
-  UpdateOutcome offer_heading(Nav& nav, T yaw_rad, T sigma_rad) {
-    if (!started_) return not_started();
-    return filter_.update_heading(nav, yaw_rad, sigma_rad);
-  }
+  UpdateOutcome offer_gnss_position(Nav& nav, const GnssFix<T>& fix);
+  UpdateOutcome offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix);
+  UpdateOutcome offer_heading(Nav& nav, T yaw_rad, T sigma_rad);
 
   /// 1σ, mode and validity; only meaningful when started().
-  NavAccuracy<T> accuracy(const NavState<T>& nav) const { return filter_.accuracy(nav); }
+  NavAccuracy<T> accuracy(const NavState<T>& nav) const;
   /// The last standstill decision (false before the first window).
   bool at_rest() const { return still_; }
   const ErrorStateFilter<T>& filter() const { return filter_; }
@@ -150,5 +92,94 @@ class Aiding {
   bool started_ = false;
   std::uint32_t propagation_errors_ = 0;
 };
+
+// ---- Aiding: member functions defined outside the class, so not inline: a translation unit
+// that uses the extern instantiation below calls them instead of instantiating them again
+// to inline them (nav_core/src instantiates each once per scalar type).
+
+template <typename T>
+Status Aiding<T>::configure(const ArraySolver<T, kNumSensors>& solver,
+                            const AidingConfig<T>& config) {
+  if (!config.enabled) {
+    config_ = config;
+    started_ = false;
+    return Status::ok();
+  }
+  if (config.decimation < 1 || config.decimation > 10000) {
+    return Status(ErrorCode::kInvalidArgument, "aiding: decimation must be 1..10000 samples");
+  }
+  ErrorStateFilter<T> filter;
+  const Status fs = filter.configure(config.filter);
+  if (!fs.is_ok()) return fs;
+  StandstillDetector<T> detector;
+  const Status ds = detector.configure(solver, config.standstill);
+  if (!ds.is_ok()) return ds;
+  config_ = config;
+  filter_ = filter;
+  detector_ = detector;
+  started_ = false;
+  return Status::ok();
+}
+
+template <typename T>
+void Aiding<T>::start(Nav& nav) {
+  if (!config_.enabled) return;
+  filter_.start(nav);
+  detector_.reset();
+  detector_.set_wdot_tolerance(wdot_tolerance());
+  pending_ = 0;
+  pending_dt_s_ = T(0);
+  still_ = false;
+  started_ = true;
+}
+
+template <typename T>
+void Aiding<T>::after_step(Nav& nav, T dt_s) {
+  if (!started_) return;
+  const NavState<T>& st = nav.state();
+  if (detector_.add(st.wdot_b, st.f_b)) {
+    still_ = detector_.at_rest();
+    detector_.set_wdot_tolerance(wdot_tolerance());
+  }
+  pending_dt_s_ += dt_s;
+  if (++pending_ < config_.decimation) return;
+  const Status s = filter_.propagate(nav, pending_dt_s_);
+  pending_ = 0;
+  pending_dt_s_ = T(0);
+  if (!s.is_ok()) {
+    ++propagation_errors_;
+    return;
+  }
+  if (still_ && config_.standstill_updates) {
+    (void)filter_.update_zupt(nav);
+    (void)filter_.update_zaru(nav);
+  }
+}
+
+template <typename T>
+UpdateOutcome Aiding<T>::offer_gnss_position(Nav& nav, const GnssFix<T>& fix) {
+  if (!started_) return not_started();
+  return filter_.update_gnss_position(nav, fix);
+}
+
+template <typename T>
+UpdateOutcome Aiding<T>::offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
+  if (!started_) return not_started();
+  return filter_.update_gnss_velocity(nav, fix);
+}
+
+template <typename T>
+UpdateOutcome Aiding<T>::offer_heading(Nav& nav, T yaw_rad, T sigma_rad) {
+  if (!started_) return not_started();
+  return filter_.update_heading(nav, yaw_rad, sigma_rad);
+}
+
+template <typename T>
+NavAccuracy<T> Aiding<T>::accuracy(const NavState<T>& nav) const {
+  return filter_.accuracy(nav);
+}
+
+extern template class Aiding<float>;
+extern template class Aiding<double>;
 
 }  // namespace gfins::nav

@@ -155,168 +155,39 @@ class ErrorStateFilter {
 
   /// Starts estimating at the strapdown's current (aligned) solution: P ← P0, the bias estimate
   /// of the strapdown to zero, history cleared, heading aligned when the configuration gives it.
-  void start(Nav& nav) {
-    // Random-constant per-sensor biases seen through the solve: M diag(σ_b²) Mᵀ.
-    p0_bias_ = Model(nav.solver(), nav.gravity()).array_noise(config_.noise.bias_sigma_mps2, T(1));
-    p_ = initial_covariance();
-    nav.set_bias(Vec3<T>::Zero(), Vec3<T>::Zero());
-    history_.clear();
-    history_.push(nav.state());
-    heading_aligned_ = config_.heading_known;
-    last_accepted_ns_.fill(kNever);
-    started_ = configured_;
-  }
+  void start(Nav& nav);
 
   /// The covariance the filter starts from and resets to.
-  StateMat initial_covariance() const {
-    using namespace filt_idx;
-    StateMat p = StateMat::Zero();
-    const T tilt2 = config_.init_sigma_tilt_rad * config_.init_sigma_tilt_rad;
-    constexpr T kPi = T(3.14159265358979323846);
-    p(kPhi, kPhi) = tilt2;
-    p(kPhi + 1, kPhi + 1) = tilt2;
-    p(kPhi + 2, kPhi + 2) = config_.heading_known
-                                ? config_.init_sigma_heading_rad * config_.init_sigma_heading_rad
-                                : kPi * kPi;
-    for (int i = 0; i < 3; ++i) {
-      p(kPos + i, kPos + i) = config_.init_sigma_pos_m * config_.init_sigma_pos_m;
-      p(kVel + i, kVel + i) = config_.init_sigma_vel_mps * config_.init_sigma_vel_mps;
-      p(kRate + i, kRate + i) = config_.init_sigma_rate_rps * config_.init_sigma_rate_rps;
-    }
-    p.template block<6, 6>(kBiasWdot, kBiasWdot) = p0_bias_;
-    return p;
-  }
+  StateMat initial_covariance() const;
 
   /// One covariance step over dt_s (the D samples since the previous call) at the strapdown's
   /// current state, which is also stored in the history. F, the noise through M and the gravity
   /// gradient come from ErrorModel on the strapdown's own solver and gravity.
-  Status propagate(const Nav& strapdown, T dt_s) {
-    if (!started_) return Status(ErrorCode::kFailedPrecondition, "filter: not started");
-    if (!(dt_s > T(0)) || !std::isfinite(dt_s)) {
-      return Status(ErrorCode::kInvalidArgument, "filter: dt_s must be positive");
-    }
-    using namespace filt_idx;
-    const NavState<T>& nav = strapdown.state();
-    const Model model(strapdown.solver(), strapdown.gravity());
-    const T h = dt_s;
-    // Continuous model: F = [F_nav G_u; 0 0], Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)].
-    // The 18×18 products are coefficient-based (lazyProduct): small code on the M4F, no GEMM.
-    StateMat f = StateMat::Zero();
-    f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = model.navigation_continuous(nav);
-    const typename Model::NavInputMat g = model.array_input_matrix(nav);
-    f.template block<err_idx::kNav, 6>(0, kBiasWdot) = g;
-    StateMat qc = StateMat::Zero();
-    const Mat6<T> noise_u =
-        model.array_noise(config_.noise.white_sigma_mps2, T(1) / config_.sample_rate_hz);
-    qc.template topLeftCorner<err_idx::kNav, err_idx::kNav>() =
-        g.lazyProduct(noise_u).lazyProduct(g.transpose());
-    qc.template block<6, 6>(kBiasWdot, kBiasWdot) =
-        model.array_noise(config_.noise.bias_rw_mps2_sqrt_s, T(1));
-    // Van Loan's series to h³ (error_model.hpp): Q_d = Q_c h + (F Q_c + Q_c Fᵀ) h²/2 +
-    // F Q_c Fᵀ h³/3; Φ = I + F h + F² h²/2; P ← Φ P Φᵀ + Q_d.
-    StateMat tmp = f.lazyProduct(qc);  // F Q_c
-    StateMat qd = qc * h + (tmp + tmp.transpose()) * (h * h / T(2));
-    qd.noalias() += tmp.lazyProduct(f.transpose()) * (h * h * h / T(3));
-    tmp = f * h;
-    StateMat phi = StateMat::Identity() + tmp;
-    phi.noalias() += tmp.lazyProduct(tmp) / T(2);
-    tmp.noalias() = phi.lazyProduct(p_);
-    p_.noalias() = tmp.lazyProduct(phi.transpose());
-    p_ += qd;
-    if (!heading_aligned_) decouple_heading();
-    condition_covariance();
-    history_.push(nav);
-    ++counters_.propagations;
-    return Status::ok();
-  }
+  Status propagate(const Nav& strapdown, T dt_s);
 
   // ---- Updates: each returns what became of it; only kAccepted (and kReset) change the state --
 
   /// Zero velocity at standstill (3-D).
-  UpdateOutcome update_zupt(Nav& nav) {
-    if (!started_) return invalid(AidingKind::kZupt);
-    return apply(zupt_measurement(nav.state(), config_.zupt_sigma_mps), AidingKind::kZupt, gate_3_,
-                 nav);
-  }
+  UpdateOutcome update_zupt(Nav& nav);
 
   /// Zero angular rate at standstill (3-D).
-  UpdateOutcome update_zaru(Nav& nav) {
-    if (!started_) return invalid(AidingKind::kZaru);
-    return apply(zaru_measurement(nav.state(), config_.zaru_sigma_rps), AidingKind::kZaru, gate_3_,
-                 nav);
-  }
+  UpdateOutcome update_zaru(Nav& nav);
 
   /// GNSS antenna position valid at fix.t_valid_ns (≤ now, within the history).
-  UpdateOutcome update_gnss_position(Nav& nav, const GnssFix<T>& fix) {
-    HistoryEntry<T> at;
-    if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssPosition);
-    if (!heading_aligned_) return reset_position(nav, fix, at);
-    return apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
-                 AidingKind::kGnssPosition, gate_3_, nav);
-  }
+  UpdateOutcome update_gnss_position(Nav& nav, const GnssFix<T>& fix);
 
   /// GNSS antenna velocity valid at fix.t_valid_ns. Before heading alignment it sets the velocity
   /// and, above track_min_speed_mps, the heading from the track.
-  UpdateOutcome update_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
-    HistoryEntry<T> at;
-    if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
-    if (!heading_aligned_) return reset_velocity_and_track(nav, fix, at);
-    return apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
-                 AidingKind::kGnssVelocity, gate_3_, nav);
-  }
+  UpdateOutcome update_gnss_velocity(Nav& nav, const GnssFix<T>& fix);
 
   /// External heading (yaw from north, rad) with its 1σ, valid now. Before heading alignment it
   /// sets the heading.
-  UpdateOutcome update_heading(Nav& nav, T yaw_rad, T sigma_rad) {
-    if (!started_ || !std::isfinite(yaw_rad) || !(sigma_rad > T(0))) {
-      return invalid(AidingKind::kHeading);
-    }
-    const Measurement<T, 1> m = heading_measurement(nav.state().q_nb, yaw_rad, sigma_rad);
-    if (!heading_aligned_) {
-      set_heading(nav, m.y(0), sigma_rad);
-      return accepted_reset(AidingKind::kHeading, nav);
-    }
-    return apply(m, AidingKind::kHeading, gate_1_, nav);
-  }
+  UpdateOutcome update_heading(Nav& nav, T yaw_rad, T sigma_rad);
 
   // ---- Outputs --------------------------------------------------------------------------------
 
   /// 1σ, mode and validity at the navigation state `nav` (the strapdown's current one).
-  NavAccuracy<T> accuracy(const NavState<T>& nav) const {
-    using namespace filt_idx;
-    NavAccuracy<T> a;
-    const Mat3<T> j = euler_error_jacobian(nav.q_nb);
-    const Mat3<T> ce = j * p_.template block<3, 3>(kPhi, kPhi) * j.transpose();
-    for (int i = 0; i < 3; ++i) {
-      a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
-      a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i));
-      a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
-    }
-    const bool aligned = started_ && (nav.status & nav_status::kAligned) != 0;
-    const bool located = aligned && heading_aligned_;
-    if (aligned &&
-        a.euler_sigma_rad.template head<2>().maxCoeff() <= config_.valid_sigma_tilt_rad) {
-      a.valid |= filter_valid::kRollPitch;
-    }
-    if (located && a.euler_sigma_rad(2) <= config_.valid_sigma_heading_rad) {
-      a.valid |= filter_valid::kHeading;
-    }
-    if (located && a.vel_sigma_mps.maxCoeff() <= config_.valid_sigma_vel_mps) {
-      a.valid |= filter_valid::kVelocity;
-    }
-    if (located && a.pos_sigma_m.maxCoeff() <= config_.valid_sigma_pos_m) {
-      a.valid |= filter_valid::kPosition;
-    }
-    if (recent(AidingKind::kZupt, nav.t_ns) || recent(AidingKind::kZaru, nav.t_ns)) {
-      a.mode |= filter_mode::kStandstill;
-    }
-    if (recent(AidingKind::kGnssPosition, nav.t_ns) ||
-        recent(AidingKind::kGnssVelocity, nav.t_ns)) {
-      a.mode |= filter_mode::kGnss;
-    }
-    if (recent(AidingKind::kHeading, nav.t_ns)) a.mode |= filter_mode::kHeading;
-    return a;
-  }
+  NavAccuracy<T> accuracy(const NavState<T>& nav) const;
 
   const StateMat& covariance() const { return p_; }
   const FilterCounters& counters() const { return counters_; }
@@ -509,6 +380,168 @@ class ErrorStateFilter {
   bool started_ = false;
   bool heading_aligned_ = true;
 };
+
+// ---- ErrorStateFilter: member functions defined outside the class, so not inline: a translation
+// unit that uses the extern instantiation below calls them instead of instantiating them again to
+// inline them (nav_core/src instantiates each once per scalar type).
+
+template <typename T, int HistoryCapacity>
+void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
+  // Random-constant per-sensor biases seen through the solve: M diag(σ_b²) Mᵀ.
+  p0_bias_ = Model(nav.solver(), nav.gravity()).array_noise(config_.noise.bias_sigma_mps2, T(1));
+  p_ = initial_covariance();
+  nav.set_bias(Vec3<T>::Zero(), Vec3<T>::Zero());
+  history_.clear();
+  history_.push(nav.state());
+  heading_aligned_ = config_.heading_known;
+  last_accepted_ns_.fill(kNever);
+  started_ = configured_;
+}
+
+template <typename T, int HistoryCapacity>
+typename ErrorStateFilter<T, HistoryCapacity>::StateMat
+ErrorStateFilter<T, HistoryCapacity>::initial_covariance() const {
+  using namespace filt_idx;
+  StateMat p = StateMat::Zero();
+  const T tilt2 = config_.init_sigma_tilt_rad * config_.init_sigma_tilt_rad;
+  constexpr T kPi = T(3.14159265358979323846);
+  p(kPhi, kPhi) = tilt2;
+  p(kPhi + 1, kPhi + 1) = tilt2;
+  p(kPhi + 2, kPhi + 2) = config_.heading_known
+                              ? config_.init_sigma_heading_rad * config_.init_sigma_heading_rad
+                              : kPi * kPi;
+  for (int i = 0; i < 3; ++i) {
+    p(kPos + i, kPos + i) = config_.init_sigma_pos_m * config_.init_sigma_pos_m;
+    p(kVel + i, kVel + i) = config_.init_sigma_vel_mps * config_.init_sigma_vel_mps;
+    p(kRate + i, kRate + i) = config_.init_sigma_rate_rps * config_.init_sigma_rate_rps;
+  }
+  p.template block<6, 6>(kBiasWdot, kBiasWdot) = p0_bias_;
+  return p;
+}
+
+template <typename T, int HistoryCapacity>
+Status ErrorStateFilter<T, HistoryCapacity>::propagate(const Nav& strapdown, T dt_s) {
+  if (!started_) return Status(ErrorCode::kFailedPrecondition, "filter: not started");
+  if (!(dt_s > T(0)) || !std::isfinite(dt_s)) {
+    return Status(ErrorCode::kInvalidArgument, "filter: dt_s must be positive");
+  }
+  using namespace filt_idx;
+  const NavState<T>& nav = strapdown.state();
+  const Model model(strapdown.solver(), strapdown.gravity());
+  const T h = dt_s;
+  // Continuous model: F = [F_nav G_u; 0 0], Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)].
+  // The 18×18 products are coefficient-based (lazyProduct): small code on the M4F, no GEMM.
+  StateMat f = StateMat::Zero();
+  f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = model.navigation_continuous(nav);
+  const typename Model::NavInputMat g = model.array_input_matrix(nav);
+  f.template block<err_idx::kNav, 6>(0, kBiasWdot) = g;
+  StateMat qc = StateMat::Zero();
+  const Mat6<T> noise_u =
+      model.array_noise(config_.noise.white_sigma_mps2, T(1) / config_.sample_rate_hz);
+  qc.template topLeftCorner<err_idx::kNav, err_idx::kNav>() =
+      g.lazyProduct(noise_u).lazyProduct(g.transpose());
+  qc.template block<6, 6>(kBiasWdot, kBiasWdot) =
+      model.array_noise(config_.noise.bias_rw_mps2_sqrt_s, T(1));
+  // Van Loan's series to h³ (error_model.hpp): Q_d = Q_c h + (F Q_c + Q_c Fᵀ) h²/2 +
+  // F Q_c Fᵀ h³/3; Φ = I + F h + F² h²/2; P ← Φ P Φᵀ + Q_d.
+  StateMat tmp = f.lazyProduct(qc);  // F Q_c
+  StateMat qd = qc * h + (tmp + tmp.transpose()) * (h * h / T(2));
+  qd.noalias() += tmp.lazyProduct(f.transpose()) * (h * h * h / T(3));
+  tmp = f * h;
+  StateMat phi = StateMat::Identity() + tmp;
+  phi.noalias() += tmp.lazyProduct(tmp) / T(2);
+  tmp.noalias() = phi.lazyProduct(p_);
+  p_.noalias() = tmp.lazyProduct(phi.transpose());
+  p_ += qd;
+  if (!heading_aligned_) decouple_heading();
+  condition_covariance();
+  history_.push(nav);
+  ++counters_.propagations;
+  return Status::ok();
+}
+
+template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_zupt(Nav& nav) {
+  if (!started_) return invalid(AidingKind::kZupt);
+  return apply(zupt_measurement(nav.state(), config_.zupt_sigma_mps), AidingKind::kZupt, gate_3_,
+               nav);
+}
+
+template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_zaru(Nav& nav) {
+  if (!started_) return invalid(AidingKind::kZaru);
+  return apply(zaru_measurement(nav.state(), config_.zaru_sigma_rps), AidingKind::kZaru, gate_3_,
+               nav);
+}
+
+template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_position(Nav& nav,
+                                                                         const GnssFix<T>& fix) {
+  HistoryEntry<T> at;
+  if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssPosition);
+  if (!heading_aligned_) return reset_position(nav, fix, at);
+  return apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
+               AidingKind::kGnssPosition, gate_3_, nav);
+}
+
+template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& nav,
+                                                                         const GnssFix<T>& fix) {
+  HistoryEntry<T> at;
+  if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
+  if (!heading_aligned_) return reset_velocity_and_track(nav, fix, at);
+  return apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
+               AidingKind::kGnssVelocity, gate_3_, nav);
+}
+
+template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav, T yaw_rad,
+                                                                   T sigma_rad) {
+  if (!started_ || !std::isfinite(yaw_rad) || !(sigma_rad > T(0))) {
+    return invalid(AidingKind::kHeading);
+  }
+  const Measurement<T, 1> m = heading_measurement(nav.state().q_nb, yaw_rad, sigma_rad);
+  if (!heading_aligned_) {
+    set_heading(nav, m.y(0), sigma_rad);
+    return accepted_reset(AidingKind::kHeading, nav);
+  }
+  return apply(m, AidingKind::kHeading, gate_1_, nav);
+}
+
+template <typename T, int HistoryCapacity>
+NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>& nav) const {
+  using namespace filt_idx;
+  NavAccuracy<T> a;
+  const Mat3<T> j = euler_error_jacobian(nav.q_nb);
+  const Mat3<T> ce = j * p_.template block<3, 3>(kPhi, kPhi) * j.transpose();
+  for (int i = 0; i < 3; ++i) {
+    a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
+    a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i));
+    a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
+  }
+  const bool aligned = started_ && (nav.status & nav_status::kAligned) != 0;
+  const bool located = aligned && heading_aligned_;
+  if (aligned && a.euler_sigma_rad.template head<2>().maxCoeff() <= config_.valid_sigma_tilt_rad) {
+    a.valid |= filter_valid::kRollPitch;
+  }
+  if (located && a.euler_sigma_rad(2) <= config_.valid_sigma_heading_rad) {
+    a.valid |= filter_valid::kHeading;
+  }
+  if (located && a.vel_sigma_mps.maxCoeff() <= config_.valid_sigma_vel_mps) {
+    a.valid |= filter_valid::kVelocity;
+  }
+  if (located && a.pos_sigma_m.maxCoeff() <= config_.valid_sigma_pos_m) {
+    a.valid |= filter_valid::kPosition;
+  }
+  if (recent(AidingKind::kZupt, nav.t_ns) || recent(AidingKind::kZaru, nav.t_ns)) {
+    a.mode |= filter_mode::kStandstill;
+  }
+  if (recent(AidingKind::kGnssPosition, nav.t_ns) || recent(AidingKind::kGnssVelocity, nav.t_ns)) {
+    a.mode |= filter_mode::kGnss;
+  }
+  if (recent(AidingKind::kHeading, nav.t_ns)) a.mode |= filter_mode::kHeading;
+  return a;
+}
 
 extern template class ErrorStateFilter<float>;
 extern template class ErrorStateFilter<double>;

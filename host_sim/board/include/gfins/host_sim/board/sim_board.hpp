@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,9 +28,11 @@
 #include "gfins/app/ports.hpp"
 #include "gfins/app/sample_clock.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
+#include "gfins/can/aiding_input.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
 #include "gfins/hal/data_ready.hpp"
+#include "gfins/host_sim/gnss_model.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
 namespace gfins::sim_board {
@@ -178,6 +181,38 @@ class MemoryCanBus final : public hal::CanBus {
   bool refuse_ = false;
   hal::CanBusState state_ = hal::CanBusState::kErrorActive;
   hal::CanCounters counters_{};
+};
+
+/// The fix a sample becomes on the bus: position and velocity, the spec's σ, age = the latency,
+/// fix id = index mod 16 (what `gfins-can gnss` sends and the simulated board's receiver too).
+can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec);
+
+/// The scenario's GNSS receiver on the simulated board's bus: a CanBus in front of the board's
+/// own that, on each receive, first hands over the frames of the fixes sent by now (t_send ≤ the
+/// scenario time of the last sample read), each fix's age stating how long before that sample
+/// it was valid; everything else goes to and comes from `inner`.
+class GnssReceiverBus final : public hal::CanBus {
+ public:
+  /// `now_s`: the scenario time of the last sample the loop read.
+  GnssReceiverBus(std::unique_ptr<hal::CanBus> inner, std::vector<sim::GnssSample> fixes,
+                  const sim::GnssSpec& spec, std::uint8_t node_id, std::function<double()> now_s);
+  std::size_t fixes_sent() const { return next_; }
+
+ private:
+  Status do_send(const hal::CanFrame& f) override { return inner_->send(f); }
+  Result<hal::CanFrame> do_receive(std::int64_t timeout_ns) override;
+  void do_service() override { inner_->service(); }
+  hal::CanBusState do_state() const override { return inner_->state(); }
+  hal::CanCounters do_counters() const override { return inner_->counters(); }
+
+  std::unique_ptr<hal::CanBus> inner_;
+  std::vector<sim::GnssSample> fixes_;
+  sim::GnssSpec spec_;
+  std::uint8_t node_id_;
+  std::function<double()> now_s_;
+  std::size_t next_ = 0;
+  std::array<hal::CanFrame, 4> pending_{};
+  std::size_t pending_next_ = 4;  // pending_[pending_next_..3] still to hand over
 };
 
 /// Stream of a host_sim scenario: trajectory and QA-1100 array model, computed sample by sample;
