@@ -2,7 +2,10 @@
 # Debian packages per architecture (docs/deploy.md): configures and builds each preset, makes
 # its .deb files with CPack into out/deb/ and runs lintian on them; fails on any lintian error.
 #
-#   scripts/package.sh [preset...]      default: host-release aarch64-linux armhf-linux
+#   scripts/package.sh [preset[:board]...]   default: host-release aarch64-linux armhf-linux
+#
+# PRESET:board makes only the board's package (gfins-fw) of that preset: what scripts/test.sh
+# makes for arm64 (the host tools for arm64 are `scripts/package.sh aarch64-linux`).
 #
 # amd64 comes from host-release, the tree scripts/test.sh has already built (the packages' layout
 # is decided when installing, from the package prefix /usr: cmake/GfinsInstall.cmake), so making
@@ -21,14 +24,21 @@ command -v dpkg-shlibdeps >/dev/null ||
   { echo "package.sh: dpkg-shlibdeps missing: install Debian package 'dpkg-dev' (scripts/install-deps.sh does)" >&2; exit 1; }
 
 made=()
-for p in "${presets[@]}"; do
-  echo "=== package: $p"
+for spec in "${presets[@]}"; do
+  p=${spec%%:*}
+  part=${spec#"$p"}
+  case "$part" in
+    "") targets=(gfins_package_programs) cpack_args=() ;;
+    :board) targets=(gfins-fw gfins_changelog_board) cpack_args=(-D CPACK_COMPONENTS_ALL=board) ;;
+    *) echo "package.sh: $spec: expected PRESET or PRESET:board" >&2; exit 2 ;;
+  esac
+  echo "=== package: $spec"
   cmake --preset "$p" >/dev/null
   # Only what goes into the packages (a preset's tests are built and run by its own step).
-  cmake --build --preset "$p" -j "$jobs" --target gfins_package_programs
+  cmake --build --preset "$p" -j "$jobs" --target "${targets[@]}"
   # A fresh CPack folder: a .deb left there by an earlier version must not be copied again.
   rm -rf "build/$p/cpack"
-  cpack --config "build/$p/CPackConfig.cmake" -B "build/$p/cpack" >/dev/null
+  cpack --config "build/$p/CPackConfig.cmake" -B "build/$p/cpack" "${cpack_args[@]}" >/dev/null
   debs_made=("build/$p/cpack"/*.deb)
   [ -e "${debs_made[0]}" ] || { echo "package.sh: cpack made no .deb for $p" >&2; exit 1; }
   for deb in "${debs_made[@]}"; do

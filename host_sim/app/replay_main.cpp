@@ -307,8 +307,10 @@ void print_report(std::FILE* f, const sim::NavReport& r, double rate_hz) {
                "), rejected %" PRIu64 " (CRC error %" PRIu64 ", saturated %" PRIu64 ")\n",
                r.samples, r.navigating, r.samples - r.navigating - r.rejected, r.rejected,
                r.invalid, r.flagged_saturated);
-  std::fprintf(f, "gaps in the sample counter: %zu, samples missing: %" PRIu64 "\n", r.gaps.size(),
-               r.missed_samples);
+  std::fprintf(f,
+               "gaps in the sample counter: %zu, samples missing: %" PRIu64
+               ", out of order (repeated or went back, not integrated): %" PRIu64 "\n",
+               r.gaps.size(), r.missed_samples, r.out_of_order);
   constexpr std::size_t kListed = 20;
   for (std::size_t i = 0; i < r.gaps.size() && i < kListed; ++i) {
     const sim::NavGap& g = r.gaps[i];

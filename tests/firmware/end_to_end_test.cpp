@@ -180,13 +180,14 @@ void expect_bit_exact(SimRig& rig, const nav::PipelineConfig<float>& want) {
 
 // The defaults of docs/firmware.md on the simulated board with calibration.file = "": the
 // factory calibration (the scenario's true parameters) and its compensator
-// (navigation.compensator = "calibration"), standard gravity 9.80665 m/s² (navigation.gravity =
-// "standard"), 1000 Hz, alignment 1 s = 1000 samples, heading 0, position [0, 0, 0].
+// (navigation.compensator = "calibration"), the calibration's local gravity (navigation.gravity =
+// "calibration": the scenario's g at its origin), 1000 Hz, alignment 1 s = 1000 samples, heading
+// 0, position [0, 0, 0].
 nav::PipelineConfig<float> documented_defaults(const calib_file::CalibrationData& factory) {
   nav::PipelineConfig<float> e;
   calibration_part(factory, e);
   e.compensator = factory.compensator;
-  e.gravity = nav::GravityModel<float>::constant(9.80665f);
+  e.gravity = nav::GravityModel<float>::constant(static_cast<float>(factory.gravity_mps2));
   e.max_condition = 100.0f;  // not configurable: the core's documented default
   e.sample_rate_hz = 1000.0f;
   e.alignment_samples = 1000;

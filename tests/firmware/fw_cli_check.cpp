@@ -87,6 +87,25 @@ TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
   EXPECT_NE(ran.output.find(kStarted), std::string::npos) << ran.output;
 }
 
+// A configuration path that never ends is refused after its first MiB (before, gfins-fw read
+// /dev/zero until the machine's memory ran out), naming the path and the limit; an empty
+// configuration file is valid (every key keeps its default).
+TEST_F(FwCli, AConfigurationThatNeverEndsIsRefusedAtItsSizeLimit) {
+  for (const bool check : {true, false}) {
+    std::vector<std::string> args = {"--config", "/dev/zero"};
+    if (check) args.emplace_back("--check-config");
+    const test::CliResult r = fw(args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(
+        r.err.find("/dev/zero: larger than 1048576 bytes, the limit for a configuration file"),
+        std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.output.find(kStarted), std::string::npos) << r.output;
+  }
+  const test::CliResult empty = fw({"--config", file("empty.toml", ""), "--check-config"});
+  EXPECT_EQ(empty.exit_code, 0) << empty.output;
+}
+
 TEST_F(FwCli, MessagesArriveWholeWithControlCharactersEscaped) {
   // A NUL inside a value used to end the message there (no reason, no newline); an ESC went to
   // the terminal raw.

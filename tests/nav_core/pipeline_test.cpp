@@ -43,6 +43,23 @@ class PipelineTest : public ::testing::Test {
     return s;
   }
 
+  // The bound on |δω̇| the rounding of the counts to one LSB leaves (see the first test): at
+  // most half an LSB per channel through M, per axis, times √3 for the norm.
+  double rounding_wdot_bound() const {
+    double bound = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      double row = 0.0;
+      for (int j = 0; j < 6; ++j) {
+        const auto jj = static_cast<std::size_t>(j);
+        const double lsb_mps2 = config_.front_end.volts_per_count[jj] * kStandardGravity /
+                                config_.front_end.scale_v_per_g[jj];
+        row += std::abs(pipeline_.solver().m()(i, j)) * lsb_mps2 / 2;
+      }
+      bound = std::max(bound, row);
+    }
+    return bound * std::sqrt(3.0);
+  }
+
   PipelineConfig<double> config_;
   NavPipeline<double> pipeline_;
 };
@@ -67,18 +84,7 @@ TEST_F(PipelineTest, AlignsThenNavigatesAndStaysAtRest) {
   // δω̇ ≤ Σ_j |M_ij| · LSB_j / 2. Kinematics then bound the drift (docs/math.md, error growth):
   // attitude δω̇ t²/2, velocity g δω̇ t³/6, position g δω̇ t⁴/24. The specific-force part of the
   // rounding is absorbed by the alignment (same samples), so tilt alone drives v and r.
-  double wdot_bound = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    double row = 0.0;
-    for (int j = 0; j < 6; ++j) {
-      const auto jj = static_cast<std::size_t>(j);
-      const double lsb_mps2 = config_.front_end.volts_per_count[jj] * kStandardGravity /
-                              config_.front_end.scale_v_per_g[jj];
-      row += std::abs(pipeline_.solver().m()(i, j)) * lsb_mps2 / 2;
-    }
-    wdot_bound = std::max(wdot_bound, row);
-  }
-  wdot_bound *= std::sqrt(3.0);  // per-axis bound → norm bound
+  const double wdot_bound = rounding_wdot_bound();
   const double g = kStandardGravity;
   EXPECT_LT(st.q_nb.angularDistance(q), wdot_bound * t * t / 2 + 1e-6);
   EXPECT_LT(st.v_n.norm(), g * wdot_bound * t * t * t / 6);
@@ -105,6 +111,43 @@ TEST_F(PipelineTest, CountsSampleGapsAndIntegratesAcrossThem) {
   pipeline_.process(frame(counts, 0, seq + 4));
   EXPECT_FALSE(pipeline_.state().status & nav_status::kSampleGap);
   EXPECT_EQ(pipeline_.counters().gaps, 1u);
+}
+
+// A counter that repeats or goes back (a recording spliced or rewound) is no gap and no time to
+// integrate: the frame leaves the state as it was (bit for bit), counts as out of order, and the
+// next frame is one period after it. Integrating it instead would take a step of 2^32 - k periods
+// (49 days at 1 kHz) and count as many missing samples.
+TEST_F(PipelineTest, ACounterThatRepeatsOrGoesBackIsNotIntegrated) {
+  const auto counts = counts_at_rest(quat_from_euler(0.02, -0.01, 0.0));
+  std::uint32_t seq = 100;
+  std::int64_t t = 0;
+  const auto next = [&](std::uint32_t s) {
+    pipeline_.process(frame(counts, t, s));
+    t += 1'000'000;
+  };
+  for (std::uint32_t i = 0; i < config_.alignment_samples + 10; ++i) next(seq++);
+  ASSERT_EQ(pipeline_.phase(), PipelinePhase::kNavigating);
+  for (const std::uint32_t bad : {seq - 1, seq - 50}) {  // a repeat, then 49 back
+    const NavState<double> before = pipeline_.state();
+    next(bad);
+    EXPECT_EQ(pipeline_.state().v_n, before.v_n);
+    EXPECT_EQ(pipeline_.state().r_n, before.r_n);
+    EXPECT_EQ(pipeline_.state().q_nb.coeffs(), before.q_nb.coeffs());
+    EXPECT_TRUE(pipeline_.state().status & nav_status::kSampleGap);
+    seq = bad + 1;
+  }
+  EXPECT_EQ(pipeline_.counters().out_of_order, 2u);
+  EXPECT_EQ(pipeline_.counters().gaps, 0u);
+  EXPECT_EQ(pipeline_.counters().missed_samples, 0u);
+  // Navigation goes on from the rewound counter, one period per frame, still at rest: the
+  // velocity stays within the drift the rounding of the counts allows over the 1.01 s
+  // navigated, g·δω̇·t³/6 (first test), which one 49-day step exceeds by orders of magnitude.
+  for (int i = 0; i < 1000; ++i) next(seq++);
+  EXPECT_FALSE(pipeline_.state().status & nav_status::kSampleGap);
+  const double t_nav = 1.01;
+  EXPECT_LT(pipeline_.state().v_n.norm(),
+            kStandardGravity * rounding_wdot_bound() * t_nav * t_nav * t_nav / 6);
+  EXPECT_TRUE(pipeline_.state().r_n.allFinite());
 }
 
 TEST_F(PipelineTest, RejectsSaturatedSamplesAndCountsThem) {

@@ -65,7 +65,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
                      ->check(CLI::IsMember({"calibration", "none", "paper", "exact"}));
   auto* o_cal = app.add_option("--calibration", calib, "calibration.file");
   auto* o_grav = app.add_option("--gravity", gravity, "navigation.gravity")
-                     ->check(CLI::IsMember({"standard", "constant", "normal"}));
+                     ->check(CLI::IsMember({"calibration", "standard", "constant", "normal"}));
   auto* o_g = app.add_option("--gravity-mps2", g, "navigation.gravity_mps2");
   auto* o_lat = app.add_option("--latitude-deg", lat, "navigation.latitude_deg");
   auto* o_h = app.add_option("--height-m", height, "navigation.height_m");
@@ -176,9 +176,9 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_cal->count()) c.calibration_file = calib;
   if (o_grav->count()) {
     c.gravity =
-        pick(gravity, std::array<const char*, 3>{"standard", "constant", "normal"},
-             std::array<GravityChoice, 3>{GravityChoice::kStandard, GravityChoice::kConstant,
-                                          GravityChoice::kNormal});
+        pick(gravity, std::array<const char*, 4>{"calibration", "standard", "constant", "normal"},
+             std::array<GravityChoice, 4>{GravityChoice::kCalibration, GravityChoice::kStandard,
+                                          GravityChoice::kConstant, GravityChoice::kNormal});
   }
   if (o_g->count()) c.gravity_mps2 = g;
   if (o_lat->count()) c.latitude_deg = lat;

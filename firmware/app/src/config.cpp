@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "gfins/app/config.hpp"
+#include "gfins/drivers/lnx/text_file.hpp"
 
 namespace gfins::app {
 
@@ -200,9 +200,9 @@ void read_all(Reader& r, FwConfig& c) {
       std::array<CompensatorChoice, 4>{CompensatorChoice::kCalibration, CompensatorChoice::kNone,
                                        CompensatorChoice::kPaper, CompensatorChoice::kExact});
   r.choice("navigation.gravity", c.gravity,
-           std::array<const char*, 3>{"standard", "constant", "normal"},
-           std::array<GravityChoice, 3>{GravityChoice::kStandard, GravityChoice::kConstant,
-                                        GravityChoice::kNormal});
+           std::array<const char*, 4>{"calibration", "standard", "constant", "normal"},
+           std::array<GravityChoice, 4>{GravityChoice::kCalibration, GravityChoice::kStandard,
+                                        GravityChoice::kConstant, GravityChoice::kNormal});
   r.number("navigation.gravity_mps2", c.gravity_mps2);
   r.number("navigation.latitude_deg", c.latitude_deg);
   r.number("navigation.height_m", c.height_m);
@@ -279,20 +279,16 @@ ConfigResult parse_config(std::string_view toml_text, const std::string& source,
 }
 
 ConfigResult load_config(const std::string& path, FwConfig base) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  // Bounded: a path that never ends (/dev/zero) or a huge file is refused after 1 MiB.
+  std::string text;
+  const Status st = drivers::lnx::read_text_file(path.c_str(), drivers::lnx::kMaxConfigBytes, text);
+  if (!st.is_ok()) {
     ConfigResult r;
-    r.error = path + ": cannot open the configuration file";
+    r.error = drivers::lnx::text_file_error(path, st, drivers::lnx::kMaxConfigBytes,
+                                            "a configuration file");
     return r;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    ConfigResult r;
-    r.error = path + ": read error";
-    return r;
-  }
-  return parse_config(text.str(), path, std::move(base));
+  return parse_config(text, path, std::move(base));
 }
 
 const char* to_string(BoardKind b) {
@@ -311,6 +307,8 @@ const char* to_string(Pacing p) {
 }
 const char* to_string(GravityChoice g) {
   switch (g) {
+    case GravityChoice::kCalibration:
+      return "calibration";
     case GravityChoice::kStandard:
       return "standard";
     case GravityChoice::kConstant:

@@ -323,6 +323,12 @@ void SampleLoop::on_sample(const RawSample& s) {
   // saturated one) and integrates across the hole with the next good one.
   if (crc_ok && saturated == 0) last_good_ = s;
   pipeline_.process(s);
+  if (pipeline_.phase() == nav::PipelinePhase::kAligning) {
+    gravity_checked_ = false;
+  } else if (!gravity_checked_) {
+    gravity_checked_ = true;
+    check_gravity(s.t_ns);
+  }
   if (capture_.active && crc_ok) capture_add(s);
   build_epoch(s);
 }
@@ -393,6 +399,28 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
     }
     if (!r.deferred) send_response(r);
   }
+}
+
+void SampleLoop::check_gravity(std::int64_t t_ns) {
+  // At rest the array measures gravity: |mean f| of the alignment window against the model the
+  // core navigates with. Allowed: 5σ of that mean (the window's own scatter) plus 1 mg for what
+  // a calibrated array's residual bias puts into |f|. Standard gravity on a board calibrated at
+  // 24.8° (1.7 mg off) or a calibration for another converter is beyond it.
+  const nav::AlignmentResult<float>& a = pipeline_.alignment();
+  if (a.samples == 0) return;
+  const double g_model = static_cast<double>(pipeline_.config().gravity.magnitude_at_origin());
+  const double f = static_cast<double>(a.gravity_mps2);
+  const double sigma_mean =
+      static_cast<double>(a.f_noise_mps2) / std::sqrt(static_cast<double>(a.samples));
+  constexpr double kResidualBiasMps2 = 1e-3 * nav::kStandardGravity;
+  const double allowed = 5.0 * sigma_mean + kResidualBiasMps2;
+  if (std::abs(f - g_model) <= allowed) return;
+  ++health_.gravity_mismatches;
+  limited_log(LogKind::kGravityMismatch, LogLevel::kWarn, t_ns,
+              "aligned at rest, |f| = {} um/s^2 but the navigation gravity is {} um/s^2 (allowed "
+              "difference {} um/s^2): check navigation.gravity and the calibration file ({} more "
+              "since the last line)",
+              std::llround(f * 1e6), std::llround(g_model * 1e6), std::llround(allowed * 1e6));
 }
 
 bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {

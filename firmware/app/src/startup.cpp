@@ -42,6 +42,11 @@ nav::PipelineConfig<float> pipeline_config(const FwConfig& c,
   calib_file::apply_to(d, p);
   p.compensator = resolve_compensator(c.compensator, d.compensator);
   switch (c.gravity) {
+    case GravityChoice::kCalibration:
+      // The local gravity the file was calibrated with: its front end's V/g assume it, so the
+      // board navigating where it was calibrated sees exactly this magnitude at rest.
+      p.gravity = nav::GravityModel<float>::constant(static_cast<float>(d.gravity_mps2));
+      break;
     case GravityChoice::kStandard:
       p.gravity = nav::GravityModel<float>::constant(static_cast<float>(nav::kStandardGravity));
       break;

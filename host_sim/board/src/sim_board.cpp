@@ -370,10 +370,17 @@ calib_file::CalibrationData scenario_calibration(const sim::Scenario& s, double 
   d.geometry.kind = calib_file::GeometryKind::kTable1;
   d.geometry.rho_m = s.rho_m;
   const sim::ArrayErrors e = ScenarioStream::errors(s);
+  // A board calibrated where the scenario is: its g (the g of V/g) is the scenario's gravity at
+  // the origin. The sensor model's parameters are per standard g, so they are restated per local
+  // g; the conversion to m/s² is unchanged (scale·g and bias·g are the same products).
+  const double g_local = std::abs(sim::gravity_model(s).magnitude_at_origin());
+  const double per_local = nav::kStandardGravity / g_local;
+  d.gravity_mps2 = g_local;
+  d.gravity_source = "simulated board: the scenario's gravity model at the origin";
   for (std::size_t j = 0; j < 6; ++j) {
     d.sensors[j].adc_lsb_v_per_count = volts_per_count;
-    d.sensors[j].scale_v_per_g = e.sensors[j].scale_v_per_g;
-    d.sensors[j].bias_g = e.sensors[j].bias_g;
+    d.sensors[j].scale_v_per_g = e.sensors[j].scale_v_per_g / per_local;
+    d.sensors[j].bias_g = e.sensors[j].bias_g * per_local;
     const nav::Vec3<double>& dr = s.misalignment.drho_b[j];
     d.sensors[j].location_error_m = {dr.x(), dr.y(), dr.z()};
   }

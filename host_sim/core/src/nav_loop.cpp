@@ -65,6 +65,7 @@ bool NavLoop<T>::finish(std::uint64_t index, std::uint32_t seq, const nav::Pipel
     report_.missed_samples += g.missing;
     report_.gaps.push_back(g);
   }
+  report_.out_of_order += after.out_of_order - before.out_of_order;
   const bool rejected = after.rejected != before.rejected;
   if (rejected) ++report_.rejected;
   // A rejected sample leaves the state unchanged: it produced no output, so it is neither hashed

@@ -53,6 +53,7 @@ struct NavReport {
   std::uint64_t flagged_saturated = 0;  // samples carrying sample_flags::kSaturated
   std::uint64_t rejected = 0;           // samples the pipeline rejected (CRC error, saturated)
   std::uint64_t missed_samples = 0;     // sum of NavGap::missing
+  std::uint64_t out_of_order = 0;       // counters that repeated or went back (not integrated)
   std::vector<NavGap> gaps;
   std::uint64_t output_hash = Fnv1a64::kOffsetBasis;  // FNV-1a-64 of every navigating state
 };

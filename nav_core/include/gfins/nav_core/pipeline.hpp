@@ -60,8 +60,11 @@ struct PipelineCounters {
   std::uint32_t gaps = 0;                // jumps of the sample counter (counted here only)
   std::uint32_t missed_samples = 0;      // samples lost in those jumps
   std::uint32_t saturated = 0;           // samples with a channel at ADC full scale
-  std::uint32_t rejected = 0;            // samples not integrated (saturated or kCrcError)
+  std::uint32_t rejected = 0;            // samples not integrated (saturated, kCrcError, or
+                                         // out of order while navigating)
   std::uint32_t alignment_restarts = 0;  // alignment windows refused (last_refusal says why)
+  std::uint32_t out_of_order = 0;        // samples whose counter repeated or went back: not
+                                         // integrated (is_behind)
   AlignmentRefusal last_refusal = AlignmentRefusal::kNone;
 };
 
@@ -90,6 +93,8 @@ class NavPipeline {
   ///   - a jump of the sample counter against the previous frame offered (whatever became of
   ///     it) is a gap: counters().gaps and counters().missed_samples grow. This is the only place
   ///     in the project that counts sequence gaps (replay and the firmware read the counters);
+  ///     a counter that repeats or goes back is no gap: counters().out_of_order grows and the
+  ///     frame is not integrated (no negative or 2^32-sample step); later frames count from it;
   ///   - a frame with sample_flags::kCrcError carries counts that are not a measurement, and a
   ///     frame with a channel at either rail of the 24-bit code (FrontEnd::convert) is saturated:
   ///     both are rejected (counters().rejected; saturated also counts in counters().saturated)
@@ -131,11 +136,21 @@ class NavPipeline {
   const FrontEnd<T, 6>& front_end() const { return front_end_; }
   const AlignmentResult<T>& alignment() const { return alignment_; }
 
+  /// True when `seq` does not come after `prev`: the same counter again, or one that went back
+  /// (a step of 2^31 or more modulo 2^32: at 1 kHz a forward jump that long is 25 days).
+  static bool is_behind(std::uint32_t seq, std::uint32_t prev) {
+    const std::uint32_t d = seq - prev;
+    return d == 0 || d >= 0x80000000u;
+  }
+
  private:
-  /// Counts a jump of the sample counter against the previous frame offered (wraps at 2^32).
+  /// Counts a jump of the sample counter against the previous frame offered (wraps at 2^32). A
+  /// counter that repeats or goes back is not a gap (nothing was lost): counted as out of order.
   void count_gap(std::uint32_t seq) {
     const std::uint32_t dseq = seq - last_seen_seq_;
-    if (have_seen_ && dseq != 1) {
+    if (have_seen_ && is_behind(seq, last_seen_seq_)) {
+      ++counters_.out_of_order;
+    } else if (have_seen_ && dseq != 1) {
       ++counters_.gaps;
       counters_.missed_samples += dseq - 1;
     }
@@ -216,8 +231,11 @@ void NavPipeline<T>::start_at(const NavState<T>& initial, const RawSample& first
   start_at_specific_force(initial, s);
 }
 
+// process() and integrate() stay inline: the per-sample path, inlined with the strapdown step
+// where the sample loop calls it (docs/performance.md, instructions per sample); the filter behind
+// it (Aiding::after_step, once per sample) stays a call into the instantiation.
 template <typename T>
-PipelinePhase NavPipeline<T>::process(const RawSample& s) {
+inline PipelinePhase NavPipeline<T>::process(const RawSample& s) {
   ++counters_.samples;
   count_gap(s.seq);
   Outputs f;
@@ -272,10 +290,18 @@ NavAccuracy<T> NavPipeline<T>::accuracy() const {
 }
 
 template <typename T>
-PipelinePhase NavPipeline<T>::integrate(const Outputs& s_raw, std::int64_t t_ns,
-                                        std::uint32_t seq) {
+inline PipelinePhase NavPipeline<T>::integrate(const Outputs& s_raw, std::int64_t t_ns,
+                                               std::uint32_t seq) {
   if (phase_ == PipelinePhase::kAligning) {
     align(s_raw, t_ns, seq);
+    return phase_;
+  }
+  if (is_behind(seq, last_seq_)) {
+    // The same sample again, or a counter that went back (a recording spliced or rewound, an ADC
+    // reset): no time to integrate. Later samples count from this one; the state is flagged.
+    last_seq_ = seq;
+    ++counters_.rejected;
+    strapdown_.mutable_state().status |= nav_status::kSampleGap;
     return phase_;
   }
   const std::uint32_t dseq = seq - last_seq_;  // wraps correctly at 2^32
@@ -283,7 +309,7 @@ PipelinePhase NavPipeline<T>::integrate(const Outputs& s_raw, std::int64_t t_ns,
   if (dseq != 1) status |= nav_status::kSampleGap;  // lost or rejected samples in between
   last_seq_ = seq;
   const NavState<T>& st = strapdown_.state();
-  const T dt_s = period_s_ * static_cast<T>(dseq == 0 ? 1u : dseq);
+  const T dt_s = period_s_ * static_cast<T>(dseq);
   // u = M s with the compensator folded in (Compensator::fold_into): one product per sample.
   strapdown_.step_linear(
       compensator_.padded_linear_part(strapdown_.solver(), s_raw, st.w_b, st.wdot_b), dt_s, t_ns,

@@ -17,7 +17,8 @@ namespace gfins::app {
 
 enum class BoardKind : std::uint8_t { kLinux, kSim, kHil };    // kHil: docs/hil.md
 enum class Pacing : std::uint8_t { kFast, kRealTime, kGpio };  // simulated board only
-enum class GravityChoice : std::uint8_t { kStandard, kConstant, kNormal };
+/// "calibration" = the local gravity the calibration file was made with (gravity.local_mps2).
+enum class GravityChoice : std::uint8_t { kCalibration, kStandard, kConstant, kNormal };
 enum class WatchdogKind : std::uint8_t { kNone, kSystemd, kDevice };
 /// "calibration" = the compensator the calibration file names.
 enum class CompensatorChoice : std::uint8_t { kCalibration, kNone, kPaper, kExact };
@@ -62,7 +63,7 @@ struct FwConfig {
 
   // [navigation]
   CompensatorChoice compensator = CompensatorChoice::kCalibration;
-  GravityChoice gravity = GravityChoice::kStandard;
+  GravityChoice gravity = GravityChoice::kCalibration;
   double gravity_mps2 = 9.80665;       // kConstant
   double latitude_deg = 0.0;           // kNormal
   double height_m = 0.0;               // kNormal

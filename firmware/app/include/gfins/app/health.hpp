@@ -32,6 +32,7 @@ struct HealthCounters {
   std::uint32_t command_errors = 0;     // commands rejected (malformed, out of range, busy)
   std::uint32_t aiding_inputs = 0;      // GNSS fixes and headings decoded from input frames
   std::uint32_t aiding_input_errors = 0;  // input frames refused (CRC, length, range, stale id)
+  std::uint32_t gravity_mismatches = 0;   // alignments whose |f| disagreed with the gravity model
   std::uint8_t stuck_mask = 0;            // channels stuck now (bit j = channel j)
   std::uint8_t saturated_mask = 0;        // channels saturated in the last sample
 };

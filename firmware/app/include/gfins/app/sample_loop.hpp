@@ -98,8 +98,9 @@ enum class LogKind : std::uint8_t {
   kCanStateBetter,  // back to error-active or warning
   kOverrun,
   kCommandRejected,
-  kInputRejected,   // a GNSS / heading input frame refused by its decoder
-  kAidingRejected,  // a decoded fix refused by the filter (χ² gate, before alignment)
+  kInputRejected,    // a GNSS / heading input frame refused by its decoder
+  kAidingRejected,   // a decoded fix refused by the filter (χ² gate, before alignment)
+  kGravityMismatch,  // the aligned |f| and the navigation gravity disagree
   kCount,
 };
 
@@ -212,6 +213,8 @@ class SampleLoop {
   /// A received frame that is a GNSS or heading input of this node: decoded, offered to the
   /// filter, counted. False when it is not one (a command frame, another node's input).
   bool handle_input(const hal::CanFrame& f, std::int64_t t_ns);
+  /// Once per alignment: the mean |f| at rest against the navigation gravity.
+  void check_gravity(std::int64_t t_ns);
   void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
            std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0);
 
@@ -221,7 +224,8 @@ class SampleLoop {
   hal::Clock& clock_;
   FwLogQueue& log_;
   const CommandCodec* codec_ = nullptr;
-  can::InputDecoder inputs_{1};  // GNSS / heading frames of options_.node_id
+  can::InputDecoder inputs_{1};   // GNSS / heading frames of options_.node_id
+  bool gravity_checked_ = false;  // check_gravity() done for the current alignment
   hal::Watchdog* watchdog_ = nullptr;
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;
