@@ -89,8 +89,8 @@ class StopSignals {
   void (*old_term_)(int);
 };
 
-/// Printed before the work starts (issue 10, "estimate samples, memory and time before
-/// starting"): "estimate: N samples[ x R runs], memory about M MB, time about T s". A negative
+/// Printed before the work starts (estimate samples, memory and time before
+/// starting): "estimate: N samples[ x R runs], memory about M MB, time about T s". A negative
 /// memory or time is left out.
 void print_estimate(std::uint64_t samples, std::size_t runs, double memory_bytes, double seconds,
                     const std::string& note);

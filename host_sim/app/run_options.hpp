@@ -1,5 +1,5 @@
-// Checks of the options run, paper63, montecarlo, covariance and gfins-replay share (issue 10,
-// "inputs checked before work starts"): each returns a message naming what is wrong.
+// Checks of the options run, paper63, montecarlo, covariance and gfins-replay share (inputs
+// checked before work starts): each returns a message naming what is wrong.
 #pragma once
 
 #include <string>

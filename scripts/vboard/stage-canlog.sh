@@ -1,5 +1,5 @@
 # shellcheck shell=sh disable=SC2154  # sourced by vm-test.sh, which sets the check helpers
-# Stage "canlog" of the in-VM test (sourced by vm-test.sh): issue 9 on a real kernel's SocketCAN.
+# Stage "canlog" of the in-VM test (sourced by vm-test.sh): the CAN log checks on a real kernel's SocketCAN.
 #   1. A candump log written by the firmware's file sink (gfins-fw --sim rest --can-log, made on
 #      the host by run.sh) is replayed by Debian's canplayer on vcan0; candump -L must capture
 #      exactly the log's frames (same count, same ID#DATA, same order).

@@ -1,5 +1,5 @@
-// Google Benchmark: Monte-Carlo runs and the covariance report on 1 and 2 threads (issue 13,
-// "Scale"). Wall time (UseRealTime) is what a user waits for; the CPU column is the whole
+// Google Benchmark: Monte-Carlo runs and the covariance report on 1 and 2 threads.
+// Wall time (UseRealTime) is what a user waits for; the CPU column is the whole
 // process's (MeasureProcessCPUTime), so CPU / wall tells how many cores the run really had. The
 // speed-up is wall(jobs 1) / wall(jobs 2); on a shared machine it is bounded by the cores the
 // other processes leave free, so read it with the load average. Nothing asserts a time; that the

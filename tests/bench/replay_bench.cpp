@@ -1,7 +1,7 @@
 // Google Benchmark: replay throughput of the navigation core from a raw-sample recording
 // (host_sim/replay.hpp), in samples/s and in multiples of real time at 1 kHz. Goals: ≥ 1000× real
 // time on one core (issue "Host simulation", Replay), ≥ 5000× including the decoding of the
-// file (issue 13). Nothing here asserts a time.
+// file. Nothing here asserts a time.
 //
 // The recording is made once, before timing: 10 s at 1 kHz of the manoeuvre trajectory
 // (make_maneuver, preceded by 0.5 s at rest for alignment) through SensorArrayModel with Table 6
@@ -12,7 +12,7 @@
 //   BM_Decode              file bytes → samples only;
 //   BM_ReplayFile<T>       the whole path of `gfins-replay`: replay_recording() opens the .gfr
 //                          file written to the temporary folder at set-up, reads it block by
-//                          block, checks every CRC, decodes and navigates (issue 13: ≥ 5000×
+//                          block, checks every CRC, decodes and navigates (goal: ≥ 5000×
 //                          real time at 1 kHz on one core, i.e. ≥ 5 M samples/s);
 //   BM_ReadFile            the same file read and decoded block by block, no navigation;
 //   BM_ReadFileAndNavigate<T>  the file read and decoded by RecordingReader, each sample handed

@@ -41,7 +41,7 @@ inline CalibrationData table6_data() {
   d.beta.angle_sigma_deg = {0.04, 0.05, 0.06, 0.07, 0.08, 0.04};
   d.alpha.angle_sigma_deg = {0.05, 0.06, 0.07, 0.08, 0.04, 0.05};
   d.compensator = nav::CompensatorKind::kExact;
-  d.gravity_mps2 = 9.7894;  // WGS-84 normal gravity at 24.8° latitude (issue 11), m/s²
+  d.gravity_mps2 = 9.7894;  // WGS-84 normal gravity at 24.8° latitude, m/s²
   d.gravity_source = "test site at 24.8 deg";
   return d;
 }

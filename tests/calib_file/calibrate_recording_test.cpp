@@ -1,4 +1,4 @@
-// gfins-calibrate on raw .gfr recordings (issue 11): still intervals found by the static
+// gfins-calibrate on raw .gfr recordings: still intervals found by the static
 // detector, poses that moved or saturated refused with the reason, too few intervals listed;
 // and the location calibration from rate-table runs (paper §4.2) with its observability report.
 #include <gmock/gmock.h>

@@ -29,7 +29,7 @@ namespace {
 using Vec3d = nav::Vec3<double>;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kLatCalDeg = 24.8;       // issue 11: g = 9.7894 m/s²
+constexpr double kLatCalDeg = 24.8;       // Hsinchu: g = 9.7894 m/s²
 constexpr double kLatNavDeg = 60.0;       // g = 9.8192 m/s²
 constexpr double kRho = 0.1;              // m
 constexpr double kLsb = 5.0 / 8388608.0;  // V/count: ±5 V over 24 bits (outputs reach 2.5 V)

@@ -118,7 +118,7 @@ const std::vector<Mount> kFullMounts = {{kX, Vec3d::Zero()},
                                         {kZ, Vec3d::Zero()},
                                         {Vec3d(1, 1, 0).normalized(), Vec3d::Zero()},
                                         {Vec3d(1, 0, 1).normalized(), Vec3d::Zero()}};
-const std::vector<double> kRates = {2.0, 4.0, 6.0, 8.0, 10.0};  // rad/s, up to 10 (issue)
+const std::vector<double> kRates = {2.0, 4.0, 6.0, 8.0, 10.0};  // rad/s, up to 10
 
 Vec3d radial(int j) {
   return nav::table1_geometry(kRho).rho_b[static_cast<std::size_t>(j)].normalized();
@@ -241,7 +241,7 @@ TEST(LocationObservabilityTest, TwoFaceDiagonalMountingsMakeEverythingObservable
 // ---------------------------------------------------------------------------------------------
 // Noise
 
-// Statistical criteria over kNoiseSeeds independent calibrations × 18 components (issue 11):
+// Statistical criteria over kNoiseSeeds independent calibrations × 18 components:
 //   coverage  fraction of |z| = |error|/σ ≤ 3 at least 99 %; mean z² in [0.8, 1.25];
 //   χ²/dof of the fit residuals, pooled over the seeds (120 dof each), within 1 ± 0.05.
 // False-failure probabilities when the solver is right. The three components of one sensor

@@ -38,9 +38,9 @@ namespace {
 using Vec3d = nav::Vec3<double>;
 
 constexpr int kDraws = 1000;
-constexpr double kMinCoverage = 0.99;  // issue 11
-constexpr double kMinMeanZ2 = 0.8;     // issue 11
-constexpr double kMaxMeanZ2 = 1.25;    // issue 11
+constexpr double kMinCoverage = 0.99;  // the calibration σ acceptance criteria
+constexpr double kMinMeanZ2 = 0.8;     // the calibration σ acceptance criteria
+constexpr double kMaxMeanZ2 = 1.25;    // the calibration σ acceptance criteria
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 struct Truth {

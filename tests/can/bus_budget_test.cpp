@@ -25,7 +25,7 @@ constexpr int worst_case_frame_bits(int data_bytes) {
 // Published figures (the note on bus budgets): 8-byte 11-bit frames at 500 kbit/s, 4505 frames/s
 // nominal, 3704 worst case, i.e. 111 and 135 bits.
 static_assert(worst_case_frame_bits(8) == 135);
-constexpr double kMaxLoad = 0.30;  // the interface's requirement (issue 9)
+constexpr double kMaxLoad = 0.30;  // the interface's bus-load requirement
 
 TEST(BusBudget, DefaultDividersStayBelowThirtyPercentWorstCase) {
   double bits_per_s = 0.0;

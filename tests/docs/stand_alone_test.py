@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The documentation stands alone (issue 10, "Docs"): every link and file path a Markdown file
+"""The documentation stands alone ("Docs"): every link and file path a Markdown file
 of the repository names resolves to a file inside the repository, and nothing refers to
 material a user of the project does not have (the development notes, design and style guides
 kept outside the repository, absolute paths of a development machine).

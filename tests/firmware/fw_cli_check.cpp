@@ -1,4 +1,4 @@
-// gfins-fw as a user runs it (issue 8 review, items 3, 4 and 15a): --check-config and the run
+// gfins-fw as a user runs it: --check-config and the run
 // accept and refuse the same configurations with the same message; messages reach the terminal
 // whole and escaped; output paths are checked before any work; a CAN log that loses frames
 // makes the run fail. The expected texts are written out here.

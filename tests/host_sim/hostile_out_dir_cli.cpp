@@ -1,4 +1,4 @@
-// gfins-sim with hostile output folder names (issue 10, "a security defect first"): the plot
+// gfins-sim with hostile output folder names ("a security defect first"): the plot
 // script is started without a shell, so a folder name is never parsed. Each name is passed as
 // given; the oracle is the file system: after the run the working directory holds exactly one
 // entry, the folder with the exact bytes of the name, and in it exactly the files `run` writes

@@ -1,4 +1,4 @@
-// gfins-sim montecarlo / covariance --jobs N (issue 13, "Scale"): the files written do not depend
+// gfins-sim montecarlo / covariance --jobs N ("Scale"): the files written do not depend
 // on the thread count. The oracle is the output of --jobs 1, compared byte for byte with --jobs
 // 2 and --jobs 7 (more threads than cores and than runs per thread). Runs the real binary
 // (GFINS_SIM_BIN) on small scenarios: 12 Monte-Carlo runs of 1 s at 100 Hz, a 0.3 s covariance

@@ -1,4 +1,4 @@
-// gfins-sim montecarlo as a user meets it (review of issue 10, items 2 and 8): the memory
+// gfins-sim montecarlo as a user meets it: the memory
 // estimate printed before the work bounds the memory the run really takes, counts the threads,
 // and is checked against the limit; progress lines reach a log; SIGINT stops cleanly.
 //

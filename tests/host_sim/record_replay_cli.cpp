@@ -1,4 +1,4 @@
-// Record, replay, dump (issue 10): `gfins-sim run --record`, `gfins-replay`, the calibration
+// Record, replay, dump: `gfins-sim run --record`, `gfins-replay`, the calibration
 // from a recording end to end, `--scalar`, the input checks, CSV units and `--decimate`.
 //
 // The tools are the real binaries (GFINS_SIM_BIN, GFINS_REPLAY_BIN, GFINS_CALIBRATE_BIN), started

@@ -1,4 +1,4 @@
-// gfins-replay as a user meets it (review of issue 10, items 8, 10, 11, 12): inputs checked
+// gfins-replay as a user meets it: inputs checked
 // before any work (an alignment longer than the recording, an array that turns during the
 // alignment), SIGINT stopping between two samples with whole files, a flagged-saturated frame
 // not navigated, a file name with a newline kept out of the dump's '#' header.

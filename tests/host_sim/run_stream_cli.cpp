@@ -1,4 +1,4 @@
-// Long runs of `gfins-sim run` (issue 10, "Inputs checked before work starts"): the CSV files and
+// Long runs of `gfins-sim run` ("Inputs checked before work starts"): the CSV files and
 // the recording are written while the run navigates, so memory does not grow with the duration,
 // and SIGINT stops a run cleanly with what was written so far and exit code 130.
 //

@@ -1,4 +1,4 @@
-// The scenario registry as a user meets it (issue 10): a name is a name and a path is a path, so a
+// The scenario registry as a user meets it: a name is a name and a path is a path, so a
 // file or folder named like a built-in scenario in the current folder never shadows it; an unknown
 // name suggests the closest built-in names; the data folders are found relative to the program.
 #include <gtest/gtest.h>

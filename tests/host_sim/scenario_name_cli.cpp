@@ -1,4 +1,4 @@
-// gfins-sim as a user meets the scenario names (issue 10): after `run NAME -o NAME` a folder NAME
+// gfins-sim as a user meets the scenario names: after `run NAME -o NAME` a folder NAME
 // sits in the current folder, and `montecarlo NAME` must still run the built-in (the issue's case
 // is `drive`; the built-in `paper-6.3` is used here, the same rule for a 0.02 s run, cheap under
 // ASan and qemu); an unknown name suggests the closest and `gfins-sim list`; `./NAME` is the

@@ -143,7 +143,7 @@ TEST(ScenarioParse, UnknownKeyAndSyntaxErrorAreReported) {
 
 TEST(ScenarioParse, ANameThatIsNotAPlainFileNameComponentIsRefused) {
   // The name becomes the output folder sim-out/<name>: given names that would reach outside it
-  // or hide (review of issue 10: "../../../escaped" wrote to ../../../escaped/), parsing fails
+  // or hide ("../../../escaped" once wrote to ../../../escaped/), parsing fails
   // naming the key and the characters allowed.
   // ("new\\nline" is a TOML escape: a real newline in the name.)
   for (const char* name : {"../../../escaped", "/tmp/abs", "a/b", ".hidden", "..", "-x", "",

@@ -1,6 +1,6 @@
 // SimulatedAdc on the sample path allocates nothing: Monte-Carlo runs push millions of samples
 // through the register-level model and the real driver, and the board's loop must not allocate
-// either (issue 8 §5). Operator new is counted over many conversions after start(), including
+// either. Operator new is counted over many conversions after start(), including
 // frames with injected faults and a full recovery (reset + reconfigure).
 #include <gtest/gtest.h>
 

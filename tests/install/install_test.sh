@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The installed programs, away from the trees they were built from (issue 10, docs/install.md):
+# The installed programs, away from the trees they were built from (docs/install.md):
 #
 #   tests/install/install_test.sh [BUILD_DIR]     default build/host-release, built with
 #                                                 `--target gfins_package_programs`
@@ -177,7 +177,7 @@ checks() {
       [ -s run-rest/nav_errors.png ] || fail "run rest: no nav_errors.png"
     fi
   fi
-  # A folder named like a built-in scenario does not shadow it (issue 10).
+  # A folder named like a built-in scenario does not shadow it.
   expect 0 "$bin/gfins-sim" run drive -o drive --no-plot
   expect 0 "$bin/gfins-sim" montecarlo drive -n 2 -o mc-drive --no-plot
   expect 2 "$bin/gfins-sim" run drvie && log_has "closest: drive" "unknown scenario name"
@@ -189,7 +189,7 @@ checks() {
   expect 0 "$bin/gfins-sim" covariance rest -o cov --no-plot
   expect 0 "$bin/gfins-sim" --duration 1
 
-  # Record, replay (navigate, PNG, dump, means), from the prefix with the trees hidden (issue 10):
+  # Record, replay (navigate, PNG, dump, means), from the prefix with the trees hidden:
   # gfins-replay finds its plot script relative to itself, like gfins-sim.
   if [ -x "$bin/gfins-replay" ]; then
     if expect 0 "$bin/gfins-sim" run rest -o rec-rest --no-plot --record rest.gfr; then

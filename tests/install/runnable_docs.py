@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs the documentation's commands as a user would (issue 10, docs/install.md).
+"""Runs the documentation's commands as a user would (docs/install.md).
 
     tests/install/runnable_docs.py [--build build/host-release] [--list]
 

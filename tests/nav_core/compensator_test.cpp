@@ -27,7 +27,7 @@ using Vec6d = Vec6<double>;
 
 constexpr double kRho = 0.1;  // cube half-size, m
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-constexpr double kLocationError = 1e-3;  // |Δρ_j|, m (issue: 1 mm, random directions)
+constexpr double kLocationError = 1e-3;  // |Δρ_j|, m (1 mm, random directions)
 
 // The issue's bound on the algebraic residual of a correct compensator, rad/s² and m/s². Double
 // rounding of outputs of about 10 m/s² through M (row 1-norm ≤ 14 /m) is about 1e-14, so any
@@ -103,7 +103,7 @@ struct Motion {
 
 // At rest, tilted: specific force of gravity plus a small linear acceleration.
 const Motion kStatic{Vec3d::Zero(), Vec3d::Zero(), Vec3d(0.8, -1.1, -9.6)};
-// Spin of 5 rad/s with 10 rad/s² angular acceleration (issue), axes deliberately not aligned.
+// Spin of 5 rad/s with 10 rad/s² angular acceleration, axes deliberately not aligned.
 const Motion kSpin{5.0 * Vec3d(1, 2, 2).normalized(), 10.0 * Vec3d(-2, 1, 2).normalized(),
                    Vec3d(0.8, -1.1, -9.6)};
 

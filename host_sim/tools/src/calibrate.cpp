@@ -50,7 +50,7 @@ HostResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
                    std::to_string(j + 1) + " (Tables 4/5 need all 36)");
       }
       p.mean_v[i][j] = at[i][j]->mean_v;
-      // σ of the mean from std_v and count where given: both routes use it (issue 11).
+      // σ of the mean from std_v and count where given: both routes use it.
       if (at[i][j]->count > 0) {
         p.sigma_v[i][j] = at[i][j]->std_v / std::sqrt(static_cast<double>(at[i][j]->count));
       }

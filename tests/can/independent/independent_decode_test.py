@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent check of the gfins CAN decoder (issue 9).
+"""Independent check of the gfins CAN decoder.
 
 A candump log is read with python-can (Debian python3-can: can.CanutilsLogReader), each frame's
 CRC-8/SAE-J1850 and epoch counter are checked by code written here from the ICD, the frames are
