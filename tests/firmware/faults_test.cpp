@@ -669,9 +669,10 @@ TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {
   expect_status_rate(bus, 1000, rig.samples);
 }
 
-// GNSS input frames with aiding on: a corrupted frame is refused, counted and logged; a whole
-// fix (the board's true position and velocity at rest, zero) reaches the filter, which accepts
-// both of its updates. The oracle is the scenario: the board is at rest at the origin.
+// GNSS and heading input frames with aiding on: a corrupted frame is refused, counted and logged;
+// a whole fix (the board's true position and velocity at rest, zero) reaches the filter, which
+// accepts both of its updates, and so does an external heading equal to the board's. The oracle is
+// the scenario: the board is at rest at the origin.
 TEST_F(Faults, GnssInputFramesReachTheFilterAndACorruptedOneIsCountedAndLogged) {
   SimRig rig("rest", 3.0);
   rig.config.aiding = true;
@@ -693,14 +694,23 @@ TEST_F(Faults, GnssInputFramesReachTheFilterAndACorruptedOneIsCountedAndLogged) 
   rig.run_cycles(1);
   for (const hal::CanFrame& f : frames) ASSERT_TRUE(rig.bus->inject_rx(f));
   rig.run_cycles(1);
+  // An external heading equal to the one the board was given (navigation.heading_deg = 0).
+  can::HeadingFix h;
+  h.sequence = 1;
+  h.heading_rad = 0.0;
+  h.sigma_rad = 0.01;
+  h.age_s = 0.01;
+  ASSERT_TRUE(rig.bus->inject_rx(can::encode_heading_fix(h, SimRig::kNode)));
+  rig.run_cycles(1);
   rig.run();
   lines_ = rig.drain_log();
   EXPECT_EQ(rig.loop->health().aiding_input_errors, 1u);
-  EXPECT_EQ(rig.loop->health().aiding_inputs, 1u);
+  EXPECT_EQ(rig.loop->health().aiding_inputs, 2u);   // the fix and the heading
   EXPECT_EQ(rig.loop->health().command_errors, 0u);  // input frames are not commands
   const auto& c = rig.loop->pipeline().aiding().filter().counters();
   EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssPosition)], 1u);
   EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssVelocity)], 1u);
+  EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kHeading)], 1u);
   EXPECT_EQ(lines_with(lines_, "aiding input frame").size(), 1u);
 }
 
