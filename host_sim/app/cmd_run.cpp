@@ -4,6 +4,7 @@
 // and gfins-calibrate reads.
 #include "commands.hpp"
 #include "common.hpp"
+#include "gfins/drivers/lnx/output_paths.hpp"
 #include "run_options.hpp"
 
 #include <cmath>
@@ -66,6 +67,16 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
   }
   const std::string& out_dir = dir.value();
   const bool navigation = s.trajectory.kind != "calibration_poses";
+  // The recording must not be one of the files the run writes into its folder.
+  const gfins::drivers::lnx::NamedOutput outputs[] = {
+      {"--record", out.record},
+      {"the run's uncompensated.csv", navigation ? out_dir + "/uncompensated.csv" : ""},
+      {"the run's compensated.csv", navigation ? out_dir + "/compensated.csv" : ""},
+      {"the run's summary.txt", out_dir + "/summary.txt"},
+  };
+  if (auto clash = gfins::drivers::lnx::output_clash(outputs)) {
+    return fail({ErrorCode::kInvalidArgument, *clash}, kExitBadInput);
+  }
   if (auto c = check_disk_space(s, out_dir, run_disk_bytes(s, out.decimate, false), "the CSV files",
                                 "use --decimate N or a shorter run");
       !c.is_ok()) {

@@ -52,11 +52,6 @@ struct ReplayOptions {
   double gravity_mps2 = nav::kStandardGravity;
 };
 
-/// Relative difference above which the calibration file's ADC LSB and the recording's disagree:
-/// both are written from the same converter configuration (Vref/(gain 2^23)), so anything beyond
-/// the 1e-9 of a decimal round trip of a double means a file of another board or gain.
-constexpr double kLsbMismatchRel = 1e-6;
-
 /// Largest standard deviation of a channel, in g, over a still alignment window: the QA-1100's
 /// 70 µg rms noise (datasheet, 10-500 Hz) and a lab bench's vibration stay far below it, while
 /// an array that turns (spin.gfr at 3 rad/s: 0.15-0.6 g) or is carried is far above it. The
@@ -228,17 +223,8 @@ gfins::sim::HostResult<nav::PipelineConfig<double>> config_of(const ReplayOption
     const auto cal = gfins::calib_file::load_calibration_file(o.cal);
     if (!cal.is_ok()) return sim::HostError{ErrorCode::kInvalidArgument, cal.status().message()};
     const auto& d = cal.value();
-    for (std::size_t j = 0; j < 6; ++j) {
-      const double a = d.sensors[j].adc_lsb_v_per_count;
-      const double b = h.volts_per_count[j];
-      if (!(std::fabs(a - b) <= kLsbMismatchRel * std::fabs(b))) {
-        char buf[256];
-        std::snprintf(buf, sizeof buf,
-                      "%s: sensor a%zu has an ADC LSB of %.9g V/count, the recording %.9g: the "
-                      "calibration is of another converter setting",
-                      o.cal.c_str(), j + 1, a, b);
-        return sim::HostError{ErrorCode::kInvalidArgument, buf};
-      }
+    if (auto why = gfins::calib_file::converter_mismatch(d, h.volts_per_count, "the recording")) {
+      return sim::HostError{ErrorCode::kInvalidArgument, o.cal + ": " + *why};
     }
     gfins::calib_file::apply_to(d, c);
     what = "calibration " + o.cal + " (device " + d.device_id + ", compensator " +

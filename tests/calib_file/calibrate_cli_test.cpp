@@ -2,6 +2,8 @@
 // carries Table 6; bad inputs give a clear message and a non-zero exit status.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "calib_file/calib_test_data.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
@@ -291,6 +294,30 @@ TEST(CalibrateCli, AnOutputThatCannotBeWrittenIsRefusedBeforeSolving) {
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_THAT(r.output, HasSubstr("it is a directory"));
   EXPECT_THAT(r.output, Not(HasSubstr("verdict")));
+  // A FIFO, a link and (as root) a device node are refused and stay what they were: the rename
+  // would have replaced each with a regular file.
+  const auto fifo = dir.path() / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto link = dir.path() / "link";
+  std::filesystem::create_symlink(dir.path() / "elsewhere.toml", link);
+  const auto node = dir.path() / "full";
+  const bool root = ::mknod(node.c_str(), S_IFCHR | 0600, ::makedev(1, 7)) == 0;  // /dev/full
+  for (const auto& [path, kind] :
+       {std::pair{fifo, "it is a FIFO"}, std::pair{link, "it is a symbolic link"},
+        std::pair{node, "it is a device node"}}) {
+    if (!root && path == node) continue;
+    r = run_cli(dir, inputs + " -o " + path.string());
+    EXPECT_EQ(r.exit_code, 4) << path;
+    EXPECT_THAT(r.output, HasSubstr(kind));
+    EXPECT_THAT(r.output, Not(HasSubstr("verdict")));
+  }
+  EXPECT_TRUE(std::filesystem::is_fifo(std::filesystem::symlink_status(fifo)));
+  EXPECT_TRUE(std::filesystem::is_symlink(std::filesystem::symlink_status(link)));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "elsewhere.toml"));
+  if (root) {
+    EXPECT_TRUE(std::filesystem::is_character_file(std::filesystem::symlink_status(node)));
+  }
+  for (const auto& p : {fifo, link, node}) std::filesystem::remove(p);
   // The check leaves nothing behind and does not refuse a writable folder.
   r = run_cli(dir, inputs + " -o " + (dir.path() / "c.toml").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;

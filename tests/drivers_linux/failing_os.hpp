@@ -16,6 +16,10 @@ class FailingOs : public Os {
  public:
   FailingOs(SaveStep fail_at, int err) : fail_at_(fail_at), err_(err) {}
 
+  int lstat(const char* path, void* st) override {
+    if (fail_at_ == SaveStep::kCheckTarget) return fail();
+    return Os::lstat(path, st);
+  }
   int mkostemp(char* t, int flags) override {
     if (fail_at_ == SaveStep::kCreateTemp) return fail();
     temp_fd_ = Os::mkostemp(t, flags);

@@ -6,10 +6,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <array>
 #include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -78,9 +83,77 @@ TEST_P(AtomicSave, AFailureAtAnyStepLeavesAWholeFileAndNoTemporaryBehind) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryStep, AtomicSave,
-                         ::testing::Values(SaveStep::kCreateTemp, SaveStep::kWrite,
-                                           SaveStep::kSyncFile, SaveStep::kCloseFile,
-                                           SaveStep::kRename, SaveStep::kSyncDir));
+                         ::testing::Values(SaveStep::kCheckTarget, SaveStep::kCreateTemp,
+                                           SaveStep::kWrite, SaveStep::kSyncFile,
+                                           SaveStep::kCloseFile, SaveStep::kRename,
+                                           SaveStep::kSyncDir));
+
+// What a rename would replace with a regular file: each is refused before anything is written
+// and is still what it was afterwards (a device node only where mknod is allowed: as root, which
+// CI and the board are).
+TEST(FileParameterStore, AnythingButARegularFileAtThePathIsRefusedAndLeftAsItWas) {
+  const TempDir dir;
+  struct Kind {
+    const char* name;
+    std::filesystem::file_type type;
+    const char* said;
+  };
+  const std::array<Kind, 5> kinds{{
+      {"fifo", std::filesystem::file_type::fifo, "is a FIFO"},
+      {"sock", std::filesystem::file_type::socket, "is a socket"},
+      {"folder", std::filesystem::file_type::directory, "is a folder"},
+      {"link", std::filesystem::file_type::symlink, "is a symbolic link"},
+      {"null", std::filesystem::file_type::character, "is a device node"},
+  }};
+  const auto target = dir.path() / "target.toml";
+  { std::ofstream(target) << "kept\n"; }
+  int made = 0;
+  for (const Kind& k : kinds) {
+    SCOPED_TRACE(k.name);
+    const auto p = dir.path() / k.name;
+    int rc = 0;
+    switch (k.type) {
+      case std::filesystem::file_type::fifo:
+        rc = ::mkfifo(p.c_str(), 0600);
+        break;
+      case std::filesystem::file_type::socket: {
+        const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+        ASSERT_GE(fd, 0);
+        sockaddr_un addr{};
+        addr.sun_family = AF_UNIX;
+        ASSERT_LT(p.string().size(), sizeof addr.sun_path);
+        std::memcpy(addr.sun_path, p.c_str(), p.string().size());
+        rc = ::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
+        ::close(fd);
+        break;
+      }
+      case std::filesystem::file_type::directory:
+        rc = std::filesystem::create_directory(p) ? 0 : -1;
+        break;
+      case std::filesystem::file_type::symlink:
+        std::filesystem::create_symlink(target, p);
+        break;
+      default:
+        rc = ::mknod(p.c_str(), S_IFCHR | 0600, ::makedev(1, 3));  // /dev/null's numbers
+        if (rc != 0 && errno == EPERM) continue;                   // not root: nothing to test
+        break;
+    }
+    ASSERT_EQ(rc, 0) << std::strerror(errno);
+    ++made;
+    auto store = FileParameterStore::open(p.string());
+    ASSERT_TRUE(store.is_ok());
+    const Status s = store.value()->save(bytes("replaced = true\n"));
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+    EXPECT_THAT(s.message(), HasSubstr(k.said));
+    EXPECT_THAT(s.message(), HasSubstr("nothing was replaced"));
+    EXPECT_EQ(store.value()->last_failed_step(), SaveStep::kCheckTarget);
+    EXPECT_EQ(std::filesystem::symlink_status(p).type(), k.type);
+  }
+  EXPECT_GE(made, 4);
+  EXPECT_EQ(read_text(target), "kept\n");  // through the link: not written either
+  // Nothing else appeared: the five paths (four without root) and the target
+  EXPECT_EQ(count_entries(dir.path()), static_cast<std::size_t>(made) + 1);
+}
 
 TEST(FileParameterStore, SaveThenLoadRoundTripsTheBytesAndTheFileIsWorldReadable) {
   const TempDir dir;

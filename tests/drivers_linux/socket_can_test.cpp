@@ -206,6 +206,29 @@ TEST(SocketCanOpen, TheNameIsCheckedAgainstIfnamsizBeforeAnyCall) {
   EXPECT_TRUE(k2.log.empty());
 }
 
+// Names the kernel never gives (dev_valid_name: ".", "..", '/', ':', white space) and names
+// with control characters (ESC would reach the terminal in every message naming the interface)
+// are refused before any call; a name the kernel does give (vcan0, can-left_1, a veth pair) is not.
+TEST(SocketCanOpen, ANameWithAControlCharacterSpaceSlashOrColonIsRefusedBeforeAnyCall) {
+  for (const char* bad :
+       {"can\x1b[2J", "can\n0", "can 0", "can/0", "can:0", "can\x7f", ".", "..", "\t"}) {
+    SCOPED_TRACE(::testing::PrintToString(std::string(bad)));
+    FakeCanKernel k;
+    SocketCanConfig c;
+    c.interface = bad;
+    const auto r = SocketCan::open(c, k);
+    EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_TRUE(k.log.empty());
+  }
+  for (const char* good : {"vcan0", "can-left_1", "veth.7", "c"}) {
+    FakeCanKernel k;
+    SocketCanConfig c;
+    c.interface = good;
+    k.interfaces[std::string(c.interface)] = 3;
+    EXPECT_TRUE(SocketCan::open(c, k).is_ok()) << good;
+  }
+}
+
 TEST(SocketCanOpen, AMissingInterfaceIsUnavailableWithENODEV) {
   FakeCanKernel k;
   SocketCanConfig c;

@@ -4,9 +4,12 @@
 // the errno values of open(2)/read(2).
 #include "gfins/drivers/lnx/text_file.hpp"
 
+#include "gfins/drivers/lnx/output_paths.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -63,6 +66,32 @@ TEST(TextFile, AFolderAndAMissingPathGiveTheirErrno) {
   const Status missing = read_text_file((dir.path() / "nope").string().c_str(), 1024, out);
   EXPECT_EQ(missing.code(), ErrorCode::kIoError);
   EXPECT_EQ(missing.os_error(), ENOENT);
+}
+
+// Oracle: the paths and links the test makes itself. Spellings of one path, a link to it and a
+// hard link are one file; a file in another folder is not; /dev/null may take several outputs.
+TEST(OutputPaths, OneFileUnderAnySpellingIsAClashAndDistinctFilesAreNot) {
+  const TempDir dir;
+  const std::string a = dir.path().string() + "/a.csv";
+  const std::string b = dir.path().string() + "/b.csv";
+  EXPECT_TRUE(same_output_file(a, a));  // neither exists yet: compared as paths
+  EXPECT_TRUE(same_output_file(a, dir.path().string() + "/./sub/../a.csv"));
+  EXPECT_FALSE(same_output_file(a, b));
+  EXPECT_FALSE(same_output_file(a, ""));
+  write_bytes(a, "x");
+  std::filesystem::create_symlink(a, dir.path() / "link.csv");
+  std::filesystem::create_hard_link(a, dir.path() / "hard.csv");
+  EXPECT_TRUE(same_output_file(a, dir.path().string() + "/link.csv"));
+  EXPECT_TRUE(same_output_file(dir.path().string() + "/hard.csv", a));
+  EXPECT_FALSE(same_output_file("/dev/null", "/dev/null"));
+  const NamedOutput outs[] = {
+      {"--one", b}, {"--two", a}, {"--three", dir.path().string() + "/link.csv"}};
+  const auto clash = output_clash(outs);
+  ASSERT_TRUE(clash.has_value());
+  EXPECT_EQ(*clash, "--two and --three name the same file '" + dir.path().string() +
+                        "/link.csv': each output needs a file of its own");
+  const NamedOutput apart[] = {{"--one", b}, {"--two", a}, {"--none", ""}};
+  EXPECT_FALSE(output_clash(apart).has_value());
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <optional>
 #include <set>
 
+#include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/can/aiding_input.hpp"
 #include "gfins/can/command.hpp"
 #include "gfins/nav_core/math.hpp"
@@ -645,6 +646,42 @@ TEST_F(Faults, MissingCalibrationIsFlaggedOnTheBus) {
   EXPECT_EQ(e.cal_id, 0u);
   EXPECT_EQ(e.mode, kModeNavigating);
   expect_status_rate(bus, 1000, rig.samples);
+}
+
+// A calibration made for another converter setting (the README's paper calibration, 1.192e-6
+// V/count, against the simulated board's ADS131M06 LSB) scales every count by their ratio: |f|
+// reads 2.8 g at rest and navigation runs away. It is refused at start-up like any bad file
+// (nominal defaults, flagged on the bus) and by the reload command (the calibration in use stays).
+// Oracle: the factory calibration's own LSB, changed by the test.
+TEST_F(Faults, ACalibrationOfAnotherConverterIsRefusedAtStartAndOnReload) {
+  SimRig& rig = make();
+  calib_file::CalibrationData other = rig.factory;
+  for (auto& sensor : other.sensors) sensor.adc_lsb_v_per_count = 1.192e-6;
+  const std::string good = ::testing::TempDir() + "gfins_factory_cal.toml";
+  const std::string bad = ::testing::TempDir() + "gfins_other_converter_cal.toml";
+  ASSERT_TRUE(calib_file::save_calibration_file(good, rig.factory).is_ok());
+  ASSERT_TRUE(calib_file::save_calibration_file(bad, other).is_ok());
+  FwConfig c = rig.config;
+  c.calibration_file = bad;
+  const StartupCalibration cal = load_calibration(c, rig.factory, &rig.factory);
+  EXPECT_FALSE(cal.from_file);
+  EXPECT_FALSE(cal.set.calibrated);
+  EXPECT_NE(cal.message.find("UNCALIBRATED: " + bad +
+                             ": sensor a1 has an ADC LSB of 1.192e-06 "
+                             "V/count, the board's converter "),
+            std::string::npos)
+      << cal.message;
+  EXPECT_NE(cal.message.find("another converter setting"), std::string::npos) << cal.message;
+  // The same file of this converter is taken.
+  c.calibration_file = good;
+  EXPECT_TRUE(load_calibration(c, rig.factory, &rig.factory).from_file);
+  // Reload: the other converter's file is refused, this converter's file is taken.
+  c.calibration_file = bad;
+  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  c.calibration_file = good;
+  EXPECT_TRUE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  static_cast<void>(std::remove(good.c_str()));
+  static_cast<void>(std::remove(bad.c_str()));
 }
 
 TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {

@@ -4,8 +4,10 @@
 // makes the run fail. The expected texts are written out here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/cli_fixture.hpp"
@@ -147,6 +149,36 @@ TEST_F(FwCli, CheckConfigNamesWhatTheConfigurationIsMadeOf) {
             std::string::npos)
       << c.output;
   EXPECT_NE(c.output.find("a run would navigate UNCALIBRATED"), std::string::npos) << c.output;
+}
+
+// Two outputs on one file would overwrite each other (the latency table over the start of the
+// CAN log): refused before the run with both names, whatever spelling of the path; /dev/null
+// for both is not a clash.
+TEST_F(FwCli, TwoOutputsOnOneFileAreRefusedBeforeTheRun) {
+  const std::string log = path("x.log");
+  for (const auto& [extra, names] :
+       {std::pair{std::vector<std::string>{"--latency-csv", log},
+                  "can.log_file (--can-log) and --latency-csv"},
+        std::pair{std::vector<std::string>{"--latency-csv", path(".") + "/./x.log"},
+                  "can.log_file (--can-log) and --latency-csv"},
+        std::pair{std::vector<std::string>{"--calibration", log},
+                  "can.log_file (--can-log) and calibration.file"}}) {
+    SCOPED_TRACE(extra[1]);
+    std::vector<std::string> args = sim_run({}, "rest", log);
+    if (const auto at = std::find(args.begin(), args.end(), extra[0]); at != args.end()) {
+      *(at + 1) = extra[1];  // sim_run's --calibration "" becomes the clashing path
+    } else {
+      args.insert(args.end(), extra.begin(), extra.end());
+    }
+    const test::CliResult r = fw(args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(names), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("name the same file"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find(kStarted), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(log));
+  }
+  const test::CliResult ok = fw(sim_run({"--latency-csv", "/dev/null"}, "rest", "/dev/null"));
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
 }
 
 TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {

@@ -519,6 +519,11 @@ rate_dps = 90
       {{"run", "paper-6.3", "--record", path("p.gfr"), "--no-plot", "-o", path("p63")},
        {"--record", "sensors.adc = false"}},
       {{"paper63", "-o", "", "--no-plot"}, {"-o/--out is empty"}},
+      // A recording that is one of the run's own files would be overwritten by it (and it).
+      {{"run", rest, "-o", path("o"), "--record", path("o") + "/compensated.csv", "--no-plot"},
+       {"--record and the run's compensated.csv name the same file"}},
+      {{"run", rest, "-o", path("o"), "--record", path("o") + "/./../o/summary.txt", "--no-plot"},
+       {"--record and the run's summary.txt name the same file"}},
   };
   for (const auto& c : cases) {
     const auto r = sim(c.args);
@@ -532,6 +537,7 @@ rate_dps = 90
   EXPECT_FALSE(fs::exists("sim-out/huge"));
   EXPECT_FALSE(fs::exists(path("p.gfr")));
   EXPECT_FALSE(fs::exists(path("p63")));
+  EXPECT_FALSE(fs::exists(path("o")));
   const auto r = replay({path("missing.gfr"), "-o", ""});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   EXPECT_NE(r.output.find("missing.gfr"), std::string::npos) << r.output;

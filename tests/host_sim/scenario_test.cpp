@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "gfins/host_sim/scenario.hpp"
 
@@ -164,6 +165,26 @@ TEST(ScenarioParse, ANameThatIsNotAPlainFileNameComponentIsRefused) {
     ASSERT_TRUE(ok.is_ok()) << ok.error().message;
     EXPECT_EQ(ok.value().name, name);
   }
+}
+
+TEST(ScenarioParse, ADescriptionWithAControlCharacterIsRefusedNamingItsPlace) {
+  // The description goes to the terminal and into summary.txt: ESC [2J would clear the screen,
+  // a newline forge a report line. TOML escapes put them there (\u001b, \n, \u007f, \u009b CSI).
+  for (const auto& [text, code, at] : {std::tuple{"evil\\u001b[2J", "U+001B", "character 5"},
+                                       std::tuple{"line\\nforged", "U+000A", "character 5"},
+                                       std::tuple{"a\\tb", "U+0009", "character 2"},
+                                       std::tuple{"\\u007f", "U+007F", "character 1"},
+                                       std::tuple{"°\\u009b2J", "U+009B", "character 2"}}) {
+    SCOPED_TRACE(text);
+    expect_error(
+        replace(kGood, "[scenario]", std::string("[scenario]\ndescription = \"") + text + "\""),
+        {"bad.toml:3:", "scenario.description", code, at, "one line of printable text"});
+  }
+  // Printable text, UTF-8 included, passes unchanged.
+  const HostResult<Scenario> ok = parse_scenario(
+      replace(kGood, "[scenario]", "[scenario]\ndescription = \"tilt 30° — ρ 0.1 m\""), "x.toml");
+  ASSERT_TRUE(ok.is_ok()) << ok.error().message;
+  EXPECT_EQ(ok.value().description, "tilt 30° — ρ 0.1 m");
 }
 
 TEST(ScenarioParse, FewerThanTwoSamplesIsRefusedAndPartialPeriodsAreFloored) {

@@ -14,6 +14,9 @@ namespace {
 // One message per step and outcome: Status messages are static (no heap on any path).
 const char* failure_message(SaveStep step) {
   switch (step) {
+    case SaveStep::kCheckTarget:
+      return "parameter store: not saved: checking the target failed; the previous file is "
+             "unchanged";
     case SaveStep::kCreateTemp:
       return "parameter store: not saved: creating the temporary file failed; the previous file "
              "is unchanged";
@@ -36,10 +39,31 @@ const char* failure_message(SaveStep step) {
   return "parameter store: save failed";
 }
 
+// What stands at the path when it is not a regular file; nullptr for a regular file.
+const char* not_a_file_message(unsigned mode) {
+  if (S_ISREG(mode)) return nullptr;
+  if (S_ISLNK(mode)) {
+    return "parameter store: not saved: the path is a symbolic link (name the file it points "
+           "to); nothing was replaced";
+  }
+  if (S_ISDIR(mode))
+    return "parameter store: not saved: the path is a folder; nothing was replaced";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) {
+    return "parameter store: not saved: the path is a device node; nothing was replaced";
+  }
+  if (S_ISFIFO(mode)) return "parameter store: not saved: the path is a FIFO; nothing was replaced";
+  if (S_ISSOCK(mode)) {
+    return "parameter store: not saved: the path is a socket; nothing was replaced";
+  }
+  return "parameter store: not saved: the path is not a regular file; nothing was replaced";
+}
+
 }  // namespace
 
 const char* to_string(SaveStep step) {
   switch (step) {
+    case SaveStep::kCheckTarget:
+      return "checking the target";
     case SaveStep::kCreateTemp:
       return "creating the temporary file";
     case SaveStep::kWrite:
@@ -127,6 +151,15 @@ Status FileParameterStore::fail(SaveStep step, int err, bool temp_exists) {
 }
 
 Status FileParameterStore::do_save(std::span<const char> blob) {
+  struct stat st {};
+  if (os_.lstat(path_.c_str(), &st) == 0) {
+    if (const char* what = not_a_file_message(st.st_mode)) {
+      last_failed_step_ = SaveStep::kCheckTarget;
+      return Status(ErrorCode::kInvalidArgument, what);
+    }
+  } else if (errno != ENOENT) {
+    return fail(SaveStep::kCheckTarget, errno, false);
+  }
   temp_ = temp_template_;  // mkostemp replaces the X's in place
   Fd fd(os_, os_.mkostemp(temp_.data(), O_CLOEXEC));
   if (!fd.valid()) return fail(SaveStep::kCreateTemp, errno, false);
@@ -151,6 +184,12 @@ Status FileParameterStore::do_save(std::span<const char> blob) {
   if (!dir_fd.valid()) return fail(SaveStep::kSyncDir, errno, false);
   if (os_.fsync(dir_fd.get()) != 0) return fail(SaveStep::kSyncDir, errno, false);
   return Status::ok();
+}
+
+Status save_file_atomically(std::string_view path, std::span<const char> blob, Os& os) {
+  auto store = FileParameterStore::open(path, os);
+  if (!store.is_ok()) return store.status();
+  return store.value()->replace(blob);
 }
 
 }  // namespace gfins::drivers::lnx

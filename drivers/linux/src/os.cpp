@@ -31,6 +31,7 @@ int Os::fchmod(int fd, unsigned mode) { return ::fchmod(fd, static_cast<mode_t>(
 int Os::mkostemp(char* path_template, int flags) { return ::mkostemp(path_template, flags); }
 int Os::rename(const char* from, const char* to) { return std::rename(from, to); }
 int Os::unlink(const char* path) { return ::unlink(path); }
+int Os::lstat(const char* path, void* st) { return ::lstat(path, static_cast<struct stat*>(st)); }
 
 int Os::socket(int domain, int type, int protocol) { return ::socket(domain, type, protocol); }
 int Os::bind(int fd, const void* addr, unsigned addr_len) {

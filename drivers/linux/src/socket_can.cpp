@@ -43,6 +43,20 @@ Result<std::unique_ptr<SocketCan>> SocketCan::open(const SocketCanConfig& config
   if (config.interface.find('\0') != std::string_view::npos) {
     return Status(ErrorCode::kInvalidArgument, "socketcan: interface name contains a NUL");
   }
+  // What the kernel's dev_valid_name() refuses (".", "..", '/', ':', white space), and every
+  // other control character: a name holding ESC or a newline would reach the terminal in
+  // every message that names the interface.
+  if (config.interface == "." || config.interface == "..") {
+    return Status(ErrorCode::kInvalidArgument,
+                  "socketcan: \".\" and \"..\" are not interface names");
+  }
+  for (const char ch : config.interface) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c <= 0x20 || c == 0x7F || c == '/' || c == ':') {
+      return Status(ErrorCode::kInvalidArgument,
+                    "socketcan: interface name holds a control character, a space, '/' or ':'");
+    }
+  }
   if (config.tx_queue_capacity == 0 || config.tx_queue_capacity > kMaxTxQueue) {
     return Status(ErrorCode::kInvalidArgument, "socketcan: tx queue capacity must be 1..256");
   }

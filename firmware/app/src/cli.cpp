@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "gfins/app/config.hpp"
+#include "gfins/drivers/lnx/output_paths.hpp"
 #include "gfins/version/version.hpp"
 
 namespace gfins::app {
@@ -218,6 +219,18 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (std::string problem = validate(c, origin); !problem.empty()) {
     out.exit_code = 2;
     out.message = "gfins-fw: " + problem + "\n";
+    return out;
+  }
+  // The files this run writes: two of them on one path would overwrite each other.
+  const drivers::lnx::NamedOutput outputs[] = {
+      {"can.log_file (--can-log)", c.can_log},
+      {"--latency-csv", out.latency_csv},
+      {"hil.port_file (--hil-port-file)", c.hil_port_file},
+      {"calibration.file (--calibration, written by the calibrate command)", c.calibration_file},
+  };
+  if (auto clash = drivers::lnx::output_clash(outputs)) {
+    out.exit_code = 2;
+    out.message = "gfins-fw: " + *clash + "\n";
     return out;
   }
   out.config = std::move(c);

@@ -2,8 +2,6 @@
 // link in place of the ADC, the CAN frames back on the same connection.
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 
@@ -15,6 +13,7 @@
 #include "gfins/app/startup.hpp"
 #include "gfins/drivers/ads131m06.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
+#include "gfins/drivers/lnx/file_parameter_store.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
 #include "gfins/drivers/qa1100_front_end.hpp"
 
@@ -118,20 +117,12 @@ BoardResult make_hil_board(const FwConfig& c) {
   parts->server = std::move(server).value();
   lnx::HilServer* srv = parts->server.get();
   if (!c.hil_port_file.empty()) {
-    // Written whole under a temporary name, then renamed: a reader never sees half a number.
-    const std::string tmp = c.hil_port_file + ".tmp";
-    {
-      std::ofstream f(tmp, std::ios::trunc);
-      f << srv->port() << "\n";
-      if (!f) {
-        out.error = "hil.port_file = \"" + c.hil_port_file + "\": cannot be written";
-        return out;
-      }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, c.hil_port_file, ec);
-    if (ec) {
-      out.error = "hil.port_file = \"" + c.hil_port_file + "\": " + ec.message();
+    // Written whole under a temporary name, then renamed: a reader never sees half a number;
+    // a device node or FIFO at the path is refused, not replaced.
+    const std::string text = std::to_string(srv->port()) + "\n";
+    const Status saved = lnx::save_file_atomically(c.hil_port_file, {text.data(), text.size()});
+    if (!saved.is_ok()) {
+      out.error = lnx::describe("hil.port_file = \"" + c.hil_port_file + "\"", saved);
       return out;
     }
   }

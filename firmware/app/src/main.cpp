@@ -76,7 +76,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   auto log_queue = std::make_unique<FwLogQueue>();
   LogDrain drain(*log_queue);
   drain.start();
-  ReloadWorker reload(calibration_reloader(cfg));
+  ReloadWorker reload(calibration_reloader(cfg, converter_lsb(board.defaults)));
 
   auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
                                            *log_queue);

@@ -95,6 +95,12 @@ calib_file::CalibrationData nominal_calibration(double volts_per_count) {
   return d;
 }
 
+std::array<double, 6> converter_lsb(const calib_file::CalibrationData& d) {
+  std::array<double, 6> lsb{};
+  for (std::size_t j = 0; j < lsb.size(); ++j) lsb[j] = d.sensors[j].adc_lsb_v_per_count;
+  return lsb;
+}
+
 StartupCalibration load_calibration(const FwConfig& c, const calib_file::CalibrationData& defaults,
                                     const calib_file::CalibrationData* factory) {
   StartupCalibration out;
@@ -111,7 +117,14 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     why = "no calibration file configured (calibration.file is empty)";
   } else {
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
+    // A file of another converter setting (another board's gain, the paper's 20-bit LSB) would
+    // scale every count wrongly: refused like any other bad file.
+    std::optional<std::string> mismatch;
     if (loaded.is_ok()) {
+      mismatch = calib_file::converter_mismatch(loaded.value(), converter_lsb(defaults),
+                                                "the board's converter");
+    }
+    if (loaded.is_ok() && !mismatch) {
       out.set.config = pipeline_config(c, loaded.value());
       out.set.cal_id = calib_file::cal_id_of(loaded.value());
       out.set.calibrated = true;
@@ -122,7 +135,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
                     ", id " + id + ")";
       return out;
     }
-    why = loaded.status().message();
+    why = mismatch ? c.calibration_file + ": " + *mismatch : loaded.status().message();
   }
   out.set.config = pipeline_config(c, defaults);
   out.set.cal_id = 0;
@@ -132,8 +145,9 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
   return out;
 }
 
-ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
-  return [c](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> {
+ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
+                                          std::optional<std::array<double, 6>> board_lsb) {
+  return [c, board_lsb](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> {
     if (c.calibration_file.empty()) {
       spdlog::error("calibration reload: no calibration file configured");
       return std::nullopt;
@@ -143,6 +157,14 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c) {
       spdlog::error("calibration reload failed, the calibration in use stays: {}",
                     loaded.status().message());
       return std::nullopt;
+    }
+    if (board_lsb) {
+      if (auto why =
+              calib_file::converter_mismatch(loaded.value(), *board_lsb, "the board's converter")) {
+        spdlog::error("calibration reload refused, the calibration in use stays: {}: {}",
+                      c.calibration_file, *why);
+        return std::nullopt;
+      }
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());

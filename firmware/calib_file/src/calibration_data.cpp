@@ -245,6 +245,24 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version) {
   return fnv1a64(canonical_serialisation(data, version));
 }
 
+std::optional<std::string> converter_mismatch(
+    const CalibrationData& data, const std::array<double, kNumSensors>& volts_per_count,
+    const std::string& what) {
+  for (std::size_t j = 0; j < kNumSensors; ++j) {
+    const double a = data.sensors[j].adc_lsb_v_per_count;
+    const double b = volts_per_count[j];
+    if (!(std::fabs(a - b) <= kLsbMismatchRel * std::fabs(b))) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    "sensor a%zu has an ADC LSB of %.9g V/count, %s %.9g: the calibration is of "
+                    "another converter setting",
+                    j + 1, a, what.c_str(), b);
+      return std::string(buf);
+    }
+  }
+  return std::nullopt;
+}
+
 std::uint32_t cal_id_of(const CalibrationData& data) {
   const std::uint64_t h = checksum(data);
   const auto id = static_cast<std::uint32_t>((h ^ (h >> 32)) & 0xFFFFFFFFu);

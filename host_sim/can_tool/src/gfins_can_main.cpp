@@ -25,6 +25,8 @@
 #include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
+#include "gfins/drivers/lnx/error_text.hpp"
+#include "gfins/drivers/lnx/file_parameter_store.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/version/version.hpp"
@@ -431,19 +433,16 @@ struct SequenceCliOptions {
   int timeout_ms = 1000;
 };
 
-bool write_text(const std::string& path, const std::string& text) {
-  // Whole file under a temporary name, then renamed over the target: a reader (gfins-calibrate)
-  // never sees half a file, and a failed run leaves the previous one intact.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    f.flush();
-    if (!f) return false;
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  return !ec;
+/// The whole file under a temporary name, then renamed over the target
+/// (lnx::save_file_atomically: a reader (gfins-calibrate) never sees half a file, a failed run
+/// leaves the previous one intact, a device node, FIFO or link at the path is refused and left
+/// alone). Says what went wrong; false then.
+bool write_output(const std::string& path, const std::string& text) {
+  const Status saved = drivers::lnx::save_file_atomically(path, {text.data(), text.size()});
+  if (saved.is_ok()) return true;
+  std::fprintf(stderr, "gfins-can calibrate: %s\n",
+               drivers::lnx::describe("'" + path + "'", saved).c_str());
+  return false;
 }
 
 /// gfins-can calibrate --rate-table: one capture of whole revolutions per run of the plan, the
@@ -509,10 +508,7 @@ int run_rate_table_sequence(const SequenceCliOptions& o, const SequenceOptions& 
       }
     }
   }
-  if (!write_text(o.output, csv)) {
-    std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.output.c_str());
-    return kExitInput;
-  }
+  if (!write_output(o.output, csv)) return kExitInput;
   std::fprintf(stderr, "gfins-can calibrate: wrote %s (%zu rate-table runs)\n", o.output.c_str(),
                plan.size());
   return kExitOk;
@@ -586,18 +582,12 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
     std::fprintf(stderr, "gfins-can calibrate: %s\n", r.error.c_str());
     return r.stop == SequenceResult::Stop::kRefused ? kExitRejected : kExitTimeout;
   }
-  if (!write_text(o.output, means_csv(r.captures, o.adc_lsb, paper))) {
-    std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.output.c_str());
-    return kExitInput;
-  }
+  if (!write_output(o.output, means_csv(r.captures, o.adc_lsb, paper))) return kExitInput;
   std::fprintf(
       stderr, "gfins-can calibrate: wrote %s (%zu poses, %s layout, %d refused on the way)\n",
       o.output.c_str(), r.captures.size(), paper ? "paper Tables 4/5" : "all sensors", r.refused);
   if (!o.poses_out.empty()) {
-    if (!write_text(o.poses_out, poses_csv(plan))) {
-      std::fprintf(stderr, "gfins-can calibrate: cannot write '%s'\n", o.poses_out.c_str());
-      return kExitInput;
-    }
+    if (!write_output(o.poses_out, poses_csv(plan))) return kExitInput;
     std::fprintf(stderr, "gfins-can calibrate: wrote %s\n", o.poses_out.c_str());
   }
   return kExitOk;

@@ -233,6 +233,28 @@ void check_name(const toml::table& sc, const Reader& rd, const std::string& name
           problem + " (the name is the file's stem when [scenario] has no name key: set one)");
 }
 
+/// The description is printed to the terminal and into summary.txt: one line of text, without
+/// the control characters (C0, DEL, C1) a TOML escape can put there and a terminal would obey
+/// (ESC [2J clears the screen; a newline would forge a line of the report).
+void check_description(const toml::table& sc, const Reader& rd, const std::string& text) {
+  std::size_t chars = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if ((c & 0xC0U) != 0x80U) ++chars;  // a character starts here (not a continuation byte)
+    unsigned code = c;
+    if (c == 0xC2 && i + 1 < text.size()) code = static_cast<unsigned char>(text[i + 1]);
+    const bool c1 = c == 0xC2 && code >= 0x80 && code <= 0x9F;
+    if (c < 0x20 || c == 0x7F || c1) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "control character U+%04X at character %zu: a description is one line of "
+                    "printable text",
+                    code, chars);
+      rd.fail(sc.get("description"), "scenario.description", buf);
+    }
+  }
+}
+
 /// [gnss]: the simulated receiver (GnssSpec). Outages are [[start_s, end_s], ...].
 GnssSpec parse_gnss(const toml::table& g, const Reader& rd) {
   const std::string p = "gnss.";
@@ -307,6 +329,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
   s.name = rd.string(sc, "scenario.", "name", s.name);
   check_name(sc, rd, s.name);
   s.description = rd.string(sc, "scenario.", "description", std::string());
+  check_description(sc, rd, s.description);
   s.duration_s = rd.number(sc, "scenario.", "duration_s", std::nullopt, 1e-3, 1e6);
   s.rate_hz = rd.number(sc, "scenario.", "rate_hz", std::nullopt, 1.0, 1e5);
   if (sample_count(s) < 2) {

@@ -49,6 +49,18 @@ std::string output_unwritable(const std::string& output) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(output, ec)) return "it is a directory";
+  // The rename would put a regular file in place of a device node, FIFO, socket or link (as
+  // root, `-o /dev/full` would replace the machine's /dev/full): the save refuses them too.
+  const fs::file_status st = fs::symlink_status(output, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) {
+    const char* kind = fs::is_symlink(st)                                   ? "a symbolic link"
+                       : fs::is_character_file(st) || fs::is_block_file(st) ? "a device node"
+                       : fs::is_fifo(st)                                    ? "a FIFO"
+                       : fs::is_socket(st)                                  ? "a socket"
+                                                                            : "not a regular file";
+    return std::string("it is ") + kind +
+           ", which the atomic save would replace with a regular file (name a regular file)";
+  }
   fs::path dir = fs::path(output).parent_path();
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir, ec)) return "its folder '" + dir.string() + "' does not exist";

@@ -3,7 +3,9 @@
 // here, before the loop starts.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "gfins/app/config.hpp"
@@ -32,7 +34,8 @@ struct StartupCalibration {
   std::string message;  // what happened (a loud warning when !from_file)
 };
 
-/// Reads `c.calibration_file`. Missing or invalid → `defaults` flagged uncalibrated (cal_id 0),
+/// Reads `c.calibration_file`. Missing, invalid or of another converter setting than `defaults`
+/// (the board's ADC LSB) → `defaults` flagged uncalibrated (cal_id 0),
 /// and `message` says why; the file is never modified. With no file configured and a `factory`
 /// calibration (the simulated board's: its scenario's true parameters), that one is used as a
 /// calibration.
@@ -45,7 +48,12 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
 calib_file::CalibrationData nominal_calibration(double volts_per_count);
 
 /// The ReloadWorker's loader for the configured file: a new set on success; logs and nullopt on
-/// failure (the calibration in use stays).
-ReloadWorker::LoadFn calibration_reloader(const FwConfig& c);
+/// failure (the calibration in use stays). With `board_lsb` (the board's converter, from
+/// converter_lsb(defaults)) a file of another converter setting is such a failure too.
+ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
+                                          std::optional<std::array<double, 6>> board_lsb = {});
+
+/// The ADC LSB of each sensor in `d`, V/count (for the defaults: the board's converter).
+std::array<double, 6> converter_lsb(const calib_file::CalibrationData& d);
 
 }  // namespace gfins::app

@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "gfins/nav_core/compensator.hpp"
@@ -169,6 +170,18 @@ std::uint64_t checksum(const CalibrationData& data, std::int64_t version = kForm
 /// for "nominal parameters, no file") mapped to 1. Two files with the same values have the same
 /// identity.
 std::uint32_t cal_id_of(const CalibrationData& data);
+
+/// Relative difference of two ADC LSBs that still counts as one converter setting (the file
+/// prints the shortest text that reads back exactly; 1e-6 leaves room for a value typed by hand
+/// to 7 digits, far below the smallest real change: a gain step of the ADS131M06 is 2×).
+inline constexpr double kLsbMismatchRel = 1e-6;
+
+/// Why `data` cannot be used with a converter of `volts_per_count` per sensor ("sensor a1 has an
+/// ADC LSB of 1.192e-06 V/count, <what> 1.43051147e-07: the calibration is of another converter
+/// setting"): every count would be scaled by their ratio, |f| with it. nullopt when they agree.
+std::optional<std::string> converter_mismatch(
+    const CalibrationData& data, const std::array<double, kNumSensors>& volts_per_count,
+    const std::string& what);
 /// FNV-1a 64-bit of arbitrary bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
 std::uint64_t fnv1a64(const std::string& bytes);
 

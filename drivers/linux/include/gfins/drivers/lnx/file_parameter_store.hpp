@@ -5,7 +5,10 @@
 // deferred write errors on some filesystems), rename it over the target, fsync the folder so
 // the rename itself survives a power cut. A failure before the rename removes the temporary
 // file and leaves the previous file byte-identical; a failure of the folder fsync is reported
-// (kIoError, SaveStep::kSyncDir) with the new file already in place.
+// (kIoError, SaveStep::kSyncDir) with the new file already in place. Only a regular file (or
+// nothing) is replaced: a device node, FIFO, socket, folder or symbolic link at the path is
+// refused before anything is written (SaveStep::kCheckTarget), since a rename would put a
+// regular file in its place (`-o /dev/full` run as root would replace the machine's /dev/full).
 #pragma once
 
 #include <cstdint>
@@ -21,12 +24,13 @@ namespace gfins::drivers::lnx {
 
 /// Steps of the atomic save, in order.
 enum class SaveStep : std::uint8_t {
-  kCreateTemp,  // mkostemp in the target's folder (+ fchmod 0644)
-  kWrite,       // write the whole blob
-  kSyncFile,    // fsync the temporary file
-  kCloseFile,   // close it
-  kRename,      // rename over the target: the commit point
-  kSyncDir,     // open + fsync the folder
+  kCheckTarget,  // lstat the target: nothing there, or a regular file
+  kCreateTemp,   // mkostemp in the target's folder (+ fchmod 0644)
+  kWrite,        // write the whole blob
+  kSyncFile,     // fsync the temporary file
+  kCloseFile,    // close it
+  kRename,       // rename over the target: the commit point
+  kSyncDir,      // open + fsync the folder
 };
 const char* to_string(SaveStep step);
 
@@ -37,6 +41,8 @@ class FileParameterStore final : public hal::ParameterStore {
                                                           Os& os = real_os());
 
   const std::string& path() const { return path_; }
+  /// The atomic save without the store's kMaxBytes limit (a tool's CSV output).
+  [[nodiscard]] Status replace(std::span<const char> blob) { return do_save(blob); }
   /// The step of the last failed save (meaningful only after save() failed).
   SaveStep last_failed_step() const { return last_failed_step_; }
 
@@ -53,5 +59,8 @@ class FileParameterStore final : public hal::ParameterStore {
   std::string temp_;           // mkostemp fills the X's
   SaveStep last_failed_step_ = SaveStep::kCreateTemp;
 };
+
+/// `blob` written to `path` with the store's atomic save and its target check, any size.
+Status save_file_atomically(std::string_view path, std::span<const char> blob, Os& os = real_os());
 
 }  // namespace gfins::drivers::lnx

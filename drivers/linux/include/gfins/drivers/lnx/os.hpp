@@ -31,6 +31,8 @@ class Os {
   virtual int mkostemp(char* path_template, int flags);
   virtual int rename(const char* from, const char* to);
   virtual int unlink(const char* path);
+  // `st` is a struct stat; the link itself is described, not what it points to.
+  virtual int lstat(const char* path, void* st);
 
   // Sockets (<sys/socket.h>, <net/if.h>, <poll.h>). `addr` is a struct sockaddr_*; `fds` an
   // array of struct pollfd; `timeout` a struct timespec (nullptr = wait forever).
