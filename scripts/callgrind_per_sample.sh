@@ -40,10 +40,6 @@ else
   out_dir="${gfins_scratch}"
 fi
 
-total_ir() {  # total_ir <callgrind.out>: the "summary:" (or "totals:") event count
-  awk '/^(summary|totals):/ { print $2; exit }' "$1"
-}
-
 printf '%-7s %-6s %14s %14s %12s\n' scalar comp "Ir(N1=${n1})" "Ir(N2=${n2})" "Ir/sample"
 for scalar in float double; do
   for comp in none paper exact; do
@@ -53,7 +49,7 @@ for scalar in float double; do
       f="${out_dir}/callgrind.${scalar}.${comp}.${tag}.out"
       valgrind --tool=callgrind --callgrind-out-file="${f}" "${exe}" "${scalar}" "${comp}" "${n}" \
         >/dev/null 2>"${f}.log"
-      ir[${tag}]="$(total_ir "${f}")"
+      ir[${tag}]="$(gfins_total_ir "${f}")"
     done
     per_sample="$(awk -v a="${ir[N1]}" -v b="${ir[N2]}" -v n1="${n1}" -v n2="${n2}" \
                    'BEGIN { printf "%.1f", (b - a) / (n2 - n1) }')"

@@ -44,3 +44,8 @@ gfins_scratch_dir() {
   gfins_scratch="$(mktemp -d)"
   trap 'rm -rf "${gfins_scratch}"' EXIT
 }
+
+# gfins_total_ir <callgrind.out>: the file's "summary:" (or "totals:") instruction count.
+gfins_total_ir() {
+  awk '/^(summary|totals):/ { print $2; exit }' "$1"
+}
