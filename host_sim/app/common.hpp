@@ -2,7 +2,6 @@
 // scripts (started without a shell), progress and the summary tables.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -22,11 +21,6 @@ inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures a
 // `run` stopped by SIGINT/SIGTERM (Ctrl-C): files closed and valid up to the last sample done
 // (128 + SIGINT, the shells' convention for a program ended by Ctrl-C).
 inline constexpr int kExitInterrupted = 130;
-
-/// A CLI11 check for a number in [lo, hi] that is finite: CLI::Range alone passes NaN (both of
-/// its comparisons are false), and an "inf" or 1e308 parsed into a double would reach the
-/// arithmetic. The message names the range.
-CLI::Validator finite_range(double lo, double hi);
 
 /// Prints "gfins-sim: <message>" on stderr and returns `exit_code`.
 int fail(const HostError& e, int exit_code);

@@ -20,6 +20,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "finite_range.hpp"
 #include "gfins/version/version.hpp"
 
 namespace {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "finite_range.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/host_sim/recording.hpp"

@@ -4,6 +4,7 @@
 // with the count the test removed. The oracle is the test's own bookkeeping of what it removed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <random>
@@ -14,6 +15,7 @@
 #include "decoder.hpp"
 #include "gfins/can/command.hpp"
 #include "gfins/can/publisher.hpp"
+#include "gfins/can/signal_codec.hpp"
 
 namespace gfins::can_tool {
 namespace {
@@ -94,8 +96,11 @@ Decoded decode(const std::vector<SentFrame>& frames) {
   Decoded d;
   StreamDecoder dec([&](const DecodedEpoch&) { ++d.epochs; },
                     [&](const Issue& i) { d.issues.push_back(i); });
+  // The log's clock (the host's) runs on across the board's restarts: never backwards.
+  std::int64_t log_us = 0;
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    dec.feed_frame(i + 1, static_cast<std::int64_t>(frames[i].seq) * 1000, frames[i].frame);
+    log_us = std::max(log_us + 1, static_cast<std::int64_t>(frames[i].seq) * 1000);
+    dec.feed_frame(i + 1, log_us, frames[i].frame);
   }
   dec.finish();
   d.summary = dec.summary();
@@ -273,6 +278,86 @@ TEST(DecoderChecks, EpochGapsOfAnySizeAreCountedExactly) {
         << d.issues[0].text;
     EXPECT_EQ(d.epochs, 200u - lost);
   }
+}
+
+// CRC-valid frames no board sends, made by editing the published Epoch frames and sealing them
+// again: each is one problem of its kind at its line, and the decode goes on (every epoch).
+// Oracle: the edit (which epoch, which value), not the decoder.
+TEST(DecoderChecks, StuckOrBackwardSampleCountAndStalledOrJumpingTimeAreProblems) {
+  RecordingBus bus;
+  publish(bus, 0, 1000);  // 100 epochs: TimeUs 1000 us per sample, SampleCount +10
+  std::vector<std::size_t> epochs;
+  for (std::size_t i = 0; i < bus.frames.size(); ++i) {
+    if (is(bus.frames[i].frame, MessageId::kEpoch)) epochs.push_back(i);
+  }
+  ASSERT_EQ(epochs.size(), 100u);
+  const can::MessageDef& em = can::message(MessageId::kEpoch);
+  const auto rewrite = [&](std::vector<SentFrame>& frames, std::size_t k, const char* signal,
+                           std::uint64_t raw) {
+    hal::CanFrame& f = frames[epochs[k]].frame;
+    const can::SignalDef& s = em.signals[can::signal_index(em, signal)];
+    can::set_payload(f, can::insert_bits(can::payload_of(f), s, raw));
+    can::seal_frame(f);
+  };
+  struct Case {
+    const char* what;
+    std::size_t epoch;
+    const char* signal;
+    std::uint64_t raw;
+    const char* text;
+  };
+  const Case cases[] = {
+      {"stuck", 30, "SampleCount", 290, "SampleCount did not advance"},
+      {"back", 40, "SampleCount", 385, "SampleCount went back by 5 samples"},
+      {"stall", 50, "TimeUs", 490'000, "TimeUs did not advance"},
+      {"jump", 60, "TimeUs", 605'000, "TimeUs advanced by 15000 us over 10 samples, 10000 us"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    std::vector<SentFrame> frames = bus.frames;
+    rewrite(frames, c.epoch, c.signal, c.raw);
+    const Decoded d = decode(frames);
+    ASSERT_EQ(d.issues.size(), 1u) << dump(d.issues);
+    EXPECT_EQ(d.issues[0].kind, IssueKind::kSequence);
+    EXPECT_EQ(d.issues[0].line, epochs[c.epoch] + 1);
+    EXPECT_NE(d.issues[0].text.find(c.text), std::string::npos) << d.issues[0].text;
+    EXPECT_EQ(d.summary.restarts, 0u);
+    EXPECT_EQ(d.epochs, 100u);
+  }
+  // Negative control: the unedited log has none.
+  EXPECT_TRUE(decode(bus.frames).issues.empty());
+}
+
+// A log whose timestamps go back and a value beyond its signal's documented range (the encoder
+// saturates there): each one problem at its line.
+TEST(DecoderChecks, LogTimeGoingBackAndAValueOutsideItsRangeAreProblems) {
+  RecordingBus bus;
+  publish(bus, 0, 200);
+  std::vector<Issue> issues;
+  StreamDecoder d2([](const DecodedEpoch&) {}, [&](const Issue& i) { issues.push_back(i); });
+  std::size_t euler_line = 0;
+  for (std::size_t i = 0; i < bus.frames.size(); ++i) {
+    hal::CanFrame f = bus.frames[i].frame;
+    std::int64_t t = static_cast<std::int64_t>(bus.frames[i].seq) * 1000;
+    if (i == 50) t -= 2'000'000;  // 2 s back
+    if (euler_line == 0 && is(f, MessageId::kEuler)) {
+      const can::MessageDef& m = can::message(MessageId::kEuler);
+      const can::SignalDef& roll = m.signals[can::signal_index(m, "Roll")];
+      can::set_payload(f, can::insert_bits(can::payload_of(f), roll, 32000));  // 3.2 rad
+      can::seal_frame(f);
+      euler_line = i + 1;
+    }
+    d2.feed_frame(i + 1, t, f);
+  }
+  d2.finish();
+  ASSERT_EQ(issues.size(), 2u) << dump(issues);
+  EXPECT_EQ(issues[0].kind, IssueKind::kOutOfRange);
+  EXPECT_EQ(issues[0].line, euler_line);
+  EXPECT_NE(issues[0].text.find("GfinsEuler.Roll = 3.2 outside its documented range"),
+            std::string::npos)
+      << issues[0].text;
+  EXPECT_EQ(issues[1].kind, IssueKind::kLogTime);
+  EXPECT_EQ(issues[1].line, 51u);
 }
 
 }  // namespace

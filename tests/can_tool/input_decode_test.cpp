@@ -72,6 +72,7 @@ std::vector<hal::CanFrame> board_with_gnss(std::vector<std::size_t>* fix_end_lin
   for (std::uint32_t seq = 0; seq < 500; ++seq) {
     can::Epoch e;
     e.nav.seq = seq;
+    e.nav.t_ns = static_cast<std::int64_t>(seq) * 1'000'000;  // 1 kHz: TimeUs advances with it
     pub.publish(e);
     for (const hal::CanFrame& f : bus.frames) out.push_back(f);
     bus.frames.clear();

@@ -82,6 +82,9 @@ Status check_dividers(const Dividers& d) {
       continue;
     }
     if (v == 0) continue;
+    if (v > kMaxDivider) {
+      return Status(ErrorCode::kOutOfRange, "can: a divider must be at most 10000 (kMaxDivider)");
+    }
     if (epoch == 0 || v % epoch != 0) {
       return Status(ErrorCode::kInvalidArgument,
                     "can: a divider must be a multiple of the Epoch divider");

@@ -20,6 +20,24 @@ constexpr std::int64_t kMaxStaleEpochs = kCounterMask;
 // A bus loses frames, not one message for this many periods on end while its epochs arrive: a
 // longer silence is the message switched off and on again (SetDivider 0, then N), not drops.
 constexpr std::int64_t kMaxFramesLostInARow = 15;
+// Largest epoch divider the board accepts (output.epoch, docs/can-interface.md): a counter step
+// of d epochs cannot span more than d times this many samples.
+constexpr std::int64_t kMaxEpochDivider = can::kMaxDivider;
+// TimeUs is the data-ready time of the epoch's sample: its advance over a run of samples is the
+// sample period times their number, up to the edge's jitter. 10 % of the advance, and at least
+// 200 µs (the loop's worst wake-up latency on the board, docs/performance.md), tells a clock
+// that jumped or a counter that skipped from jitter.
+constexpr double kTimeTolerance = 0.10;
+constexpr double kTimeToleranceMinUs = 200.0;
+constexpr std::int64_t kTimeModulo = std::int64_t{1} << 32;  // GfinsEpoch.TimeUs is 32 bits
+
+std::uint32_t time_us_of(const hal::CanFrame& f) {
+  static constexpr std::size_t kSig =
+      can::signal_index(can::message(can::MessageId::kEpoch), "TimeUs");
+  static_assert(kSig != can::kNoSignal);
+  return static_cast<std::uint32_t>(
+      can::extract_bits(can::payload_of(f), can::kEpochSignals[kSig]));
+}
 
 std::vector<Column> make_columns() {
   std::vector<Column> cols;
@@ -70,7 +88,15 @@ std::uint16_t sample_count_of(const hal::CanFrame& f) {
 }
 
 /// How a new GfinsEpoch frame (counter c, sample count s) follows the open epoch.
-enum class EpochJump : std::uint8_t { kAdvance, kDuplicate, kStale, kRestart, kUnexplained };
+enum class EpochJump : std::uint8_t {
+  kAdvance,
+  kDuplicate,
+  kStale,
+  kRestart,
+  kUnexplained,
+  kStuck,      // SampleCount unchanged while the counter advanced
+  kBackwards,  // SampleCount went back by less than any forward explanation could span
+};
 struct EpochStep {
   EpochJump kind = EpochJump::kAdvance;
   std::int64_t epochs = 0;   // kAdvance: epochs advanced (1 = the next one)
@@ -84,7 +110,7 @@ EpochStep classify_epoch(std::uint8_t c_old, std::uint16_t s_old, std::int64_t s
                          std::uint8_t c_new, std::uint16_t s_new) {
   const std::int64_t d = (c_new - c_old) & kCounterMask;
   const std::int64_t fwd = (std::int64_t{s_new} - s_old + kSampleModulo) % kSampleModulo;
-  if (fwd == 0) return {d == 0 ? EpochJump::kDuplicate : EpochJump::kUnexplained};
+  if (fwd == 0) return {d == 0 ? EpochJump::kDuplicate : EpochJump::kStuck};
   const std::int64_t back = kSampleModulo - fwd;
   if (step > 0 && fwd % step == 0 && ((fwd / step) & kCounterMask) == d) {
     return {EpochJump::kAdvance, fwd / step, fwd, step};
@@ -96,6 +122,12 @@ EpochStep classify_epoch(std::uint8_t c_old, std::uint16_t s_old, std::int64_t s
   if (step > 0 && back % step == 0 && back / step <= kMaxStaleEpochs &&
       ((-(back / step)) & kCounterMask) == d) {
     return {EpochJump::kStale};
+  }
+  // No divider the board accepts makes d epochs this long, or the count went back by less than
+  // one epoch: the sample count went back (a board that restarts starts at sample 0, counter 0,
+  // above).
+  if (d != 0 && (fwd > d * kMaxEpochDivider || (step > 0 && back < step))) {
+    return {EpochJump::kBackwards, 0, back};
   }
   if (d != 0) {
     // A new epoch divider (SetDivider GfinsEpoch) or the first spacing seen: the counter counts
@@ -148,6 +180,12 @@ const char* to_string(IssueKind k) {
       return "orphan frame";
     case IssueKind::kInputRejected:
       return "rejected input";
+    case IssueKind::kSequence:
+      return "sequence";
+    case IssueKind::kLogTime:
+      return "log time";
+    case IssueKind::kOutOfRange:
+      return "out of range";
     case IssueKind::kCount_:
       break;
   }
@@ -177,6 +215,12 @@ void StreamDecoder::notice(std::uint64_t line, std::string text) {
 
 void StreamDecoder::feed_line(std::uint64_t line_no, std::string_view line) {
   ++summary_.lines;
+  // A byte-order mark (an editor's UTF-8 save) would make the line read as a comment and lose
+  // its frame: skipped, and said.
+  if (constexpr std::string_view kBom = "\xEF\xBB\xBF"; line.starts_with(kBom)) {
+    notice(line_no, "UTF-8 byte-order mark at the start of the line skipped");
+    line.remove_prefix(kBom.size());
+  }
   if (drivers::lnx::is_candump_comment(line)) {
     ++summary_.comment_lines;
     return;
@@ -198,6 +242,15 @@ void StreamDecoder::feed_line(std::uint64_t line_no, std::string_view line) {
 void StreamDecoder::feed_frame(std::uint64_t line_no, std::int64_t time_us,
                                const hal::CanFrame& f) {
   ++summary_.frames;
+  if (time_us < last_log_time_us_) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "log timestamp goes back by %.6f s (%.6f -> %.6f)",
+                  static_cast<double>(last_log_time_us_ - time_us) * 1e-6,
+                  static_cast<double>(last_log_time_us_) * 1e-6,
+                  static_cast<double>(time_us) * 1e-6);
+    issue(IssueKind::kLogTime, line_no, buf);
+  }
+  last_log_time_us_ = time_us;
   std::uint8_t node = 0;
   const can::MessageDef* m = f.extended ? nullptr : can::find_message(f.id, &node);
   if (m == nullptr) {
@@ -294,8 +347,10 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
     n.index = 0;
     n.step = 0;
     n.prev_index = -1;
+    n.have_time = true;
+    n.time_us = time_us_of(f);
     open_epoch(n, node, line, time_us);
-    store(n, can::message(can::MessageId::kEpoch), f);
+    store(n, can::message(can::MessageId::kEpoch), f, line);
     return;
   }
   const EpochStep j = classify_epoch(n.counter, n.sample, n.step, counter, sample);
@@ -310,10 +365,7 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
                 counter_text(n.counter, n.sample) + " had opened");
       return;
     case EpochJump::kRestart:
-    case EpochJump::kUnexplained: {
-      close_epoch(n);
-      flush_early_as_orphans(n, static_cast<std::uint8_t>((n.counter + 1) & kCounterMask));
-      settle_pending(n);
+    case EpochJump::kUnexplained:
       ++summary_.restarts;
       notice(line, std::string(j.kind == EpochJump::kRestart
                                    ? "the board started again"
@@ -321,19 +373,25 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
                                      "epochs explains the jump)") +
                        ": " + counter_text(n.counter, n.sample) + " -> " +
                        counter_text(counter, sample) + "; epochs lost before it are not counted");
-      reset_tracks(n, true);
-      n.counter = counter;
-      n.sample = sample;
-      n.index += kSampleModulo;  // a new run: no gap is measured across it
-      n.step = 0;
-      n.prev_index = -1;
-      open_epoch(n, node, line, time_us);
-      store(n, can::message(can::MessageId::kEpoch), f);
+      resync(n, node, line, time_us, f, counter, sample);
       return;
-    }
+    case EpochJump::kStuck:
+    case EpochJump::kBackwards:
+      // CRC-valid frames no board sends: the counter advanced but the sample count did not (or
+      // went back). A problem, not a restart; decoding picks up from this epoch.
+      issue(IssueKind::kSequence, line,
+            (j.kind == EpochJump::kStuck
+                 ? "SampleCount did not advance"
+                 : "SampleCount went back by " + std::to_string(j.samples) + " samples") +
+                " while the counter advanced: " + counter_text(n.counter, n.sample) + " -> " +
+                counter_text(counter, sample));
+      resync(n, node, line, time_us, f, counter, sample);
+      n.have_time = false;  // which of the two epochs is wrong is not known: no time check across
+      return;
     case EpochJump::kAdvance:
       break;
   }
+  check_time(n, line, time_us_of(f), j.samples);
   close_epoch(n);
   const std::int64_t old_index = n.index;
   const std::uint8_t next_counter = static_cast<std::uint8_t>((n.counter + 1) & kCounterMask);
@@ -370,7 +428,7 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
   n.counter = counter;
   n.sample = sample;
   open_epoch(n, node, line, time_us);
-  store(n, can::message(can::MessageId::kEpoch), f);
+  store(n, can::message(can::MessageId::kEpoch), f, line);
   if (n.early_count != 0) {
     for (std::size_t i = 0; i < n.early.size(); ++i) {
       EarlyFrame& e = n.early[i];
@@ -378,10 +436,59 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
       issue(IssueKind::kReordered, e.line,
             std::string(can::kMessages[i].name) + " of epoch counter " + std::to_string(counter) +
                 " arrived before its GfinsEpoch frame (line " + std::to_string(line) + ")");
-      store(n, can::kMessages[i], e.frame);
+      store(n, can::kMessages[i], e.frame, e.line);
       e.used = false;
     }
     n.early_count = 0;
+  }
+}
+
+void StreamDecoder::resync(NodeState& n, std::uint8_t node, std::uint64_t line,
+                           std::int64_t time_us, const hal::CanFrame& f, std::uint8_t counter,
+                           std::uint16_t sample) {
+  close_epoch(n);
+  flush_early_as_orphans(n, static_cast<std::uint8_t>((n.counter + 1) & kCounterMask));
+  settle_pending(n);
+  reset_tracks(n, true);
+  n.counter = counter;
+  n.sample = sample;
+  n.index += kSampleModulo;  // a new run: no gap is measured across it
+  n.step = 0;
+  n.prev_index = -1;
+  n.have_time = true;  // the rate learnt stays: same board, same clock
+  n.time_us = time_us_of(f);
+  open_epoch(n, node, line, time_us);
+  store(n, can::message(can::MessageId::kEpoch), f, line);
+}
+
+void StreamDecoder::check_time(NodeState& n, std::uint64_t line, std::uint32_t time_us,
+                               std::int64_t samples) {
+  const std::uint32_t before = n.time_us;
+  const bool had = n.have_time;
+  n.have_time = true;
+  n.time_us = time_us;
+  if (!had || samples <= 0) return;
+  const auto dt = static_cast<double>((std::int64_t{time_us} - before + kTimeModulo) % kTimeModulo);
+  char buf[200];
+  if (dt == 0.0) {
+    std::snprintf(buf, sizeof buf, "TimeUs did not advance (%u us) over %lld samples", time_us,
+                  static_cast<long long>(samples));
+    issue(IssueKind::kSequence, line, buf);
+    n.have_time = false;  // the next epoch starts the comparison again: one problem, one report
+    return;
+  }
+  if (n.us_per_sample <= 0.0) {
+    n.us_per_sample = dt / static_cast<double>(samples);  // the first regular advance
+    return;
+  }
+  const double expected = n.us_per_sample * static_cast<double>(samples);
+  if (std::fabs(dt - expected) > std::max(kTimeTolerance * expected, kTimeToleranceMinUs)) {
+    std::snprintf(buf, sizeof buf,
+                  "TimeUs advanced by %.0f us over %lld samples, %.0f us expected at the %.1f "
+                  "us per sample of the earlier epochs (%u -> %u)",
+                  dt, static_cast<long long>(samples), expected, n.us_per_sample, before, time_us);
+    issue(IssueKind::kSequence, line, buf);
+    n.have_time = false;
   }
 }
 
@@ -404,7 +511,7 @@ void StreamDecoder::on_data_frame(NodeState& n, const can::MessageDef& m, std::u
             std::string(m.name) + " twice in epoch counter " + std::to_string(counter));
       return;
     }
-    store(n, m, f);
+    store(n, m, f, line);
     return;
   }
   if (counter == ((n.counter + 1) & kCounterMask)) {
@@ -554,7 +661,8 @@ void StreamDecoder::open_epoch(NodeState& n, std::uint8_t node, std::uint64_t li
   n.epoch.present.assign(nc, false);
 }
 
-void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f) {
+void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f,
+                          std::uint64_t line) {
   const std::size_t mi = msg_index(m);
   n.seen[mi] = true;
   MessageTrack& t = n.tracks[mi];
@@ -572,8 +680,20 @@ void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::Can
   for (std::size_t i = r.first; i < r.end; ++i) {
     const can::SignalDef& s = *cols[i].signal;
     if (s.mux >= 0 && s.mux != selector) continue;
-    n.epoch.values[i] = can::decode_signal(s, can::extract_bits(p, s));
+    const double v = can::decode_signal(s, can::extract_bits(p, s));
+    n.epoch.values[i] = v;
     n.epoch.present[i] = true;
+    // The encoder saturates at [min, max] (half a quantisation step of rounding either side);
+    // a wrapping signal (TimeUs, SampleCount) has no range to leave.
+    const double slack = 0.5 * std::fabs(s.factor);
+    if (s.overflow == can::Overflow::kSaturate && s.min < s.max &&
+        (v < s.min - slack || v > s.max + slack)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%.*s.%.*s = %.9g outside its documented range [%g, %g]",
+                    static_cast<int>(m.name.size()), m.name.data(), static_cast<int>(s.name.size()),
+                    s.name.data(), v, s.min, s.max);
+      issue(IssueKind::kOutOfRange, line, buf);
+    }
   }
 }
 

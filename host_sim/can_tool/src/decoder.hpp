@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ enum class IssueKind : std::uint8_t {
                    // frame whose counter matches no epoch near the open one
   kInputRejected,  // an aiding input frame the board would reject (stale or mixed fix id,
                    // value out of range, reserved bits, incomplete fix)
+  kSequence,       // CRC-valid but impossible: SampleCount stuck or going back while the counter
+                   // advances; TimeUs standing still or off the rate its epochs showed
+  kLogTime,        // the log's timestamps go back
+  kOutOfRange,     // a decoded value outside the signal's documented [min, max]
   kCount_,
 };
 const char* to_string(IssueKind k);
@@ -150,12 +155,18 @@ class StreamDecoder {
     std::array<MessageTrack, can::kMessageCount> tracks{};
     std::array<EarlyFrame, can::kMessageCount> early{};  // counter = open counter + 1
     std::size_t early_count = 0;
+    bool have_time = false;      // time_us holds the open epoch's TimeUs
+    std::uint32_t time_us = 0;   // GfinsEpoch.TimeUs of the open epoch
+    double us_per_sample = 0.0;  // TimeUs per sample learnt from the first regular advance
   };
 
   void issue(IssueKind k, std::uint64_t line, std::string text);
   void notice(std::uint64_t line, std::string text);
   void on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us,
                       const hal::CanFrame& f);
+  void resync(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us,
+              const hal::CanFrame& f, std::uint8_t counter, std::uint16_t sample);
+  void check_time(NodeState& n, std::uint64_t line, std::uint32_t time_us, std::int64_t samples);
   void on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
                      std::uint64_t line, const hal::CanFrame& f);
   void on_command(const hal::CanFrame& f, std::uint8_t node, bool response);
@@ -163,7 +174,7 @@ class StreamDecoder {
                 std::int64_t time_us);
   void open_epoch(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us);
   void close_epoch(NodeState& n);
-  void store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f);
+  void store(NodeState& n, const can::MessageDef& m, const hal::CanFrame& f, std::uint64_t line);
   void sight(MessageTrack& t, const can::MessageDef& m, std::int64_t index, std::uint64_t line,
              bool adjacent = false);
   void flush_early_as_orphans(NodeState& n, std::uint8_t lost_counter);
@@ -177,6 +188,7 @@ class StreamDecoder {
   InputSink on_input_;
   Summary summary_;
   std::vector<can::InputDecoder> inputs_;  // one per node id
+  std::int64_t last_log_time_us_ = std::numeric_limits<std::int64_t>::min();
   std::array<NodeState, can::kMaxNodeId + 1> nodes_{};
 };
 

@@ -39,6 +39,15 @@ def flip(line, byte, mask):
     return head + '#' + b.hex().upper()
 
 
+def stamp(line, t):
+    """line with the log timestamp t (a moved frame carries the time it arrived at)."""
+    return '(%.6f)' % t + line[line.index(')') + 1:]
+
+
+def time_of(line):
+    return float(line[1:line.index(')')])
+
+
 L = list(base)
 write('clean', L, [], 10)
 write('crlf', L, [], 10, newline='\r\n')
@@ -84,7 +93,7 @@ L = base[:20] + base[30:]
 write('epoch_drop', L, [(21, 'epoch drop 1')], 9)
 
 # The position-down frame of epoch 1 (line 20) arrives after epoch 2 opened.
-L = base[:19] + [base[20], base[19]] + base[21:]
+L = base[:19] + [base[20], stamp(base[19], time_of(base[20]))] + base[21:]
 write('reordered', L, [(21, 'reordered')], 10)
 
 # The Epoch frame of epoch 3 (line 31) lost: its 7 data frames came without it. One problem at
@@ -94,7 +103,7 @@ L = base[:30] + base[31:]
 write('orphan', L, [(31, 'orphan frame')], 9)
 
 # An old Epoch frame (epoch 1, line 13) replayed after epoch 2: the counter goes back.
-L = base[:30] + [base[12]] + base[30:]
+L = base[:30] + [stamp(base[12], time_of(base[29]))] + base[30:]
 write('counter_back', L, [(31, 'reordered')], 10)
 
 # The log ends in the middle of line 50 (no newline): that line is reported, 6 epochs decode.
@@ -121,7 +130,7 @@ L = long_base[:a] + long_base[b:]
 write('gap10', L, [(a + 1, 'epoch drop 10')], 50 - 10)
 
 # The board starts again: a second run (counter 0, sample count 0) follows the first. No problem.
-write('restart', base + base, [], 20)
+write('restart', base + [stamp(l, time_of(l) + 0.1) for l in base], [], 20)
 
 # candump started on a running bus: the first 4 frames of epoch 0 are not in the log; the other
 # 8 precede the first Epoch frame. No problem; 9 epochs.
@@ -162,3 +171,76 @@ write('euler_lost', L, [(epoch_starts(L)[26] + 1, 'frame drop 1')], 50)
 # Two in a row lost (epochs 24 and 26): one gap of three periods, reported once with its count.
 L = without_euler(long_base, lambda k: k not in (24, 26))
 write('euler_lost_two', L, [(epoch_starts(L)[28] + 1, 'frame drop 2')], 50)
+
+
+# --- CRC-valid anomalies: the edits below re-seal each frame they change --------------------
+
+def crc8(bs):
+    """CRC-8/SAE-J1850 (poly 0x1D, init 0xFF, xorout 0xFF), docs/can-interface.md."""
+    r = 0xFF
+    for b in bs:
+        r ^= b
+        for _ in range(8):
+            r = ((r << 1) ^ 0x1D) & 0xFF if r & 0x80 else (r << 1) & 0xFF
+    return r ^ 0xFF
+
+
+def edit(line, fn):
+    """line with its 8 data bytes passed through fn (a bytearray edited in place), re-sealed."""
+    head, data = line.split('#')
+    b = bytearray.fromhex(data)
+    fn(b)
+    cid = int(head.split()[-1], 16)
+    b[7] = crc8(bytes([cid & 0xFF, (cid >> 8) & 0xFF]) + bytes(b[:7]))
+    return head + '#' + b.hex().upper()
+
+
+def set_le(b, at, n, value):
+    b[at:at + n] = (value % (1 << (8 * n))).to_bytes(n, 'little')
+
+
+def get_le(b, at, n):
+    return int.from_bytes(b[at:at + n], 'little')
+
+
+E = epoch_starts(base)  # GfinsEpoch: TimeUs bytes 0-3, SampleCount bytes 4-5 (little-endian)
+
+# A line stamped one second before the one above it (a log merged from two sources): reported
+# at that line; the frames themselves are fine.
+L = list(base)
+L[24] = stamp(L[24], time_of(L[23]) - 1.0)
+write('log_time_back', L, [(25, 'log time')], 10)
+
+# Epoch 3's SampleCount stuck at epoch 2's (20 instead of 30) while its counter advances.
+L = list(base)
+L[E[3]] = edit(L[E[3]], lambda b: set_le(b, 4, 2, 20))
+write('sample_stuck', L, [(E[3] + 1, 'sequence')], 10)
+
+# Epoch 5's SampleCount 35: back by 5 from epoch 4's 40, less than one epoch.
+L = list(base)
+L[E[5]] = edit(L[E[5]], lambda b: set_le(b, 4, 2, 35))
+write('sample_back', L, [(E[5] + 1, 'sequence')], 10)
+
+# Epoch 4's TimeUs equal to epoch 3's: the device clock stood still for 10 samples.
+L = list(base)
+t3 = get_le(bytearray.fromhex(base[E[3]].split('#')[1]), 0, 4)
+L[E[4]] = edit(L[E[4]], lambda b: set_le(b, 0, 4, t3))
+write('time_stall', L, [(E[4] + 1, 'sequence')], 10)
+
+# Epoch 4's TimeUs 5 ms late: 15 ms for 10 samples at 1 ms each.
+L = list(base)
+L[E[4]] = edit(L[E[4]], lambda b: set_le(b, 0, 4, get_le(b, 0, 4) + 5000))
+write('time_jump', L, [(E[4] + 1, 'sequence')], 10)
+
+# Roll of the first GfinsEuler frame (id 130, bytes 0-1, 1e-4 rad) set to 3.2 rad, outside the
+# documented [-3.1416, 3.1416] that the board's encoder saturates at.
+L = list(base)
+i = next(k for k, l in enumerate(L) if ' 130#' in l)
+L[i] = edit(L[i], lambda b: set_le(b, 0, 2, 32000))
+write('out_of_range', L, [(i + 1, 'out of range')], 10)
+
+# A UTF-8 byte-order mark before the first line (a log saved by an editor): skipped with a
+# notice, its frame decoded, no problem.
+L = list(base)
+L[0] = '\ufeff' + L[0]
+write('bom', L, [], 10)

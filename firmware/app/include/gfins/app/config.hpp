@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gfins/can/message_table.hpp"
 #include "gfins/nav_core/compensator.hpp"
 
 namespace gfins::app {
@@ -36,7 +37,7 @@ inline constexpr std::size_t kNumMessages = kMessageNames.size();
 /// docs/can-interface.md.
 inline constexpr std::array<std::uint16_t, kNumMessages> kDefaultDividers = {
     10, 10, 10, 20, 10, 20, 10, 10, 10, 10, 1000, 1000, 0, 0};
-inline constexpr std::uint16_t kMaxDivider = 10000;
+inline constexpr std::uint16_t kMaxDivider = can::kMaxDivider;
 
 /// ADS131M06 output data rates reachable with its 8.192 MHz clock (datasheet §8.4.2.2, OSR
 /// 1024..8192 → f_MOD / OSR with f_MOD = 4.096 MHz).

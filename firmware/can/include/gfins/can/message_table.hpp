@@ -681,6 +681,9 @@ inline constexpr std::uint8_t kOpRealign = 1;
 inline constexpr std::uint8_t kOpResetNavigation = 2;
 inline constexpr std::uint8_t kOpSetCompensator = 3;
 inline constexpr std::uint8_t kOpSetDivider = 4;
+/// Largest divider of the sample rate a message can have (the configuration's output.* and the
+/// SetDivider command alike): 10 s between frames at 1 kHz.
+inline constexpr std::uint16_t kMaxDivider = 10000;
 inline constexpr std::uint8_t kOpReportCalibrationId = 5;
 inline constexpr std::uint8_t kOpStartCapture = 6;
 inline constexpr std::uint8_t kOpReloadCalibration = 7;
@@ -723,7 +726,8 @@ inline constexpr std::array<SignalDef, 11> kCommandSignals{{
                  kCompensatorValues, kAtCommand, "SetCompensator: compensator to use"),
     unsigned_int("DividerMessage", Field::kCmdMessage, 0, 16, 8, 17.0, kOpSetDivider,
                  kMessageIdValues, kAtCommand, "SetDivider: the data message"),
-    unsigned_int("Divider", Field::kCmdDivider, 0, 24, 16, 65535.0, kOpSetDivider, {}, kAtCommand,
+    unsigned_int("Divider", Field::kCmdDivider, 0, 24, 16, double{kMaxDivider}, kOpSetDivider, {},
+                 kAtCommand,
                  "SetDivider: new divider of the sample rate (0 = off); a multiple of the "
                  "Epoch divider"),
     unsigned_int("CapturePose", Field::kCmdPose, 0, 16, 8, kMaxCapturePose, kOpStartCapture, {},
