@@ -20,30 +20,15 @@ n2="${3:-1200}"
 exe="${build}/tests/bench/gfins_filter_ir"
 gfins_need_file "${exe}" "build target gfins_filter_ir (Release, GFINS_BUILD_BENCHMARKS=ON) first"
 gfins_need_command valgrind "apt-get install valgrind"
-if ! (( n2 > n1 && n1 > 0 )); then
-  echo "callgrind_filter.sh: need 0 < N1 < N2" >&2
-  exit 2
-fi
+gfins_need_counts "${n1}" "${n2}"
 gfins_scratch_dir
 
 printf '%-7s %-14s %12s %12s %10s\n' scalar operation "Ir(N1=${n1})" "Ir(N2=${n2})" "Ir/call"
 for scalar in float double; do
   for op in propagate zupt zaru gnss-position gnss-velocity heading; do
-    declare -A ir=()
-    for tag in N1 N2; do
-      n="${n1}"; [[ "${tag}" == N2 ]] && n="${n2}"
-      f="${gfins_scratch}/callgrind.${scalar}.${op}.${tag}.out"
-      if ! valgrind --tool=callgrind --callgrind-out-file="${f}" "${exe}" "${scalar}" "${op}" "${n}" \
-        >/dev/null 2>"${f}.log"; then
-        echo "callgrind_filter.sh: ${exe} ${scalar} ${op} ${n} failed:" >&2
-        cat "${f}.log" >&2
-        exit 1
-      fi
-      ir[${tag}]="$(gfins_total_ir "${f}")"
-    done
-    per_call="$(awk -v a="${ir[N1]}" -v b="${ir[N2]}" -v n1="${n1}" -v n2="${n2}" \
-                 'BEGIN { printf "%.0f", (b - a) / (n2 - n1) }')"
-    printf '%-7s %-14s %12s %12s %10s\n' "${scalar}" "${op}" "${ir[N1]}" "${ir[N2]}" "${per_call}"
-    unset ir
+    gfins_ir_per_unit "${gfins_scratch}/callgrind.${scalar}.${op}" "${n1}" "${n2}" \
+      "${exe}" "${scalar}" "${op}"
+    printf '%-7s %-14s %12s %12s %10.0f\n' "${scalar}" "${op}" "${gfins_ir1}" "${gfins_ir2}" \
+      "${gfins_per_unit}"
   done
 done

@@ -23,10 +23,7 @@ n2="${3:-120000}"
 exe="${build}/tests/bench/gfins_pipeline_ir"
 gfins_need_file "${exe}" "build target gfins_pipeline_ir (Release, GFINS_BUILD_BENCHMARKS=ON) first"
 gfins_need_command valgrind "apt-get install valgrind"
-if ! (( n2 > n1 && n1 > 0 )); then
-  echo "callgrind_per_sample.sh: need 0 < N1 < N2" >&2
-  exit 2
-fi
+gfins_need_counts "${n1}" "${n2}"
 build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "${build}/CMakeCache.txt" 2>/dev/null || true)"
 if [[ "${build_type}" != "Release" ]]; then
   echo "warning: ${build} is a '${build_type}' build; the documented figures are Release" >&2
@@ -43,17 +40,9 @@ fi
 printf '%-7s %-6s %14s %14s %12s\n' scalar comp "Ir(N1=${n1})" "Ir(N2=${n2})" "Ir/sample"
 for scalar in float double; do
   for comp in none paper exact; do
-    declare -A ir=()
-    for tag in N1 N2; do
-      n="${n1}"; [[ "${tag}" == N2 ]] && n="${n2}"
-      f="${out_dir}/callgrind.${scalar}.${comp}.${tag}.out"
-      valgrind --tool=callgrind --callgrind-out-file="${f}" "${exe}" "${scalar}" "${comp}" "${n}" \
-        >/dev/null 2>"${f}.log"
-      ir[${tag}]="$(gfins_total_ir "${f}")"
-    done
-    per_sample="$(awk -v a="${ir[N1]}" -v b="${ir[N2]}" -v n1="${n1}" -v n2="${n2}" \
-                   'BEGIN { printf "%.1f", (b - a) / (n2 - n1) }')"
-    printf '%-7s %-6s %14s %14s %12s\n' "${scalar}" "${comp}" "${ir[N1]}" "${ir[N2]}" "${per_sample}"
-    unset ir
+    gfins_ir_per_unit "${out_dir}/callgrind.${scalar}.${comp}" "${n1}" "${n2}" \
+      "${exe}" "${scalar}" "${comp}"
+    printf '%-7s %-6s %14s %14s %12s\n' "${scalar}" "${comp}" "${gfins_ir1}" "${gfins_ir2}" \
+      "${gfins_per_unit}"
   done
 done

@@ -31,12 +31,19 @@ constexpr double kTimeTolerance = 0.10;
 constexpr double kTimeToleranceMinUs = 200.0;
 constexpr std::int64_t kTimeModulo = std::int64_t{1} << 32;  // GfinsEpoch.TimeUs is 32 bits
 
-std::uint32_t time_us_of(const hal::CanFrame& f) {
-  static constexpr std::size_t kSig =
-      can::signal_index(can::message(can::MessageId::kEpoch), "TimeUs");
+/// The raw bits of GfinsEpoch signal `kSig` (an index into kEpochSignals) in frame `f`.
+template <std::size_t kSig>
+std::uint64_t epoch_bits(const hal::CanFrame& f) {
   static_assert(kSig != can::kNoSignal);
-  return static_cast<std::uint32_t>(
-      can::extract_bits(can::payload_of(f), can::kEpochSignals[kSig]));
+  return can::extract_bits(can::payload_of(f), can::kEpochSignals[kSig]);
+}
+constexpr std::size_t kTimeUsSig =
+    can::signal_index(can::message(can::MessageId::kEpoch), "TimeUs");
+constexpr std::size_t kSampleCountSig =
+    can::signal_index(can::message(can::MessageId::kEpoch), "SampleCount");
+
+std::uint32_t time_us_of(const hal::CanFrame& f) {
+  return static_cast<std::uint32_t>(epoch_bits<kTimeUsSig>(f));
 }
 
 std::vector<Column> make_columns() {
@@ -80,11 +87,7 @@ std::size_t msg_index(const can::MessageDef& m) { return static_cast<std::size_t
 std::int64_t default_period(const can::MessageDef& m) { return m.default_divider; }
 
 std::uint16_t sample_count_of(const hal::CanFrame& f) {
-  static constexpr std::size_t kSig =
-      can::signal_index(can::message(can::MessageId::kEpoch), "SampleCount");
-  static_assert(kSig != can::kNoSignal);
-  return static_cast<std::uint16_t>(
-      can::extract_bits(can::payload_of(f), can::kEpochSignals[kSig]));
+  return static_cast<std::uint16_t>(epoch_bits<kSampleCountSig>(f));
 }
 
 /// How a new GfinsEpoch frame (counter c, sample count s) follows the open epoch.
