@@ -244,6 +244,18 @@ def main():
         check(os.path.exists(png) and open(png, 'rb').read(8) == b'\x89PNG\r\n\x1a\n',
               'plot: no PNG')
 
+    # gfins-can-gen: arguments are read whole (a node "abc" was node 0, exit 0).
+    for argv, code in ((['dbc', 'abc'], 1), (['dbc', '3x'], 1), (['dbc', '16'], 1),
+                       (['dbc', ''], 1), (['dbc', '1', '2'], 1), (['dbc', '15'], 0),
+                       (['log', 'nan'], 1), (['log', '1e400'], 1), (['log', '2s'], 1),
+                       (['log', '0.05'], 0), (['icd', 'extra'], 1)):
+        r = run([a.gen] + argv)
+        check(r.returncode == code,
+              f'gfins-can-gen {argv}: exit {r.returncode}, expected {code}: {r.stderr.decode()}')
+        if code == 1:
+            check(r.stderr.decode().startswith('gfins-can-gen: '),
+                  f'gfins-can-gen {argv}: no message naming the tool: {r.stderr.decode()!r}')
+
     print(f'cli: {len(failures)} failed checks')
     for f in failures:
         print('  ' + f)

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/cli_fixture.hpp"
@@ -62,6 +63,15 @@ TEST_F(AbsurdArgsCli, EndlessInputsAreRefusedAfterTheirLimit) {
                                 "--gravity", "9.8", "-o", path("cal.toml")});
   EXPECT_NE(cal.exit_code, 0) << cal.output;
   EXPECT_NE(cal.output.find("larger than 16777216 bytes"), std::string::npos) << cal.output;
+  // A recording is sized and read by offset: /dev/zero read as "a file of 0 bytes" and a folder
+  // failed at a seek. Each is named as what it is.
+  for (const auto& [input, what] :
+       {std::pair{std::string("/dev/zero"), "is a device"}, std::pair{path("."), "is a folder"}}) {
+    const CliResult replay = run(GFINS_REPLAY_BIN, {input, "-o", path("r")});
+    EXPECT_EQ(replay.exit_code, kExitBadInput) << replay.output;
+    EXPECT_NE(replay.output.find(what), std::string::npos) << replay.output;
+    EXPECT_NE(replay.output.find("not a recording file"), std::string::npos) << replay.output;
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 //   gfins-can-gen log SECONDS  a candump log of a synthetic moving board (tests, benchmarks)
 //   gfins-can-gen --version    version and git revision; --help the usage and exit codes
 // The tests regenerate the same text and fail when the committed files differ.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -25,6 +26,23 @@ constexpr const char* kUsage =
     "Exit codes: 0 written to stdout; 1 command line rejected; 2 stdout could not be "
     "written.\n";
 
+/// `text` as a whole decimal integer in [lo, hi] (no sign, no trailing characters).
+bool parse_int(const char* text, int lo, int hi, int& out) {
+  if (text[0] < '0' || text[0] > '9') return false;
+  char* end = nullptr;
+  const long v = std::strtol(text, &end, 10);
+  if (*end != '\0' || v < lo || v > hi) return false;
+  out = static_cast<int>(v);
+  return true;
+}
+
+/// `text` as a whole finite number.
+bool parse_number(const char* text, double& out) {
+  char* end = nullptr;
+  out = std::strtod(text, &end);
+  return end != text && *end == '\0' && std::isfinite(out);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -40,11 +58,16 @@ int main(int argc, char** argv) {
     const std::string v = gfins::version::version_line("gfins-can-gen") + "\n";
     return std::fputs(v.c_str(), stdout) < 0 ? 2 : 0;
   }
+  const bool takes_value = std::strcmp(argv[1], "dbc") == 0 || std::strcmp(argv[1], "log") == 0;
+  if (const int max_args = takes_value ? 3 : 2; argc > max_args) {
+    std::fprintf(stderr, "gfins-can-gen: unexpected argument '%s'\n%s", argv[max_args], kUsage);
+    return 1;
+  }
   std::string text;
   if (std::strcmp(argv[1], "dbc") == 0) {
-    const int node = argc > 2 ? std::atoi(argv[2]) : 0;
-    if (node < 0 || node > gfins::can::kMaxNodeId) {
-      std::fprintf(stderr, "gfins-can-gen: node id must be 0..15\n");
+    int node = 0;
+    if (argc > 2 && !parse_int(argv[2], 0, gfins::can::kMaxNodeId, node)) {
+      std::fprintf(stderr, "gfins-can-gen: node id '%s': must be a whole number 0..15\n", argv[2]);
       return 1;
     }
     text = generate_dbc(static_cast<std::uint8_t>(node));
@@ -53,9 +76,10 @@ int main(int argc, char** argv) {
   } else if (std::strcmp(argv[1], "budget") == 0) {
     text = generate_budget_table(gfins::can::kDefaultSampleRateHz, gfins::can::kDefaultBitRate);
   } else if (std::strcmp(argv[1], "log") == 0) {
-    const double seconds = argc > 2 ? std::atof(argv[2]) : 10.0;
-    if (!(seconds > 0.0 && seconds <= 86400.0)) {
-      std::fprintf(stderr, "gfins-can-gen: log duration must be in (0, 86400] s\n");
+    double seconds = 10.0;
+    if ((argc > 2 && !parse_number(argv[2], seconds)) || !(seconds > 0.0 && seconds <= 86400.0)) {
+      std::fprintf(stderr, "gfins-can-gen: log duration '%s': must be a number in (0, 86400] s\n",
+                   argc > 2 ? argv[2] : "");
       return 1;
     }
     if (!write_synthetic_log(stdout, seconds, gfins::can::kDefaultSampleRateHz, 0) ||

@@ -3,6 +3,8 @@
 // here its CodecStatus becomes a HostError whose message names the offset and the values.
 #include "gfins/host_sim/recording.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -223,6 +225,21 @@ HostResult<RecordingReader> RecordingReader::open(const std::string& path) {
   if (r.file_ == nullptr) {
     return HostError{ErrorCode::kIoError,
                      "recording: cannot open " + path + ": " + std::strerror(errno), 0};
+  }
+  // The reader sizes the file and reads it by offset: a device (/dev/zero would read as a file
+  // of 0 bytes), a FIFO or a folder is named as what it is.
+  struct stat st {};
+  if (::fstat(::fileno(r.file_), &st) != 0 || !S_ISREG(st.st_mode)) {
+    const char* what = S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                       : S_ISFIFO(st.st_mode)                     ? "a FIFO or pipe"
+                       : S_ISDIR(st.st_mode)                      ? "a folder"
+                       : S_ISSOCK(st.st_mode)                     ? "a socket"
+                                                                  : "not a regular file";
+    return HostError{ErrorCode::kInvalidArgument,
+                     "recording: " + path + " is " + what +
+                         ", not a recording file (a recording is read from a regular file: it is "
+                         "sized and read by offset)",
+                     0};
   }
   // One read system call per kReadBufferBytes (32 blocks of the default size) instead of two
   // per block. Must come before any other operation on the stream; the buffer is ours (glibc
