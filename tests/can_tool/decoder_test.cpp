@@ -328,6 +328,45 @@ TEST(DecoderChecks, StuckOrBackwardSampleCountAndStalledOrJumpingTimeAreProblems
   EXPECT_TRUE(decode(bus.frames).issues.empty());
 }
 
+// Epochs without a conversion (StatusFlags bit 15, data-ready lost: the firmware publishes the
+// loop's periods while the ADC delivers nothing, docs/faults.md) carry the loop's time, not an
+// edge's: TimeUs running at another pace there is no problem, and the check resumes after them.
+TEST(DecoderChecks, EpochsWithoutAConversionAreNotHeldToTheDataReadyTime) {
+  RecordingBus bus;
+  can::Publisher pub(bus, can::PublisherConfig{});
+  std::int64_t t_ns = 0;
+  for (std::uint32_t s = 0; s < 600; ++s) {
+    const bool lost = s >= 200 && s < 300;  // 10 epochs of data-ready lost
+    t_ns += lost ? 3'000'000 : 1'000'000;   // the loop waits 3 periods per timeout
+    can::Epoch e;
+    e.nav.seq = s;
+    e.nav.t_ns = t_ns;
+    e.mode = 2;
+    if (lost) e.status_bits = 1u << 15;
+    bus.seq = s;
+    pub.publish(e);
+  }
+  const Decoded d = decode(bus.frames);
+  EXPECT_TRUE(d.issues.empty()) << dump(d.issues);
+  EXPECT_EQ(d.epochs, 60u);
+  // The same pace change with the bit clear is a problem: the check is on (negative control).
+  RecordingBus plain;
+  can::Publisher pub2(plain, can::PublisherConfig{});
+  t_ns = 0;
+  for (std::uint32_t s = 0; s < 600; ++s) {
+    t_ns += s >= 200 && s < 300 ? 3'000'000 : 1'000'000;
+    can::Epoch e;
+    e.nav.seq = s;
+    e.nav.t_ns = t_ns;
+    e.mode = 2;
+    plain.seq = s;
+    pub2.publish(e);
+  }
+  const Decoded p = decode(plain.frames);
+  EXPECT_FALSE(p.issues.empty());
+  for (const Issue& i : p.issues) EXPECT_EQ(i.kind, IssueKind::kSequence) << i.text;
+}
+
 // A log whose timestamps go back and a value beyond its signal's documented range (the encoder
 // saturates there): each one problem at its line.
 TEST(DecoderChecks, LogTimeGoingBackAndAValueOutsideItsRangeAreProblems) {

@@ -394,8 +394,8 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
     case EpochJump::kAdvance:
       break;
   }
-  check_time(n, line, time_us_of(f), j.samples);
   close_epoch(n);
+  check_time(n, line, time_us_of(f), j.samples);
   const std::int64_t old_index = n.index;
   const std::uint8_t next_counter = static_cast<std::uint8_t>((n.counter + 1) & kCounterMask);
   std::int64_t missing = j.epochs - 1;
@@ -466,22 +466,25 @@ void StreamDecoder::resync(NodeState& n, std::uint8_t node, std::uint64_t line,
 
 void StreamDecoder::check_time(NodeState& n, std::uint64_t line, std::uint32_t time_us,
                                std::int64_t samples) {
+  // Judged when the epoch closes: its GfinsStatus says whether TimeUs is a data-ready time.
   const std::uint32_t before = n.time_us;
   const bool had = n.have_time;
   n.have_time = true;
   n.time_us = time_us;
+  n.time_issue.clear();
+  n.time_learn = 0.0;
   if (!had || samples <= 0) return;
   const auto dt = static_cast<double>((std::int64_t{time_us} - before + kTimeModulo) % kTimeModulo);
   char buf[200];
+  n.time_issue_line = line;
   if (dt == 0.0) {
     std::snprintf(buf, sizeof buf, "TimeUs did not advance (%u us) over %lld samples", time_us,
                   static_cast<long long>(samples));
-    issue(IssueKind::kSequence, line, buf);
-    n.have_time = false;  // the next epoch starts the comparison again: one problem, one report
+    n.time_issue = buf;
     return;
   }
   if (n.us_per_sample <= 0.0) {
-    n.us_per_sample = dt / static_cast<double>(samples);  // the first regular advance
+    n.time_learn = dt / static_cast<double>(samples);  // the first regular advance
     return;
   }
   const double expected = n.us_per_sample * static_cast<double>(samples);
@@ -490,9 +493,29 @@ void StreamDecoder::check_time(NodeState& n, std::uint64_t line, std::uint32_t t
                   "TimeUs advanced by %.0f us over %lld samples, %.0f us expected at the %.1f "
                   "us per sample of the earlier epochs (%u -> %u)",
                   dt, static_cast<long long>(samples), expected, n.us_per_sample, before, time_us);
-    issue(IssueKind::kSequence, line, buf);
-    n.have_time = false;
+    n.time_issue = buf;
   }
+}
+
+void StreamDecoder::settle_time(NodeState& n) {
+  // An epoch without a conversion (StatusFlags bit 1 sample gap, 2 input invalid, 15 data-ready
+  // lost: docs/faults.md) carries the loop's time, not a data-ready edge's: no comparison into or
+  // out of it.
+  static const int kFlags = column_index("StatusFlags");
+  constexpr std::uint32_t kNoConversion = (1u << 1) | (1u << 2) | (1u << 15);
+  const double flags = kFlags >= 0 && static_cast<std::size_t>(kFlags) < n.epoch.values.size()
+                           ? n.epoch.values[static_cast<std::size_t>(kFlags)]
+                           : std::numeric_limits<double>::quiet_NaN();
+  if (std::isfinite(flags) && (static_cast<std::uint32_t>(flags) & kNoConversion) != 0) {
+    n.have_time = false;
+  } else if (!n.time_issue.empty()) {
+    issue(IssueKind::kSequence, n.time_issue_line, n.time_issue);
+    n.have_time = false;  // the next epoch starts the comparison again: one fault, one report
+  } else if (n.time_learn > 0.0 && n.us_per_sample <= 0.0) {
+    n.us_per_sample = n.time_learn;
+  }
+  n.time_issue.clear();
+  n.time_learn = 0.0;
 }
 
 void StreamDecoder::on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
@@ -702,6 +725,7 @@ void StreamDecoder::store(NodeState& n, const can::MessageDef& m, const hal::Can
 
 void StreamDecoder::close_epoch(NodeState& n) {
   if (!n.have_epoch || n.epoch.values.empty()) return;
+  settle_time(n);
   ++summary_.epochs;
   if (on_epoch_) on_epoch_(n.epoch);
   n.epoch.values.clear();  // emitted once

@@ -158,6 +158,9 @@ class StreamDecoder {
     bool have_time = false;      // time_us holds the open epoch's TimeUs
     std::uint32_t time_us = 0;   // GfinsEpoch.TimeUs of the open epoch
     double us_per_sample = 0.0;  // TimeUs per sample learnt from the first regular advance
+    std::string time_issue;      // the open epoch's TimeUs problem, reported when it closes
+    std::uint64_t time_issue_line = 0;
+    double time_learn = 0.0;  // the open epoch's us per sample, learnt when it closes
   };
 
   void issue(IssueKind k, std::uint64_t line, std::string text);
@@ -167,6 +170,7 @@ class StreamDecoder {
   void resync(NodeState& n, std::uint8_t node, std::uint64_t line, std::int64_t time_us,
               const hal::CanFrame& f, std::uint8_t counter, std::uint16_t sample);
   void check_time(NodeState& n, std::uint64_t line, std::uint32_t time_us, std::int64_t samples);
+  void settle_time(NodeState& n);
   void on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
                      std::uint64_t line, const hal::CanFrame& f);
   void on_command(const hal::CanFrame& f, std::uint8_t node, bool response);
