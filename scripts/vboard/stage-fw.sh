@@ -47,6 +47,8 @@ gfins-can decode /tmp/fw-candump.log --view csv -o /tmp/fw.csv --quiet 2>/tmp/fw
 dec_rc=$?
 summary=$(grep '^summary:' /tmp/fw-decode.log)
 echo "VBOARD-INFO fw decode: $summary"
+# The problems themselves (FILE:LINE: kind: what), so a failure says what it was.
+grep -v '^summary:' /tmp/fw-decode.log | head -n 10 | sed 's/^/VBOARD-LOG fw decode: /'
 check fw-decode-clean "gfins-can decode exit $dec_rc (0: every frame's CRC valid, counters continuous, no issue)" \
   [ $dec_rc -eq 0 ]
 
