@@ -356,7 +356,12 @@ void StreamDecoder::on_epoch_frame(NodeState& n, std::uint8_t node, std::uint64_
     store(n, can::message(can::MessageId::kEpoch), f, line);
     return;
   }
-  const EpochStep j = classify_epoch(n.counter, n.sample, n.step, counter, sample);
+  EpochStep j = classify_epoch(n.counter, n.sample, n.step, counter, sample);
+  if ((j.kind == EpochJump::kStuck || j.kind == EpochJump::kBackwards) && without_conversion(n)) {
+    // The loop numbered the epochs without a conversion; the first conversion starts the ADC's
+    // own count (docs/faults.md): the sequence starts again, as at a restart.
+    j.kind = EpochJump::kUnexplained;
+  }
   switch (j.kind) {
     case EpochJump::kDuplicate:
       issue(IssueKind::kDuplicate, line,
@@ -497,16 +502,21 @@ void StreamDecoder::check_time(NodeState& n, std::uint64_t line, std::uint32_t t
   }
 }
 
-void StreamDecoder::settle_time(NodeState& n) {
-  // An epoch without a conversion (StatusFlags bit 1 sample gap, 2 input invalid, 15 data-ready
-  // lost: docs/faults.md) carries the loop's time, not a data-ready edge's: no comparison into or
-  // out of it.
+bool StreamDecoder::without_conversion(const NodeState& n) {
+  // StatusFlags bit 1 sample gap, 2 input invalid, 15 data-ready lost (docs/faults.md): the
+  // firmware published the loop's period, numbered and timed by the loop, not a conversion.
   static const int kFlags = column_index("StatusFlags");
   constexpr std::uint32_t kNoConversion = (1u << 1) | (1u << 2) | (1u << 15);
   const double flags = kFlags >= 0 && static_cast<std::size_t>(kFlags) < n.epoch.values.size()
                            ? n.epoch.values[static_cast<std::size_t>(kFlags)]
                            : std::numeric_limits<double>::quiet_NaN();
-  if (std::isfinite(flags) && (static_cast<std::uint32_t>(flags) & kNoConversion) != 0) {
+  return std::isfinite(flags) && (static_cast<std::uint32_t>(flags) & kNoConversion) != 0;
+}
+
+void StreamDecoder::settle_time(NodeState& n) {
+  // An epoch without a conversion carries the loop's time, not a data-ready edge's: no
+  // comparison into or out of it.
+  if (without_conversion(n)) {
     n.have_time = false;
   } else if (!n.time_issue.empty()) {
     issue(IssueKind::kSequence, n.time_issue_line, n.time_issue);

@@ -171,6 +171,7 @@ class StreamDecoder {
               const hal::CanFrame& f, std::uint8_t counter, std::uint16_t sample);
   void check_time(NodeState& n, std::uint64_t line, std::uint32_t time_us, std::int64_t samples);
   void settle_time(NodeState& n);
+  static bool without_conversion(const NodeState& n);
   void on_data_frame(NodeState& n, const can::MessageDef& m, std::uint8_t counter,
                      std::uint64_t line, const hal::CanFrame& f);
   void on_command(const hal::CanFrame& f, std::uint8_t node, bool response);
