@@ -74,7 +74,8 @@ ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
-  gfins_nav_bench gfins_pipeline_ir gfins_filter_bench gfins_filter_ir gfins_replay_bench nav_core_integrator_stability_long \
+  gfins_nav_bench gfins_pipeline_ir gfins_filter_bench gfins_filter_ir gfins_replay_bench \
+  nav_core_integrator_stability_long \
   nav_core_error_state_filter_long nav_core_filter_nees_long host_sim_aided_run_long \
   can_tool_fw_aided_e2e \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
