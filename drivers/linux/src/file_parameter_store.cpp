@@ -4,9 +4,13 @@
 #include <limits.h>
 #include <sys/stat.h>
 
+#include <array>
 #include <cerrno>
+#include <string_view>
+#include <utility>
 
 #include "fd.hpp"
+#include "gfins/drivers/lnx/output_paths.hpp"
 
 namespace gfins::drivers::lnx {
 namespace {
@@ -39,21 +43,22 @@ const char* failure_message(SaveStep step) {
   return "parameter store: save failed";
 }
 
-// What stands at the path when it is not a regular file; nullptr for a regular file.
-const char* not_a_file_message(unsigned mode) {
-  if (S_ISREG(mode)) return nullptr;
-  if (S_ISLNK(mode)) {
-    return "parameter store: not saved: the path is a symbolic link (name the file it points "
-           "to); nothing was replaced";
-  }
-  if (S_ISDIR(mode))
-    return "parameter store: not saved: the path is a folder; nothing was replaced";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) {
-    return "parameter store: not saved: the path is a device node; nothing was replaced";
-  }
-  if (S_ISFIFO(mode)) return "parameter store: not saved: the path is a FIFO; nothing was replaced";
-  if (S_ISSOCK(mode)) {
-    return "parameter store: not saved: the path is a socket; nothing was replaced";
+// The store's messages are static (no heap): one per kind that non_regular_kind() names.
+const char* not_a_file_message(const char* kind) {
+  static constexpr std::array<std::pair<std::string_view, const char*>, 6> kMessages{{
+      {"a symbolic link",
+       "parameter store: not saved: the path is a symbolic link (name the file it points to); "
+       "nothing was replaced"},
+      {"a folder", "parameter store: not saved: the path is a folder; nothing was replaced"},
+      {"a device node",
+       "parameter store: not saved: the path is a device node; nothing was replaced"},
+      {"a FIFO", "parameter store: not saved: the path is a FIFO; nothing was replaced"},
+      {"a socket", "parameter store: not saved: the path is a socket; nothing was replaced"},
+      {"a special file",
+       "parameter store: not saved: the path is a special file; nothing was replaced"},
+  }};
+  for (const auto& [name, message] : kMessages) {
+    if (name == kind) return message;
   }
   return "parameter store: not saved: the path is not a regular file; nothing was replaced";
 }
@@ -153,9 +158,9 @@ Status FileParameterStore::fail(SaveStep step, int err, bool temp_exists) {
 Status FileParameterStore::do_save(std::span<const char> blob) {
   struct stat st {};
   if (os_.lstat(path_.c_str(), &st) == 0) {
-    if (const char* what = not_a_file_message(st.st_mode)) {
+    if (const char* kind = non_regular_kind(st.st_mode)) {
       last_failed_step_ = SaveStep::kCheckTarget;
-      return Status(ErrorCode::kInvalidArgument, what);
+      return Status(ErrorCode::kInvalidArgument, not_a_file_message(kind));
     }
   } else if (errno != ENOENT) {
     return fail(SaveStep::kCheckTarget, errno, false);

@@ -1,9 +1,21 @@
 #include "gfins/drivers/lnx/output_paths.hpp"
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <system_error>
 
 namespace gfins::drivers::lnx {
+
+const char* non_regular_kind(unsigned st_mode) {
+  if (S_ISREG(st_mode)) return nullptr;
+  if (S_ISLNK(st_mode)) return "a symbolic link";
+  if (S_ISDIR(st_mode)) return "a folder";
+  if (S_ISCHR(st_mode) || S_ISBLK(st_mode)) return "a device node";
+  if (S_ISFIFO(st_mode)) return "a FIFO";
+  if (S_ISSOCK(st_mode)) return "a socket";
+  return "a special file";
+}
 
 bool same_output_file(const std::string& a, const std::string& b) {
   namespace fs = std::filesystem;

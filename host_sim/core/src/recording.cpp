@@ -3,6 +3,8 @@
 // here its CodecStatus becomes a HostError whose message names the offset and the values.
 #include "gfins/host_sim/recording.hpp"
 
+#include "gfins/drivers/lnx/output_paths.hpp"
+
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -229,12 +231,10 @@ HostResult<RecordingReader> RecordingReader::open(const std::string& path) {
   // The reader sizes the file and reads it by offset: a device (/dev/zero would read as a file
   // of 0 bytes), a FIFO or a folder is named as what it is.
   struct stat st {};
-  if (::fstat(::fileno(r.file_), &st) != 0 || !S_ISREG(st.st_mode)) {
-    const char* what = S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-                       : S_ISFIFO(st.st_mode)                     ? "a FIFO or pipe"
-                       : S_ISDIR(st.st_mode)                      ? "a folder"
-                       : S_ISSOCK(st.st_mode)                     ? "a socket"
-                                                                  : "not a regular file";
+  const bool stat_ok = ::fstat(::fileno(r.file_), &st) == 0;
+  if (const char* what =
+          stat_ok ? gfins::drivers::lnx::non_regular_kind(st.st_mode) : "not readable";
+      what != nullptr) {
     return HostError{ErrorCode::kInvalidArgument,
                      "recording: " + path + " is " + what +
                          ", not a recording file (a recording is read from a regular file: it is "

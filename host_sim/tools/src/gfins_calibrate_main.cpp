@@ -4,6 +4,7 @@
 // Exit status: 0 file written (or --dry-run done), 1 bad usage or input, 2 the solver failed,
 // 3 the verdict is not good and --force was not given (nothing written), 4 the file could not
 // be written.
+#include <sys/stat.h>
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
@@ -22,6 +23,7 @@
 #include "calibrate.hpp"
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/drivers/lnx/output_paths.hpp"
 #include "gfins/nav_core/gravity.hpp"
 #include "gfins/version/version.hpp"
 
@@ -51,15 +53,12 @@ std::string output_unwritable(const std::string& output) {
   if (fs::is_directory(output, ec)) return "it is a directory";
   // The rename would put a regular file in place of a device node, FIFO, socket or link (as
   // root, `-o /dev/full` would replace the machine's /dev/full): the save refuses them too.
-  const fs::file_status st = fs::symlink_status(output, ec);
-  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) {
-    const char* kind = fs::is_symlink(st)                                   ? "a symbolic link"
-                       : fs::is_character_file(st) || fs::is_block_file(st) ? "a device node"
-                       : fs::is_fifo(st)                                    ? "a FIFO"
-                       : fs::is_socket(st)                                  ? "a socket"
-                                                                            : "not a regular file";
-    return std::string("it is ") + kind +
-           ", which the atomic save would replace with a regular file (name a regular file)";
+  struct stat st {};
+  if (::lstat(output.c_str(), &st) == 0) {
+    if (const char* kind = gfins::drivers::lnx::non_regular_kind(st.st_mode)) {
+      return std::string("it is ") + kind +
+             ", which the atomic save would replace with a regular file (name a regular file)";
+    }
   }
   fs::path dir = fs::path(output).parent_path();
   if (dir.empty()) dir = ".";

@@ -17,6 +17,12 @@ struct NamedOutput {
   std::string path;
 };
 
+/// What stands at a path that is not a regular file, from its st_mode (stat(2)): "a symbolic
+/// link", "a folder", "a device node", "a FIFO", "a socket", "a special file"; nullptr for a
+/// regular file. One wording for every tool that refuses such a path (an atomic save would
+/// replace it with a regular file; a recording is read by offset).
+const char* non_regular_kind(unsigned st_mode);
+
 /// True when `a` and `b` are one file: the same inode when both exist, else the same path once
 /// '.', '..' and symbolic links are resolved. A character device (/dev/null) is never a clash:
 /// writing two streams to it loses nothing that was not meant to be lost.
