@@ -108,6 +108,11 @@ TEST(Publisher, DividerRules) {
   EXPECT_FALSE(pub.set_divider(MessageId::kCommand, 10).is_ok());
   EXPECT_FALSE(pub.set_divider(MessageId::kEpoch, 20).is_ok());  // Quaternion at 10 would orphan
   EXPECT_TRUE(pub.set_divider(MessageId::kEuler, 0).is_ok());    // off
+  // The table's limit (kMaxDivider, 10 s between frames at 1 kHz), which the DBC's Divider range
+  // and the configuration rule state too: at it accepted, one above refused and unchanged.
+  EXPECT_TRUE(pub.set_divider(MessageId::kSensorsA, 10000).is_ok());
+  EXPECT_EQ(pub.set_divider(MessageId::kSensorsA, 10010).code(), ErrorCode::kOutOfRange);
+  EXPECT_EQ(pub.divider(MessageId::kSensorsA), 10000);
   EXPECT_TRUE(pub.set_divider(MessageId::kEpoch, 5).is_ok());
   EXPECT_EQ(pub.divider(MessageId::kStatus), 5);
   PublisherConfig bad;
