@@ -5,6 +5,8 @@
     plot_sim.py paper63 DIR [CORE]      DIR/<config>_{before,after}.csv → Figs. 7-10, nav errors
     plot_sim.py montecarlo DIR [TITLE]  DIR/montecarlo.csv → envelopes and log-log growth
     plot_sim.py replay DIR [TITLE]      DIR/navigation.csv (gfins-replay) → DIR/replay.png
+    plot_sim.py aided DIR [TITLE]       DIR/{unaided,aided}.csv → DIR/accuracy.png, the errors
+                                        with the filter's ±3σ (gfins-sim aided)
 
 TITLE names the scenario (or recording), the compensator and the core; every figure carries it.
 Column names carry units and frames (docs/simulation.md, "Output files"): err_v_n_x_mps is the
@@ -245,9 +247,54 @@ def cmd_montecarlo(d, title):
     save(fig, d + "/montecarlo_growth.png")
 
 
+# gfins-sim aided: each row one quantity, unaided (left, symmetric-log scale: it grows by orders
+# of magnitude, and a diverged run ends where its values stop being finite) and aided (right,
+# linear, with the filter's ±3σ as dashed lines of the same colour).
+AIDED_ROWS = [
+    ("roll / pitch error (deg)", [("err_euler_roll_rad", "sigma_euler_roll_rad", "roll"),
+                                  ("err_euler_pitch_rad", "sigma_euler_pitch_rad", "pitch")],
+     180 / np.pi),
+    ("heading error (deg)", [("err_euler_heading_rad", "sigma_euler_heading_rad", "heading")],
+     180 / np.pi),
+    ("velocity error, NED (m/s)", [(f"err_v_n_{a}_mps", f"sigma_v_n_{a}_mps", n)
+                                   for a, n in zip(AXES, NED)], 1.0),
+    ("position error, NED (m)", [(f"err_r_n_{a}_m", f"sigma_r_n_{a}_m", n)
+                                 for a, n in zip(AXES, NED)], 1.0),
+]
+
+
+def cmd_aided(d, title):
+    runs = [(load(d + "/unaided.csv"), "unaided"), (load(d + "/aided.csv"), "aided, ±3σ dashed")]
+    fig, axs = plt.subplots(len(AIDED_ROWS), 2, figsize=(12, 10), sharex=True)
+    for r, (label, cols, k) in enumerate(AIDED_ROWS):
+        for c, (data, which) in enumerate(runs):
+            ax = axs[r][c]
+            t = data["t_s"]
+            for i, (err, sig, name) in enumerate(cols):
+                ax.plot(t, data[err] * k, color=COLORS[i], lw=1, label=name)
+                if c == 1:
+                    s3 = 3 * data[sig] * k
+                    ax.plot(t, s3, color=COLORS[i], lw=0.8, ls="--")
+                    ax.plot(t, -s3, color=COLORS[i], lw=0.8, ls="--")
+            if c == 0:
+                finite = np.concatenate([np.abs(data[e][np.isfinite(data[e])]) * k
+                                         for e, _, _ in cols])
+                small = np.percentile(finite, 5) if finite.size else 1.0
+                ax.set_yscale("symlog", linthresh=max(small, 1e-6))
+            ax.grid(True, alpha=0.3)
+            ax.set_ylabel(label, fontsize=8)
+            ax.legend(loc="best", fontsize=7)
+            if r == 0:
+                ax.set_title(which)
+            if r == len(AIDED_ROWS) - 1:
+                ax.set_xlabel("t (s)")
+    fig.suptitle(f"navigation errors, unaided and aided: {title}", fontsize=10)
+    save(fig, d + "/accuracy.png")
+
+
 def main():
     cmds = {"run": cmd_run, "paper63": cmd_paper63, "montecarlo": cmd_montecarlo,
-            "replay": cmd_replay}
+            "replay": cmd_replay, "aided": cmd_aided}
     if len(sys.argv) not in (3, 4) or sys.argv[1] not in cmds:
         sys.exit(__doc__)
     default = "float32" if sys.argv[1] == "paper63" else sys.argv[2]

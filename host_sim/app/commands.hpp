@@ -35,6 +35,9 @@ struct OutputOptions {
 /// gfins-sim run FILE|NAME: without and with compensation, CSV, summary, PNG.
 int cmd_run(const std::string& name, const OutputOptions& out);
 
+/// gfins-sim aided FILE|NAME: compensated navigation aided and unaided, errors side by side.
+int cmd_aided(const std::string& name, const OutputOptions& out);
+
 /// gfins-sim paper63: the paper's §6.3 in four configurations.
 int cmd_paper63(const OutputOptions& out);
 

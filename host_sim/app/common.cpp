@@ -246,6 +246,22 @@ void print_run_table(std::FILE* f, const SeriesStats& uncompensated,
     std::fprintf(f, "samples rejected by the pipeline (saturated or CRC error): %llu, gaps: %zu\n",
                  static_cast<unsigned long long>(rep.rejected), rep.gaps.size());
   }
+  if (rep.aided) {
+    // The filter's updates of the compensated run, per kind: accepted / rejected by the χ² gate /
+    // invalid (nav::FilterCounters).
+    static constexpr const char* kKinds[] = {"ZUPT", "ZARU", "GNSS position", "GNSS velocity",
+                                             "heading"};
+    std::fprintf(f, "aiding updates (accepted/rejected/invalid):");
+    for (std::size_t k = 0; k < std::size(kKinds); ++k) {
+      std::fprintf(f, "%s %s %u/%u/%u", k == 0 ? "" : ",", kKinds[k], rep.filter.accepted[k],
+                   rep.filter.rejected[k], rep.filter.invalid[k]);
+    }
+    std::fprintf(f,
+                 "; standstill decisions vetoed (moving) %u, GNSS lock-out resets %u, "
+                 "divergence restarts %u, covariance resets %u\n",
+                 rep.motion_vetoes, rep.filter.gnss_lockout_resets, rep.filter.divergence_restarts,
+                 rep.filter.covariance_resets);
+  }
 }
 
 }  // namespace gfins::sim::app

@@ -78,6 +78,17 @@ int sim_main(int argc, char** argv) {
   run_cmd
       ->add_option("scenario", scenario_name, "file (has a '/' or ends in .toml) or built-in name")
       ->required();
+  auto* aided_cmd = cli.add_subcommand(
+      "aided", "a scenario aided (its [aiding] switched on) and unaided: errors side by side");
+  aided_cmd
+      ->add_option("scenario", scenario_name, "file (has a '/' or ends in .toml) or built-in name")
+      ->default_val("urban-stop-and-go");
+  std::size_t aided_decimate = 100;
+  aided_cmd
+      ->add_option("--decimate", aided_decimate,
+                   "write every N-th sample to the CSV files (default 100: 10 rows/s at 1 kHz)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
+      ->capture_default_str();
   auto* p63 = cli.add_subcommand("paper63", "the paper's §6.3 experiment, Figs. 7-10");
   auto* mc = cli.add_subcommand("montecarlo", "N seeds: error statistics and growth slopes");
   mc->add_option("scenario", scenario_name, "file, or built-in name")
@@ -114,7 +125,7 @@ int sim_main(int argc, char** argv) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
   std::vector<CLI::Option*> out_opts;
-  for (auto* c : {run_cmd, p63, mc, cov}) {
+  for (auto* c : {run_cmd, aided_cmd, p63, mc, cov}) {
     out_opts.push_back(
         c->add_option("-o,--out", out.dir, "output folder (default sim-out/<name>)"));
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
@@ -131,7 +142,7 @@ int sim_main(int argc, char** argv) {
         ->check(CLI::Range(1, 1024));
   }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
-  for (auto* c : {run_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
+  for (auto* c : {run_cmd, aided_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
   cli.require_subcommand(0, 1);
   try {
     cli.parse(argc, argv);
@@ -152,6 +163,10 @@ int sim_main(int argc, char** argv) {
     }
   }
   if (*run_cmd) return app::cmd_run(scenario_name, out);
+  if (*aided_cmd) {
+    out.decimate = aided_decimate;
+    return app::cmd_aided(scenario_name, out);
+  }
   if (*p63) return app::cmd_paper63(out);
   if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out);
   cov_opts.jobs = jobs;

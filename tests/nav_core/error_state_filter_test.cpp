@@ -92,6 +92,86 @@ TEST(ErrorStateFilterTest, RejectedUpdateLeavesStateAndCovarianceUntouched) {
   EXPECT_EQ(filter.update_gnss_position(nav, fix).status, UpdateStatus::kInvalid);
 }
 
+// A navigation solution outside its own σ: every fix is 100 m off (the gate's χ²(3) quantile of
+// 16.3 against NIS ≈ 100²/(1.5² + 1²) ≈ 3,000), so the gate alone would refuse them forever. The
+// lock-out recovery sets the position from the fix at the configured count (the 25th here),
+// counted; with the recovery off all 25 stay rejected and the position is unchanged.
+struct RestFilter {
+  ErrorStateFilter<double> filter;
+  ArraySolver<double> solver = ArraySolver<double>::create(table1_geometry(0.1)).value();
+  Strapdown<double> nav{solver, GravityModel<double>::constant(testing::kG)};
+  explicit RestFilter(const FilterConfig<double>& config) {
+    const testing::Truth x = testing::rest(Quat<double>::Identity());
+    nav.initialize(testing::nav_state_of<double>(x), testing::ideal_outputs(solver.geometry(), x));
+    EXPECT_TRUE(filter.configure(config).is_ok());
+    filter.start(nav);
+    EXPECT_TRUE(filter.propagate(nav, 0.05).is_ok());
+  }
+  GnssFix<double> fix_at(const Vec3<double>& r) const {
+    GnssFix<double> fix;
+    fix.t_valid_ns = nav.state().t_ns;
+    fix.value_n = r;
+    fix.sigma = Vec3<double>::Constant(1.5);
+    return fix;
+  }
+};
+
+TEST(ErrorStateFilterTest, LockOutRecoveryTakesThePositionFromTheFixAfterTheCount) {
+  FilterConfig<double> config;
+  config.gnss_lockout_fixes = 25;
+  static RestFilter on(config);
+  const Vec3<double> far(kOutlierM, -40.0, 2.0);
+  const auto kind = static_cast<std::size_t>(AidingKind::kGnssPosition);
+  for (int i = 0; i < 24; ++i) {
+    EXPECT_EQ(on.filter.update_gnss_position(on.nav, on.fix_at(far)).status,
+              UpdateStatus::kRejected);
+  }
+  EXPECT_EQ(on.filter.counters().gnss_lockout_resets, 0u);
+  EXPECT_LT(on.nav.state().r_n.norm(), 1e-9);  // still where it started
+  // The 25th: still reported rejected (not applied as a measurement), but the position is reset.
+  EXPECT_EQ(on.filter.update_gnss_position(on.nav, on.fix_at(far)).status, UpdateStatus::kRejected);
+  EXPECT_EQ(on.filter.counters().gnss_lockout_resets, 1u);
+  EXPECT_EQ(on.filter.counters().rejected[kind], 25u);
+  EXPECT_LT((on.nav.state().r_n - far).norm(), 1e-9);  // no lever arm: the array is at the fix
+  const auto& p = on.filter.covariance();
+  EXPECT_NEAR(p(filt_idx::kPos, filt_idx::kPos), 1.5 * 1.5, 1e-12);
+  // The next fix at the same place is accepted: the filter is back.
+  EXPECT_EQ(on.filter.update_gnss_position(on.nav, on.fix_at(far)).status, UpdateStatus::kAccepted);
+
+  config.gnss_lockout_fixes = 0;  // negative control: no recovery
+  static RestFilter off(config);
+  for (int i = 0; i < 30; ++i) (void)off.filter.update_gnss_position(off.nav, off.fix_at(far));
+  EXPECT_EQ(off.filter.counters().rejected[kind], 30u);
+  EXPECT_EQ(off.filter.counters().gnss_lockout_resets, 0u);
+  EXPECT_LT(off.nav.state().r_n.norm(), 1e-9);
+}
+
+// Divergence: a rate of 20 rad/s (above max_rate_rps, 10) is a solution that has run away; the
+// restart zeroes the rate, forgets the heading and widens the tilt to half the limit. A rate of
+// 1 rad/s with the initial covariance is not a divergence.
+TEST(ErrorStateFilterTest, DivergedSolutionRestarts) {
+  FilterConfig<double> config;
+  static RestFilter f(config);
+  f.nav.apply_correction(Vec3<double>::Zero(), Vec3<double>::Zero(), Vec3<double>::Zero(),
+                         Vec3<double>(-1.0, 0, 0));  // ω̂ = 1 rad/s about x
+  EXPECT_FALSE(f.filter.restart_if_diverged(f.nav));
+  EXPECT_EQ(f.filter.counters().divergence_restarts, 0u);
+  f.nav.apply_correction(Vec3<double>::Zero(), Vec3<double>::Zero(), Vec3<double>::Zero(),
+                         Vec3<double>(0, -20.0, 0));  // |ω̂| ≈ 20 rad/s
+  ASSERT_GT(f.nav.state().w_b.norm(), config.max_rate_rps);
+  EXPECT_TRUE(f.filter.restart_if_diverged(f.nav));
+  EXPECT_EQ(f.filter.counters().divergence_restarts, 1u);
+  EXPECT_LT(f.nav.state().w_b.norm(), 1e-12);
+  EXPECT_FALSE(f.filter.heading_aligned());
+  const auto& p = f.filter.covariance();
+  const double half = config.diverged_sigma_tilt_rad / 2;
+  EXPECT_NEAR(p(filt_idx::kPhi, filt_idx::kPhi), half * half, 1e-12);
+  EXPECT_NEAR(p(filt_idx::kRate, filt_idx::kRate),
+              config.restart_sigma_rate_rps * config.restart_sigma_rate_rps, 1e-12);
+  // The restarted filter is not diverged (the restart leaves room below the limit).
+  EXPECT_FALSE(f.filter.restart_if_diverged(f.nav));
+}
+
 // Lever arm of 1 m (0.6 m forward, 0.8 m up: the up part offsets the height by 0.8 m whatever the
 // heading) and 100 ms latency (1 m along track at 10 m/s). Modelled, the errors stay within 3σ
 // (≥ 95 % of the epoch-axis pairs after the first 10 s; for a consistent filter the expected

@@ -219,6 +219,7 @@ void read_all(Reader& r, FwConfig& c) {
   r.number("aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps);
   r.boolean("aiding.inputs", c.aiding_inputs);
   r.vec3("aiding.gnss_lever_arm_m", c.aiding_gnss_lever_arm_m);
+  r.number("aiding.track_heading_sigma_deg", c.aiding_track_heading_sigma_deg);
   r.text("calibration.file", c.calibration_file);
   r.integer("realtime.priority", c.rt_priority, 0, kMaxRtPriority);
   r.boolean("realtime.lock_memory", c.lock_memory);

@@ -161,7 +161,9 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
         Sigma{"aiding.bias_sigma_ug", c.aiding_bias_sigma_ug, 0.1, 1e6, "µg"},
         Sigma{"aiding.bias_rw_ug_sqrt_s", c.aiding_bias_rw_ug_sqrt_s, 0.0, 1e5, "µg/√s"},
         Sigma{"aiding.zupt_sigma_mps", c.aiding_zupt_sigma_mps, 1e-4, 10.0, "m/s"},
-        Sigma{"aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps, 1e-6, 10.0, "rad/s"}}) {
+        Sigma{"aiding.zaru_sigma_rps", c.aiding_zaru_sigma_rps, 1e-6, 10.0, "rad/s"},
+        Sigma{"aiding.track_heading_sigma_deg", c.aiding_track_heading_sigma_deg, 0.0, 90.0,
+              "° (0: off)"}}) {
     if (!(g.value >= g.lo && g.value <= g.hi)) {
       return P{g.key, num(g.value), "must be " + num(g.lo) + ".." + num(g.hi) + " " + g.unit};
     }

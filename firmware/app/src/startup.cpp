@@ -28,6 +28,8 @@ nav::AidingConfig<float> aiding_config(const FwConfig& c, const nav::PipelineCon
   a.filter.noise.bias_rw_mps2_sqrt_s.fill(static_cast<float>(c.aiding_bias_rw_ug_sqrt_s * kUg));
   a.filter.zupt_sigma_mps = static_cast<float>(c.aiding_zupt_sigma_mps);
   a.filter.zaru_sigma_rps = static_cast<float>(c.aiding_zaru_sigma_rps);
+  a.filter.track_heading_sigma_rad =
+      static_cast<float>(c.aiding_track_heading_sigma_deg * 3.14159265358979323846 / 180.0);
   a.filter.gnss_lever_arm_b = nav::Vec3<float>(static_cast<float>(c.aiding_gnss_lever_arm_m[0]),
                                                static_cast<float>(c.aiding_gnss_lever_arm_m[1]),
                                                static_cast<float>(c.aiding_gnss_lever_arm_m[2]));

@@ -303,7 +303,7 @@ void parse_aiding(const toml::table& root, const Reader& rd, AidingSpec& a) {
   const std::string p = "aiding.";
   rd.only(*t, p,
           {"enabled", "decimation", "standstill", "window", "false_alarm", "zupt_sigma_mps",
-           "zaru_sigma_rps", "bias_sigma_ug", "bias_rw_ug_sqrt_s"});
+           "zaru_sigma_rps", "bias_sigma_ug", "bias_rw_ug_sqrt_s", "track_heading_sigma_deg"});
   a.enabled = rd.boolean(*t, p, "enabled", true);
   a.decimation = static_cast<std::uint32_t>(rd.number(*t, p, "decimation", 10.0, 1.0, 10000.0));
   a.standstill = rd.boolean(*t, p, "standstill", a.standstill);
@@ -313,6 +313,8 @@ void parse_aiding(const toml::table& root, const Reader& rd, AidingSpec& a) {
   a.zaru_sigma_rps = rd.number(*t, p, "zaru_sigma_rps", a.zaru_sigma_rps, 1e-9, 10.0);
   a.bias_sigma_ug = rd.number(*t, p, "bias_sigma_ug", a.bias_sigma_ug, 1e-3, 1e6);
   a.bias_rw_ug_sqrt_s = rd.number(*t, p, "bias_rw_ug_sqrt_s", a.bias_rw_ug_sqrt_s, 0.0, 1e6);
+  a.track_heading_sigma_deg =
+      rd.number(*t, p, "track_heading_sigma_deg", a.track_heading_sigma_deg, 0.0, 90.0);
 }
 
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {

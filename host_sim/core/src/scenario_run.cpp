@@ -15,12 +15,15 @@
 #include <string>
 #include <utility>
 
+#include "gfins/host_sim/accuracy.hpp"
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/sample_source.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
+#include "gfins/nav_core/filter/euler_error.hpp"
+#include "gfins/nav_core/math.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 
 namespace gfins::sim {
@@ -133,6 +136,19 @@ SampleRecord record_of(const TruthState& truth, const nav::NavState<double>& e) 
   return rec;
 }
 
+/// record_of, with the filter's 1σ when the pipeline's filter runs.
+template <typename T>
+SampleRecord record_of(const TruthState& truth, const nav::NavPipeline<T>& p) {
+  SampleRecord rec = record_of(truth, p.state().template cast<double>());
+  if (p.aiding().started()) {
+    const nav::NavAccuracy<T> a = p.accuracy();
+    rec.euler_sigma_rad = a.euler_sigma_rad.template cast<double>();
+    rec.v_sigma_n = a.vel_sigma_mps.template cast<double>();
+    rec.r_sigma_n = a.pos_sigma_m.template cast<double>();
+  }
+  return rec;
+}
+
 /// The filter and standstill detector of [aiding], with the noise the scenario's sensors have
 /// (white σ per sample: the stated noise, else the QA-1100 model's 70 µg, never below the
 /// converter's 1 µg class quantisation) and the bias prior and walk [aiding] states.
@@ -150,6 +166,7 @@ nav::AidingConfig<T> aiding_config(const Scenario& s, const nav::GravityModel<T>
   c.filter.noise.white_sigma_mps2.fill(static_cast<T>(white));
   c.filter.noise.bias_sigma_mps2.fill(static_cast<T>(a.bias_sigma_ug * 1e-6 * g));
   c.filter.noise.bias_rw_mps2_sqrt_s.fill(static_cast<T>(a.bias_rw_ug_sqrt_s * 1e-6 * g));
+  c.filter.track_heading_sigma_rad = static_cast<T>(a.track_heading_sigma_deg * M_PI / 180.0);
   c.filter.zupt_sigma_mps = static_cast<T>(a.zupt_sigma_mps);
   c.filter.zaru_sigma_rps = static_cast<T>(a.zaru_sigma_rps);
   c.standstill.window = a.window;
@@ -214,11 +231,11 @@ HostResult<RunSeries> navigate(const Scenario& s, const Stream& st, nav::Compens
     for (int j = 0; j < 6; ++j) first(j) -= bias_mps2[static_cast<std::size_t>(j)];
     pipeline->start_at_specific_force(init, first.template cast<T>());
   }
-  r.samples.push_back(record_of(st.truth.front(), pipeline->state().template cast<double>()));
+  r.samples.push_back(record_of(st.truth.front(), *pipeline));
   const std::size_t n = st.truth.size();
   const std::size_t every = std::max<std::size_t>(n / 100, 1);
   NavLoop<T> loop(*pipeline, [&](std::uint64_t, const nav::NavState<T>& e) {
-    r.samples.push_back(record_of(st.truth[e.seq], e.template cast<double>()));
+    r.samples.push_back(record_of(st.truth[e.seq], *pipeline));
   });
   GnssFeeder gnss(st.gnss, s.gnss);
   for (std::size_t k = 1; k < n; ++k) {
@@ -271,6 +288,11 @@ Vec3d SampleRecord::att_err_b() const {
   Quatd dq = truth.q_nb.conjugate() * q_nb_est;
   if (dq.w() < 0) dq.coeffs() *= -1.0;
   return 2.0 * dq.vec();
+}
+
+Vec3d SampleRecord::euler_err() const {
+  const Vec3d d = nav::euler_from_quat(q_nb_est) - nav::euler_from_quat(truth.q_nb);
+  return Vec3d(nav::wrap_pi(d.x()), nav::wrap_pi(d.y()), nav::wrap_pi(d.z()));
 }
 
 HostResult<CalibrationOutcome> simulate_calibration(const Scenario& s) {
@@ -514,6 +536,15 @@ HostResult<SeriesCsvWriter> SeriesCsvWriter::open(const std::string& path, std::
   vec_cols("err_att_b", "rad");
   vec_cols("err_v_n", "mps");
   vec_cols("err_r_n", "m");
+  // Euler-angle errors and the aiding filter's 1σ (nan: no filter), docs/simulation.md.
+  const auto euler_cols = [&](const char* name) {
+    for (const char* c : {"roll", "pitch", "heading"})
+      head += std::string(",") + name + "_" + c + "_rad";
+  };
+  euler_cols("err_euler");
+  euler_cols("sigma_euler");
+  vec_cols("sigma_v_n", "mps");
+  vec_cols("sigma_r_n", "m");
   std::fprintf(f, "%s\n", head.c_str());
   return SeriesCsvWriter(f, path, decimate);
 }
@@ -541,6 +572,10 @@ void SeriesCsvWriter::write_row(const SampleRecord& x) {
   v3(x.att_err_b());
   v3(x.v_err_n());
   v3(x.r_err_n());
+  v3(x.euler_err());
+  v3(x.euler_sigma_rad);
+  v3(x.v_sigma_n);
+  v3(x.r_sigma_n);
   std::fprintf(f, "\n");
   ++written_;
 }
@@ -630,12 +665,14 @@ struct StreamedSeries {
   std::unique_ptr<NavLoop<T>> loop;
   std::optional<SeriesCsvWriter> csv;
   SeriesStats* stats = nullptr;
+  AccuracyTracker* accuracy = nullptr;
   std::array<double, 6> bias_mps2{};
   HostStatus sink_status = Done{};
   std::unique_ptr<GnssFeeder> gnss;
 
   HostStatus take(const SampleRecord& rec) {
     stats->add(rec);
+    if (accuracy != nullptr) accuracy->add(rec);
     if (csv) return csv->add(rec);
     return Done{};
   }
@@ -667,7 +704,9 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
          &targets.uncompensated_csv, &out.uncompensated},
         {s.compensator, comp_misalignment, bias_comp, &targets.compensated_csv, &out.compensated}};
     for (const Spec& sp : specs) {
+      if (sp.stats == &out.uncompensated && !targets.uncompensated_run) continue;
       auto r = std::make_unique<StreamedSeries<T>>();
+      if (sp.stats == &out.compensated) r->accuracy = targets.accuracy;
       GFINS_TRY(auto p, make_pipeline<T>(s, vpc, sf, sp.kind, sp.m, sp.bias));
       r->pipeline = std::move(p);
       r->stats = sp.stats;
@@ -679,10 +718,10 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
       }
       StreamedSeries<T>* self = r.get();
       r->loop = std::make_unique<NavLoop<T>>(
-          *r->pipeline, [self, &current](std::uint64_t, const nav::NavState<T>& e) {
+          *r->pipeline, [self, &current](std::uint64_t, const nav::NavState<T>&) {
             // The sink runs inside step(), for the sample just offered: its truth is `current`.
             if (!self->sink_status.is_ok()) return;
-            self->sink_status = self->take(record_of(*current, e.template cast<double>()));
+            self->sink_status = self->take(record_of(*current, *self->pipeline));
           });
       runs.push_back(std::move(r));
     }
@@ -717,8 +756,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
           r->pipeline->start_at_specific_force(init,
                                                specific_force(*x, r->bias_mps2).template cast<T>());
         }
-        GFINS_TRY_STATUS(
-            r->take(record_of(x->truth, r->pipeline->state().template cast<double>())));
+        GFINS_TRY_STATUS(r->take(record_of(x->truth, *r->pipeline)));
         continue;
       }
       r->gnss->offer_due(*r->pipeline, t_prev_s);

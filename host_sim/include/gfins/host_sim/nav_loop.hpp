@@ -56,6 +56,9 @@ struct NavReport {
   std::uint64_t out_of_order = 0;       // counters that repeated or went back (not integrated)
   std::vector<NavGap> gaps;
   std::uint64_t output_hash = Fnv1a64::kOffsetBasis;  // FNV-1a-64 of every navigating state
+  bool aided = false;  // the aiding filter ran (filter is its counters)
+  nav::FilterCounters filter{};
+  std::uint32_t motion_vetoes = 0;  // standstill decisions refused by the ZUPT's gate
 };
 
 template <typename T>
@@ -78,7 +81,15 @@ class NavLoop {
   /// Offers every sample of `samples` in order; returns the report so far.
   const NavReport& run(std::span<const RawSample> samples);
 
-  const NavReport& report() const { return report_; }
+  /// The counters, with the aiding filter's as they are now.
+  const NavReport& report() {
+    report_.aided = pipeline_.aiding().started();
+    if (report_.aided) {
+      report_.filter = pipeline_.aiding().filter().counters();
+      report_.motion_vetoes = pipeline_.aiding().motion_vetoes();
+    }
+    return report_;
+  }
   nav::NavPipeline<T>& pipeline() { return pipeline_; }
 
  private:

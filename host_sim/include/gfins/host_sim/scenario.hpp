@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -85,6 +86,9 @@ struct AidingSpec {
   double zaru_sigma_rps = 1e-3;     // 1σ of the zero-rate pseudo-measurement
   double bias_sigma_ug = 500.0;     // random-constant bias 1σ per sensor (prior), µg
   double bias_rw_ug_sqrt_s = 10.0;  // bias random walk per sensor, µg/√s
+  // Heading from the GNSS track with this side-slip 1σ (degrees; 0: off), for a vehicle that
+  // moves along its x axis (FilterConfig::track_heading_sigma_rad).
+  double track_heading_sigma_deg = 0.0;
 };
 
 struct Scenario {
@@ -225,6 +229,14 @@ struct SampleRecord {
   Vec3d r_err_n() const { return r_n_est - truth.r_n; }
   /// Small-angle attitude error (rad, body): 2 vec(q_true* ⊗ q_est).
   Vec3d att_err_b() const;
+  /// Roll, pitch and heading error (rad, estimate − truth, each wrapped to ±π).
+  Vec3d euler_err() const;
+
+  // The aiding filter's 1σ at this sample (roll/pitch/heading, NED velocity, NED position):
+  // NaN when no filter runs (an unaided run, or before the filter starts).
+  Vec3d euler_sigma_rad = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Vec3d v_sigma_n = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Vec3d r_sigma_n = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct RunSeries {
@@ -391,11 +403,15 @@ struct SeriesStats {
 SeriesStats series_stats(const RunSeries& r);
 
 /// Where a streamed run writes while it navigates, and how it can be stopped.
+class AccuracyTracker;  // accuracy.hpp
+
 struct StreamTargets {
-  std::string uncompensated_csv;  // empty: not written
-  std::string compensated_csv;    // empty: not written
-  std::size_t decimate = 1;       // of both CSV files (write_series_csv)
-  std::string recording;          // empty: none; else the .gfr of every sample offered
+  bool uncompensated_run = true;        // false: only the compensated run navigates
+  AccuracyTracker* accuracy = nullptr;  // fed every record of the compensated run (if not null)
+  std::string uncompensated_csv;        // empty: not written
+  std::string compensated_csv;          // empty: not written
+  std::size_t decimate = 1;             // of both CSV files (write_series_csv)
+  std::string recording;                // empty: none; else the .gfr of every sample offered
   /// Polled before each sample: when it reads non-zero the run stops there, closes its files
   /// (the recording's last block and record_count written: a valid file) and reports it.
   /// Set by a signal handler (SIGINT/SIGTERM), hence volatile sig_atomic_t.

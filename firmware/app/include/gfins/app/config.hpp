@@ -83,6 +83,7 @@ struct FwConfig {
   double aiding_zaru_sigma_rps = 0.001;    // 1σ of the zero-rate update
   bool aiding_inputs = true;  // GNSS / heading input frames of can.node_id feed the filter
   std::array<double, 3> aiding_gnss_lever_arm_m{};  // GNSS antenna from the array centre, FRD, m
+  double aiding_track_heading_sigma_deg = 0.0;      // > 0: heading from the GNSS track (a vehicle)
 
   // [calibration]
   std::string calibration_file = "/var/lib/gfins/calibration.toml";

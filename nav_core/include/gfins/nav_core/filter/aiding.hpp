@@ -5,8 +5,16 @@
 //   - the standstill detector takes the sample's [ω̇; f] (a decision every W samples);
 //   - every D samples (FilterConfig's propagation interval, AidingConfig::decimation) the filter
 //     propagates its covariance over the time since the previous propagation, and while the
-//     last detector decision says "at rest" it applies the zero-velocity and zero-rate updates
-//     (ZUPT, ZARU), each through its χ² gate.
+//     last detector decision says "at rest" it applies the zero-velocity update (ZUPT) and, only
+//     when the ZUPT was accepted, the zero-rate update (ZARU), each through its χ² gate. The
+//     detector sees accelerometers only, and a straight drive at constant speed reads like rest
+//     (constant specific force, no angular acceleration); the ZUPT's gate, against the filter's
+//     own velocity, is what tells them apart. A ZARU alone would pass its gate through a gentle
+//     turn at speed (a few mrad/s) and pull the rate to zero: it is vetoed with the ZUPT
+//     (counted, motion_vetoes()). A GNSS velocity fix faster than
+//     AidingConfig::gnss_moving_speed_mps vetoes both until the board is known to have slowed
+//     (once the filter's velocity σ is large, as in an outage, the ZUPT's gate alone would let a
+//     cruise at 30 m/s be set to zero).
 // External aiding (GNSS position and velocity, heading) enters through the offer_*() calls with
 // the measurement's own time of validity.
 //
@@ -31,6 +39,12 @@ struct AidingConfig {
   bool enabled = false;
   std::uint32_t decimation = 10;  // filter propagation every D integrated samples (100 Hz at 1 kHz)
   bool standstill_updates = true;  // ZUPT + ZARU while the detector says "at rest"
+  // A GNSS velocity fix faster than this (horizontal, m/s) says the board moves: no standstill
+  // update, whatever the detector says, until a slower fix comes or the navigation's own
+  // horizontal speed is below this by 2σ (it braked during an outage). A constant-speed straight
+  // drive reads like rest to accelerometers, and once the filter's velocity σ has grown (an
+  // outage) the ZUPT's own gate no longer refuses it.
+  T gnss_moving_speed_mps = T(0.5);
   FilterConfig<T> filter{};
   StandstillConfig<T> standstill{};
 };
@@ -67,6 +81,9 @@ class Aiding {
   const StandstillDetector<T>& detector() const { return detector_; }
   const AidingConfig<T>& config() const { return config_; }
   std::uint32_t propagation_errors() const { return propagation_errors_; }
+  /// Standstill decisions not applied because the board moves: vetoed by GNSS, or
+  /// the ZUPT was rejected (no ZARU then either).
+  std::uint32_t motion_vetoes() const { return motion_vetoes_; }
 
  private:
   /// ‖mean ω̇‖ the detector allows at rest: 3σ of what the filter does not know of the ω̇ bias
@@ -91,6 +108,8 @@ class Aiding {
   bool still_ = false;
   bool started_ = false;
   std::uint32_t propagation_errors_ = 0;
+  std::uint32_t motion_vetoes_ = 0;
+  bool moving_ = false;  // the last GNSS velocity fix said "moving" (AidingConfig)
 };
 
 // ---- Aiding: member functions defined outside the class, so not inline: a translation unit
@@ -130,6 +149,7 @@ void Aiding<T>::start(Nav& nav) {
   pending_ = 0;
   pending_dt_s_ = T(0);
   still_ = false;
+  moving_ = false;
   started_ = true;
 }
 
@@ -150,9 +170,22 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
     ++propagation_errors_;
     return;
   }
-  if (still_ && config_.standstill_updates) {
-    (void)filter_.update_zupt(nav);
-    (void)filter_.update_zaru(nav);
+  if (filter_.restart_if_diverged(nav)) return;
+  if (moving_) {
+    using namespace filt_idx;
+    const auto& p = filter_.covariance();
+    const T sigma_h = std::sqrt(std::max(p(kVel, kVel), p(kVel + 1, kVel + 1)));
+    const T speed = nav.state().v_n.template head<2>().norm();
+    if (speed + T(2) * sigma_h <= config_.gnss_moving_speed_mps) moving_ = false;
+  }
+  if (still_ && config_.standstill_updates && moving_) {
+    ++motion_vetoes_;
+  } else if (still_ && config_.standstill_updates) {
+    if (filter_.update_zupt(nav).status == UpdateStatus::kAccepted) {
+      (void)filter_.update_zaru(nav);
+    } else {
+      ++motion_vetoes_;
+    }
   }
 }
 
@@ -165,6 +198,9 @@ UpdateOutcome Aiding<T>::offer_gnss_position(Nav& nav, const GnssFix<T>& fix) {
 template <typename T>
 UpdateOutcome Aiding<T>::offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
   if (!started_) return not_started();
+  if (fix.value_n.allFinite()) {
+    moving_ = fix.value_n.template head<2>().norm() > config_.gnss_moving_speed_mps;
+  }
   return filter_.update_gnss_velocity(nav, fix);
 }
 

@@ -23,6 +23,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -62,8 +63,32 @@ struct FilterConfig {
   T zaru_sigma_rps = T(1e-3);
   // GNSS antenna lever arm, m, body FRD from the array centre.
   Vec3<T> gnss_lever_arm_b = Vec3<T>::Zero();
+  // Lock-out recovery: after this many consecutive rejected fixes of one kind (GNSS position or
+  // velocity) the filter's own covariance is what is wrong (the gate keeps out every fix of a
+  // navigation solution that has drifted outside its stated σ, so it would never come back): the
+  // quantity is set from the fix, and the attitude, rate and bias covariance go back to their
+  // initial values (counted in FilterCounters::gnss_lockout_resets). 0: never.
+  std::uint32_t gnss_lockout_fixes = 25;
   // Heading from the GNSS track once the horizontal speed exceeds this (heading_known = false).
   T track_min_speed_mps = T(3);
+  // A land vehicle moves along its body x axis (no side slip): above track_min_speed_mps every
+  // GNSS velocity fix also gives the heading, atan2(v_E, v_N) of the array's velocity (the
+  // antenna's minus ω × l), with 1σ² = (σ_v / speed)² + this², the side slip's 1σ. It is the only
+  // heading information at constant speed: an accelerometer array's rate error grows with the
+  // ω̇ bias, and the heading with it, while GNSS velocity sees the heading only under horizontal
+  // acceleration. 0: off (a handheld or walking board, whose x axis need not point where it goes).
+  T track_heading_sigma_rad = T(0);
+  // Divergence: the linear error model holds for small errors only, and an accelerometer
+  // array's rate error feeds itself through the centripetal terms (ω̇ error ∝ ω δω + δω²), so a
+  // solution that has gone far (a long outage) runs away in finite time. When the tilt 1σ exceeds
+  // diverged_sigma_tilt_rad or |ω̂| exceeds max_rate_rps the filter restarts (counted in
+  // FilterCounters::divergence_restarts): the rate is set to zero with restart_sigma_rate_rps,
+  // the tilt 1σ to half diverged_sigma_tilt_rad, the heading unknown until the GNSS track or a
+  // heading sets it again, the bias to its prior. The output is then not valid until the σ come
+  // back below the validity horizons.
+  T diverged_sigma_tilt_rad = T(0.35);  // 20°
+  T max_rate_rps = T(10);
+  T restart_sigma_rate_rps = T(0.3);
   // An aiding kind counts in mode() for this long after its last accepted update.
   T aiding_timeout_s = T(2);
   // Validity horizons: a quantity is valid while aligned and its 1σ is at or below these.
@@ -116,7 +141,9 @@ struct FilterCounters {
   std::array<std::uint32_t, kAidingKinds> rejected{};
   std::array<std::uint32_t, kAidingKinds> invalid{};
   std::uint32_t propagations = 0;
-  std::uint32_t covariance_resets = 0;  // non-finite or negative diagonal found and reset
+  std::uint32_t covariance_resets = 0;    // non-finite or negative diagonal found and reset
+  std::uint32_t gnss_lockout_resets = 0;  // FilterConfig::gnss_lockout_fixes reached
+  std::uint32_t divergence_restarts = 0;  // FilterConfig::diverged_sigma_tilt_rad, max_rate_rps
 };
 
 template <typename T, int HistoryCapacity = 32>
@@ -141,7 +168,9 @@ class ErrorStateFilter {
     if (!(config.zupt_sigma_mps > T(0)) || !(config.zaru_sigma_rps > T(0)) ||
         !(config.init_sigma_tilt_rad > T(0)) || !(config.init_sigma_heading_rad > T(0)) ||
         !(config.init_sigma_pos_m > T(0)) || !(config.init_sigma_vel_mps > T(0)) ||
-        !(config.init_sigma_rate_rps > T(0)) || !(config.variance_floor > T(0))) {
+        !(config.init_sigma_rate_rps > T(0)) || !(config.variance_floor > T(0)) ||
+        !(config.diverged_sigma_tilt_rad > T(0)) || !(config.max_rate_rps > T(0)) ||
+        !(config.restart_sigma_rate_rps > T(0))) {
       return Status(ErrorCode::kInvalidArgument, "filter: every sigma must be positive");
     }
     config_ = config;
@@ -164,6 +193,14 @@ class ErrorStateFilter {
   /// current state, which is also stored in the history. F, the noise through M and the gravity
   /// gradient come from ErrorModel on the strapdown's own solver and gravity.
   Status propagate(const Nav& strapdown, T dt_s);
+
+  /// FilterConfig's divergence test (call after propagate): true when it fired and the filter
+  /// restarted (the strapdown's rate zeroed, the covariance widened, the heading unknown).
+  bool restart_if_diverged(Nav& nav) {
+    if (!started_ || !diverged(nav)) return false;
+    restart_after_divergence(nav);
+    return true;
+  }
 
   // ---- Updates: each returns what became of it; only kAccepted (and kReset) change the state --
 
@@ -326,6 +363,98 @@ class ErrorStateFilter {
     return accepted_reset(AidingKind::kGnssVelocity, nav);
   }
 
+  /// The heading of the GNSS track (FilterConfig::track_heading_sigma_rad), valid at the fix's
+  /// instant; counted as a heading update. Below the speed threshold nothing happens (kInvalid,
+  /// not counted: there is no track to read).
+  UpdateOutcome update_track_heading(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
+    const Vec3<T> v = fix.value_n - at.q_nb * at.w_b.cross(config_.gnss_lever_arm_b);
+    const T speed = v.template head<2>().norm();
+    if (!(speed >= config_.track_min_speed_mps)) return UpdateOutcome{};
+    const T sv = fix.sigma.template head<2>().maxCoeff() / speed;
+    const T sigma =
+        std::sqrt(sv * sv + config_.track_heading_sigma_rad * config_.track_heading_sigma_rad);
+    return apply(heading_measurement(at.q_nb, std::atan2(v.y(), v.x()), sigma),
+                 AidingKind::kHeading, gate_1_, nav);
+  }
+
+  /// FilterConfig's divergence test, after each propagation.
+  bool diverged(const Nav& nav) const {
+    using namespace filt_idx;
+    const T limit = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad;
+    const NavState<T>& x = nav.state();
+    return !(p_(kPhi, kPhi) <= limit && p_(kPhi + 1, kPhi + 1) <= limit) ||
+           !(x.w_b.norm() <= config_.max_rate_rps) || !x.v_n.allFinite() || !x.r_n.allFinite();
+  }
+
+  /// The restart of FilterConfig (diverged_sigma_tilt_rad).
+  void restart_after_divergence(Nav& nav) {
+    using namespace filt_idx;
+    ++counters_.divergence_restarts;
+    const NavState<T>& x = nav.state();
+    const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
+    nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
+    const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
+    const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
+    p_ = initial_covariance();
+    // Half the limit: the restart must leave room before the test fires again.
+    const T tilt2 = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad / T(4);
+    constexpr T kPi = T(3.14159265358979323846);
+    p_(kPhi, kPhi) = tilt2;
+    p_(kPhi + 1, kPhi + 1) = tilt2;
+    p_(kPhi + 2, kPhi + 2) = kPi * kPi;
+    heading_aligned_ = false;
+    const T rate2 = config_.restart_sigma_rate_rps * config_.restart_sigma_rate_rps;
+    for (int i = 0; i < 3; ++i) {
+      p_(kRate + i, kRate + i) = rate2;
+      p_(kPos + i, kPos + i) = std::max(p_(kPos + i, kPos + i), pos_var(i));
+      p_(kVel + i, kVel + i) = std::max(p_(kVel + i, kVel + i), vel_var(i));
+    }
+    if (!p_.allFinite()) p_ = initial_covariance();
+    gnss_rejected_run_.fill(0);
+  }
+
+  /// Counts consecutive rejections of a GNSS kind; at FilterConfig::gnss_lockout_fixes the
+  /// quantity is set from this fix (as before heading alignment, the lever arm's length added to
+  /// the position variance because the attitude is in doubt) and the attitude, rate and bias
+  /// covariance return to the initial one, decorrelated, the heading variance never below what it
+  /// was. The outcome stays kRejected: the fix was not applied as a measurement.
+  UpdateOutcome after_gnss(UpdateOutcome o, AidingKind kind, Nav& nav, const GnssFix<T>& fix,
+                           const HistoryEntry<T>& at) {
+    std::uint32_t& run = gnss_rejected_run_[kind == AidingKind::kGnssPosition ? 0 : 1];
+    if (o.status != UpdateStatus::kRejected) {
+      run = 0;
+      return o;
+    }
+    if (config_.gnss_lockout_fixes == 0 || ++run < config_.gnss_lockout_fixes) return o;
+    run = 0;
+    ++counters_.gnss_lockout_resets;
+    using namespace filt_idx;
+    const StateMat p0 = initial_covariance();
+    const T heading_var = std::max(p_(kPhi + 2, kPhi + 2), p0(kPhi + 2, kPhi + 2));
+    const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
+    const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
+    p_ = p0;
+    p_(kPhi + 2, kPhi + 2) = heading_var;
+    const T l2 = config_.gnss_lever_arm_b.squaredNorm();
+    const Vec3<T> fix_var = fix.sigma.cwiseProduct(fix.sigma);
+    if (kind == AidingKind::kGnssPosition) {
+      const Vec3<T> dr = at.r_n + at.q_nb * config_.gnss_lever_arm_b - fix.value_n;
+      nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
+      history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
+      reset_block(kPos, fix_var + Vec3<T>::Constant(l2));
+      reset_block(kVel, vel_var.cwiseMax(p0.template block<3, 3>(kVel, kVel).diagonal()));
+    } else {
+      // The antenna moves with ω × l beside the array: |ω|²|l|² is added for the lever arm.
+      const Vec3<T> dv = at.v_n - fix.value_n;
+      nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), dv, Vec3<T>::Zero());
+      history_.shift(Vec3<T>::Zero(), Vec3<T>::Zero(), dv);
+      reset_block(kVel, fix_var + Vec3<T>::Constant(at.w_b.squaredNorm() * l2));
+      reset_block(kPos, pos_var.cwiseMax(p0.template block<3, 3>(kPos, kPos).diagonal()));
+    }
+    condition_covariance();
+    return o;
+  }
+
   /// Heading set directly (before alignment): dyaw = ψ̂ − ψ removed by the rotation about the
   /// down axis φ = [0, 0, −dyaw] (the yaw error is −φ_D, euler_error.hpp).
   void set_heading(Nav& nav, T dyaw, T sigma_rad) {
@@ -374,6 +503,7 @@ class ErrorStateFilter {
   NavHistory<T, HistoryCapacity> history_{};
   FilterCounters counters_{};
   std::array<std::int64_t, kAidingKinds> last_accepted_ns_{};
+  std::array<std::uint32_t, 2> gnss_rejected_run_{};  // consecutive rejections: position, velocity
   T gate_1_ = T(0);
   T gate_3_ = T(0);
   bool configured_ = false;
@@ -395,6 +525,7 @@ void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
   history_.push(nav.state());
   heading_aligned_ = config_.heading_known;
   last_accepted_ns_.fill(kNever);
+  gnss_rejected_run_.fill(0);
   started_ = configured_;
 }
 
@@ -480,8 +611,9 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_position(Nav& na
   HistoryEntry<T> at;
   if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssPosition);
   if (!heading_aligned_) return reset_position(nav, fix, at);
-  return apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
-               AidingKind::kGnssPosition, gate_3_, nav);
+  const UpdateOutcome o = apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
+                                AidingKind::kGnssPosition, gate_3_, nav);
+  return after_gnss(o, AidingKind::kGnssPosition, nav, fix, at);
 }
 
 template <typename T, int HistoryCapacity>
@@ -490,8 +622,16 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& na
   HistoryEntry<T> at;
   if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
   if (!heading_aligned_) return reset_velocity_and_track(nav, fix, at);
-  return apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
-               AidingKind::kGnssVelocity, gate_3_, nav);
+  const UpdateOutcome o = apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
+                                AidingKind::kGnssVelocity, gate_3_, nav);
+  const UpdateOutcome out = after_gnss(o, AidingKind::kGnssVelocity, nav, fix, at);
+  if (config_.track_heading_sigma_rad > T(0)) {
+    // The history entry was shifted by the velocity update's feedback: read it again.
+    HistoryEntry<T> now_at;
+    if (history_.at(fix.t_valid_ns, nav.state(), now_at))
+      (void)update_track_heading(nav, fix, now_at);
+  }
+  return out;
 }
 
 template <typename T, int HistoryCapacity>

@@ -1,0 +1,139 @@
+#include "gfins/host_sim/accuracy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace gfins::sim {
+
+const std::array<const char*, kConsistencyComponents> kConsistencyNames = {
+    "roll", "pitch", "heading", "v_N", "v_E", "v_D", "r_N", "r_E", "r_D"};
+
+namespace {
+constexpr double kDeg = 180.0 / 3.14159265358979323846;
+}  // namespace
+
+AccuracyTracker::AccuracyTracker(std::vector<double> checkpoints_s, double rms_from_s,
+                                 const std::vector<std::pair<double, double>>& windows,
+                                 double after_s)
+    : checkpoints_s_(std::move(checkpoints_s)),
+      at_(checkpoints_s_.size()),
+      rms_from_s_(rms_from_s),
+      after_s_(after_s) {
+  for (const auto& [a, b] : windows) {
+    Window w;
+    w.start_s = a;
+    w.end_s = b;
+    windows_.push_back(w);
+  }
+}
+
+ErrorSnapshot AccuracyTracker::snapshot(const SampleRecord& x) {
+  const Vec3d e = x.euler_err();
+  const Vec3d r = x.r_err_n();
+  ErrorSnapshot s;
+  s.t_s = x.t_s;
+  s.tilt_deg = std::max(std::abs(e.x()), std::abs(e.y())) * kDeg;
+  s.heading_deg = std::abs(e.z()) * kDeg;
+  s.vel_mps = x.v_err_n().norm();
+  s.pos_h_m = std::hypot(r.x(), r.y());
+  s.pos_v_m = std::abs(r.z());
+  s.seen = true;
+  return s;
+}
+
+void AccuracyTracker::keep_worst(ErrorSnapshot& w, const ErrorSnapshot& e) {
+  // NaN (a diverged run) counts as worst: a comparison with NaN is false, so test for it.
+  const auto worse = [](double a, double b) {
+    if (std::isnan(b)) return false;  // already the worst there is
+    return std::isnan(a) || a > b;
+  };
+  if (!w.seen || worse(e.tilt_deg, w.tilt_deg)) {
+    w.tilt_deg = e.tilt_deg;
+    w.t_s = e.t_s;
+  }
+  if (!w.seen || worse(e.heading_deg, w.heading_deg)) w.heading_deg = e.heading_deg;
+  if (!w.seen || worse(e.vel_mps, w.vel_mps)) w.vel_mps = e.vel_mps;
+  if (!w.seen || worse(e.pos_h_m, w.pos_h_m)) w.pos_h_m = e.pos_h_m;
+  if (!w.seen || worse(e.pos_v_m, w.pos_v_m)) w.pos_v_m = e.pos_v_m;
+  w.seen = true;
+}
+
+void AccuracyTracker::add(const SampleRecord& x) {
+  const ErrorSnapshot e = snapshot(x);
+  for (std::size_t i = 0; i < checkpoints_s_.size(); ++i) {
+    if (!at_[i].seen && x.t_s >= checkpoints_s_[i]) at_[i] = e;
+  }
+  for (Window& w : windows_) {
+    if (x.t_s >= w.start_s && x.t_s < w.end_s) keep_worst(w.worst_inside, e);
+    if (!w.after.seen && x.t_s >= w.end_s + after_s_) w.after = e;
+  }
+  if (x.t_s < rms_from_s_) return;
+  ++n_;
+  tilt2_ += e.tilt_deg * e.tilt_deg;
+  heading2_ += e.heading_deg * e.heading_deg;
+  vel2_ += e.vel_mps * e.vel_mps;
+  pos2_ += e.pos_h_m * e.pos_h_m;
+  keep_worst(worst_, e);
+  bool outside = !windows_.empty();
+  for (const Window& w : windows_) {
+    if (x.t_s >= w.start_s && x.t_s < w.end_s + after_s_) outside = false;
+  }
+  if (outside) {
+    ++n_out_;
+    tilt2_out_ += e.tilt_deg * e.tilt_deg;
+    heading2_out_ += e.heading_deg * e.heading_deg;
+    vel2_out_ += e.vel_mps * e.vel_mps;
+    pos2_out_ += e.pos_h_m * e.pos_h_m;
+  }
+  const Vec3d ee = x.euler_err();
+  const std::array<double, kConsistencyComponents> err = {
+      ee.x(),          ee.y(),          ee.z(),          x.v_err_n().x(), x.v_err_n().y(),
+      x.v_err_n().z(), x.r_err_n().x(), x.r_err_n().y(), x.r_err_n().z()};
+  const std::array<double, kConsistencyComponents> sig = {
+      x.euler_sigma_rad.x(), x.euler_sigma_rad.y(), x.euler_sigma_rad.z(),
+      x.v_sigma_n.x(),       x.v_sigma_n.y(),       x.v_sigma_n.z(),
+      x.r_sigma_n.x(),       x.r_sigma_n.y(),       x.r_sigma_n.z()};
+  if (!std::isfinite(sig[0])) return;  // no filter at this sample
+  ++sigma_n_;
+  for (std::size_t i = 0; i < kConsistencyComponents; ++i) {
+    if (std::abs(err[i]) <= 3.0 * sig[i]) ++within_[i];
+  }
+}
+
+namespace {
+double rms(double sum2, std::uint64_t n) {
+  return n == 0 ? std::nan("") : std::sqrt(sum2 / static_cast<double>(n));
+}
+}  // namespace
+
+double AccuracyTracker::tilt_rms_deg() const { return rms(tilt2_, n_); }
+double AccuracyTracker::heading_rms_deg() const { return rms(heading2_, n_); }
+double AccuracyTracker::vel_rms_mps() const { return rms(vel2_, n_); }
+double AccuracyTracker::pos_h_rms_m() const { return rms(pos2_, n_); }
+
+ErrorSnapshot AccuracyTracker::rms_outside() const {
+  ErrorSnapshot e;
+  e.seen = n_out_ > 0;
+  e.tilt_deg = rms(tilt2_out_, n_out_);
+  e.heading_deg = rms(heading2_out_, n_out_);
+  e.vel_mps = rms(vel2_out_, n_out_);
+  e.pos_h_m = rms(pos2_out_, n_out_);
+  return e;
+}
+
+double AccuracyTracker::within_3sigma(std::size_t component) const {
+  if (sigma_n_ == 0 || component >= kConsistencyComponents) return std::nan("");
+  return static_cast<double>(within_[component]) / static_cast<double>(sigma_n_);
+}
+
+std::string AccuracyTracker::describe_rms() const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "RMS over t >= %g s: tilt %.3g deg, heading %.3g deg, velocity %.3g m/s, "
+                "horizontal position %.3g m",
+                rms_from_s_, tilt_rms_deg(), heading_rms_deg(), vel_rms_mps(), pos_h_rms_m());
+  return buf;
+}
+
+}  // namespace gfins::sim

@@ -1,0 +1,90 @@
+// Navigation accuracy of one run against its truth, accumulated sample by sample (a streamed run
+// keeps no series): the errors at chosen instants, RMS over the run after a settling time, the
+// worst errors, the errors inside and after chosen windows (GNSS outages), and, when the aiding
+// filter runs, how often each error lies within 3σ of the filter's own covariance (the
+// consistency a user relies on when reading the σ off the bus). docs/navigation-accuracy.md.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gfins/host_sim/scenario.hpp"
+
+namespace gfins::sim {
+
+/// The errors of one sample, in the units a user reads (degrees, m/s, m).
+struct ErrorSnapshot {
+  double t_s = 0;
+  double tilt_deg = 0;     // max(|roll error|, |pitch error|)
+  double heading_deg = 0;  // |heading error|
+  double vel_mps = 0;      // |velocity error| (3-D)
+  double pos_h_m = 0;      // horizontal position error
+  double pos_v_m = 0;      // |down position error|
+  bool seen = false;       // a sample at or after the instant was seen
+};
+
+/// The nine error components compared with 3σ: roll, pitch, heading, v N/E/D, r N/E/D.
+inline constexpr std::size_t kConsistencyComponents = 9;
+extern const std::array<const char*, kConsistencyComponents> kConsistencyNames;
+
+class AccuracyTracker {
+ public:
+  /// checkpoints_s: instants whose errors are kept (the first sample at or after each);
+  /// rms_from_s: RMS and worst values over t ≥ this; windows: [start, end) spans (outages) whose
+  /// worst error inside and error `after_s` past their end are kept.
+  AccuracyTracker(std::vector<double> checkpoints_s, double rms_from_s,
+                  const std::vector<std::pair<double, double>>& windows = {},
+                  double after_s = 10.0);
+
+  void add(const SampleRecord& x);
+
+  const std::vector<ErrorSnapshot>& checkpoints() const { return at_; }
+  double rms_from_s() const { return rms_from_s_; }
+  std::uint64_t rms_samples() const { return n_; }
+  double tilt_rms_deg() const;
+  double heading_rms_deg() const;
+  double vel_rms_mps() const;
+  double pos_h_rms_m() const;
+  /// The same RMS without the windows and the after_s past each (the error with GNSS), and the
+  /// samples it covers (0 without windows: then it is the RMS above).
+  std::uint64_t rms_outside_samples() const { return n_out_; }
+  ErrorSnapshot rms_outside() const;
+  const ErrorSnapshot& worst() const { return worst_; }  // each field its own worst (t: tilt's)
+
+  struct Window {
+    double start_s = 0, end_s = 0;
+    ErrorSnapshot worst_inside;  // each field its own worst inside [start, end)
+    ErrorSnapshot after;         // at end + after_s
+  };
+  const std::vector<Window>& windows() const { return windows_; }
+
+  /// Samples (t ≥ rms_from_s) that carried the filter's σ, and of those how many had each
+  /// component within 3σ.
+  std::uint64_t sigma_samples() const { return sigma_n_; }
+  double within_3sigma(std::size_t component) const;
+
+  /// One-line summaries for a terminal (what `gfins-sim aided` prints).
+  std::string describe_rms() const;
+
+ private:
+  static ErrorSnapshot snapshot(const SampleRecord& x);
+  static void keep_worst(ErrorSnapshot& w, const ErrorSnapshot& e);
+
+  std::vector<double> checkpoints_s_;
+  std::vector<ErrorSnapshot> at_;
+  double rms_from_s_;
+  double after_s_;
+  std::vector<Window> windows_;
+  std::uint64_t n_ = 0;
+  double tilt2_ = 0, heading2_ = 0, vel2_ = 0, pos2_ = 0;
+  std::uint64_t n_out_ = 0;
+  double tilt2_out_ = 0, heading2_out_ = 0, vel2_out_ = 0, pos2_out_ = 0;
+  ErrorSnapshot worst_{};
+  std::uint64_t sigma_n_ = 0;
+  std::array<std::uint64_t, kConsistencyComponents> within_{};
+};
+
+}  // namespace gfins::sim

@@ -1,0 +1,71 @@
+// AccuracyTracker against errors written into synthetic records, so every figure is known by
+// hand: a position error of 3 m north and 4 m east is 5 m horizontal; RMS of 1 and 7 is 5; a
+// component is within 3σ or not by construction.
+#include "gfins/host_sim/accuracy.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace gfins::sim {
+namespace {
+
+SampleRecord record(double t, double pos_n, double pos_e, double heading_rad = 0,
+                    double sigma = std::numeric_limits<double>::quiet_NaN()) {
+  SampleRecord r;
+  r.t_s = t;
+  r.truth.t_s = t;
+  r.r_n_est = Vec3d(pos_n, pos_e, 0);
+  // Heading error: the estimate turned about down by heading_rad.
+  r.q_nb_est = Quatd(Eigen::AngleAxisd(heading_rad, Vec3d::UnitZ()));
+  r.euler_sigma_rad.setConstant(sigma);
+  r.v_sigma_n.setConstant(sigma);
+  r.r_sigma_n.setConstant(sigma);
+  return r;
+}
+
+TEST(AccuracyTracker, CheckpointsRmsWorstAndWindows) {
+  AccuracyTracker a({1.0, 3.0}, 1.0, {{2.0, 3.0}}, 1.0);
+  a.add(record(0.0, 100, 0));  // before rms_from: only in no statistic
+  a.add(record(1.0, 3, 4));    // 5 m, checkpoint 1
+  a.add(record(2.0, 0, 7));    // 7 m, inside the window
+  a.add(record(3.0, 0, 1));    // 1 m, checkpoint 3; the window's end (not inside)
+  a.add(record(4.0, 0, 2));    // 2 m: 1 s after the window
+  ASSERT_EQ(a.checkpoints().size(), 2u);
+  EXPECT_DOUBLE_EQ(a.checkpoints()[0].pos_h_m, 5.0);
+  EXPECT_DOUBLE_EQ(a.checkpoints()[1].pos_h_m, 1.0);
+  EXPECT_EQ(a.rms_samples(), 4u);
+  EXPECT_DOUBLE_EQ(a.pos_h_rms_m(), std::sqrt((25.0 + 49.0 + 1.0 + 4.0) / 4.0));
+  EXPECT_DOUBLE_EQ(a.worst().pos_h_m, 7.0);
+  ASSERT_EQ(a.windows().size(), 1u);
+  EXPECT_DOUBLE_EQ(a.windows()[0].worst_inside.pos_h_m, 7.0);
+  EXPECT_DOUBLE_EQ(a.windows()[0].after.pos_h_m, 2.0);
+  // Outside the window and the 1 s after it ([2, 4)): t = 1 and t = 4.
+  EXPECT_EQ(a.rms_outside_samples(), 2u);
+  EXPECT_DOUBLE_EQ(a.rms_outside().pos_h_m, std::sqrt((25.0 + 4.0) / 2.0));
+}
+
+TEST(AccuracyTracker, HeadingErrorInDegreesAndWithin3Sigma) {
+  AccuracyTracker a({}, 0.0);
+  const double deg = M_PI / 180.0;
+  a.add(record(0.0, 0, 0, 2.0 * deg, 1.0 * deg));   // heading 2σ: within
+  a.add(record(1.0, 0, 0, -4.0 * deg, 1.0 * deg));  // 4σ: outside
+  a.add(record(2.0, 0, 0, 0.0));                    // no σ: not counted
+  EXPECT_NEAR(a.worst().heading_deg, 4.0, 1e-9);
+  EXPECT_NEAR(a.heading_rms_deg(), std::sqrt((4.0 + 16.0 + 0.0) / 3.0), 1e-9);
+  EXPECT_EQ(a.sigma_samples(), 2u);
+  EXPECT_DOUBLE_EQ(a.within_3sigma(2), 0.5);  // heading
+  EXPECT_DOUBLE_EQ(a.within_3sigma(6), 1.0);  // r_N: zero error
+}
+
+TEST(AccuracyTracker, NonFiniteErrorIsTheWorst) {
+  AccuracyTracker a({}, 0.0);
+  a.add(record(0.0, 1, 0));
+  a.add(record(1.0, std::numeric_limits<double>::quiet_NaN(), 0));
+  a.add(record(2.0, 2, 0));
+  EXPECT_TRUE(std::isnan(a.worst().pos_h_m));
+}
+
+}  // namespace
+}  // namespace gfins::sim
