@@ -31,4 +31,9 @@ if [[ -x "$bin/host_sim/can_tool/gfins-can" ]]; then
 else
   echo "note: gfins-can is not in this build; the summary above is gfins-fw's own."
 fi
+# What the board's aiding does: the 10-minute stop-and-go drive with GNSS, aided and unaided from
+# the same simulated sensors, errors against the truth side by side (docs/navigation-accuracy.md;
+# a few seconds).
+echo
+"$bin/host_sim/app/gfins-sim" aided urban-stop-and-go -o out/aided-urban-stop-and-go --no-plot
 echo "programs installed in out/gfins/bin: export PATH=\"\$PWD/out/gfins/bin:\$PATH\" (README, Running things)"
