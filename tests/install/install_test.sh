@@ -12,8 +12,8 @@
 #    into them fails, and nothing else on the machine (other builds, ctest -j) sees a change;
 #    this needs root (as CI is) and fails with exit status 2 and a message saying so when not;
 # 4. every program and subcommand runs from T: --version, --help, gfins-sim list / run (PNG when
-#    matplotlib is there) / paper63 / montecarlo / covariance, a built-in name next to a folder of
-#    the same name, an unknown name's suggestion, gfins-calibrate on the shipped example,
+#    matplotlib is there) / aided / paper63 / montecarlo / covariance, a built-in name next to a
+#    folder of the same name, an unknown name's suggestion, gfins-calibrate on the shipped example,
 #    gfins-can decode + plot of the shipped log, gfins-can-gen, gfins-fw --sim writing a candump
 #    log that gfins-can decodes cleanly, and gfins-fw from its own package alone.
 #
@@ -187,6 +187,13 @@ checks() {
   fi
   expect 0 "$bin/gfins-sim" montecarlo rest -n 3 -o mc-rest --no-plot
   expect 0 "$bin/gfins-sim" covariance rest -o cov --no-plot
+  if expect 0 "$bin/gfins-sim" aided walk -o aided-walk "${plot[@]}"; then
+    log_has "within the filter's 3 sigma" "aided walk"
+    [ -s aided-walk/aided.csv ] || fail "aided walk: no aided.csv"
+    if [ ${#plot[@]} = 0 ]; then
+      [ -s aided-walk/accuracy.png ] || fail "aided walk: no accuracy.png"
+    fi
+  fi
   expect 0 "$bin/gfins-sim" --duration 1
 
   # Record, replay (navigate, PNG, dump, means), from the prefix with the trees hidden:
