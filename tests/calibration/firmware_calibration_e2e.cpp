@@ -37,9 +37,9 @@
 #include "capture_sequence.hpp"
 #include "command_client.hpp"
 #include "csv.hpp"
-#include "gfins/app/can_adapters.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/epoch_sinks.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
@@ -178,8 +178,7 @@ struct Board {
     board_bus = std::make_unique<BoardEnd>(wire);
     host_bus = std::make_unique<HostEnd>(
         wire, [this] { return step(); }, period_ns);
-    sink = std::make_unique<app::CanEpochSink>(*board_bus, kNode, app::to_can_dividers(config));
-    codec = std::make_unique<app::CanCommandCodec>(kNode);
+    sink = std::make_unique<app::PublisherSink>(*board_bus, kNode, app::bus_dividers(config));
     log = std::make_unique<app::FwLogQueue>();
     // No file yet: the nominal chain (what a new board runs with), calibration id 0.
     const auto cal =
@@ -197,7 +196,7 @@ struct Board {
           return load(c);
         });
     loop = std::make_unique<app::SampleLoop>(*tap, *board_bus, *sink, clock, *log);
-    loop->set_command_codec(codec.get());
+    loop->set_commands(true);
     loop->set_reload_worker(reload.get());
     if (const Status st = loop->configure(cal.set, app::loop_options(config)); !st.is_ok()) {
       throw std::runtime_error(st.message());
@@ -249,8 +248,7 @@ struct Board {
   std::unique_ptr<TraceSource> tap;
   std::unique_ptr<BoardEnd> board_bus;
   std::unique_ptr<HostEnd> host_bus;
-  std::unique_ptr<app::CanEpochSink> sink;
-  std::unique_ptr<app::CanCommandCodec> codec;
+  std::unique_ptr<app::PublisherSink> sink;
   std::unique_ptr<app::FwLogQueue> log;
   std::mutex gate_mutex;  // in_step, between step() and the reload worker's load
   std::condition_variable gate_cv;

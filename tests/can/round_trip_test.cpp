@@ -87,7 +87,7 @@ Epoch sample_epoch() {
   e.nav.t_ns = 1'234'567'891'000;
   e.nav.seq = 70'010;
   e.nav.w_b = nav::Vec3<float>(1.0f, -0.5f, 0.0f);
-  e.mode = static_cast<std::uint8_t>(Mode::kNavigating);
+  e.mode = Mode::kNavigating;
   return e;
 }
 

@@ -24,7 +24,7 @@ Epoch moving_epoch() {
   e.nav.f_b = nav::Vec3<float>(0.5f, -0.4f, -9.8f);
   e.nav.v_n = nav::Vec3<float>(10.0f, -3.0f, 0.2f);
   e.nav.r_n = nav::Vec3<float>(100.0f, -30.0f, 2.0f);
-  e.mode = static_cast<std::uint8_t>(Mode::kNavigating);
+  e.mode = Mode::kNavigating;
   return e;
 }
 
@@ -135,7 +135,7 @@ TEST(Validity, NothingValidSendsNoZeroAndNoIdentityAndFlagsTheEpoch) {
   ArrayBus<64> bus;
   Publisher pub(bus, PublisherConfig{});
   Epoch e;  // identity attitude, zero everything: what an aligning state holds
-  e.mode = static_cast<std::uint8_t>(Mode::kAligning);
+  e.mode = Mode::kAligning;
   e.valid = Validity::none();
   pub.publish(e);
   ASSERT_GT(bus.count, 2u);

@@ -68,7 +68,7 @@ class BoardBus final : public hal::CanBus {
       }
       case can::Opcode::kReloadCalibration:
         // The firmware answers a reload with the status frame, then the new calibration id
-        // (firmware/app can_adapters.cpp, docs/can-interface.md).
+        // (SampleLoop::send_response in firmware/app, docs/can-interface.md).
         rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, 0}, kNode));
         rx_.push_back(can::encode_calibration_id_response(c.token, 0x0BADCAFE, kNode));
         break;

@@ -80,7 +80,7 @@ void publish(RecordingBus& bus, std::uint32_t first, std::uint32_t count,
     can::Epoch e;
     e.nav.seq = s;
     e.nav.t_ns = static_cast<std::int64_t>(s) * 1'000'000;  // 1 kHz
-    e.mode = 2;
+    e.mode = can::Mode::kNavigating;
     bus.seq = s;
     pub.publish(e);
   }
@@ -341,7 +341,7 @@ TEST(DecoderChecks, EpochsWithoutAConversionAreNotHeldToTheDataReadyTime) {
     can::Epoch e;
     e.nav.seq = s;
     e.nav.t_ns = t_ns;
-    e.mode = 2;
+    e.mode = can::Mode::kNavigating;
     if (lost) e.status_bits = 1u << 15;
     bus.seq = s;
     pub.publish(e);
@@ -358,7 +358,7 @@ TEST(DecoderChecks, EpochsWithoutAConversionAreNotHeldToTheDataReadyTime) {
     can::Epoch e;
     e.nav.seq = s;
     e.nav.t_ns = t_ns;
-    e.mode = 2;
+    e.mode = can::Mode::kNavigating;
     plain.seq = s;
     pub2.publish(e);
   }

@@ -60,7 +60,7 @@ TEST(EndToEnd, CoreStatesSurviveTheBusWithinQuantisation) {
     ASSERT_EQ(pipe.process(s), nav::PipelinePhase::kNavigating);
     can::Epoch e;
     e.nav = pipe.state();
-    e.mode = static_cast<std::uint8_t>(can::Mode::kNavigating);
+    e.mode = can::Mode::kNavigating;
     e.cal_id = 77;
     states[k] = e.nav;
     bus.t_us = s.t_ns / 1000;

@@ -24,7 +24,7 @@ using testing::SimRig;
 
 // The value a signal should carry for an epoch, read here from the NavState and the firmware's
 // epoch (not from the publisher's own field accessor) for every navigation and health field.
-double expected_value(const Epoch& e, const can::SignalDef& s) {
+double expected_value(const can::Epoch& e, const can::SignalDef& s) {
   const auto& n = e.nav;
   const int i = s.index;
   // A navigation group the epoch does not stand behind (aligning) goes out as not available.
@@ -73,9 +73,9 @@ double expected_value(const Epoch& e, const can::SignalDef& s) {
     case can::Field::kCalId:
       return e.cal_id;
     case can::Field::kMissedEdges:
-      return e.health.missed_edges;
+      return e.health.missed_drdy_edges;
     case can::Field::kAdcCrcErrors:
-      return e.health.crc_errors;
+      return e.health.adc_crc_errors;
     case can::Field::kAdcResets:
       return e.health.adc_resets;
     case can::Field::kSaturatedSamples:
@@ -92,11 +92,11 @@ double expected_value(const Epoch& e, const can::SignalDef& s) {
       const can::Validity& v = e.valid;
       const bool any_na =
           !(v.attitude && v.rate && v.angular_accel && v.accel && v.velocity && v.position);
-      return can::epoch_field(to_can_epoch(e), s.field, s.index) +
+      return can::epoch_field(e, s.field, s.index) +
              (any_na ? static_cast<double>(can::status_bits::kCanNotAvailable) : 0.0);
     }
     default:  // Euler angles, mode, time: the protocol's own mapping
-      return can::epoch_field(to_can_epoch(e), s.field, s.index);
+      return can::epoch_field(e, s.field, s.index);
   }
 }
 
@@ -107,7 +107,7 @@ TEST(CanOutput, DecodedFramesEqualTheNavStateWithinQuantisation) {
   const auto frames = rig.bus->sent();
   ASSERT_GT(frames.size(), 1000u);
   std::size_t epoch_index = 0, compared = 0;
-  const Epoch* current = nullptr;
+  const can::Epoch* current = nullptr;
   std::int64_t last_counter = -1;
   for (const hal::CanFrame& f : frames) {
     std::uint8_t node = 0;
@@ -179,7 +179,7 @@ class CanCommands : public ::testing::Test {
     rig_->loop->set_reload_worker(worker_.get());
     rig_->configure();
     rig_->run_cycles(1500);
-    ASSERT_EQ(rig_->loop->mode(), Mode::kNavigating);
+    ASSERT_EQ(rig_->loop->mode(), can::Mode::kNavigating);
   }
   void TearDown() override { std::filesystem::remove(path_); }
 
@@ -249,7 +249,7 @@ TEST_F(CanCommands, Realign) {
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
   EXPECT_EQ(part(r, 0)->token, 11);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kAligning);
   EXPECT_NEAR(rig_->loop->pipeline().config().heading_rad, 0.25f, 1e-3f);  // heading signal step
 }
 
@@ -257,7 +257,7 @@ TEST_F(CanCommands, ResetNavigation) {
   const auto r = send(cmd(can::Opcode::kResetNavigation, 12));
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kAligning);
 }
 
 TEST_F(CanCommands, SetCompensatorValidAndOutOfRange) {
@@ -375,7 +375,7 @@ TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {
 // What a command could change on the board, read through the loop's public state and its bus
 // output (the dividers at work).
 struct BoardState {
-  Mode mode{};
+  can::Mode mode{};
   nav::PipelinePhase phase{};
   float heading_rad = 0;
   nav::CompensatorKind compensator{};

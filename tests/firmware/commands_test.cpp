@@ -20,110 +20,111 @@ class Commands : public ::testing::Test {
     rig_ = std::make_unique<SimRig>("rest", 8.0);
     rig_->configure();
     rig_->run_cycles(1500);  // aligned and navigating
-    ASSERT_EQ(rig_->loop->mode(), Mode::kNavigating);
+    ASSERT_EQ(rig_->loop->mode(), can::Mode::kNavigating);
   }
-  Response exec(const Command& c) {
-    Response r;
+  can::Response exec(const can::Command& c) {
+    SampleLoop::CommandReply r;
     rig_->loop->execute(c, r);
-    return r;
+    return r.response;
   }
   std::unique_ptr<SimRig> rig_;
 };
 
 TEST_F(Commands, RealignRestartsAlignmentWithTheGivenHeading) {
-  Command c;
-  c.kind = CommandKind::kRealign;
+  can::Command c;
+  c.opcode = can::Opcode::kRealign;
   c.token = 7;
   c.heading_rad = 0.5f;
-  const Response r = exec(c);
-  EXPECT_EQ(r.result, CommandResult::kOk);
+  const can::Response r = exec(c);
+  EXPECT_EQ(r.result, can::ResultCode::kOk);
   EXPECT_EQ(r.token, 7);
   rig_->run_cycles(1);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kAligning);
   rig_->run_cycles(1100);
-  ASSERT_EQ(rig_->loop->mode(), Mode::kNavigating);
+  ASSERT_EQ(rig_->loop->mode(), can::Mode::kNavigating);
   EXPECT_FLOAT_EQ(rig_->loop->pipeline().config().heading_rad, 0.5f);
 }
 
 TEST_F(Commands, RealignWithAnOutOfRangeHeadingChangesNothing) {
-  Command c;
-  c.kind = CommandKind::kRealign;
+  can::Command c;
+  c.opcode = can::Opcode::kRealign;
   c.heading_rad = 7.0f;  // > 2π
   const std::uint32_t errors = rig_->loop->health().command_errors;
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
   EXPECT_EQ(rig_->loop->health().command_errors, errors + 1);
   rig_->run_cycles(1);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kNavigating);
   c.heading_rad = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
 }
 
 TEST_F(Commands, ResetNavigationRealignsWithTheConfiguredHeading) {
-  Command c;
-  c.kind = CommandKind::kResetNavigation;
-  EXPECT_EQ(exec(c).result, CommandResult::kOk);
+  can::Command c;
+  c.opcode = can::Opcode::kResetNavigation;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOk);
   rig_->run_cycles(1);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kAligning);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kAligning);
   EXPECT_FLOAT_EQ(rig_->loop->pipeline().config().heading_rad, 0.0f);
 }
 
 TEST_F(Commands, SetCompensatorSwitchesWithoutInterruptingNavigation) {
-  Command c;
-  c.kind = CommandKind::kSetCompensator;
+  can::Command c;
+  c.opcode = can::Opcode::kSetCompensator;
   c.compensator = nav::CompensatorKind::kExact;
   const auto v_before = rig_->loop->pipeline().state().v_n;
-  EXPECT_EQ(exec(c).result, CommandResult::kOk);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOk);
   EXPECT_EQ(rig_->loop->pipeline().config().compensator, nav::CompensatorKind::kExact);
   // Navigation continues from the same state (no re-alignment): velocity unchanged at the switch.
   EXPECT_EQ(rig_->loop->pipeline().phase(), nav::PipelinePhase::kNavigating);
   EXPECT_EQ(rig_->loop->pipeline().state().v_n, v_before);
   rig_->run_cycles(10);
-  EXPECT_EQ(rig_->loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig_->loop->mode(), can::Mode::kNavigating);
 }
 
 TEST_F(Commands, SetCompensatorOutOfRangeChangesNothing) {
-  Command c;
-  c.kind = CommandKind::kSetCompensator;
+  can::Command c;
+  c.opcode = can::Opcode::kSetCompensator;
   c.compensator = static_cast<nav::CompensatorKind>(9);
   const auto before = rig_->loop->pipeline().config().compensator;
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
   EXPECT_EQ(rig_->loop->pipeline().config().compensator, before);
 }
 
 TEST_F(Commands, SetDividerValidAndOutOfRange) {
-  Command c;
-  c.kind = CommandKind::kSetDivider;
-  c.message = 3;
+  can::Command c;
+  c.opcode = can::Opcode::kSetDivider;
+  c.message = static_cast<can::MessageId>(3);
   c.divider = 50;
-  EXPECT_EQ(exec(c).result, CommandResult::kOk);
-  c.message = static_cast<std::uint8_t>(kNumMessages);
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
-  c.message = 3;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOk);
+  c.message = static_cast<can::MessageId>(kNumMessages);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
+  c.message = static_cast<can::MessageId>(3);
   c.divider = kMaxDivider + 1;
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
 }
 
 TEST_F(Commands, ReportCalibrationGivesTheIdentityInUse) {
-  Command c;
-  c.kind = CommandKind::kReportCalibration;
-  const Response r = exec(c);
-  EXPECT_EQ(r.result, CommandResult::kOk);
-  EXPECT_EQ(r.cal_id, calib_file::cal_id_of(rig_->factory));
-  EXPECT_TRUE(r.calibrated);
+  can::Command c;
+  c.opcode = can::Opcode::kReportCalibrationId;
+  const can::Response r = exec(c);
+  EXPECT_EQ(r.result, can::ResultCode::kOk);
+  // The identity itself goes out in the frame after the response (can_round_trip_test.cpp).
+  EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(rig_->factory));
+  EXPECT_TRUE(rig_->loop->calibrated());
 }
 
 TEST_F(Commands, CaptureAveragesNSamplesPerChannel) {
-  Command c;
-  c.kind = CommandKind::kCaptureCalibration;
+  can::Command c;
+  c.opcode = can::Opcode::kStartCapture;
   c.pose = 4;
   c.samples = 500;
-  EXPECT_EQ(exec(c).result, CommandResult::kOk);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOk);
   EXPECT_TRUE(rig_->loop->capture_active());
-  EXPECT_EQ(exec(c).result, CommandResult::kBusy);  // one capture at a time
+  EXPECT_EQ(exec(c).result, can::ResultCode::kBusy);  // one capture at a time
   const std::size_t first = rig_->tap->samples().size();
   rig_->run_cycles(500);
   EXPECT_FALSE(rig_->loop->capture_active());
-  const CaptureResult& cap = rig_->loop->last_capture();
+  const can::CaptureResult& cap = rig_->loop->last_capture();
   EXPECT_EQ(cap.pose, 4);
   EXPECT_EQ(cap.samples, 500);
   EXPECT_FALSE(cap.motion());
@@ -154,21 +155,21 @@ TEST_F(Commands, CaptureAveragesNSamplesPerChannel) {
 }
 
 TEST_F(Commands, CaptureOutOfRangeIsRejected) {
-  Command c;
-  c.kind = CommandKind::kCaptureCalibration;
+  can::Command c;
+  c.opcode = can::Opcode::kStartCapture;
   c.samples = 0;
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
   c.samples = 10;
-  c.pose = kMaxPose + 1;
-  EXPECT_EQ(exec(c).result, CommandResult::kOutOfRange);
+  c.pose = can::kMaxCapturePose + 1;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
   EXPECT_FALSE(rig_->loop->capture_active());
 }
 
 TEST_F(Commands, ReloadWithoutAWorkerFailsAndKeepsTheCalibration) {
-  Command c;
-  c.kind = CommandKind::kReloadCalibration;
+  can::Command c;
+  c.opcode = can::Opcode::kReloadCalibration;
   const std::uint32_t id = rig_->loop->cal_id();
-  EXPECT_EQ(exec(c).result, CommandResult::kFailed);
+  EXPECT_EQ(exec(c).result, can::ResultCode::kFailed);
   EXPECT_EQ(rig_->loop->cal_id(), id);
 }
 

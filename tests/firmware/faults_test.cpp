@@ -238,9 +238,9 @@ struct Resume {
 
 Resume resume(const SimRig& base, const SimRig& faulty, const std::set<std::uint32_t>& skipped) {
   const auto& epochs = base.recording->epochs();
-  const auto by_seq = [&](std::uint32_t seq) -> const Epoch& {
+  const auto by_seq = [&](std::uint32_t seq) -> const can::Epoch& {
     const auto it = std::find_if(epochs.begin(), epochs.end(),
-                                 [&](const Epoch& e) { return e.nav.seq == seq; });
+                                 [&](const can::Epoch& e) { return e.nav.seq == seq; });
     if (it == epochs.end()) throw std::runtime_error("baseline has no epoch for that sample");
     return *it;
   };
@@ -290,7 +290,7 @@ class Faults : public ::testing::Test {
     baseline_ = new SimRig("rest", kRunSeconds);
     baseline_->configure();
     baseline_->run();
-    ASSERT_EQ(baseline_->loop->mode(), Mode::kNavigating);
+    ASSERT_EQ(baseline_->loop->mode(), can::Mode::kNavigating);
   }
   static void TearDownTestSuite() {
     delete baseline_;
@@ -390,7 +390,7 @@ TEST_F(Faults, ShortSilenceOnDataReadyTimesOutDegradesThenResumes) {
   EXPECT_EQ(health_after(bus, kFaultSeq + 3).missed, 3u);
   expect_status_rate(bus, 1000, rig.samples);
   EXPECT_EQ(lines_with(lines_, "no data-ready edge").size(), 1u);
-  EXPECT_EQ(rig.loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
   std::set<std::uint32_t> lost;
   for (std::uint32_t k = 0; k < 3; ++k) lost.insert(kFaultSeq + k);
   expect_resumes(resume(*baseline_, rig, lost));
@@ -449,7 +449,7 @@ TEST_F(Faults, AdcResetMidRunIsCountedAndNavigationContinues) {
   expect_flags(bus, kFaultSeq + 10, kFaultSeq + 1000, kBitAdcRecovered);
   expect_status_rate(bus, 1000, rig.samples, {kFaultSeq});
   EXPECT_EQ(lines_with(lines_, "ADC reset").size(), 1u);
-  EXPECT_EQ(rig.loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
   expect_resumes(resume(*baseline_, rig, {kFaultSeq}));
 }
 
@@ -474,7 +474,7 @@ TEST_F(Faults, StuckChannelIsDetectedAfterKSamplesDegradesAndClears) {
   expect_status_rate(bus, 1000, rig.samples);
   EXPECT_EQ(lines_with(lines_, "stuck: code unchanged").size(), 1u);
   EXPECT_EQ(lines_with(lines_, "stuck channel mask now 0").size(), 1u);
-  EXPECT_EQ(rig.loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
 }
 
 TEST_F(Faults, SaturatedChannelIsRejectedDegradesAndNavigationResumes) {
@@ -496,7 +496,7 @@ TEST_F(Faults, SaturatedChannelIsRejectedDegradesAndNavigationResumes) {
   const auto sat = lines_with(lines_, "full scale");
   ASSERT_EQ(sat.size(), 1u);  // three in 3 ms: one line
   EXPECT_NE(sat[0].find("mask 0x1"), std::string::npos) << sat[0];
-  EXPECT_EQ(rig.loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
   std::set<std::uint32_t> lost;
   for (std::uint32_t k = 0; k < 3; ++k) lost.insert(kFaultSeq + k);
   expect_resumes(resume(*baseline_, rig, lost));

@@ -55,7 +55,7 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   rig.loop->set_status_board(&status_board);
   rig.configure();
   rig.run_cycles(kWarmUpCycles);
-  ASSERT_EQ(rig.loop->mode(), Mode::kNavigating);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
   // When many thousand cycles run, with the CAN sink refusing and going bus-off in between, ADC
   // reads failing (the no-sample epochs and the paced retry) and the ADC dead for a while.
   // The window, phase by phase; the phases add up to kCountedCycles (docs/firmware.md quotes it).

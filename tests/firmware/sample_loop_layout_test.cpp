@@ -28,28 +28,28 @@ TEST(SampleLoopLayout, EveryInlineAccessorReadsWhatTheLoopPublished) {
   // Given the simulated board at rest,
   SimRig rig("rest", kRunSeconds);
   // before configure() the loop is starting up; configure() (out of line) starts alignment.
-  EXPECT_EQ(rig.loop->mode(), Mode::kStartup);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kStartup);
   rig.configure();
-  EXPECT_EQ(rig.loop->mode(), Mode::kAligning);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kAligning);
   bool navigated = false;
   // When it runs cycle by cycle,
   while (!rig.source->finished()) {
     rig.run_cycles(1);
     ASSERT_FALSE(rig.recording->epochs().empty());
-    const Epoch& e = rig.recording->epochs().back();
+    const can::Epoch& e = rig.recording->epochs().back();
     const std::size_t cycle = rig.recording->epochs().size();
     SCOPED_TRACE("cycle " + std::to_string(cycle));
     // then the inline accessors agree with the epoch the library wrote:
     ASSERT_EQ(rig.loop->mode(), e.mode);
     ASSERT_EQ(rig.loop->cal_id(), e.cal_id);
-    ASSERT_EQ(rig.loop->calibrated(), (e.status_bits & status_bits::kUncalibrated) == 0);
+    ASSERT_EQ(rig.loop->calibrated(), (e.status_bits & status_bits::kNominalCalibration) == 0);
     ASSERT_EQ(rig.loop->capture_active(), (e.status_bits & status_bits::kCaptureActive) != 0);
     const HealthCounters& h = rig.loop->health();
-    ASSERT_EQ(h.samples, e.health.samples);
-    ASSERT_EQ(h.rejected_samples, e.health.rejected_samples);
+    ASSERT_EQ(h.missed_edges, e.health.missed_drdy_edges);
+    ASSERT_EQ(h.crc_errors, e.health.adc_crc_errors);
+    ASSERT_EQ(h.saturated_samples, e.health.saturated_samples);
     ASSERT_EQ(h.log_dropped, e.health.log_dropped);
-    ASSERT_EQ(h.stuck_mask, e.health.stuck_mask);
-    ASSERT_EQ(h.saturated_mask, e.health.saturated_mask);
+    ASSERT_EQ(h.stuck_mask, e.health.stuck_channel_mask);
     // the sample counter is the number of samples the tap saw the loop read,
     ASSERT_EQ(h.samples, rig.tap->samples().size());
     // and the navigation state read through pipeline() is the one the epoch copied, bit for bit
@@ -59,11 +59,11 @@ TEST(SampleLoopLayout, EveryInlineAccessorReadsWhatTheLoopPublished) {
     ASSERT_EQ(s.w_b, e.nav.w_b);
     ASSERT_EQ(s.v_n, e.nav.v_n);
     ASSERT_EQ(s.r_n, e.nav.r_n);
-    navigated = navigated || e.mode == Mode::kNavigating;
+    navigated = navigated || e.mode == can::Mode::kNavigating;
   }
   // The run reached navigation (the rest scenario has no fault), so both modes were compared.
   EXPECT_TRUE(navigated);
-  EXPECT_EQ(rig.loop->mode(), Mode::kNavigating);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
 }
 
 }  // namespace

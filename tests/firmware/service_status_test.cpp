@@ -25,7 +25,7 @@ std::string text_of(const StatusSnapshot& s, double rate_hz) {
 
 TEST(ServiceStatus, AHealthyNavigatingBoardSaysSoWithRateAndCalibration) {
   StatusSnapshot s;
-  s.mode = Mode::kNavigating;
+  s.mode = can::Mode::kNavigating;
   s.calibrated = true;
   s.cal_id = 0x4fd264c0;
   s.samples = 123456;  // not in the line: it would change the text every second
@@ -34,7 +34,7 @@ TEST(ServiceStatus, AHealthyNavigatingBoardSaysSoWithRateAndCalibration) {
 
 TEST(ServiceStatus, EveryNonZeroFaultCounterIsNamedInOrder) {
   StatusSnapshot s;
-  s.mode = Mode::kAligning;
+  s.mode = can::Mode::kAligning;
   s.calibrated = false;
   s.missed_edges = 12;
   s.can_tx_dropped = 452;
@@ -64,7 +64,8 @@ TEST(ServiceStatus, EachCounterAloneAppearsUnderItsName) {
   };
   for (const Case& c : cases) {
     StatusSnapshot s;
-    s.mode = Mode::kDegraded;
+    s.mode = can::Mode::kNavigating;
+    s.degraded = true;
     s.*c.field = 3;
     const std::string t = text_of(s, 2000.0);
     EXPECT_EQ(t, std::string("DEGRADED (navigating on a faulty input) at 2000 Hz, UNCALIBRATED "
@@ -76,7 +77,8 @@ TEST(ServiceStatus, EachCounterAloneAppearsUnderItsName) {
 
 TEST(ServiceStatus, TheLongestLineFitsAndAShortBufferIsCutAndTerminated) {
   StatusSnapshot s;
-  s.mode = Mode::kDegraded;
+  s.mode = can::Mode::kNavigating;
+  s.degraded = true;
   s.calibrated = true;
   s.cal_id = 0xffffffffu;
   for (auto* f : {&s.missed_edges, &s.drdy_timeouts, &s.crc_errors, &s.adc_resets,
@@ -121,16 +123,16 @@ TEST(StatusReporter, SendsStatusThroughSdNotifyOnlyWhenTheLineChanges) {
   StatusBoard board;
   HealthCounters h;
   h.samples = 10;
-  board.publish(Mode::kAligning, true, 0x1234abcd, h);
+  board.publish(can::Mode::kAligning, false, true, 0x1234abcd, h);
   StatusReporter reporter(*wd.value(), board, 500.0);
 
   // When it reports twice with nothing changed, then after an edge was missed
   ASSERT_TRUE(reporter.report_now().is_ok());
   h.samples = 510;  // only the sample count moved: the same line
-  board.publish(Mode::kAligning, true, 0x1234abcd, h);
+  board.publish(can::Mode::kAligning, false, true, 0x1234abcd, h);
   ASSERT_TRUE(reporter.report_now().is_ok());
   h.missed_edges = 1;
-  board.publish(Mode::kNavigating, true, 0x1234abcd, h);
+  board.publish(can::Mode::kNavigating, false, true, 0x1234abcd, h);
   ASSERT_TRUE(reporter.report_now().is_ok());
 
   // Then sd_notify got two STATUS= assignments, each the whole line
@@ -193,7 +195,7 @@ TEST(StatusReporter, TheLoopFillsTheBoardWithItsModeCalibrationAndHealth) {
   rig.run();
   // Then the board holds what the loop itself reports
   const StatusSnapshot s = board.read();
-  EXPECT_EQ(s.mode, Mode::kNavigating);
+  EXPECT_EQ(s.mode, can::Mode::kNavigating);
   EXPECT_EQ(s.mode, rig.loop->mode());
   EXPECT_TRUE(s.calibrated);
   EXPECT_EQ(s.cal_id, calib_file::cal_id_of(rig.factory));

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "gfins/app/can_adapters.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/epoch_sinks.hpp"
 #include "gfins/app/logger.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
@@ -46,11 +46,18 @@ class TapSource final : public app::SampleSource {
 ///  - set_dead(true): every read fails at once without waiting for an edge, as the ADS131M06
 ///    driver does in its kFailed state (kFailedPrecondition). When the ADC comes back, the
 ///    conversions made meanwhile are lost (read and dropped until one is not older than the
-///    clock), so the sample clock never runs backwards.
+///    clock), so the sample clock never runs backwards;
+///  - add_flags(n, flags): the next n samples carry `flags` besides their own (a producer that
+///    flags a frame the chip model would not: a recording's saturated frames, counts off the
+///    rails).
 class FaultySource final : public app::SampleSource {
  public:
   FaultySource(app::SampleSource& inner, hal::Clock& clock) : inner_(inner), clock_(clock) {}
   void fail_reads(std::uint32_t n) { fail_ = n; }
+  void add_flags(std::uint32_t n, std::uint32_t flags) {
+    flag_n_ = n;
+    flags_ = flags;
+  }
   void set_dead(bool dead) {
     if (dead_ && !dead) revive_ = true;
     dead_ = dead;
@@ -75,6 +82,12 @@ class FaultySource final : public app::SampleSource {
       --fail_;
       return Status(ErrorCode::kIoError, "spidev: SPI_IOC_MESSAGE failed");
     }
+    if (flag_n_ > 0 && r.is_ok()) {
+      --flag_n_;
+      RawSample s = r.value();
+      s.flags |= flags_;
+      return s;
+    }
     return r;
   }
   app::AdcCounters do_counters() const override { return inner_.counters(); }
@@ -83,6 +96,8 @@ class FaultySource final : public app::SampleSource {
   app::SampleSource& inner_;
   hal::Clock& clock_;
   std::uint32_t fail_ = 0;
+  std::uint32_t flag_n_ = 0;
+  std::uint32_t flags_ = 0;
   bool dead_ = false;
   bool revive_ = false;
 };
@@ -93,7 +108,7 @@ class StallingSink final : public app::EpochSink {
  public:
   StallingSink(app::EpochSink& next, app::SampleClock& clock) : next_(next), clock_(clock) {}
   void stall(std::uint32_t epochs, std::int64_t stall_ns) { left_ = epochs, stall_ns_ = stall_ns; }
-  std::uint32_t publish(const app::Epoch& e) override {
+  std::uint32_t publish(const can::Epoch& e) override {
     const std::uint32_t n = next_.publish(e);
     if (left_ > 0) {
       --left_;
@@ -119,6 +134,7 @@ struct SimRig {
     s = p.value();
     config.board = app::BoardKind::kSim;
     config.calibration_file.clear();
+    config.node_id = kNode;  // the node whose commands the loop answers
     samples = static_cast<std::uint32_t>(seconds * s.rate_hz) + 1;
     test::SimChain chain = test::make_sim_chain(s, clock, samples, faults);
     stream = std::move(chain.stream);
@@ -127,16 +143,15 @@ struct SimRig {
     faulty = std::make_unique<FaultySource>(*source, clock);
     tap = std::make_unique<TapSource>(*faulty, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
-    publisher = std::make_unique<app::CanEpochSink>(*bus, kNode, app::to_can_dividers(config));
+    publisher = std::make_unique<app::PublisherSink>(*bus, kNode, app::bus_dividers(config));
     stalling = std::make_unique<StallingSink>(*publisher, clock);
-    codec = std::make_unique<app::CanCommandCodec>(kNode);
     // Twice the samples: cycles without a sample publish epochs too (one per period).
     recording = std::make_unique<app::RecordingSink>(stalling.get(), 2 * std::size_t{samples});
     log = std::make_unique<app::FwLogQueue>();
     factory = sim_board::scenario_calibration(s, adc->volts_per_count());
     cal = app::load_calibration(config, factory, &factory).set;
     loop = std::make_unique<app::SampleLoop>(*tap, *bus, *recording, clock, *log);
-    loop->set_command_codec(codec.get());
+    loop->set_commands(true);
   }
 
   void configure() {
@@ -173,9 +188,8 @@ struct SimRig {
   std::unique_ptr<FaultySource> faulty;
   std::unique_ptr<TapSource> tap;
   std::unique_ptr<sim_board::MemoryCanBus> bus;
-  std::unique_ptr<app::CanEpochSink> publisher;
+  std::unique_ptr<app::PublisherSink> publisher;
   std::unique_ptr<StallingSink> stalling;
-  std::unique_ptr<app::CanCommandCodec> codec;
   std::unique_ptr<app::RecordingSink> recording;
   std::unique_ptr<app::FwLogQueue> log;
   calib_file::CalibrationData factory;

@@ -159,6 +159,25 @@ TEST_F(PipelineTest, RejectsSaturatedSamplesAndCountsThem) {
   EXPECT_EQ(pipeline_.counters().samples, 1u);
 }
 
+TEST_F(PipelineTest, FramesFlaggedSaturatedAreRejectedOffTheRailsToo) {
+  // A producer's saturation flag (a clipped input) rejects the frame even when no count sits on a
+  // rail, as a CRC error does: sample_flags::kNotMeasured, the rule every loop shares.
+  const auto counts = counts_at_rest(Quat<double>::Identity());
+  std::uint32_t seq = 0;
+  for (; seq < config_.alignment_samples; ++seq) pipeline_.process(frame(counts, 0, seq));
+  ASSERT_EQ(pipeline_.phase(), PipelinePhase::kNavigating);
+  const NavState<double> before = pipeline_.state();
+  pipeline_.process(frame(counts, 0, seq, sample_flags::kSaturated));
+  EXPECT_EQ(pipeline_.counters().rejected, 1u);
+  EXPECT_EQ(pipeline_.counters().saturated, 1u);
+  EXPECT_EQ(pipeline_.state().seq, before.seq);
+  EXPECT_EQ(pipeline_.state().v_n, before.v_n);
+  // A frame flagged only as read late is a measurement.
+  pipeline_.process(frame(counts, 0, seq + 1, sample_flags::kLateRead));
+  EXPECT_EQ(pipeline_.counters().rejected, 1u);
+  EXPECT_EQ(pipeline_.state().seq, seq + 1);
+}
+
 TEST_F(PipelineTest, CrcErrorFramesAreRejectedAndAreNotGaps) {
   // Given a navigating pipeline,
   const auto counts = counts_at_rest(Quat<double>::Identity());

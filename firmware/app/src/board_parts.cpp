@@ -2,7 +2,7 @@
 
 #include "boards.hpp"
 #include "gfins/app/board.hpp"
-#include "gfins/app/can_adapters.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/drivers/lnx/candump_file_bus.hpp"
 #include "gfins/drivers/lnx/dev_watchdog.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
@@ -90,8 +90,8 @@ std::string open_watchdog(const FwConfig& c, hal::Clock& clock, Board& b) {
 
 void add_can_protocol(const FwConfig& c, Board& b) {
   const auto node = static_cast<std::uint8_t>(c.node_id);
-  b.sink = std::make_unique<CanEpochSink>(*b.bus, node, to_can_dividers(c));
-  b.codec = std::make_unique<CanCommandCodec>(node);
+  b.sink = std::make_unique<PublisherSink>(*b.bus, node, bus_dividers(c));
+  b.commands = true;
 }
 
 DataReadyResult open_data_ready(const FwConfig& c) {

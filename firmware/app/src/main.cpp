@@ -80,7 +80,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
 
   auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
                                            *log_queue);
-  loop->set_command_codec(board.codec.get());
+  loop->set_commands(board.commands);
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);
   // The service status line (systemd STATUS=): the loop leaves its mode and health counters on

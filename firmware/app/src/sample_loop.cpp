@@ -42,7 +42,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   can_seen_ = bus_.counters();
   can_state_ = bus_.state();
   ref_t_ns_ = clock_.now_ns();
-  mode_ = Mode::kAligning;
+  mode_ = can::Mode::kAligning;
   return Status::ok();
 }
 
@@ -111,7 +111,8 @@ SampleLoop::Cycle SampleLoop::step() {
                 kDeadAdcWatchdogNs / 1000000, health_.adc_read_errors);
   }
   if (status_board_ != nullptr)
-    status_board_->publish(mode_, cal_.calibrated, cal_.cal_id, health_);
+    status_board_->publish(mode_, (epoch_.status_bits & status_bits::kHealthDegraded) != 0,
+                           cal_.calibrated, cal_.cal_id, health_);
   if (watchdog_ != nullptr && !watchdog_held_) (void)watchdog_->kick();
   if (cycle == Cycle::kReadError) {
     // A read that failed at once (a dead chip, an SPI error) must not make the loop spin: wait
@@ -175,18 +176,17 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   epoch_.nav.status = nav::nav_status::kInputInvalid | (aligned ? nav::nav_status::kAligned : 0u);
   epoch_.accel_mps2.fill(kNaN);
   std::uint32_t bits = events_.get(sample_index_) | cause | status_bits::kInputInvalid;
-  if (!cal_.calibrated) bits |= status_bits::kUncalibrated;
+  if (!cal_.calibrated) bits |= status_bits::kNominalCalibration;
   if (aligned) bits |= status_bits::kAligned;
-  if (health_.stuck_mask != 0) bits |= status_bits::kStuckChannel;
+  if (health_.stuck_mask != 0) bits |= status_bits::kAdcChannelStuck;
   if (capture_.active) bits |= status_bits::kCaptureActive;
   // Nothing is being measured: the output is degraded whatever the cause.
-  bits |= status_bits::kDegraded;
-  mode_ = aligned ? Mode::kDegraded : Mode::kAligning;
-  epoch_.mode = mode_;
+  bits |= status_bits::kHealthDegraded;
+  set_mode(aligned, bits);
   epoch_.status_bits = bits;
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
-  epoch_.health = health_;
+  epoch_.health = bus_health(health_);
   epoch_.valid = can::Validity::none();  // no sample behind this epoch
   epoch_.accuracy = epoch_accuracy(pipeline_, t_ns);
 }
@@ -195,7 +195,7 @@ void SampleLoop::update_adc_counters(std::uint32_t sample) {
   const AdcCounters c = adc_.counters();
   if (c.crc_errors != adc_seen_.crc_errors) {
     health_.crc_errors += c.crc_errors - adc_seen_.crc_errors;
-    events_.set(status_bits::kCrcError, sample);
+    events_.set(status_bits::kAdcCrcError, sample);
     limited_log(LogKind::kCrcError, LogLevel::kWarn, t_cycle_,
                 "ADC frame CRC error: sample skipped (CRC errors: {}; {} more since the last line)",
                 health_.crc_errors);
@@ -222,7 +222,7 @@ void SampleLoop::update_can_counters(std::uint32_t sample, std::int64_t t_ns) {
   const hal::CanCounters c = bus_.counters();
   if (c.tx_dropped != can_seen_.tx_dropped) {
     health_.can_tx_dropped += c.tx_dropped - can_seen_.tx_dropped;
-    events_.set(status_bits::kCanTxDrop, sample);
+    events_.set(status_bits::kCanTxDropped, sample);
     limited_log(LogKind::kCanTxDrop, LogLevel::kWarn, t_ns,
                 "CAN frames dropped by the bus backend (dropped: {}; {} more since the last line)",
                 health_.can_tx_dropped);
@@ -233,7 +233,7 @@ void SampleLoop::update_can_counters(std::uint32_t sample, std::int64_t t_ns) {
       (c.rx_kernel_dropped - can_seen_.rx_kernel_dropped) + (c.rx_dropped - can_seen_.rx_dropped);
   if (rx_lost != 0) {
     health_.can_rx_dropped += rx_lost;
-    events_.set(status_bits::kCanRxDrop, sample);
+    events_.set(status_bits::kCanRxDropped, sample);
     limited_log(LogKind::kCanRxDrop, LogLevel::kWarn, t_ns,
                 "{} received CAN frame(s) lost before the loop read them (lost: {}; {} more "
                 "since the last line)",
@@ -284,21 +284,17 @@ void SampleLoop::on_sample(const RawSample& s) {
   update_adc_counters(k);
 
   const bool crc_ok = (s.flags & sample_flags::kCrcError) == 0;
-  std::uint8_t saturated = 0;
-  for (std::size_t j = 0; j < kAdcChannels; ++j) {
-    if (s.counts[j] >= kAdcCodeMax || s.counts[j] <= kAdcCodeMin) {
-      saturated = static_cast<std::uint8_t>(saturated | (1u << j));
-    }
-  }
+  const std::uint8_t saturated = rail_mask(s.counts);
+  const bool flagged_saturated = (s.flags & sample_flags::kSaturated) != 0;
   if (crc_ok) {
     health_.saturated_mask = saturated;
-    if (saturated != 0) {
+    if (saturated != 0 || flagged_saturated) {
       ++health_.saturated_samples;
       limited_log(LogKind::kSaturated, LogLevel::kWarn, s.t_ns,
                   "channel mask {:#x} at full scale (saturated samples: {}; {} more since the "
                   "last line)",
                   saturated, health_.saturated_samples);
-      events_.set(status_bits::kSaturated, k);
+      events_.set(status_bits::kAdcSaturated, k);
     }
     const std::uint8_t stuck = stuck_.update(s.counts);
     if (stuck != health_.stuck_mask) {
@@ -317,11 +313,12 @@ void SampleLoop::on_sample(const RawSample& s) {
     }
     last_counts_ = s.counts;
   }
-  if (!crc_ok || saturated != 0) ++health_.rejected_samples;
-
-  // A CRC error means the counts are not a measurement: the pipeline skips the sample (and a
-  // saturated one) and integrates across the hole with the next good one.
-  if (crc_ok && saturated == 0) last_good_ = s;
+  // A CRC error or a saturated channel means the counts are not a measurement: the pipeline
+  // skips the sample and integrates across the hole with the next good one (is_measurement,
+  // the core's rule).
+  const bool measured = is_measurement(s);
+  if (!measured) ++health_.rejected_samples;
+  if (measured) last_good_ = s;
   pipeline_.process(s);
   if (pipeline_.phase() == nav::PipelinePhase::kAligning) {
     gravity_checked_ = false;
@@ -333,6 +330,19 @@ void SampleLoop::on_sample(const RawSample& s) {
   build_epoch(s);
 }
 
+void SampleLoop::set_mode(bool aligned, std::uint32_t bits) {
+  // GfinsEpoch.Mode: a navigation on faulty inputs is still navigating (the HealthDegraded bit
+  // says so); a calibration capture while navigating is reported as calibrating.
+  if (!aligned) {
+    mode_ = can::Mode::kAligning;
+  } else if ((bits & status_bits::kCaptureActive) != 0) {
+    mode_ = can::Mode::kCalibrating;
+  } else {
+    mode_ = can::Mode::kNavigating;
+  }
+  epoch_.mode = mode_;
+}
+
 void SampleLoop::build_epoch(const RawSample& s) {
   const std::uint32_t k = sample_index_;
   epoch_.nav = pipeline_.state();
@@ -341,7 +351,7 @@ void SampleLoop::build_epoch(const RawSample& s) {
   // and a rejected sample is flagged as such.
   epoch_.nav.t_ns = s.t_ns;
   epoch_.nav.seq = s.seq;
-  if ((s.flags & sample_flags::kCrcError) != 0 || health_.saturated_mask != 0) {
+  if (!is_measurement(s)) {
     epoch_.nav.status |= nav::nav_status::kInputInvalid;
   }
   nav::Vec6<float> f;
@@ -349,24 +359,23 @@ void SampleLoop::build_epoch(const RawSample& s) {
   for (std::size_t j = 0; j < kAdcChannels; ++j) epoch_.accel_mps2[j] = f(static_cast<int>(j));
   const bool aligned = pipeline_.phase() == nav::PipelinePhase::kNavigating;
   std::uint32_t bits = events_.get(k);
-  if (!cal_.calibrated) bits |= status_bits::kUncalibrated;
+  if (!cal_.calibrated) bits |= status_bits::kNominalCalibration;
   if (aligned) bits |= status_bits::kAligned;
   if ((epoch_.nav.status & nav::nav_status::kInputInvalid) != 0) bits |= status_bits::kInputInvalid;
   if ((epoch_.nav.status & nav::nav_status::kCompensated) != 0) bits |= status_bits::kCompensated;
-  if (health_.stuck_mask != 0) bits |= status_bits::kStuckChannel;
+  if (health_.stuck_mask != 0) bits |= status_bits::kAdcChannelStuck;
   if (capture_.active) bits |= status_bits::kCaptureActive;
   // Degraded: the solution integrates inputs known to be wrong (a stuck or saturated channel) or
   // the ADC stopped delivering (no edge, or a read that failed); a CRC error or a missed edge
   // alone costs one step across a gap.
-  const bool degraded = (bits & (status_bits::kStuckChannel | status_bits::kSaturated |
+  const bool degraded = (bits & (status_bits::kAdcChannelStuck | status_bits::kAdcSaturated |
                                  status_bits::kDataReadyLost | status_bits::kAdcReadError)) != 0;
-  if (degraded) bits |= status_bits::kDegraded;
-  mode_ = !aligned ? Mode::kAligning : (degraded ? Mode::kDegraded : Mode::kNavigating);
-  epoch_.mode = mode_;
+  if (degraded) bits |= status_bits::kHealthDegraded;
+  set_mode(aligned, bits);
   epoch_.status_bits = bits;
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
-  epoch_.health = health_;
+  epoch_.health = bus_health(health_);
   epoch_.valid = epoch_validity(pipeline_);
   epoch_.accuracy = epoch_accuracy(pipeline_, s.t_ns);
 }
@@ -374,30 +383,28 @@ void SampleLoop::build_epoch(const RawSample& s) {
 // ---- Commands -------------------------------------------------------------------------------
 
 void SampleLoop::handle_commands(std::int64_t t_ns) {
-  if (codec_ == nullptr && !options_.aiding_inputs) return;
+  if (!commands_ && !options_.aiding_inputs) return;
   for (int i = 0; i < kMaxCommandsPerCycle; ++i) {
     const Result<hal::CanFrame> f = bus_.receive(0);
     if (!f.is_ok()) return;  // kTimeout: nothing waiting
     if (options_.aiding_inputs && handle_input(f.value(), t_ns)) continue;
-    if (codec_ == nullptr) continue;
-    const DecodedFrame d = codec_->decode(f.value());
+    if (!commands_) continue;
+    const can::DecodedCommand d = can::decode_command(f.value(), options_.node_id);
     if (!d.addressed) continue;
-    Response r;
-    if (!d.ok) {
-      r.raw_opcode = d.raw_opcode;
-      r.token = d.token;
-      r.result = d.error;
+    CommandReply r;
+    if (!d.ok()) {
+      r.response = can::error_response(d.error);
       ++health_.command_errors;
       limited_log(LogKind::kCommandRejected, LogLevel::kWarn, t_ns,
                   "command frame id {:#x} rejected: result {} ({} more since the last line)",
-                  f.value().id, static_cast<std::int64_t>(d.error));
+                  f.value().id, static_cast<std::int64_t>(d.error.code));
     } else {
       execute(d.command, r);
       log(LogLevel::kInfo, t_ns, "command {} token {} -> result {}",
-          static_cast<std::int64_t>(d.command.kind), d.command.token,
-          static_cast<std::int64_t>(r.result));
+          static_cast<std::int64_t>(d.command.opcode), d.command.token,
+          static_cast<std::int64_t>(r.response.result));
     }
-    if (!r.deferred) send_response(r);
+    if (!r.deferred) send_response(r.response);
   }
 }
 
@@ -474,11 +481,15 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
   return true;
 }
 
-void SampleLoop::send_response(const Response& r) {
-  if (codec_ == nullptr) return;
-  std::array<hal::CanFrame, 24> frames{};
-  const std::size_t n = codec_->encode(r, frames);
-  for (std::size_t i = 0; i < n && i < frames.size(); ++i) (void)bus_.send(frames[i]);
+void SampleLoop::send_response(const can::Response& r) {
+  if (!commands_) return;
+  (void)bus_.send(can::encode_response(r, options_.node_id));
+  // The calibration identity follows the response of a report or a reload that succeeded.
+  const auto op = static_cast<can::Opcode>(r.opcode);
+  if (r.result == can::ResultCode::kOk &&
+      (op == can::Opcode::kReportCalibrationId || op == can::Opcode::kReloadCalibration)) {
+    (void)bus_.send(can::encode_calibration_id_response(r.token, cal_.cal_id, options_.node_id));
+  }
 }
 
 Status SampleLoop::reconfigure_keep_navigation(const nav::PipelineConfig<float>& cfg) {
@@ -491,80 +502,78 @@ Status SampleLoop::reconfigure_keep_navigation(const nav::PipelineConfig<float>&
   return Status::ok();
 }
 
-void SampleLoop::execute(const Command& c, Response& r) {
-  r = Response{};
-  r.kind = c.kind;
-  r.raw_opcode = static_cast<std::uint8_t>(c.kind);
-  r.token = c.token;
-  r.cal_id = cal_.cal_id;
-  r.calibrated = cal_.calibrated;
-  const auto reject = [&](CommandResult why) {
-    r.result = why;
+void SampleLoop::execute(const can::Command& c, CommandReply& r) {
+  using can::ResultCode;
+  r = CommandReply{};
+  r.response.opcode = static_cast<std::uint8_t>(c.opcode);
+  r.response.token = c.token;
+  const auto reject = [&](ResultCode why) {
+    r.response.result = why;
     ++health_.command_errors;
   };
-  switch (c.kind) {
-    case CommandKind::kRealign:
-    case CommandKind::kResetNavigation: {
-      const bool realign = c.kind == CommandKind::kRealign;
+  switch (c.opcode) {
+    case can::Opcode::kRealign:
+    case can::Opcode::kResetNavigation: {
+      const bool realign = c.opcode == can::Opcode::kRealign;
       if (realign && !(std::abs(c.heading_rad) <= 2.0f * std::numbers::pi_v<float>)) {
-        return reject(CommandResult::kOutOfRange);
+        return reject(ResultCode::kOutOfRange);
       }
       // A new alignment while the vehicle moves would navigate from a wrong attitude: with the
       // aiding's standstill detector running, only a board it judges at rest (or a forced
       // command) starts over.
       if (!c.forced && pipeline_.aiding().started() && !pipeline_.aiding().at_rest()) {
-        return reject(CommandResult::kMoving);
+        return reject(ResultCode::kMoving);
       }
       nav::PipelineConfig<float> cfg = cal_.config;
       cfg.heading_rad = realign ? c.heading_rad : options_.initial_heading_rad;
       cfg.r0_n = options_.initial_position_n;
-      if (!pipeline_.configure(cfg).is_ok()) return reject(CommandResult::kFailed);
+      if (!pipeline_.configure(cfg).is_ok()) return reject(ResultCode::kFailed);
       cal_.config = cfg;
       stuck_.reset();
       break;
     }
-    case CommandKind::kSetCompensator: {
+    case can::Opcode::kSetCompensator: {
       if (c.compensator != nav::CompensatorKind::kNone &&
           c.compensator != nav::CompensatorKind::kPaper &&
           c.compensator != nav::CompensatorKind::kExact) {
-        return reject(CommandResult::kOutOfRange);
+        return reject(ResultCode::kOutOfRange);
       }
       nav::PipelineConfig<float> cfg = cal_.config;
       cfg.compensator = c.compensator;
-      if (!reconfigure_keep_navigation(cfg).is_ok()) return reject(CommandResult::kFailed);
+      if (!reconfigure_keep_navigation(cfg).is_ok()) return reject(ResultCode::kFailed);
       cal_.config = cfg;
       break;
     }
-    case CommandKind::kSetDivider:
-      if (c.message >= kNumMessages || c.divider > kMaxDivider) {
-        return reject(CommandResult::kOutOfRange);
+    case can::Opcode::kSetDivider:
+      if (static_cast<std::size_t>(c.message) >= kNumMessages || c.divider > kMaxDivider) {
+        return reject(ResultCode::kOutOfRange);
       }
-      if (!out_.set_divider(c.message, c.divider).is_ok())
-        return reject(CommandResult::kOutOfRange);
-      r.value = c.divider;
+      if (!out_.set_divider(static_cast<std::size_t>(c.message), c.divider).is_ok())
+        return reject(ResultCode::kOutOfRange);
+      r.response.value = c.divider;
       break;
-    case CommandKind::kReportCalibration:
+    case can::Opcode::kReportCalibrationId:
       break;
-    case CommandKind::kCaptureCalibration:
-      if (c.samples == 0 || c.samples > kMaxCaptureSamples || c.pose > kMaxPose) {
-        return reject(CommandResult::kOutOfRange);
+    case can::Opcode::kStartCapture:
+      if (c.samples == 0 || c.samples > kMaxCaptureSamples || c.pose > can::kMaxCapturePose) {
+        return reject(ResultCode::kOutOfRange);
       }
-      if (capture_.active) return reject(CommandResult::kBusy);
+      if (capture_.active) return reject(ResultCode::kBusy);
       capture_ = Capture{};
       capture_.active = true;
       capture_.command = c;
       capture_.target = c.samples;
-      r.value = c.samples;
+      r.response.value = c.samples;
       break;
-    case CommandKind::kReloadCalibration:
-      if (reload_ == nullptr) return reject(CommandResult::kFailed);
-      if (reload_pending_ || !reload_->request(cal_.config)) return reject(CommandResult::kBusy);
+    case can::Opcode::kReloadCalibration:
+      if (reload_ == nullptr) return reject(ResultCode::kFailed);
+      if (reload_pending_ || !reload_->request(cal_.config)) return reject(ResultCode::kBusy);
       reload_pending_ = true;
       reload_token_ = c.token;
       r.deferred = true;  // answered when the worker is done (poll_reload)
       break;
     default:
-      return reject(CommandResult::kUnknownOpcode);
+      return reject(ResultCode::kUnknownOpcode);
   }
   ++health_.commands;
 }
@@ -584,20 +593,14 @@ void SampleLoop::capture_add(const RawSample& s) {
 
 void SampleLoop::capture_finish() {
   const auto& fe = pipeline_.front_end().params();
-  Response r;
-  r.kind = CommandKind::kCaptureCalibration;
-  r.raw_opcode = static_cast<std::uint8_t>(r.kind);
-  r.token = capture_.command.token;
-  r.result = CommandResult::kOk;
-  r.cal_id = cal_.cal_id;
-  r.calibrated = cal_.calibrated;
-  r.has_capture = true;
-  r.capture.pose = capture_.command.pose;
-  r.capture.samples = capture_.command.samples;
+  can::CaptureResult& cap = last_capture_;
+  cap = can::CaptureResult{};
+  cap.pose = capture_.command.pose;
+  cap.samples = capture_.command.samples;
   for (std::size_t j = 0; j < kAdcChannels; ++j) {
-    CaptureChannel& ch = r.capture.channels[j];
+    can::ChannelCapture& ch = cap.channels[j];
     const std::uint32_t n = capture_.n[j];
-    ch.count = n;
+    ch.count = static_cast<std::uint16_t>(std::min<std::uint32_t>(n, kMaxCaptureSamples));
     ch.mean_counts = static_cast<float>(capture_.mean[j]);
     const double sd = n > 1 ? std::sqrt(capture_.m2[j] / static_cast<double>(n - 1)) : 0.0;
     ch.std_counts = static_cast<float>(sd);
@@ -608,10 +611,13 @@ void SampleLoop::capture_finish() {
     ch.motion = sd * g_per_count > kCaptureMotionStdG;
   }
   capture_.active = false;
-  last_capture_ = r.capture;
-  log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}", r.capture.pose,
-      r.capture.channels[0].count, r.capture.motion() ? 1 : 0);
-  send_response(r);
+  log(LogLevel::kInfo, 0, "calibration capture pose {} done: {} samples, motion {}", cap.pose,
+      cap.channels[0].count, cap.motion() ? 1 : 0);
+  if (!commands_) return;
+  for (const hal::CanFrame& f :
+       can::encode_capture_result(cap, capture_.command.token, options_.node_id)) {
+    (void)bus_.send(f);
+  }
 }
 
 void SampleLoop::poll_reload(std::int64_t t_ns) {
@@ -620,11 +626,10 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
   const ReloadWorker::Poll p = reload_->poll(fresh);
   if (p == ReloadWorker::Poll::kNothing) return;
   reload_pending_ = false;
-  Response r;
-  r.kind = CommandKind::kReloadCalibration;
-  r.raw_opcode = static_cast<std::uint8_t>(r.kind);
+  can::Response r;
+  r.opcode = static_cast<std::uint8_t>(can::Opcode::kReloadCalibration);
   r.token = reload_token_;
-  r.result = CommandResult::kFailed;
+  r.result = can::ResultCode::kFailed;
   if (p == ReloadWorker::Poll::kReady) {
     nav::PipelineConfig<float> cfg = fresh.config;
     cfg.sample_rate_hz = cal_.config.sample_rate_hz;
@@ -637,17 +642,15 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
       cal_.config = cfg;
       cal_.cal_id = fresh.cal_id;
       cal_.calibrated = fresh.calibrated;
-      r.result = CommandResult::kOk;
+      r.result = can::ResultCode::kOk;
       log(LogLevel::kInfo, t_ns, "calibration reloaded: id {:#x}", cal_.cal_id);
     }
   }
-  if (r.result != CommandResult::kOk) {
+  if (r.result != can::ResultCode::kOk) {
     ++health_.command_errors;
     log(LogLevel::kError, t_ns, "calibration reload failed; the previous calibration (id {}) stays",
         cal_.cal_id);
   }
-  r.cal_id = cal_.cal_id;
-  r.calibrated = cal_.calibrated;
   send_response(r);
 }
 

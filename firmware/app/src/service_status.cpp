@@ -22,16 +22,21 @@ namespace {
   *len = std::min(out.size() - 1, *len + static_cast<std::size_t>(n));
 }
 
-const char* mode_text(Mode m) {
+const char* mode_text(can::Mode m, bool degraded) {
   switch (m) {
-    case Mode::kStartup:
+    case can::Mode::kStartup:
       return "starting (no sample yet)";
-    case Mode::kAligning:
+    case can::Mode::kAligning:
       return "aligning (keep the board still)";
-    case Mode::kNavigating:
-      return "navigating";
-    case Mode::kDegraded:
-      return "DEGRADED (navigating on a faulty input)";
+    case can::Mode::kNavigating:
+      return degraded ? "DEGRADED (navigating on a faulty input)" : "navigating";
+    case can::Mode::kCalibrating:
+      return degraded ? "DEGRADED (navigating on a faulty input), calibration capture running"
+                      : "navigating, calibration capture running";
+    case can::Mode::kFault:
+      return "FAULT (navigation stopped)";
+    case can::Mode::kReplay:
+      return "replaying";
   }
   return "unknown mode";
 }
@@ -42,7 +47,7 @@ std::size_t format_service_status(std::span<char> out, const StatusSnapshot& s, 
   if (out.empty()) return 0;
   out[0] = '\0';
   std::size_t len = 0;
-  append(out, &len, "%s at %.0f Hz, ", mode_text(s.mode), rate_hz);
+  append(out, &len, "%s at %.0f Hz, ", mode_text(s.mode, s.degraded), rate_hz);
   if (s.calibrated) {
     append(out, &len, "calibration %08x", static_cast<unsigned>(s.cal_id));
   } else {

@@ -109,7 +109,7 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
     case Field::kSampleCount:
       return static_cast<double>(n.seq);
     case Field::kMode:
-      return e.mode;
+      return static_cast<double>(e.mode);
     case Field::kStatusFlags:
       return static_cast<double>((e.status_bits | (n.status & status_bits::kNavStatusMask)) &
                                  status_bits::kAllBits);

@@ -228,7 +228,7 @@ bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,
   const auto n = static_cast<std::uint64_t>(seconds * sample_rate_hz);
   constexpr std::int64_t kLogStartUs = 1'700'000'000'000'000;
   can::Epoch e;
-  e.mode = static_cast<std::uint8_t>(can::Mode::kNavigating);
+  e.mode = can::Mode::kNavigating;
   e.cal_id = 0x00C0FFEE;
   for (std::uint64_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) / sample_rate_hz;

@@ -28,16 +28,11 @@ bool NavLoop<T>::step(const RawSample& s) {
   if ((s.flags & sample_flags::kCrcError) != 0) ++report_.invalid;
   if ((s.flags & sample_flags::kSaturated) != 0) ++report_.flagged_saturated;
   const nav::PipelineCounters before = pipeline_.counters();
-  // A frame the converter flagged saturated (an input beyond its range: the counts are clipped,
-  // whether or not they sit exactly on a rail) is not a measurement, like a frame with a CRC
-  // error. The pipeline rejects the latter by its flag and the former only by the count rails, so
-  // the host loop hands it on marked kCrcError: the pipeline's one rejection path (counted in
-  // counters().rejected, state untouched, the gap count of its seq kept, the next good frame
-  // integrates across the hole). The report still counts it under its own flag
-  // (flagged_saturated), not as a CRC error. docs/replay.md: flagged frames are rejected.
-  RawSample offered = s;
-  if ((s.flags & sample_flags::kSaturated) != 0) offered.flags |= sample_flags::kCrcError;
-  const nav::PipelinePhase phase = pipeline_.process(offered);
+  // A frame with a CRC error or flagged saturated is not a measurement: the pipeline rejects it
+  // (is_measurement, raw_sample.hpp: counted in counters().rejected, state untouched, the gap
+  // count of its seq kept, the next good frame integrates across the hole), as the board's loop
+  // does. docs/replay.md: flagged frames are rejected.
+  const nav::PipelinePhase phase = pipeline_.process(s);
   return finish(index, s.seq, before, phase);
 }
 

@@ -239,9 +239,10 @@ inline PipelinePhase NavPipeline<T>::process(const RawSample& s) {
   ++counters_.samples;
   count_gap(s.seq);
   Outputs f;
+  // is_measurement() (raw_sample.hpp), with the rails found by the conversion itself.
   const std::uint32_t saturated = front_end_.convert(s.counts, f);
-  if (saturated != 0) ++counters_.saturated;
-  if ((s.flags & sample_flags::kCrcError) != 0 || saturated != 0) {
+  if (saturated != 0 || (s.flags & sample_flags::kSaturated) != 0) ++counters_.saturated;
+  if ((s.flags & sample_flags::kNotMeasured) != 0 || saturated != 0) {
     ++counters_.rejected;
     return phase_;
   }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace gfins {
@@ -22,6 +23,12 @@ inline constexpr std::uint32_t kCrcError = 1u << 0;   // frame CRC mismatch: cou
 inline constexpr std::uint32_t kSaturated = 1u << 1;  // a channel at full scale
 inline constexpr std::uint32_t kLateRead = 1u << 2;   // read after the next data-ready edge
 inline constexpr std::uint32_t kSynthetic = 1u << 3;  // produced by a simulation, not hardware
+/// Flags that make a frame not a measurement (the counts are garbage or clipped). The one rule,
+/// applied by the core (NavPipeline::process) and by every loop that counts rejected samples
+/// (the board's SampleLoop, the host's NavLoop): a frame carrying one of these, or with a channel
+/// on a rail of the converter (a clipped input, whether or not the producer flagged it), is not
+/// integrated.
+inline constexpr std::uint32_t kNotMeasured = kCrcError | kSaturated;
 }  // namespace sample_flags
 
 struct RawSample {
@@ -30,5 +37,21 @@ struct RawSample {
   std::array<std::int32_t, kAdcChannels> counts{};  // 24-bit two's complement, sign-extended
   std::uint32_t flags = 0;                          // sample_flags bits
 };
+
+/// Channels whose code sits on a rail of the converter (bit j = channel j).
+inline std::uint8_t rail_mask(const std::array<std::int32_t, kAdcChannels>& counts) {
+  std::uint8_t m = 0;
+  for (std::size_t j = 0; j < kAdcChannels; ++j) {
+    if (counts[j] >= kAdcCodeMax || counts[j] <= kAdcCodeMin) {
+      m = static_cast<std::uint8_t>(m | (1u << j));
+    }
+  }
+  return m;
+}
+
+/// The rule of sample_flags::kNotMeasured: whether the core integrates this frame.
+inline bool is_measurement(const RawSample& s) {
+  return (s.flags & sample_flags::kNotMeasured) == 0 && rail_mask(s.counts) == 0;
+}
 
 }  // namespace gfins

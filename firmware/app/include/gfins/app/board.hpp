@@ -32,7 +32,7 @@ struct Board {
   std::unique_ptr<SampleSource> source;
   std::unique_ptr<hal::CanBus> bus;
   std::unique_ptr<EpochSink> sink;
-  std::unique_ptr<CommandCodec> codec;                 // null: commands not handled
+  bool commands = false;  // the CAN command frames of the node are decoded and answered
   std::unique_ptr<hal::Watchdog> watchdog;             // null: none
   calib_file::CalibrationData defaults;                // nominal calibration of this board
   std::optional<calib_file::CalibrationData> factory;  // used when no file is configured
@@ -101,7 +101,7 @@ std::string open_can_output(const FwConfig& c, hal::Clock& clock, Board& b);
 /// The configured watchdog into b.watchdog (none, systemd or /dev/watchdog). "" or what failed.
 std::string open_watchdog(const FwConfig& c, hal::Clock& clock, Board& b);
 
-/// The CAN protocol on b.bus: the epoch sink (publisher) and the command codec.
+/// The CAN protocol on b.bus: the epoch sink (publisher) and command handling.
 void add_can_protocol(const FwConfig& c, Board& b);
 
 /// The data-ready line of adc.gpio_chip / adc.drdy_line through libgpiod, as the Linux board

@@ -42,7 +42,8 @@ inline constexpr std::uint16_t kMaxDivider = can::kMaxDivider;
 /// ADS131M06 output data rates reachable with its 8.192 MHz clock (datasheet §8.4.2.2, OSR
 /// 1024..8192 → f_MOD / OSR with f_MOD = 4.096 MHz).
 inline constexpr std::array<double, 4> kSampleRatesHz = {500.0, 1000.0, 2000.0, 4000.0};
-inline constexpr int kMaxNodeId = 15;      // 4 bits of the identifier (docs/can-interface.md)
+inline constexpr int kMaxNodeId =
+    can::kMaxNodeId;                       // 4 bits of the identifier (docs/can-interface.md)
 inline constexpr int kMaxRtPriority = 99;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
 
 struct FwConfig {

@@ -14,7 +14,7 @@ namespace gfins::app {
 class RecordingSink final : public EpochSink {
  public:
   RecordingSink(EpochSink* next, std::size_t reserve) : next_(next) { epochs_.reserve(reserve); }
-  std::uint32_t publish(const Epoch& e) override {
+  std::uint32_t publish(const can::Epoch& e) override {
     if (epochs_.size() < epochs_.capacity()) {
       epochs_.push_back(e);
     } else {
@@ -25,19 +25,19 @@ class RecordingSink final : public EpochSink {
   Status set_divider(std::size_t m, std::uint16_t d) override {
     return next_ != nullptr ? next_->set_divider(m, d) : Status::ok();
   }
-  const std::vector<Epoch>& epochs() const { return epochs_; }
+  const std::vector<can::Epoch>& epochs() const { return epochs_; }
   std::uint64_t overflow() const { return overflow_; }
 
  private:
   EpochSink* next_;
-  std::vector<Epoch> epochs_;
+  std::vector<can::Epoch> epochs_;
   std::uint64_t overflow_ = 0;
 };
 
 /// Keeps the last epoch and a count (no bus).
 class CountingSink final : public EpochSink {
  public:
-  std::uint32_t publish(const Epoch& e) override {
+  std::uint32_t publish(const can::Epoch& e) override {
     last_ = e;
     ++count_;
     return 0;
@@ -45,11 +45,11 @@ class CountingSink final : public EpochSink {
   Status set_divider(std::size_t m, std::uint16_t) override {
     return m < 14 ? Status::ok() : Status(ErrorCode::kOutOfRange, "no such message");
   }
-  const Epoch& last() const { return last_; }
+  const can::Epoch& last() const { return last_; }
   std::uint64_t count() const { return count_; }
 
  private:
-  Epoch last_{};
+  can::Epoch last_{};
   std::uint64_t count_ = 0;
 };
 

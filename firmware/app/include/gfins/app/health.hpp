@@ -37,33 +37,27 @@ struct HealthCounters {
   std::uint8_t saturated_mask = 0;        // channels saturated in the last sample
 };
 
-/// Bits of Epoch::status_bits: the positions of the CAN status frame's StatusFlags
-/// (docs/can-interface.md). Bits 0..3 mirror nav::nav_status; 4 and 5 are set by the publisher
-/// (a value clipped / not available); 14..17 are the firmware's additions (docs/faults.md).
-/// Event bits (marked *) stay set for kEventHoldSamples after the event so a status frame sent at
-/// a lower rate still shows it; the counters are exact.
-namespace status_bits {
-// One source: the CAN protocol's bit positions (firmware/can/include/gfins/can/epoch.hpp), under
-// the names the firmware's health code uses.
-inline constexpr std::uint32_t kAligned = can::status_bits::kAligned;            // alignment done
-inline constexpr std::uint32_t kSampleGap = can::status_bits::kSampleGap;        // * edges lost
-inline constexpr std::uint32_t kInputInvalid = can::status_bits::kInputInvalid;  // rejected
-inline constexpr std::uint32_t kCompensated = can::status_bits::kCompensated;
-inline constexpr std::uint32_t kCrcError = can::status_bits::kAdcCrcError;    // *
-inline constexpr std::uint32_t kSaturated = can::status_bits::kAdcSaturated;  // *
-inline constexpr std::uint32_t kStuckChannel = can::status_bits::kAdcChannelStuck;
-inline constexpr std::uint32_t kUncalibrated = can::status_bits::kNominalCalibration;
-inline constexpr std::uint32_t kLoopOverrun = can::status_bits::kLoopOverrun;  // *
-inline constexpr std::uint32_t kCanTxDrop = can::status_bits::kCanTxDropped;   // *
-inline constexpr std::uint32_t kCaptureActive = can::status_bits::kCaptureActive;
-inline constexpr std::uint32_t kDegraded = can::status_bits::kHealthDegraded;
-inline constexpr std::uint32_t kAdcRecovered = can::status_bits::kAdcRecovered;    // *
-inline constexpr std::uint32_t kDataReadyLost = can::status_bits::kDataReadyLost;  // *
-inline constexpr std::uint32_t kBusOff = can::status_bits::kBusOff;                // *
-inline constexpr std::uint32_t kExtraEdge = can::status_bits::kExtraEdge;          // *
-inline constexpr std::uint32_t kCanRxDrop = can::status_bits::kCanRxDropped;       // *
-inline constexpr std::uint32_t kAdcReadError = can::status_bits::kAdcReadError;    // *
-}  // namespace status_bits
+/// Bits of can::Epoch::status_bits are the CAN status frame's StatusFlags
+/// (firmware/can/include/gfins/can/epoch.hpp, docs/can-interface.md): the firmware sets them by
+/// those names. Event bits (sample gap, CRC error, saturation, loop overrun, CAN drops, ADC
+/// recovery, data-ready lost, bus-off, extra edge, ADC read error) stay set for kEventHoldSamples
+/// after the event so a status frame sent at a lower rate still shows it; the counters are exact.
+namespace status_bits = can::status_bits;
+
+/// The counters the bus carries (GfinsHealthAdc / GfinsHealthSystem), out of the loop's.
+inline can::Health bus_health(const HealthCounters& h) {
+  can::Health c;
+  c.missed_drdy_edges = h.missed_edges;
+  c.adc_crc_errors = h.crc_errors;
+  c.adc_resets = h.adc_resets;
+  c.saturated_samples = h.saturated_samples;
+  c.stuck_channel_mask = h.stuck_mask;
+  c.can_tx_dropped = h.can_tx_dropped;
+  c.bus_off_events = h.bus_off_events;
+  c.loop_overruns = h.loop_overruns;
+  c.log_dropped = h.log_dropped;
+  return c;
+}
 
 /// Event bits held for one second at 1 kHz (status frames go out at 100 Hz by default).
 inline constexpr std::uint32_t kEventHoldSamples = 1000;

@@ -24,6 +24,8 @@
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/app/status_board.hpp"
 #include "gfins/can/aiding_input.hpp"
+#include "gfins/can/command.hpp"
+#include "gfins/can/epoch.hpp"
 #include "gfins/hal/can_bus.hpp"
 #include "gfins/hal/clock.hpp"
 #include "gfins/hal/watchdog.hpp"
@@ -49,7 +51,6 @@ inline constexpr std::int64_t kDeadAdcWatchdogNs = 10000000000;
 inline constexpr auto kMaxGapEpochsPerCycle = static_cast<std::uint32_t>(2 * kReadTimeoutPeriods);
 /// A calibration capture averages at most this many samples (65 s at 1 kHz).
 inline constexpr std::uint32_t kMaxCaptureSamples = 65535;
-inline constexpr std::uint8_t kMaxPose = 63;
 /// Capture motion threshold: a channel whose standard deviation exceeds 2 mg of its scale factor
 /// was not static (QA-1100 noise is 70 µg rms per sample, docs/sensor-model.md: ~30x that).
 inline constexpr double kCaptureMotionStdG = 2e-3;
@@ -144,8 +145,9 @@ class SampleLoop {
   SampleLoop(SampleSource& adc, hal::CanBus& bus, EpochSink& out, hal::Clock& clock,
              FwLogQueue& log);
 
-  /// Optional collaborators (set before configure): command codec, watchdog, reload worker.
-  void set_command_codec(const CommandCodec* codec) { codec_ = codec; }
+  /// Optional collaborators (set before configure): command handling (the CAN command frames of
+  /// options.node_id, decoded and answered by the CAN protocol's codec), watchdog, reload worker.
+  void set_commands(bool on) { commands_ = on; }
   void set_watchdog(hal::Watchdog* wd) { watchdog_ = wd; }
   void set_reload_worker(ReloadWorker* w) { reload_ = w; }
   /// Where each cycle leaves the mode and health for the service status line (read by another
@@ -165,21 +167,30 @@ class SampleLoop {
   bool kicking_watchdog() const { return !watchdog_held_; }
   const LatencyHistogram& latency() const { return latency_; }
   const nav::NavPipeline<float>& pipeline() const { return pipeline_; }
-  Mode mode() const { return mode_; }
+  /// GfinsEpoch.Mode of the last epoch (navigating on faulty inputs is kNavigating with the
+  /// HealthDegraded status bit).
+  can::Mode mode() const { return mode_; }
   std::uint32_t cal_id() const { return cal_.cal_id; }
   bool calibrated() const { return cal_.calibrated; }
   bool capture_active() const { return capture_.active; }
   /// The result of the last finished calibration capture (also sent as response frames).
-  const CaptureResult& last_capture() const { return last_capture_; }
+  const can::CaptureResult& last_capture() const { return last_capture_; }
 
+  /// What execute() decided: the response frame's fields, and whether it goes out now or when
+  /// the work is done (a reload answers once the worker has read the file; a capture's result
+  /// frames follow its last sample).
+  struct CommandReply {
+    can::Response response{};
+    bool deferred = false;
+  };
   /// Executes one decoded command (the CAN path calls it; tests may too). Fills `r` with the
   /// immediate response; nothing changes when the command is rejected.
-  void execute(const Command& c, Response& r);
+  void execute(const can::Command& c, CommandReply& r);
 
  private:
   struct Capture {
     bool active = false;
-    Command command{};
+    can::Command command{};
     std::uint32_t target = 0;
     std::array<double, kAdcChannels> mean{}, m2{};
     std::array<std::uint32_t, kAdcChannels> n{};
@@ -193,7 +204,10 @@ class SampleLoop {
   void capture_finish();
   void handle_commands(std::int64_t t_ns);
   void poll_reload(std::int64_t t_ns);
-  void send_response(const Response& r);
+  /// The response frame, and the calibration identity after a report or reload that succeeded.
+  void send_response(const can::Response& r);
+  /// GfinsEpoch.Mode from the alignment and this epoch's status bits.
+  void set_mode(bool aligned, std::uint32_t bits);
   void build_epoch(const RawSample& s);
   void publish_gap(std::int64_t t_ns, std::uint32_t cause);
   void build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint32_t cause);
@@ -223,7 +237,7 @@ class SampleLoop {
   EpochSink& out_;
   hal::Clock& clock_;
   FwLogQueue& log_;
-  const CommandCodec* codec_ = nullptr;
+  bool commands_ = false;
   can::InputDecoder inputs_{1};   // GNSS / heading frames of options_.node_id
   bool gravity_checked_ = false;  // check_gravity() done for the current alignment
   hal::Watchdog* watchdog_ = nullptr;
@@ -241,8 +255,8 @@ class SampleLoop {
   StuckDetector stuck_{};
   LatchedBits events_{};
   Capture capture_{};
-  CaptureResult last_capture_{};
-  Epoch epoch_{};
+  can::CaptureResult last_capture_{};
+  can::Epoch epoch_{};
   LatencyHistogram latency_{};
   std::array<std::int32_t, kAdcChannels> last_counts_{};
   RawSample last_good_{};  // the last sample the core could integrate (warm restarts)
@@ -250,7 +264,7 @@ class SampleLoop {
   bool have_seq_ = false;
   std::uint8_t reload_token_ = 0;
   bool reload_pending_ = false;
-  Mode mode_ = Mode::kStartup;
+  can::Mode mode_ = can::Mode::kStartup;
   std::uint32_t sample_index_ = 0;
   LogLimiter limiter_{};
   std::int64_t t_cycle_ = 0;  // time of this cycle's edge (or of the failed read)

@@ -9,13 +9,14 @@
 #include <cstdint>
 
 #include "gfins/app/health.hpp"
-#include "gfins/app/ports.hpp"
+#include "gfins/can/epoch.hpp"
 
 namespace gfins::app {
 
 /// One reading of the board's state for the status line.
 struct StatusSnapshot {
-  Mode mode = Mode::kStartup;
+  can::Mode mode = can::Mode::kStartup;
+  bool degraded = false;  // navigating on a faulty input (the HealthDegraded status bit)
   bool calibrated = false;
   std::uint32_t cal_id = 0;
   std::uint32_t samples = 0;
@@ -33,9 +34,11 @@ struct StatusSnapshot {
 class StatusBoard {
  public:
   /// The loop's side: once per cycle.
-  void publish(Mode mode, bool calibrated, std::uint32_t cal_id, const HealthCounters& h) {
+  void publish(can::Mode mode, bool degraded, bool calibrated, std::uint32_t cal_id,
+               const HealthCounters& h) {
     constexpr auto kR = std::memory_order_relaxed;
     mode_.store(static_cast<std::uint8_t>(mode), kR);
+    degraded_.store(degraded, kR);
     calibrated_.store(calibrated, kR);
     cal_id_.store(cal_id, kR);
     samples_.store(h.samples, kR);
@@ -54,7 +57,8 @@ class StatusBoard {
   StatusSnapshot read() const {
     constexpr auto kR = std::memory_order_relaxed;
     StatusSnapshot s;
-    s.mode = static_cast<Mode>(mode_.load(kR));
+    s.mode = static_cast<can::Mode>(mode_.load(kR));
+    s.degraded = degraded_.load(kR);
     s.calibrated = calibrated_.load(kR);
     s.cal_id = cal_id_.load(kR);
     s.samples = samples_.load(kR);
@@ -71,7 +75,8 @@ class StatusBoard {
   }
 
  private:
-  std::atomic<std::uint8_t> mode_{static_cast<std::uint8_t>(Mode::kStartup)};
+  std::atomic<std::uint8_t> mode_{static_cast<std::uint8_t>(can::Mode::kStartup)};
+  std::atomic<bool> degraded_{false};
   std::atomic<bool> calibrated_{false};
   std::atomic<std::uint32_t> cal_id_{0}, samples_{0}, missed_edges_{0}, drdy_timeouts_{0},
       crc_errors_{0}, adc_resets_{0}, stuck_mask_{0}, can_tx_dropped_{0}, can_rx_dropped_{0},

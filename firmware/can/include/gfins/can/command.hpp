@@ -110,6 +110,13 @@ struct CaptureResult {
   std::uint8_t pose = 0;
   std::uint16_t samples = 0;
   std::array<ChannelCapture, 6> channels{};
+  /// A channel's spread says the board moved: the pose was not static.
+  bool motion() const {
+    for (const ChannelCapture& c : channels) {
+      if (c.motion) return true;
+    }
+    return false;
+  }
 };
 
 /// A finished capture: 6 mean, 6 std, 6 count/flag frames, then the CaptureDone frame (the host

@@ -129,7 +129,7 @@ struct Accuracy {
 struct Epoch {
   nav::NavState<float> nav;           // q_nb, ω_b, ω̇_b, f_b, v_n, r_n (frames: b FRD, n NED)
   std::array<float, 6> accel_mps2{};  // compensated outputs of the six sensors, m/s²
-  std::uint8_t mode = 0;              // Mode
+  Mode mode = Mode::kStartup;         // GfinsEpoch.Mode
   std::uint32_t status_bits = 0;      // status_bits (nav.status bits 0..3 are ORed in)
   std::uint32_t cal_id = 0;           // identity of the calibration in use (0 = nominal)
   Health health;

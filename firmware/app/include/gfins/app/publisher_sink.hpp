@@ -1,0 +1,29 @@
+// The board's epoch sink: the CAN protocol's Publisher (rate dividers + message table →
+// hal::CanBus). Allocation-free, like everything the loop calls.
+#pragma once
+
+#include <cstdint>
+
+#include "gfins/app/config.hpp"
+#include "gfins/app/ports.hpp"
+#include "gfins/can/epoch.hpp"
+#include "gfins/can/publisher.hpp"
+
+namespace gfins::app {
+
+/// Publisher dividers from the configuration's [output] (index = can::MessageId), with the
+/// filter's messages at the table's rates when aiding is on.
+can::Dividers bus_dividers(const FwConfig& c);
+
+class PublisherSink final : public EpochSink {
+ public:
+  PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers);
+  std::uint32_t publish(const can::Epoch& e) override;
+  Status set_divider(std::size_t message, std::uint16_t divider) override;
+  const can::Publisher& publisher() const { return publisher_; }
+
+ private:
+  can::Publisher publisher_;
+};
+
+}  // namespace gfins::app
