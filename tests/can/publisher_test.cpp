@@ -115,6 +115,19 @@ TEST(Publisher, DividerRules) {
   EXPECT_EQ(pub.divider(MessageId::kSensorsA), 10000);
   EXPECT_TRUE(pub.set_divider(MessageId::kEpoch, 5).is_ok());
   EXPECT_EQ(pub.divider(MessageId::kStatus), 5);
+  // The epoch and status frames are never off, even with every other message off (a silent
+  // board would look like a dead one).
+  for (const MessageDef& m : kMessages) {
+    if (m.kind == MessageKind::kData && m.id != MessageId::kEpoch && m.id != MessageId::kStatus) {
+      ASSERT_TRUE(pub.set_divider(m.id, 0).is_ok()) << m.name;
+    }
+  }
+  EXPECT_EQ(pub.set_divider(MessageId::kEpoch, 0).code(), ErrorCode::kOutOfRange);
+  EXPECT_EQ(pub.divider(MessageId::kEpoch), 5);
+  EXPECT_EQ(pub.divider(MessageId::kStatus), 5);
+  PublisherConfig silent;
+  silent.dividers.fill(0);
+  EXPECT_EQ(check_config(silent).code(), ErrorCode::kOutOfRange);
   PublisherConfig bad;
   bad.node_id = 16;
   EXPECT_FALSE(check_config(bad).is_ok());

@@ -48,7 +48,7 @@ TEST_F(Commands, RealignRestartsAlignmentWithTheGivenHeading) {
 TEST_F(Commands, RealignWithAnOutOfRangeHeadingChangesNothing) {
   can::Command c;
   c.opcode = can::Opcode::kRealign;
-  c.heading_rad = 7.0f;  // > 2π
+  c.heading_rad = 4.0f;  // beyond ±π (the command's Heading signal, docs/can-interface.md)
   const std::uint32_t errors = rig_->loop->health().command_errors;
   EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
   EXPECT_EQ(rig_->loop->health().command_errors, errors + 1);
@@ -101,6 +101,15 @@ TEST_F(Commands, SetDividerValidAndOutOfRange) {
   c.message = static_cast<can::MessageId>(3);
   c.divider = kMaxDivider + 1;
   EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
+  // Switching the epoch (and with it the status) off is refused: the board never goes silent.
+  c.message = can::MessageId::kEpoch;
+  c.divider = 0;
+  const std::uint32_t errors = rig_->loop->health().command_errors;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOutOfRange);
+  EXPECT_EQ(rig_->loop->health().command_errors, errors + 1);
+  const std::uint64_t frames = rig_->bus->total();
+  rig_->run_cycles(100);
+  EXPECT_GE(rig_->bus->total(), frames + 20);  // epoch + status every 10 samples, at least
 }
 
 TEST_F(Commands, ReportCalibrationGivesTheIdentityInUse) {

@@ -515,7 +515,9 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
     case can::Opcode::kRealign:
     case can::Opcode::kResetNavigation: {
       const bool realign = c.opcode == can::Opcode::kRealign;
-      if (realign && !(std::abs(c.heading_rad) <= 2.0f * std::numbers::pi_v<float>)) {
+      // The command's Heading signal range (±3.1416 rad: ±π to its resolution); the codec
+      // refuses a frame beyond it, a caller of execute() is held to the same.
+      if (realign && !(std::abs(static_cast<double>(c.heading_rad)) <= can::kHeadingLimitRad)) {
         return reject(ResultCode::kOutOfRange);
       }
       // A new alignment while the vehicle moves would navigate from a wrong attitude: with the

@@ -72,6 +72,11 @@ bool flags_epoch(Field field) {
 
 Status check_dividers(const Dividers& d) {
   const std::uint16_t epoch = d[idx(MessageId::kEpoch)];
+  // The epoch and status frames say that the board is alive and how it is: never off (a SetDivider
+  // of 0 for the epoch would leave a silent board on the bus).
+  if (epoch == 0) {
+    return Status(ErrorCode::kOutOfRange, "can: the Epoch divider cannot be 0 (never off)");
+  }
   if (d[idx(MessageId::kStatus)] != epoch) {
     return Status(ErrorCode::kInvalidArgument, "can: the Status divider must equal the Epoch's");
   }

@@ -681,6 +681,8 @@ inline constexpr std::uint8_t kOpRealign = 1;
 inline constexpr std::uint8_t kOpResetNavigation = 2;
 inline constexpr std::uint8_t kOpSetCompensator = 3;
 inline constexpr std::uint8_t kOpSetDivider = 4;
+/// Realign's heading range: ±π, rounded up to the signal's 1e-4 rad resolution.
+inline constexpr double kHeadingLimitRad = 3.1416;
 /// Largest divider of the sample rate a message can have (the configuration's output.* and the
 /// SetDivider command alike): 10 s between frames at 1 kHz.
 inline constexpr std::uint16_t kMaxDivider = 10000;
@@ -709,8 +711,8 @@ inline constexpr std::array<SignalDef, 11> kCommandSignals{{
               .is_signed = true,
               .factor = 1e-4,
               .unit = "rad",
-              .min = -3.1416,
-              .max = 3.1416,
+              .min = -kHeadingLimitRad,
+              .max = kHeadingLimitRad,
               .mux = kOpRealign,
               .instant = kAtCommand,
               .comment = "Realign: heading (yaw of q_nb) to align to; roll and pitch from "
