@@ -488,6 +488,8 @@ duration_s = 1e6
 rate_hz = 1e5
 [trajectory]
 kind = "rest"
+[sensors]
+adc = false
 )TOML");
   const std::string short_run = file("short.toml", R"TOML([scenario]
 duration_s = 0.004

@@ -130,11 +130,14 @@ TEST_F(RunStreamCli, RunAboveTheMemoryLimitCompletesWithBoundedMemory) {
 // A run whose files cannot fit on the disk is refused before any work, with the figures, and
 // leaves no folder behind. 10^11 samples (10^6 s at 100 kHz, the largest a scenario allows)
 // make at least 2 × 10^11 CSV rows of > 100 bytes each: 2 × 10^13 bytes, more than any file
-// system this test runs on has free (checked below with std::filesystem::space).
+// system this test runs on has free (checked below with std::filesystem::space). 100 kHz is
+// beyond the ADC model (32 kHz): the scenario runs in m/s² ([sensors] adc = false).
 TEST_F(RunStreamCli, RunThatCannotFitOnTheDiskIsRefusedWithTheNumbers) {
   constexpr double kMinBytesNeeded = 2e13;
   ASSERT_LT(static_cast<double>(fs::space(dir()).available), kMinBytesNeeded);
-  const fs::path toml = write_scenario("huge", rest_scenario(1.0e6, 1.0e5));
+  std::string text = rest_scenario(1.0e6, 1.0e5);
+  text.replace(text.find("noise_mg = 1.0\n"), 15, "noise_mg = 1.0\nadc = false\n");
+  const fs::path toml = write_scenario("huge", text);
   const fs::path out = dir() / "a" / "huge";
   const CliResult r = run(GFINS_SIM_BIN, {"run", toml.string(), "-o", out.string(), "--no-plot"});
   EXPECT_EQ(r.exit_code, 2) << r.output;

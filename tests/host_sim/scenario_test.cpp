@@ -111,6 +111,24 @@ TEST(ScenarioParse, WrongTypeIsNamedWithItsLine) {
   expect_error(replace(kGood, "seed = 3", "seed = 3.5"), {"scenario.seed", "expected an integer"});
 }
 
+TEST(ScenarioParse, ARateTheConverterModelCannotMakeIsRefusedWhileReading) {
+  // ADS131M06: f_DATA = CLKIN / (2 OSR), CLKIN <= 8.192 MHz, OSR >= 128 (datasheet §8.3.6,
+  // §8.3.7): 32,000 Hz at most. kGood has no [sensors] adc key, so the ADC is on.
+  const auto at = [](const char* rate) {
+    return replace(kGood, "rate_hz = 100.0", std::string("rate_hz = ") + rate);
+  };
+  ASSERT_TRUE(parse_scenario(at("32000.0"), "ok.toml").is_ok());
+  expect_error(at("32000.5"),
+               {"bad.toml:4:", "scenario.rate_hz", "at most 32000 Hz", "adc = false"});
+  expect_error(at("90000.0"), {"scenario.rate_hz", "ADS131M06"});
+  // Without the converter (the paper's m/s² setting) the documented range up to 1e5 holds.
+  const std::string no_adc =
+      replace(at("90000.0"), "noise_mps2 = 5e-4", "noise_mps2 = 5e-4\nadc = false");
+  const HostResult<Scenario> p = parse_scenario(no_adc, "fast.toml");
+  ASSERT_TRUE(p.is_ok()) << p.error().message;
+  EXPECT_EQ(p.value().rate_hz, 90000.0);
+}
+
 TEST(ScenarioParse, UnknownTrajectoryAndOtherChoicesListTheAllowedOnes) {
   expect_error(replace(kGood, "\"constant_acceleration\"", "\"loop_the_loop\""),
                {"bad.toml:12:", "trajectory.kind", "unknown value 'loop_the_loop'", "coning"});

@@ -5,6 +5,9 @@
 
 namespace gfins::sim {
 
+static_assert(SimulatedAdc::kMaxSampleRateHz == 8.192e6 / (2.0 * drivers::ads131m06::kOsrValues[0]),
+              "the smallest OSR sets the fastest rate");
+
 SimulatedAdc::SimulatedAdc(const SimulatedAdcConfig& c)
     : config_(c), chip_(c.adc.vref_v), driver_(chip_, line_, c.adc) {
   line_.set_listener(this);

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gfins/host_sim/chip/simulated_adc.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "gfins/nav_core/paper_table6.hpp"
 
@@ -476,6 +477,17 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
       rd.fail(se->get("adc"), q + "adc",
               "false (the paper's §6.3 m/s² setting) needs model = \"paper\", not \"qa1100\"");
     }
+  }
+
+  // The converter model makes at most 32 kHz (SimulatedAdc::kMaxSampleRateHz): refused while the
+  // scenario is read, before any command creates its output.
+  if (s.adc && s.rate_hz > SimulatedAdc::kMaxSampleRateHz) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "%g Hz is beyond what the ADS131M06 model converts (at most %g Hz: CLKIN 8.192 "
+                  "MHz / (2 x OSR 128)); set [sensors] adc = false for a faster rate",
+                  s.rate_hz, SimulatedAdc::kMaxSampleRateHz);
+    rd.fail(sc.get("rate_hz"), "scenario.rate_hz", buf);
   }
 
   // [compensator]

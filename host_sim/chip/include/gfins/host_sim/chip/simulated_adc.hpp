@@ -45,6 +45,9 @@ class SimulatedAdc : private SimDataReadyLine::Listener {
   /// nothing fits.
   static Result<SimulatedAdcConfig> config_for(double vref_v, double gain, double input_divider,
                                                double sample_rate_hz);
+  /// The fastest rate config_for accepts: CLKIN 8.192 MHz / (2 × the smallest OSR, 128) (§8.3.6,
+  /// §8.3.7) = 32 kHz.
+  static constexpr double kMaxSampleRateHz = 8.192e6 / (2.0 * 128.0);
 
   /// Starts the driver against the model (reset, identity, configuration with read-back) and
   /// checks that the model now converts at the configured rate. kInvalidArgument for a front
