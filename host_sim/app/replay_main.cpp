@@ -38,8 +38,12 @@ namespace nav = gfins::nav;
 using gfins::ErrorCode;
 using gfins::RawSample;
 
+std::string printable(const std::string& text);
+
+/// Every message names its input; a file name may hold control characters (ESC, a newline): they
+/// reach the terminal escaped.
 int fail(const std::string& message, int exit_code) {
-  std::fprintf(stderr, "gfins-replay: %s\n", message.c_str());
+  std::fprintf(stderr, "gfins-replay: %s\n", printable(message).c_str());
   return exit_code;
 }
 
@@ -228,7 +232,7 @@ gfins::sim::HostResult<nav::PipelineConfig<double>> config_of(const ReplayOption
       return sim::HostError{ErrorCode::kInvalidArgument, o.cal + ": " + *why};
     }
     gfins::calib_file::apply_to(d, c);
-    what = "calibration " + o.cal + " (device " + d.device_id + ", compensator " +
+    what = "calibration " + printable(o.cal) + " (device " + d.device_id + ", compensator " +
            nav::to_string(d.compensator) + ")";
   }
   c.gravity = nav::GravityModel<double>::constant(o.gravity_mps2);
@@ -372,8 +376,8 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
   std::FILE* summary = std::fopen(summary_path.c_str(), "w");
   if (summary == nullptr) return fail("cannot write " + summary_path, app::kExitError);
   for (std::FILE* f : {stdout, summary}) {
-    std::fprintf(f, "gfins-replay %s: %g Hz, %s, %s\n", o.recording.c_str(), h.sample_rate_hz,
-                 cal_text.c_str(),
+    std::fprintf(f, "gfins-replay %s: %g Hz, %s, %s\n", printable(o.recording).c_str(),
+                 h.sample_rate_hz, cal_text.c_str(),
                  app::scalar_text(std::is_same_v<T, float> ? sim::NavScalar::kFloat
                                                            : sim::NavScalar::kDouble));
     print_report(f, r, h.sample_rate_hz);

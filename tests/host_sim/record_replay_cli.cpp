@@ -290,6 +290,17 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
       kExitOk);
   const auto with = replay({rest, "--cal", cal, "-o", path("with"), "--no-plot"});
   ASSERT_EQ(with.exit_code, kExitOk) << with.output;
+  // A calibration file whose name holds ESC and a newline: the report and the messages show
+  // them escaped (\x1b, \x0a), never raw (a terminal would act on them).
+  const std::string hostile = path("cal\x1b[2J\nforged.toml");
+  std::filesystem::copy_file(cal, hostile);
+  const auto named = replay({rest, "--cal", hostile, "-o", path("named"), "--no-plot"});
+  ASSERT_EQ(named.exit_code, kExitOk) << named.output;
+  EXPECT_EQ(named.output.find('\x1b'), std::string::npos) << named.output;
+  EXPECT_NE(named.output.find("cal\\x1b[2J\\x0aforged.toml"), std::string::npos) << named.output;
+  const auto missing = replay({rest, "--cal", hostile + "\x1b", "-o", path("m"), "--no-plot"});
+  EXPECT_NE(missing.exit_code, kExitOk);
+  EXPECT_EQ(missing.output.find('\x1b'), std::string::npos) << missing.output;
   const auto without = replay({rest, "-o", path("without"), "--no-plot"});
   ASSERT_EQ(without.exit_code, kExitOk) << without.output;
   const auto final_r = [](const Csv& nav) {
