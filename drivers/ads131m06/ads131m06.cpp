@@ -366,12 +366,7 @@ Result<RawSample> Ads131m06::read_sample(std::int64_t timeout_ns) {
         }
       }
     }
-    for (const std::int32_t c : f.codes) {
-      if (c >= kAdcCodeMax || c <= kAdcCodeMin) {
-        s.flags |= sample_flags::kSaturated;
-        break;
-      }
-    }
+    if (rail_mask(f.codes) != 0) s.flags |= sample_flags::kSaturated;
     if ((s.flags & sample_flags::kSaturated) != 0) ++counters_.saturated_samples;
     track_stuck(f.codes);
     s.counts = f.codes;

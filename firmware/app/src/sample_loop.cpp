@@ -315,8 +315,8 @@ void SampleLoop::on_sample(const RawSample& s) {
   }
   // A CRC error or a saturated channel means the counts are not a measurement: the pipeline
   // skips the sample and integrates across the hole with the next good one (is_measurement,
-  // the core's rule).
-  const bool measured = is_measurement(s);
+  // the core's rule, here with the rails already scanned).
+  const bool measured = (s.flags & sample_flags::kNotMeasured) == 0 && saturated == 0;
   if (!measured) ++health_.rejected_samples;
   if (measured) last_good_ = s;
   pipeline_.process(s);
@@ -326,8 +326,8 @@ void SampleLoop::on_sample(const RawSample& s) {
     gravity_checked_ = true;
     check_gravity(s.t_ns);
   }
-  if (capture_.active && crc_ok) capture_add(s);
-  build_epoch(s);
+  if (capture_.active && crc_ok) capture_add(s, saturated);
+  build_epoch(s, measured);
 }
 
 void SampleLoop::set_mode(bool aligned, std::uint32_t bits) {
@@ -343,7 +343,7 @@ void SampleLoop::set_mode(bool aligned, std::uint32_t bits) {
   epoch_.mode = mode_;
 }
 
-void SampleLoop::build_epoch(const RawSample& s) {
+void SampleLoop::build_epoch(const RawSample& s, bool measured) {
   const std::uint32_t k = sample_index_;
   epoch_.nav = pipeline_.state();
   // Every epoch refers to the sample just read (its edge time and counter). When the core did
@@ -351,7 +351,7 @@ void SampleLoop::build_epoch(const RawSample& s) {
   // and a rejected sample is flagged as such.
   epoch_.nav.t_ns = s.t_ns;
   epoch_.nav.seq = s.seq;
-  if (!is_measurement(s)) {
+  if (!measured) {
     epoch_.nav.status |= nav::nav_status::kInputInvalid;
   }
   nav::Vec6<float> f;
@@ -580,9 +580,9 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
   ++health_.commands;
 }
 
-void SampleLoop::capture_add(const RawSample& s) {
+void SampleLoop::capture_add(const RawSample& s, std::uint8_t rails) {
   for (std::size_t j = 0; j < kAdcChannels; ++j) {
-    if (s.counts[j] >= kAdcCodeMax || s.counts[j] <= kAdcCodeMin) capture_.saturated[j] = true;
+    if (((rails >> j) & 1u) != 0) capture_.saturated[j] = true;
     // Welford's running mean and sum of squares (numerically stable for long captures).
     const auto v = static_cast<double>(s.counts[j]);
     const double n = static_cast<double>(++capture_.n[j]);

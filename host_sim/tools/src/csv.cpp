@@ -240,13 +240,10 @@ HostResult<Recording> read_gfr(const std::filesystem::path& path) {
   rec.crc_error.reserve(r.samples.size());
   for (const RawSample& smp : r.samples) {
     std::array<double, 6> v{};
-    std::uint8_t sat = 0;
     for (std::size_t j = 0; j < 6; ++j) {
       v[j] = static_cast<double>(smp.counts[j]) * rec.volts_per_count[j];
-      if (smp.counts[j] >= kAdcCodeMax || smp.counts[j] <= kAdcCodeMin) {
-        sat = static_cast<std::uint8_t>(sat | (1u << j));
-      }
     }
+    std::uint8_t sat = rail_mask(smp.counts);
     // The flag says some channel saturated; the codes say which. A flag without a code at full
     // scale (the driver saw it, the code was then clamped) marks every channel.
     if ((smp.flags & sample_flags::kSaturated) != 0 && sat == 0) sat = 0x3F;

@@ -7,14 +7,9 @@
 // failed at once, are its only sleeps).
 #pragma once
 
-#include <array>
 #include <cstdint>
 
-#include "gfins/app/health.hpp"
 #include "gfins/can/epoch.hpp"
-#include "gfins/hal/can_bus.hpp"
-#include "gfins/nav_core/compensator.hpp"
-#include "gfins/nav_core/nav_state.hpp"
 #include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
 

@@ -200,7 +200,8 @@ class SampleLoop {
   void on_sample(const RawSample& s);
   void update_adc_counters(std::uint32_t sample);
   void update_can_counters(std::uint32_t sample, std::int64_t t_ns);
-  void capture_add(const RawSample& s);
+  /// `rails`: rail_mask of the sample's counts (on_sample has it already).
+  void capture_add(const RawSample& s, std::uint8_t rails);
   void capture_finish();
   void handle_commands(std::int64_t t_ns);
   void poll_reload(std::int64_t t_ns);
@@ -208,7 +209,8 @@ class SampleLoop {
   void send_response(const can::Response& r);
   /// GfinsEpoch.Mode from the alignment and this epoch's status bits.
   void set_mode(bool aligned, std::uint32_t bits);
-  void build_epoch(const RawSample& s);
+  /// `measured`: the sample is one the core integrates (is_measurement).
+  void build_epoch(const RawSample& s, bool measured);
   void publish_gap(std::int64_t t_ns, std::uint32_t cause);
   void build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint32_t cause);
   void on_read_error(std::int64_t t_ns, const Status& st);
