@@ -310,7 +310,35 @@ class OutOfRange : public LoadErrors {
 TEST_F(OutOfRange, NegativeScaleFactor) {
   CalibrationData d = table6_data();
   d.sensors[2].scale_v_per_g = -0.500242;
-  expect_refused(d, "sensor.3.scale_v_per_g", "= -0.500242: must be a positive number");
+  expect_refused(d, "sensor.3.scale_v_per_g", "= -0.500242: must be in [1e-6, 1e6] V/g");
+}
+
+// Finite, positive, and still no scale factor: 1e300 and 1e-300 V/g become inf and 0 in the
+// float32 core (whose message said "not a positive finite number" of a positive finite value).
+// The bounds are the ones docs/calibration-file.md states; the edges themselves are accepted.
+TEST_F(OutOfRange, ScaleFactorsAndLsbTheFloatCoreCannotHold) {
+  for (const double sf : {1e300, 1e-300, 1.01e6, 0.99e-6}) {
+    CalibrationData d = table6_data();
+    d.sensors[1].scale_v_per_g = sf;
+    expect_refused(d, "sensor.2.scale_v_per_g", "must be in [1e-6, 1e6] V/g");
+  }
+  for (const double lsb : {1e-300, 0.99e-12}) {
+    CalibrationData d = table6_data();
+    d.sensors[3].adc_lsb_v_per_count = lsb;
+    expect_refused(d, "sensor.4.adc_lsb_v_per_count", "must be in [1e-12, 1] V/count");
+  }
+  const auto accepted = [this](const CalibrationData& d) {
+    const auto out = dir_.path() / "edge.toml";
+    return save_calibration_file(out, d).is_ok() && load_calibration_file(out).is_ok();
+  };
+  for (const double sf : {1e-6, 1e6}) {
+    CalibrationData d = table6_data();
+    d.sensors[1].scale_v_per_g = sf;
+    EXPECT_TRUE(accepted(d)) << sf;
+  }
+  CalibrationData d = table6_data();
+  d.sensors[3].adc_lsb_v_per_count = 1e-12;
+  EXPECT_TRUE(accepted(d));
 }
 
 TEST_F(OutOfRange, NaNBias) {

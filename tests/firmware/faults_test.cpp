@@ -684,6 +684,51 @@ TEST_F(Faults, ACalibrationOfAnotherConverterIsRefusedAtStartAndOnReload) {
   static_cast<void>(std::remove(bad.c_str()));
 }
 
+// A calibration that loads (every value in range) but that the navigation core refuses: a custom
+// geometry whose six axes are all x sees no rotation about x and no y/z specific force, so the
+// array's solve is singular. Like any bad file it leaves the board on its flagged defaults
+// (start-up), keeps the calibration in use (reload) and is named by --check-config's note; before,
+// the run stopped with exit 1 and --check-config said nothing. Oracle: the geometry, by
+// construction (rank 1 at most in the three force columns).
+TEST_F(Faults, ACalibrationTheCoreRefusesLeavesTheBoardOnItsDefaults) {
+  SimRig& rig = make();
+  calib_file::CalibrationData singular = rig.factory;
+  singular.geometry.kind = calib_file::GeometryKind::kCustom;
+  for (std::size_t j = 0; j < singular.geometry.axes.size(); ++j) {
+    singular.geometry.axes[j] = {1.0, 0.0, 0.0};
+    singular.geometry.positions_m[j] = {0.0, 0.1 * static_cast<double>(j) - 0.25, 0.05};
+  }
+  const std::string bad = ::testing::TempDir() + "gfins_singular_cal.toml";
+  ASSERT_TRUE(calib_file::save_calibration_file(bad, singular).is_ok());
+  ASSERT_TRUE(calib_file::load_calibration_file(bad).is_ok()) << "the file itself is valid";
+  FwConfig c = rig.config;
+  c.calibration_file = bad;
+  const StartupCalibration cal = load_calibration(c, rig.factory, &rig.factory);
+  EXPECT_FALSE(cal.from_file);
+  EXPECT_FALSE(cal.set.calibrated);
+  EXPECT_EQ(cal.set.cal_id, 0u);
+  EXPECT_NE(cal.message.find("UNCALIBRATED: " + bad + ": the navigation core refuses it: "),
+            std::string::npos)
+      << cal.message;
+  // The defaults it falls back to are the ones the core takes: the run goes on.
+  rig.loop = std::make_unique<SampleLoop>(*rig.tap, *rig.bus, *rig.recording, rig.clock, *rig.log);
+  ASSERT_TRUE(rig.loop->configure(cal.set, loop_options(c)).is_ok());
+  rig.run();
+  const Bus bus = decode(rig);
+  const BusEpoch& e = on_bus(bus, 3000);
+  EXPECT_EQ(e.flags & kBitNominalCal, kBitNominalCal);
+  EXPECT_EQ(e.mode, kModeNavigating);
+  // Reload refuses it; --check-config's note names it.
+  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  const std::string note = calibration_note(c);
+  EXPECT_NE(note.find("the navigation core refuses it"), std::string::npos) << note;
+  EXPECT_NE(note.find("UNCALIBRATED"), std::string::npos) << note;
+  // The factory calibration itself passes the same rule (the check is not a blanket refusal).
+  const std::array<double, 6> lsb = converter_lsb(rig.factory);
+  EXPECT_FALSE(calibration_refusal(c, rig.factory, &lsb).has_value());
+  static_cast<void>(std::remove(bad.c_str()));
+}
+
 TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {
   SimRig& rig = make();
   rig.run_cycles(2000);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 namespace gfins::nav {
 namespace {
 
@@ -55,6 +57,25 @@ TEST(FrontEndTest, RejectsNonPositiveScaleFactor) {
   p = paper_like_params();
   p.volts_per_count[5] = -1e-7;
   EXPECT_EQ(FrontEnd<double>::create(p).status().code(), ErrorCode::kInvalidArgument);
+}
+
+// Each value a positive normal float, their gain LSB*g/SF not: 1e-30 V/count over 1e10 V/g is
+// 1e-39 m/s² per count, below float's smallest normal 1.18e-38 (and 1e-20 * 9.8 / 1e-20 * 1e30
+// overflows). The double core holds both gains, so only the float core refuses.
+TEST(FrontEndTest, RejectsAGainTheScalarTypeCannotHold) {
+  auto p = paper_like_params();
+  p.volts_per_count[2] = 1e-30;
+  p.scale_v_per_g[2] = 1e10;
+  EXPECT_TRUE(FrontEnd<double>::create(p).is_ok());
+  const auto tiny = FrontEnd<float>::create(p.cast<float>());
+  EXPECT_EQ(tiny.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(std::string(tiny.status().message()).find("gain"), std::string::npos);
+  p = paper_like_params();
+  p.volts_per_count[2] = 1e30;
+  p.scale_v_per_g[2] = 1e-10;
+  EXPECT_TRUE(FrontEnd<double>::create(p).is_ok());
+  EXPECT_EQ(FrontEnd<float>::create(p.cast<float>()).status().code(),
+            ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

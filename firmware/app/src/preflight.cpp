@@ -6,6 +6,7 @@
 
 #include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
+#include "gfins/app/startup.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 
 namespace gfins::app {
@@ -69,9 +70,17 @@ std::string calibration_note(const FwConfig& c) {
                                       : std::string("calibration.file is empty") + kConsequence;
   }
   const auto loaded = calib_file::load_calibration_file(c.calibration_file);
-  if (loaded.is_ok()) return "";
-  return "calibration.file = " + quote_text(c.calibration_file) + ": " + loaded.status().message() +
-         kConsequence;
+  std::string why;
+  if (!loaded.is_ok()) {
+    why = loaded.status().message();
+  } else if (auto refusal = calibration_refusal(c, loaded.value(), nullptr)) {
+    // The converter check needs the board itself; everything else is checked here as a run
+    // would check it.
+    why = *refusal;
+  } else {
+    return "";
+  }
+  return "calibration.file = " + quote_text(c.calibration_file) + ": " + why + kConsequence;
 }
 
 }  // namespace gfins::app

@@ -103,6 +103,22 @@ std::array<double, 6> converter_lsb(const calib_file::CalibrationData& d) {
   return lsb;
 }
 
+std::optional<std::string> calibration_refusal(const FwConfig& c,
+                                               const calib_file::CalibrationData& d,
+                                               const std::array<double, 6>* board_lsb) {
+  // A file of another converter setting (another board's gain, the paper's 20-bit LSB) would
+  // scale every count wrongly.
+  if (board_lsb != nullptr) {
+    if (auto why = calib_file::converter_mismatch(d, *board_lsb, "the board's converter")) {
+      return why;
+    }
+  }
+  if (const Status s = nav::NavPipeline<float>::check(pipeline_config(c, d)); !s.is_ok()) {
+    return std::string("the navigation core refuses it: ") + s.message();
+  }
+  return std::nullopt;
+}
+
 StartupCalibration load_calibration(const FwConfig& c, const calib_file::CalibrationData& defaults,
                                     const calib_file::CalibrationData* factory) {
   StartupCalibration out;
@@ -119,14 +135,11 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     why = "no calibration file configured (calibration.file is empty)";
   } else {
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
-    // A file of another converter setting (another board's gain, the paper's 20-bit LSB) would
-    // scale every count wrongly: refused like any other bad file.
-    std::optional<std::string> mismatch;
-    if (loaded.is_ok()) {
-      mismatch = calib_file::converter_mismatch(loaded.value(), converter_lsb(defaults),
-                                                "the board's converter");
-    }
-    if (loaded.is_ok() && !mismatch) {
+    const std::array<double, 6> board_lsb = converter_lsb(defaults);
+    // Refused like any other bad file: the board navigates on its flagged defaults.
+    std::optional<std::string> refusal;
+    if (loaded.is_ok()) refusal = calibration_refusal(c, loaded.value(), &board_lsb);
+    if (loaded.is_ok() && !refusal) {
       out.set.config = pipeline_config(c, loaded.value());
       out.set.cal_id = calib_file::cal_id_of(loaded.value());
       out.set.calibrated = true;
@@ -137,7 +150,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
                     ", id " + id + ")";
       return out;
     }
-    why = mismatch ? c.calibration_file + ": " + *mismatch : loaded.status().message();
+    why = refusal ? c.calibration_file + ": " + *refusal : loaded.status().message();
   }
   out.set.config = pipeline_config(c, defaults);
   out.set.cal_id = 0;
@@ -160,13 +173,10 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
                     loaded.status().message());
       return std::nullopt;
     }
-    if (board_lsb) {
-      if (auto why =
-              calib_file::converter_mismatch(loaded.value(), *board_lsb, "the board's converter")) {
-        spdlog::error("calibration reload refused, the calibration in use stays: {}: {}",
-                      c.calibration_file, *why);
-        return std::nullopt;
-      }
+    if (auto why = calibration_refusal(c, loaded.value(), board_lsb ? &*board_lsb : nullptr)) {
+      spdlog::error("calibration reload refused, the calibration in use stays: {}: {}",
+                    c.calibration_file, *why);
+      return std::nullopt;
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());

@@ -124,9 +124,9 @@ class Validator {
     if (!std::isfinite(x)) return "must be a finite number";
     switch (domain) {
       case Domain::kAdcLsb:
-        return x > 0.0 && x <= kMaxAdcLsbV ? "" : "must be in (0, 1] V/count";
+        return x >= kMinAdcLsbV && x <= kMaxAdcLsbV ? "" : "must be in [1e-12, 1] V/count";
       case Domain::kScale:
-        return x > 0.0 ? "" : "must be a positive number (V/g)";
+        return x >= kMinScaleVPerG && x <= kMaxScaleVPerG ? "" : "must be in [1e-6, 1e6] V/g";
       case Domain::kSigma:
         return x >= 0.0 ? "" : "an uncertainty must not be negative";
       case Domain::kBias:

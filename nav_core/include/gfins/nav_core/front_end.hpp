@@ -48,8 +48,8 @@ class FrontEnd {
 
   FrontEnd() = default;
 
-  /// Fails with kInvalidArgument when a scale factor, LSB or the calibration gravity is zero,
-  /// negative or not finite.
+  /// Fails with kInvalidArgument when a scale factor, LSB, their gain or the calibration gravity
+  /// is zero, negative or not finite (or the gain subnormal) in T.
   static Result<FrontEnd> create(const FrontEndParams<T, N>& p) {
     FrontEnd fe;
     const T g = p.gravity_mps2;  // local gravity of the calibration site: the g of V/g
@@ -61,12 +61,14 @@ class FrontEnd {
       const auto i = static_cast<std::size_t>(j);
       const T sf = p.scale_v_per_g[i];
       const T lsb = p.volts_per_count[i];
+      const T gain = lsb * g / sf;
       if (!(sf > T(0)) || !(lsb > T(0)) || !std::isfinite(sf) || !std::isfinite(lsb) ||
-          !std::isfinite(p.bias_g[i])) {
+          !std::isfinite(p.bias_g[i]) || !std::isnormal(gain)) {
         return Status(ErrorCode::kInvalidArgument,
-                      "front end: a scale factor or ADC LSB is not a positive finite number");
+                      "front end: a scale factor or ADC LSB, or their gain LSB*g/SF, is zero, "
+                      "negative or not finite in the core's scalar type");
       }
-      fe.gain_(j) = lsb * g / sf;
+      fe.gain_(j) = gain;
       fe.offset_(j) = p.bias_g[i] * g;
     }
     fe.params_ = p;

@@ -79,6 +79,11 @@ class NavPipeline {
   /// keeps its previous (last good) configuration.
   [[nodiscard]] Status configure(const PipelineConfig<T>& config);
 
+  /// Whether configure() would accept `config`, with its message if not: the same checks, run
+  /// on a scratch pipeline, so that a caller can refuse a calibration before it replaces the one
+  /// in use. Needs sizeof(NavPipeline) of stack (about 7 kB for float): host and Linux only.
+  [[nodiscard]] static Status check(const PipelineConfig<T>& config);
+
   /// Skips alignment: navigation starts at `initial` with this sample (simulation with known
   /// truth, or a warm start). Only the counts of `first` are used: initial.seq and initial.t_ns
   /// say which sample it is, and the next process() counts its gap against initial.seq. The
@@ -222,6 +227,12 @@ Status NavPipeline<T>::configure(const PipelineConfig<T>& config) {
   phase_ = PipelinePhase::kAligning;
   configured_ = true;
   return Status::ok();
+}
+
+template <typename T>
+Status NavPipeline<T>::check(const PipelineConfig<T>& config) {
+  NavPipeline<T> scratch;
+  return scratch.configure(config);
 }
 
 template <typename T>

@@ -34,8 +34,9 @@ struct StartupCalibration {
   std::string message;  // what happened (a loud warning when !from_file)
 };
 
-/// Reads `c.calibration_file`. Missing, invalid or of another converter setting than `defaults`
-/// (the board's ADC LSB) → `defaults` flagged uncalibrated (cal_id 0),
+/// Reads `c.calibration_file`. Missing, invalid, of another converter setting than `defaults`
+/// (the board's ADC LSB) or refused by the navigation core → `defaults` flagged uncalibrated
+/// (cal_id 0),
 /// and `message` says why; the file is never modified. With no file configured and a `factory`
 /// calibration (the simulated board's: its scenario's true parameters), that one is used as a
 /// calibration.
@@ -52,6 +53,14 @@ calib_file::CalibrationData nominal_calibration(double volts_per_count);
 /// converter_lsb(defaults)) a file of another converter setting is such a failure too.
 ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
                                           std::optional<std::array<double, 6>> board_lsb = {});
+
+/// Why the board cannot run with a calibration that loaded: another converter setting than
+/// `board_lsb` (when given), or a set the navigation core refuses (a singular custom geometry, a
+/// scale factor the float32 core cannot hold). nullopt when it can. The one rule of start-up,
+/// reload and --check-config.
+std::optional<std::string> calibration_refusal(const FwConfig& c,
+                                               const calib_file::CalibrationData& d,
+                                               const std::array<double, 6>* board_lsb);
 
 /// The ADC LSB of each sensor in `d`, V/count (for the defaults: the board's converter).
 std::array<double, 6> converter_lsb(const calib_file::CalibrationData& d);

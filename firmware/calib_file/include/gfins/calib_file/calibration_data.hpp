@@ -42,6 +42,13 @@ inline constexpr double kMaxPositionM = 10.0;          // custom geometry positi
 inline constexpr double kMaxLocationErrorOfRho = 0.5;  // |Δρ component| ≤ ρ/2
 inline constexpr double kAxisUnitTolerance = 1e-6;     // nominal axes are unit vectors
 inline constexpr double kMaxAdcLsbV = 1.0;             // V/count; a 24-bit ADC is ~1e-7
+/// Smallest ADC LSB and the scale-factor range: the navigation core runs in float32, whose
+/// front-end gain LSB·g/SF must be a normal float (1.2e-38 .. 3.4e38). These bounds keep the gain
+/// within 1e-17 .. 1e7 and still admit any real chain: a 32-bit converter with a 1 V reference
+/// has 4.7e-10 V/count; a sensor output of 1 µV/g or 1 MV/g is no accelerometer.
+inline constexpr double kMinAdcLsbV = 1e-12;
+inline constexpr double kMinScaleVPerG = 1e-6;
+inline constexpr double kMaxScaleVPerG = 1e6;
 inline constexpr std::size_t kMaxDeviceIdLength = 64;
 inline constexpr std::size_t kMaxSourceLength = 256;
 /// Accepted local gravity, m/s². Normal gravity on the WGS-84 ellipsoid spans 9.7803 (equator) to
