@@ -175,8 +175,9 @@ int cmd_aided(const std::string& name, const OutputOptions& out) {
   if (!out.plot) return kExitOk;
   const std::string title = s.name + ", " + nav::to_string(s.compensator) + " compensator, " +
                             (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
-  if (auto p = plot("plot_sim.py", {"aided", dir.value(), title}); !p.is_ok()) {
-    return fail(p.error(), kExitPlotFailed);
+  if (const int rc = plot_step("gfins-sim", "plot_sim.py", {"aided", dir.value(), title});
+      rc != kExitOk) {
+    return rc;
   }
   std::printf("figures: %s/accuracy.png\n", dir.value().c_str());
   return kExitOk;

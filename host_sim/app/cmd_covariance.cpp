@@ -146,8 +146,9 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   if (!out.plot) return kExitOk;
   const std::string title = s.name + ", reference run in the " +
                             (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
-  if (auto p = plot("plot_covariance.py", {out_dir, title}); !p.is_ok()) {
-    return fail(p.error(), kExitPlotFailed);
+  if (const int rc = plot_step("gfins-sim", "plot_covariance.py", {out_dir, title});
+      rc != kExitOk) {
+    return rc;
   }
   return kExitOk;
 }

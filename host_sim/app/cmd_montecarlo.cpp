@@ -93,8 +93,9 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
   const std::string title = s.name + ", " + nav::to_string(s.compensator) + " compensator, " +
                             std::to_string(r.runs) + " runs, " +
                             (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
-  if (auto p = plot("plot_sim.py", {"montecarlo", out_dir, title}); !p.is_ok()) {
-    return fail(p.error(), kExitPlotFailed);
+  if (const int rc = plot_step("gfins-sim", "plot_sim.py", {"montecarlo", out_dir, title});
+      rc != kExitOk) {
+    return rc;
   }
   return kExitOk;
 }

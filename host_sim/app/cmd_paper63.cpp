@@ -111,10 +111,11 @@ int cmd_paper63(const OutputOptions& out) {
       "(largest |error| before / after).\nwritten: %s/bounds.csv and per-config CSV files\n",
       out_dir.c_str());
   if (!out.plot) return kExitOk;
-  if (auto p = plot("plot_sim.py", {"paper63", out_dir,
-                                    scalar.value() == NavScalar::kFloat ? "float32" : "double"});
-      !p.is_ok()) {
-    return fail(p.error(), kExitPlotFailed);
+  if (const int rc = plot_step(
+          "gfins-sim", "plot_sim.py",
+          {"paper63", out_dir, scalar.value() == NavScalar::kFloat ? "float32" : "double"});
+      rc != kExitOk) {
+    return rc;
   }
   return kExitOk;
 }

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/host_sim/data_paths.hpp"
@@ -73,22 +74,68 @@ HostStatus plot(const std::string& script, const std::vector<std::string>& args)
   argv.insert(argv.end(), args.begin(), args.end());
   // The summary first, then the script's own output (both go to the same terminal or log).
   (void)std::fflush(stdout);
-  const auto r = lnx::run_program(argv);
-  if (!r.is_ok()) {
-    const int err = r.status().os_error();
+  // Ctrl-C while the script runs: a terminal's Ctrl-C reaches the script too (it dies by SIGINT,
+  // quietly: the scripts restore SIGINT's default action); a signal sent to this program alone
+  // is passed on as SIGTERM. Either way the caller reports the interruption, not a failed plot.
+  const StopSignals handlers;
+  auto started = lnx::start_program(argv);
+  if (!started.is_ok()) {
+    const int err = started.status().os_error();
     return HostError{ErrorCode::kUnavailable,
                      "plotting failed: cannot start " + python + " " + path + ": " +
-                         r.status().message() +
+                         started.status().message() +
                          (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) +
                          "; the CSV files are written"};
   }
-  if (!r.value().ok()) {
+  lnx::ChildProcess child = started.value();
+  constexpr auto kPoll = std::chrono::milliseconds(20);
+  constexpr auto kGrace = std::chrono::seconds(5);  // then SIGKILL: a script that ignores SIGTERM
+  std::chrono::steady_clock::time_point stop_sent{};
+  bool term_sent = false;
+  bool kill_sent = false;
+  lnx::ProcessExit ended;
+  for (;;) {
+    auto polled = lnx::poll_program(child);
+    if (!polled.is_ok()) {
+      return HostError{ErrorCode::kIoError, "plotting failed: waiting for " + script + ": " +
+                                                polled.status().message() + ": " +
+                                                std::strerror(polled.status().os_error())};
+    }
+    if (polled.value()) {
+      ended = *polled.value();
+      break;
+    }
+    if (g_stop_signal != 0 && !term_sent) {
+      (void)lnx::signal_program(child, SIGTERM);
+      term_sent = true;
+      stop_sent = std::chrono::steady_clock::now();
+    } else if (term_sent && !kill_sent && std::chrono::steady_clock::now() - stop_sent > kGrace) {
+      (void)lnx::signal_program(child, SIGKILL);
+      kill_sent = true;
+    }
+    std::this_thread::sleep_for(kPoll);
+  }
+  if (g_stop_signal != 0) {
     return HostError{ErrorCode::kUnavailable,
-                     "plotting failed: " + script + " ended with " + lnx::describe(r.value()) +
+                     "interrupted (signal " + std::to_string(static_cast<int>(g_stop_signal)) +
+                         ") while plotting: " + script + " stopped (" + lnx::describe(ended) +
+                         "); the CSV files are written, the PNG figures are not"};
+  }
+  if (!ended.ok()) {
+    return HostError{ErrorCode::kUnavailable,
+                     "plotting failed: " + script + " ended with " + lnx::describe(ended) +
                          " (its message is above; set GFINS_PYTHON to a python3 with matplotlib, "
                          "or pass --no-plot); the CSV files are written"};
   }
   return Done{};
+}
+
+int plot_step(const char* program, const std::string& script,
+              const std::vector<std::string>& args) {
+  const HostStatus p = plot(script, args);
+  if (p.is_ok()) return kExitOk;
+  std::fprintf(stderr, "%s: %s\n", program, p.error().message.c_str());
+  return g_stop_signal != 0 ? kExitInterrupted : kExitPlotFailed;
 }
 
 ProgressFn tty_progress(const std::string& what) {

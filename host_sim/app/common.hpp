@@ -47,7 +47,13 @@ HostStatus close_output(std::FILE* f, const std::string& path);
 /// ($GFINS_PYTHON, else Debian's /usr/bin/python3, which has python3-matplotlib; a python3 first on
 /// PATH often lacks it), without a shell: the arguments reach the script as they are, whatever they
 /// contain. Fails with a message naming the script and its exit status (or why it could not start).
+/// Ctrl-C (SIGINT) or SIGTERM while it runs stops the script and fails with "interrupted (signal
+/// N) while plotting"; g_stop_signal then says so.
 HostStatus plot(const std::string& script, const std::vector<std::string>& args);
+
+/// plot() as the last step of a command: kExitOk; or its message on stderr after "<program>: "
+/// and kExitInterrupted (stopped by a signal) or kExitPlotFailed.
+int plot_step(const char* program, const std::string& script, const std::vector<std::string>& args);
 
 /// Progress on a TTY only (a log file gets no \r lines).
 ProgressFn tty_progress(const std::string& what);

@@ -34,8 +34,9 @@ int sim_main(int argc, char** argv) {
   const std::string footer =
       "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
       "scenario rejected (also: a run whose files would not fit on the disk); 3 CSV written but "
-      "plotting failed (PNG asked for); 130 run stopped by Ctrl-C/SIGINT or SIGTERM, its files "
-      "closed and valid up to the time in summary.txt.\n"
+      "plotting failed (PNG asked for); 130 stopped by Ctrl-C/SIGINT or SIGTERM: every file "
+      "written is whole (run: up to the time in summary.txt; montecarlo: the runs finished; "
+      "covariance: the files it names; while plotting: everything but the PNG).\n"
       "A scenario argument with a '/' or ending in .toml is a file (./drive), otherwise a "
       "built-in name (gfins-sim list).\n"
       "Environment: GFINS_SCENARIO_DIR (built-in scenarios), GFINS_SCRIPTS_DIR (plot scripts; "

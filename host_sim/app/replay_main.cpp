@@ -420,9 +420,9 @@ int navigate(const ReplayOptions& o, const sim::RecordingHeader& h,
                                      : std::filesystem::path(o.cal).filename().string()) +
                       ", compensator " + nav::to_string(cfg.compensator) + ", " +
                       (std::is_same_v<T, float> ? "float32" : "double") + " core";
-  if (auto p = app::plot("plot_sim.py", {"replay", out_dir, title}); !p.is_ok()) {
-    std::fprintf(stderr, "gfins-replay: %s\n", p.error().message.c_str());
-    return app::kExitPlotFailed;
+  if (const int rc = app::plot_step("gfins-replay", "plot_sim.py", {"replay", out_dir, title});
+      rc != app::kExitOk) {
+    return rc;
   }
   std::printf("figures: %s/replay.png\n", out_dir.c_str());
   return app::kExitOk;
@@ -534,7 +534,7 @@ int replay_main(int argc, char** argv) {
       "calibration file rejected (also: --align-s longer than the recording, an array that is "
       "not still during the alignment); 3 CSV written but plotting failed (PNG asked for); 130 "
       "stopped by Ctrl-C/SIGINT or SIGTERM, navigation.csv and summary.txt complete up to the "
-      "sample in summary.txt.";
+      "sample in summary.txt (while plotting: everything but the PNG).";
   // dump and means write to stdout only: no folder, no plot.
   const char* stdout_footer =
       "Exit codes: 0 ok; 1 stdout could not be written; 2 command line or recording rejected.";

@@ -8,10 +8,14 @@
 // python3-matplotlib (scripts/install-deps.sh); each run is a tiny scenario (0.05 s at 100 Hz).
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gfins/drivers/linux/spawn.hpp"
@@ -210,6 +214,30 @@ TEST(Spawn, AProgramThatCannotStartAndOneThatFailsAreTold) {
   EXPECT_FALSE(failed.value().ok());
   const auto nul = lnx::run_program(std::vector<std::string>{"true", std::string("a\0b", 3)});
   EXPECT_EQ(nul.status().code(), ErrorCode::kInvalidArgument);
+}
+
+// poll_program: nothing while the child runs, its exit once it ended (reaped: a second poll has
+// no child); a signal's end is told as such.
+TEST(Spawn, PollingAChildTellsRunningFromEnded) {
+  auto started = lnx::start_program(std::vector<std::string>{"sleep", "30"});
+  ASSERT_TRUE(started.is_ok());
+  lnx::ChildProcess child = started.value();
+  const auto running = lnx::poll_program(child);
+  ASSERT_TRUE(running.is_ok());
+  EXPECT_FALSE(running.value().has_value()) << "sleep 30 ended at once";
+  ASSERT_TRUE(lnx::signal_program(child, SIGTERM).is_ok());
+  std::optional<lnx::ProcessExit> ended;
+  for (int i = 0; i < 1000 && !ended; ++i) {  // up to 10 s
+    const auto p = lnx::poll_program(child);
+    ASSERT_TRUE(p.is_ok());
+    ended = p.value();
+    if (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(ended.has_value());
+  EXPECT_FALSE(ended->exited);
+  EXPECT_EQ(ended->signal, SIGTERM);
+  EXPECT_EQ(child.pid, -1);
+  EXPECT_EQ(lnx::poll_program(child).status().code(), ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -74,8 +74,7 @@ TEST(FrontEndTest, RejectsAGainTheScalarTypeCannotHold) {
   p.volts_per_count[2] = 1e30;
   p.scale_v_per_g[2] = 1e-10;
   EXPECT_TRUE(FrontEnd<double>::create(p).is_ok());
-  EXPECT_EQ(FrontEnd<float>::create(p.cast<float>()).status().code(),
-            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(FrontEnd<float>::create(p.cast<float>()).status().code(), ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -85,13 +85,16 @@ Status signal_program(const ChildProcess& child, int signal) {
   return Status::ok();
 }
 
-Result<ProcessExit> wait_program(ChildProcess& child) {
+namespace {
+// One wait4 on `child`; `flags` 0 blocks, WNOHANG returns nullopt while it runs.
+Result<std::optional<ProcessExit>> reap(ChildProcess& child, int flags) {
   if (child.pid <= 0) return Status(ErrorCode::kInvalidArgument, "spawn: no child to wait for");
   int wstatus = 0;
   rusage usage{};
   for (;;) {
-    const pid_t w = wait4(child.pid, &wstatus, 0, &usage);
+    const pid_t w = wait4(child.pid, &wstatus, flags, &usage);
     if (w == child.pid) break;
+    if (w == 0) return std::optional<ProcessExit>{};  // WNOHANG: still running
     if (w < 0 && errno == EINTR) continue;  // a signal handler ran; the child is still there
     return Status(ErrorCode::kIoError, "spawn: waitpid failed", errno);
   }
@@ -104,7 +107,18 @@ Result<ProcessExit> wait_program(ChildProcess& child) {
   } else if (WIFSIGNALED(wstatus)) {
     e.signal = WTERMSIG(wstatus);
   }
-  return e;
+  return std::optional<ProcessExit>{e};
+}
+}  // namespace
+
+Result<ProcessExit> wait_program(ChildProcess& child) {
+  auto r = reap(child, 0);
+  if (!r.is_ok()) return r.status();
+  return *r.value();
+}
+
+Result<std::optional<ProcessExit>> poll_program(ChildProcess& child) {
+  return reap(child, WNOHANG);
 }
 
 std::string describe(const ProcessExit& e) {

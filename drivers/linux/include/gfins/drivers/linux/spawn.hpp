@@ -7,6 +7,7 @@
 // for it and gets its exit status.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 
@@ -54,6 +55,10 @@ Result<ChildProcess> start_program(std::span<const std::string> argv,
 Status signal_program(const ChildProcess& child, int signal);
 /// Waits for a started child and reaps it (its pid is then -1). kIoError when waiting fails.
 Result<ProcessExit> wait_program(ChildProcess& child);
+/// wait_program without blocking: nullopt while the child runs, its exit (reaped) once it ended.
+/// For a caller that must notice its own stop flag while a child runs: SA_RESTART handlers (what
+/// std::signal installs) never wake a blocking wait.
+Result<std::optional<ProcessExit>> poll_program(ChildProcess& child);
 
 /// "exit status 3" / "killed by signal 9 (Killed)": for messages.
 std::string describe(const ProcessExit& e);
