@@ -93,8 +93,11 @@ extern "C" [[gnu::noinline]] void gfins_filter_step() {
   (void)g_pipeline.offer_gnss_position(fix);
   fix.value_n = read_gnss(3);
   (void)g_pipeline.offer_gnss_velocity(fix);
-  const float heading = g_gnss[6];
-  (void)g_pipeline.offer_heading(heading, 0.05F);
+  nav::HeadingFix<float> heading;
+  heading.t_valid_ns = fix.t_valid_ns;
+  heading.yaw_rad = g_gnss[6];
+  heading.sigma_rad = 0.05F;
+  (void)g_pipeline.offer_heading(heading);
   const nav::NavAccuracy<float> a = g_pipeline.accuracy();
   for (int i = 0; i < 3; ++i) {
     g_acc_out[i] = a.euler_sigma_rad(i);

@@ -94,7 +94,8 @@ class FilterRig {
         return out.status == nav::UpdateStatus::kAccepted;
       }
       case FilterOp::kHeading:
-        return f.update_heading(nav_, T(0), T(0.01)).status == nav::UpdateStatus::kAccepted;
+        return f.update_heading(nav_, nav::HeadingFix<T>{nav_.state().t_ns, T(0), T(0.01)})
+                   .status == nav::UpdateStatus::kAccepted;
     }
     return false;
   }

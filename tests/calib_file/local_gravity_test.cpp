@@ -1,4 +1,4 @@
-// Issue 11, defect 1: a board calibrated at one latitude and navigating at rest at another senses
+// A board calibrated at one latitude and navigating at rest at another senses
 // its own site's gravity, to the noise floor, once the calibration file carries the local
 // gravity of the calibration site and the front end converts V/g with it. Converting with
 // standard gravity (the defect) leaves every specific force 9.80665/g_cal − 1 off.

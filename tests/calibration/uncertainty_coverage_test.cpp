@@ -1,4 +1,4 @@
-// Issue 11, defect 2: every calibration route reports uncertainties that cover the truth.
+// Every calibration route reports uncertainties that cover the truth.
 //
 // A Monte-Carlo of each route — the paper's procedure (eqs. (17)/(18) + least squares) and the
 // general solver on the poses of Tables 2/3, and the general solver on fourteen board poses —

@@ -191,7 +191,7 @@ TEST(Cli, PrintDefaultConfigPrintsTheShippedFile) {
   EXPECT_EQ(r.message, default_config_text());
 }
 
-// ---- Issue 8 review, items 1-5: the expected messages are written out in full -----------------
+// ---- Refused values: the expected messages are written out in full ---------------------------
 
 // Item 1: a quoted key is ONE key, dots included (TOML 1.0, "Keys"): "can.node_id" = 7 is not
 // can → node_id, so it is unknown, and must not be accepted and ignored.

@@ -784,16 +784,25 @@ TEST_F(Faults, GnssInputFramesReachTheFilterAndACorruptedOneIsCountedAndLogged) 
   h.age_s = 0.01;
   ASSERT_TRUE(rig.bus->inject_rx(can::encode_heading_fix(h, SimRig::kNode)));
   rig.run_cycles(1);
+  // The same heading 5 s old (ExtHeadingAge reaches 8.19 s): the loop dates it by its age, which
+  // lies before the filter's history (320 ms at the default rates), so it is refused, not taken
+  // as a heading of now.
+  h.sequence = 2;
+  h.age_s = 5.0;
+  ASSERT_TRUE(rig.bus->inject_rx(can::encode_heading_fix(h, SimRig::kNode)));
+  rig.run_cycles(1);
   rig.run();
   lines_ = rig.drain_log();
   EXPECT_EQ(rig.loop->health().aiding_input_errors, 1u);
-  EXPECT_EQ(rig.loop->health().aiding_inputs, 2u);   // the fix and the heading
+  EXPECT_EQ(rig.loop->health().aiding_inputs, 3u);   // the fix and the two headings
   EXPECT_EQ(rig.loop->health().command_errors, 0u);  // input frames are not commands
   const auto& c = rig.loop->pipeline().aiding().filter().counters();
   EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssPosition)], 1u);
   EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kGnssVelocity)], 1u);
   EXPECT_EQ(c.accepted[static_cast<std::size_t>(nav::AidingKind::kHeading)], 1u);
+  EXPECT_EQ(c.invalid[static_cast<std::size_t>(nav::AidingKind::kHeading)], 1u);
   EXPECT_EQ(lines_with(lines_, "aiding input frame").size(), 1u);
+  EXPECT_EQ(lines_with(lines_, "aiding input not applied").size(), 1u);
 }
 
 // Gravity the board has: a board at rest at 24.8° and 50 m, where WGS-84 normal gravity is

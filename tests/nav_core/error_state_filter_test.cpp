@@ -259,6 +259,89 @@ TEST(ErrorStateFilterTest, HeadingFromTheGnssTrack) {
   EXPECT_NE(acc.mode & filter_mode::kGnss, 0);
 }
 
+// ---- External heading with a time of validity ------------------------------------------------
+
+// A tight figure eight (20 m, one per 10 s: 36°/s of yaw rate at its loops) on ideal outputs. The
+// heading frame says the true yaw at 2.8 s and arrives at 3.0 s (age 0.2 s, as ExtHeadingAge
+// carries it); the yaw turns by |ψ(3.0) − ψ(2.8)| in between, which the test computes from the
+// truth. Compared with the filter's heading at its time of validity the fix is right; stamped
+// with its arrival time (the age ignored) it is that many degrees off.
+struct HeadingRun {
+  UpdateOutcome outcome;
+  double yaw_err_rad = 0;  // ψ̂ − ψ at 3.0 s, after the fix
+  double turn_rad = 0;     // ψ(3.0) − ψ(2.8) of the truth
+};
+
+constexpr double kTv = 2.8, kNow = 3.0;  // the heading's time of validity, its arrival
+
+// The run to kNow, then a heading fix saying the true yaw at kTv, stamped `stamped_s`.
+HeadingRun heading_with_age(bool heading_known, double stamped_s) {
+  constexpr double kR = 20, kW = 2 * kPi / 10, kRate = 200;
+  constexpr int kDecimation = 10;  // propagation (and a history entry) at 20 Hz
+  const auto truth = [](double t) { return testing::figure_eight(t, kR, kW); };
+  static ErrorStateFilter<double> filter;
+  const auto solver = ArraySolver<double>::create(table1_geometry(0.1)).value();
+  Strapdown<double> nav(solver, GravityModel<double>::constant(testing::kG));
+  RunSpec spec;
+  spec.rate_hz = kRate;
+  auto config = testing::filter_config(spec);
+  config.heading_known = heading_known;
+  const testing::Truth x0 = truth(0);
+  NavState<double> init = testing::nav_state_of<double>(x0);
+  if (!heading_known)
+    init.q_nb = quat_from_rotation_vector<double>(Vec3<double>(0, 0, 1.0)) * x0.q_nb;
+  init.status = nav_status::kAligned;
+  nav.initialize(init, testing::ideal_outputs(solver.geometry(), x0));
+  EXPECT_TRUE(filter.configure(config).is_ok());
+  filter.start(nav);
+  const long steps = std::lround(kNow * kRate);
+  for (long k = 1; k <= steps; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    nav.step(testing::ideal_outputs(solver.geometry(), truth(t)), 1.0 / kRate,
+             std::llround(t * 1e9), static_cast<std::uint32_t>(k));
+    if (k % kDecimation == 0) {
+      EXPECT_TRUE(filter.propagate(nav, kDecimation / kRate).is_ok());
+    }
+  }
+  const double yaw_tv = euler_from_quat(truth(kTv).q_nb).z();
+  const double yaw_now = euler_from_quat(truth(kNow).q_nb).z();
+  HeadingFix<double> fix;
+  fix.t_valid_ns = std::llround(stamped_s * 1e9);
+  fix.yaw_rad = yaw_tv;
+  fix.sigma_rad = 0.5 * kPi / 180;
+  HeadingRun r;
+  r.outcome = filter.update_heading(nav, fix);
+  r.yaw_err_rad = wrap_pi(euler_from_quat(nav.state().q_nb).z() - yaw_now);
+  r.turn_rad = wrap_pi(yaw_now - yaw_tv);
+  return r;
+}
+
+TEST(ErrorStateFilterTest, ExternalHeadingIsComparedAtItsTimeOfValidity) {
+  // Heading unknown: the fix sets it. With its age, to the interpolation error of the history
+  // (slerp between 50 ms entries on ideal outputs: ~1e-4 rad, far below the turn); without,
+  // off by the whole turn.
+  const HeadingRun set = heading_with_age(false, kTv);
+  const HeadingRun set_now = heading_with_age(false, kNow);
+  std::printf("turn over the age %.2f deg; reset error with the age %.4f deg, without %.2f deg\n",
+              set.turn_rad * 180 / kPi, set.yaw_err_rad * 180 / kPi,
+              set_now.yaw_err_rad * 180 / kPi);
+  ASSERT_GT(std::abs(set.turn_rad), 3 * kPi / 180) << "the test needs a turn during the age";
+  EXPECT_EQ(set.outcome.status, UpdateStatus::kReset);
+  constexpr double kInterpTol = 1e-3;  // rad; 17 times below the turn this test needs
+  EXPECT_NEAR(set.yaw_err_rad, 0.0, kInterpTol);
+  EXPECT_NEAR(set_now.yaw_err_rad, -set.turn_rad, kInterpTol);  // negative control
+  // Heading known and right: the fix is an update through the χ² gate. With its age the
+  // innovation is the interpolation error (NIS ≪ 1); stamped now it is the turn, over 6σ of
+  // 0.5°: rejected by the gate (χ²₁ at the 0.999 gate is 10.8, the turn gives ≥ 36).
+  const HeadingRun upd = heading_with_age(true, kTv);
+  const HeadingRun upd_now = heading_with_age(true, kNow);
+  EXPECT_EQ(upd.outcome.status, UpdateStatus::kAccepted);
+  EXPECT_LT(upd.outcome.nis, 1.0F);
+  EXPECT_EQ(upd_now.outcome.status, UpdateStatus::kRejected);
+  // A fix older than the history (32 entries at 20 Hz: 1.55 s back) is refused, not applied.
+  EXPECT_EQ(heading_with_age(true, kNow - 2.0).outcome.status, UpdateStatus::kInvalid);
+}
+
 // ---- Euler σ: the Jacobian against finite differences of the Euler angles -------------------
 
 TEST(ErrorStateFilterTest, EulerJacobianMatchesFiniteDifferences) {

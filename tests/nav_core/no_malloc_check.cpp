@@ -86,7 +86,8 @@ long allocations_for_filter() {
     outcomes += static_cast<std::uint32_t>(filter.update_gnss_position(nav, fix).status);
     fix.value_n = k == 100 ? Vec3<T>(T(5), T(0), T(0)) : Vec3<T>::Zero();
     outcomes += static_cast<std::uint32_t>(filter.update_gnss_velocity(nav, fix).status);
-    outcomes += static_cast<std::uint32_t>(filter.update_heading(nav, T(0), T(0.1)).status);
+    outcomes += static_cast<std::uint32_t>(
+        filter.update_heading(nav, HeadingFix<T>{nav.state().t_ns, T(0), T(0.1)}).status);
     if (filter.accuracy(nav.state()).valid == 0xff) return -3;
   }
   if (!filter.heading_aligned() || outcomes == 0) return -4;

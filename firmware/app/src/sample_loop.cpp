@@ -470,8 +470,11 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
       note(pipeline_.offer_gnss_velocity(fix));
     }
   } else {
-    note(pipeline_.offer_heading(static_cast<float>(e.heading.heading_rad),
-                                 static_cast<float>(e.heading.sigma_rad)));
+    nav::HeadingFix<float> fix;
+    fix.t_valid_ns = t_ns - static_cast<std::int64_t>(std::llround(e.heading.age_s * 1e9));
+    fix.yaw_rad = static_cast<float>(e.heading.heading_rad);
+    fix.sigma_rad = static_cast<float>(e.heading.sigma_rad);
+    note(pipeline_.offer_heading(fix));
   }
   if (worst != nav::UpdateStatus::kAccepted) {
     limited_log(LogKind::kAidingRejected, LogLevel::kInfo, t_ns,

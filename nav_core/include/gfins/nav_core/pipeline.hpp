@@ -121,12 +121,13 @@ class NavPipeline {
   PipelinePhase process_specific_force(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq);
 
   // ---- Aiding (PipelineConfig::aiding) -------------------------------------------------------
-  // External measurements with their own time of validity (GnssFix::t_valid_ns, on the samples'
-  // clock); each goes through the filter's χ² gate. Not aligned or aiding off: kInvalid.
+  // External measurements with their own time of validity (GnssFix / HeadingFix::t_valid_ns, on
+  // the samples' clock); each goes through the filter's χ² gate. Not aligned or aiding off:
+  // kInvalid.
 
   UpdateOutcome offer_gnss_position(const GnssFix<T>& fix);
   UpdateOutcome offer_gnss_velocity(const GnssFix<T>& fix);
-  UpdateOutcome offer_heading(T yaw_rad, T sigma_rad);
+  UpdateOutcome offer_heading(const HeadingFix<T>& fix);
   /// The filter, the detector and the accuracy of state(); aiding().started() says whether the
   /// σ mean anything (aiding on and aligned).
   const Aiding<T>& aiding() const { return aiding_; }
@@ -292,8 +293,8 @@ UpdateOutcome NavPipeline<T>::offer_gnss_velocity(const GnssFix<T>& fix) {
 }
 
 template <typename T>
-UpdateOutcome NavPipeline<T>::offer_heading(T yaw_rad, T sigma_rad) {
-  return aiding_.offer_heading(strapdown_, yaw_rad, sigma_rad);
+UpdateOutcome NavPipeline<T>::offer_heading(const HeadingFix<T>& fix) {
+  return aiding_.offer_heading(strapdown_, fix);
 }
 
 template <typename T>

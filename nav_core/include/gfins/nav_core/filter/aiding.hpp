@@ -71,7 +71,7 @@ class Aiding {
 
   UpdateOutcome offer_gnss_position(Nav& nav, const GnssFix<T>& fix);
   UpdateOutcome offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix);
-  UpdateOutcome offer_heading(Nav& nav, T yaw_rad, T sigma_rad);
+  UpdateOutcome offer_heading(Nav& nav, const HeadingFix<T>& fix);
 
   /// 1σ, mode and validity; only meaningful when started().
   NavAccuracy<T> accuracy(const NavState<T>& nav) const;
@@ -205,9 +205,9 @@ UpdateOutcome Aiding<T>::offer_gnss_velocity(Nav& nav, const GnssFix<T>& fix) {
 }
 
 template <typename T>
-UpdateOutcome Aiding<T>::offer_heading(Nav& nav, T yaw_rad, T sigma_rad) {
+UpdateOutcome Aiding<T>::offer_heading(Nav& nav, const HeadingFix<T>& fix) {
   if (!started_) return not_started();
-  return filter_.update_heading(nav, yaw_rad, sigma_rad);
+  return filter_.update_heading(nav, fix);
 }
 
 template <typename T>

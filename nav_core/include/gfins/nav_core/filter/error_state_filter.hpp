@@ -217,9 +217,11 @@ class ErrorStateFilter {
   /// and, above track_min_speed_mps, the heading from the track.
   UpdateOutcome update_gnss_velocity(Nav& nav, const GnssFix<T>& fix);
 
-  /// External heading (yaw from north, rad) with its 1σ, valid now. Before heading alignment it
-  /// sets the heading.
-  UpdateOutcome update_heading(Nav& nav, T yaw_rad, T sigma_rad);
+  /// External heading valid at fix.t_valid_ns (≤ now, within the history): the innovation is
+  /// taken against the filter's heading at that instant, so a heading that is 200 ms old on a
+  /// board turning at 30°/s is not read as a 6° error. Before heading alignment it sets the
+  /// heading (the offset found at that instant, applied now).
+  UpdateOutcome update_heading(Nav& nav, const HeadingFix<T>& fix);
 
   // ---- Outputs --------------------------------------------------------------------------------
 
@@ -635,14 +637,16 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& na
 }
 
 template <typename T, int HistoryCapacity>
-UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav, T yaw_rad,
-                                                                   T sigma_rad) {
-  if (!started_ || !std::isfinite(yaw_rad) || !(sigma_rad > T(0))) {
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav,
+                                                                   const HeadingFix<T>& fix) {
+  HistoryEntry<T> at;
+  if (!started_ || !std::isfinite(fix.yaw_rad) || !(fix.sigma_rad > T(0)) ||
+      !std::isfinite(fix.sigma_rad) || !history_.at(fix.t_valid_ns, nav.state(), at)) {
     return invalid(AidingKind::kHeading);
   }
-  const Measurement<T, 1> m = heading_measurement(nav.state().q_nb, yaw_rad, sigma_rad);
+  const Measurement<T, 1> m = heading_measurement(at.q_nb, fix.yaw_rad, fix.sigma_rad);
   if (!heading_aligned_) {
-    set_heading(nav, m.y(0), sigma_rad);
+    set_heading(nav, m.y(0), fix.sigma_rad);
     return accepted_reset(AidingKind::kHeading, nav);
   }
   return apply(m, AidingKind::kHeading, gate_1_, nav);

@@ -11,6 +11,8 @@
 // σ grow without bound there, which is the truth about those angles.
 #pragma once
 
+#include <cstdint>
+
 #include <cmath>
 
 #include "gfins/nav_core/filter/measurement.hpp"
@@ -40,6 +42,15 @@ T wrap_pi(T a) {
   while (a <= -kPi) a += T(2) * kPi;
   return a;
 }
+
+/// An external heading (dual-antenna GNSS, magnetometer): yaw from north, its 1σ and the instant
+/// it was valid (the filter compares it with its own heading at that instant, from the history).
+template <typename T>
+struct HeadingFix {
+  std::int64_t t_valid_ns = 0;
+  T yaw_rad = T(0);
+  T sigma_rad = T(1);
+};
 
 /// External heading (yaw, rad from north, 1σ sigma_rad): y = ψ̂ − ψ = J_yaw φ − n, 1-D.
 template <typename T>
