@@ -2,7 +2,10 @@
 // line and key, unknown keys, and the command line overriding the file.
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <vector>
 
@@ -378,6 +381,18 @@ TEST(Cli, PreflightFindsWhatOnlyTheRunFoundBefore) {
   EXPECT_EQ(preflight(c, boards, "o"),
             "o: can.log_file = \"/nonexistent-gfins/x.log\": its folder \"/nonexistent-gfins\" "
             "does not exist");
+  // A folder that is a symlink loop does not "not exist": the system's ELOOP text says what it is.
+  const std::string loop = ::testing::TempDir() + "gfins-preflight-loop";
+  std::filesystem::remove(loop);
+  std::filesystem::remove(loop + "2");
+  std::filesystem::create_symlink(loop + "2", loop);
+  std::filesystem::create_symlink(loop, loop + "2");
+  c.can_log = loop + "/x.log";
+  EXPECT_EQ(preflight(c, boards, "o"), "o: can.log_file = \"" + loop + "/x.log\": its folder \"" +
+                                           loop +
+                                           "\" cannot be looked at: " + std::strerror(ELOOP));
+  std::filesystem::remove(loop);
+  std::filesystem::remove(loop + "2");
   c.can_log = "/tmp";
   EXPECT_EQ(preflight(c, boards, "o"), "o: can.log_file = \"/tmp\": is a folder, not a file");
   c.can_log = "out.log";  // the working folder

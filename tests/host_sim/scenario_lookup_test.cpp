@@ -3,7 +3,9 @@
 // name suggests the closest built-in names; the data folders are found relative to the program.
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -106,6 +108,16 @@ TEST_F(ScenarioLookupFs, UnknownNameSuggestsClosestAndList) {
   const auto missing = load_scenario("./nothing.toml", kBuiltinDir);
   ASSERT_FALSE(missing.is_ok());
   EXPECT_NE(missing.error().message.find("no such scenario file"), std::string::npos);
+  // A symlink loop is not a missing file: the system's ELOOP text (strerror), not "no such".
+  fs::create_symlink("loop-b.toml", dir_ / "loop-a.toml");
+  fs::create_symlink("loop-a.toml", dir_ / "loop-b.toml");
+  const auto loop = load_scenario("./loop-a.toml", kBuiltinDir);
+  ASSERT_FALSE(loop.is_ok());
+  const std::string& lm = loop.error().message;
+  EXPECT_NE(lm.find("./loop-a.toml: cannot look at it: " + std::string(std::strerror(ELOOP))),
+            std::string::npos)
+      << lm;
+  EXPECT_EQ(lm.find("no such"), std::string::npos) << lm;
 }
 
 // data_paths: the prefixes above a program's folder, as laid out by an install and a build tree.

@@ -22,8 +22,10 @@ std::string output_path_problem(const std::string& path) {
   const fs::path p(path);
   if (fs::is_directory(p, ec)) return "is a folder, not a file";
   const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  if (!fs::exists(parent, ec))
-    return "its folder " + quote_text(parent.string()) + " does not exist";
+  const bool there = fs::exists(parent, ec);
+  if (ec)
+    return "its folder " + quote_text(parent.string()) + " cannot be looked at: " + ec.message();
+  if (!there) return "its folder " + quote_text(parent.string()) + " does not exist";
   if (!fs::is_directory(parent, ec)) return quote_text(parent.string()) + " is not a folder";
   return "";
 }

@@ -37,7 +37,13 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 HostResult<Scenario> load_file(const fs::path& path) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) {
+  const bool there = fs::exists(path, ec);
+  if (ec) {
+    // Not "no such file": a symlink loop (ELOOP), a folder on the way that may not be searched
+    // (EACCES), a name too long. The system's own words say which.
+    return HostError{ErrorCode::kIoError, path.string() + ": cannot look at it: " + ec.message()};
+  }
+  if (!there) {
     return HostError{ErrorCode::kInvalidArgument, path.string() + ": no such scenario file"};
   }
   if (fs::is_directory(path, ec)) {

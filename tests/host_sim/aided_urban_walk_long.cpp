@@ -1,0 +1,108 @@
+// The built-in `urban-stop-and-go` (660 s: 15 s stops every 50 s, 12 m/s on a weaving road; 5 Hz
+// receiver, 1.5 m / 0.1 m/s, 100 ms latency, lever arm) and `walk` (300 s at 1.4 m/s with a 1 s
+// stop every 4 s; handheld receiver 1 Hz, 3 m / 0.2 m/s, 200 ms) scenarios through the host
+// navigation loop with their [aiding] switched on, as `gfins-sim aided` runs them: the figures of
+// docs/navigation-accuracy.md, held by bounds. QA-1100 model at 40 °C, float32 core. The oracle is
+// each trajectory's analytic truth.
+//
+// Bounds, and where they come from:
+//  - RMS over t ≥ 10 s: horizontal position ≤ 1.5 m and velocity ≤ 0.1 m/s (the aiding targets
+//    for a 1.5 m / 0.1 m/s receiver; the walk's receiver is worse, the same bounds hold), heading
+//    ≤ 1° (the target after the first turn). Measured urban 0.21 m, 0.066 m/s, 0.29°; walk 0.55 m,
+//    0.018 m/s, 0.28°.
+//  - tilt RMS: the walk meets the 0.3° target (0.11°); the urban drive misses it (0.34°: the
+//    sensor model's scale-factor drift under acceleration is not among the filter's states,
+//    docs/navigation-accuracy.md), so its bound is 0.5°, the measured figure with room for the
+//    float core's rounding, and still failed by a filter that loses its tilt in the stops' braking.
+//  - bounded over ten minutes (urban): at 600 s position ≤ 1.5 m and velocity ≤ 0.1 m/s (measured
+//    0.22 m and 0.042 m/s), as at 60 s.
+//  - every error component within the filter's 3σ in ≥ 98 % of the samples after 10 s (measured
+//    99.5 % urban, 100 % walk; the samples are correlated in time, see aided_highway_long.cpp).
+//  - negative control: the same drive unaided is kilometres off at 60 s (measured 2.4 km), so the
+//    position bound cannot pass without the filter.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "gfins/host_sim/accuracy.hpp"
+#include "gfins/host_sim/scenario.hpp"
+
+namespace gfins::sim {
+namespace {
+
+const std::string kScenarioDir = std::string(GFINS_TEST_DATA_DIR) + "/../../host_sim/scenarios";
+
+constexpr double kPosRmsMaxM = 1.5;
+constexpr double kVelRmsMaxMps = 0.1;
+constexpr double kHeadingRmsMaxDeg = 1.0;
+constexpr double kTiltTargetDeg = 0.3;
+constexpr double kUrbanTiltRmsMaxDeg = 0.5;
+constexpr double kWithin3SigmaMin = 0.98;
+constexpr double kUnaidedOffAt60sMinM = 1000.0;
+
+AccuracyTracker run_aided(const std::string& name, bool aided) {
+  auto s = load_scenario(name, kScenarioDir);
+  EXPECT_TRUE(s.is_ok()) << s.error().message;
+  Scenario sc = s.value();
+  EXPECT_TRUE(sc.gnss.has_value()) << name;
+  sc.aiding.enabled = aided;
+  AccuracyTracker acc({60.0, 600.0}, 10.0);
+  StreamTargets t;
+  t.uncompensated_run = false;
+  t.accuracy = &acc;
+  auto o = run_scenario_streamed(sc, t, {}, NavScalar::kFloat);
+  EXPECT_TRUE(o.is_ok()) << o.error().message;
+  return acc;
+}
+
+void expect_consistent(const AccuracyTracker& acc) {
+  ASSERT_GT(acc.sigma_samples(), 200000u);
+  for (std::size_t k = 0; k < kConsistencyComponents; ++k) {
+    EXPECT_GE(acc.within_3sigma(k), kWithin3SigmaMin) << kConsistencyNames[k];
+  }
+}
+
+TEST(AidedUrban, TenMinutesOfStopAndGoStayWithinTheTargets) {
+  const AccuracyTracker acc = run_aided("urban-stop-and-go", true);
+  ASSERT_GT(acc.rms_samples(), 600000u);
+  EXPECT_LE(acc.pos_h_rms_m(), kPosRmsMaxM);
+  EXPECT_LE(acc.vel_rms_mps(), kVelRmsMaxMps);
+  EXPECT_LE(acc.heading_rms_deg(), kHeadingRmsMaxDeg);
+  EXPECT_LE(acc.tilt_rms_deg(), kUrbanTiltRmsMaxDeg);
+  ASSERT_EQ(acc.checkpoints().size(), 2u);
+  for (const ErrorSnapshot& at : acc.checkpoints()) {
+    ASSERT_TRUE(at.seen) << at.t_s;
+    EXPECT_LE(at.pos_h_m, kPosRmsMaxM) << "at " << at.t_s << " s";
+    EXPECT_LE(at.vel_mps, kVelRmsMaxMps) << "at " << at.t_s << " s";
+  }
+  EXPECT_TRUE(std::isfinite(acc.worst().pos_h_m + acc.worst().tilt_deg));
+  expect_consistent(acc);
+  std::printf("urban aided: %s; at 600 s pos %.3f m, vel %.3f m/s\n", acc.describe_rms().c_str(),
+              acc.checkpoints()[1].pos_h_m, acc.checkpoints()[1].vel_mps);
+}
+
+TEST(AidedUrban, UnaidedTheSameDriveIsKilometresOff) {
+  const AccuracyTracker acc = run_aided("urban-stop-and-go", false);
+  ASSERT_FALSE(acc.checkpoints().empty());
+  const ErrorSnapshot& at60 = acc.checkpoints()[0];
+  ASSERT_TRUE(at60.seen);
+  // Non-finite counts as off: the unaided solution leaves the finite numbers within 100 s.
+  EXPECT_FALSE(at60.pos_h_m <= kUnaidedOffAt60sMinM) << at60.pos_h_m;
+  std::printf("urban unaided at 60 s: %.0f m\n", at60.pos_h_m);
+}
+
+TEST(AidedWalk, AStopEveryFourSecondsAndAHandheldReceiver) {
+  const AccuracyTracker acc = run_aided("walk", true);
+  ASSERT_GT(acc.rms_samples(), 280000u);
+  EXPECT_LE(acc.pos_h_rms_m(), kPosRmsMaxM);
+  EXPECT_LE(acc.vel_rms_mps(), kVelRmsMaxMps);
+  EXPECT_LE(acc.heading_rms_deg(), kHeadingRmsMaxDeg);
+  EXPECT_LE(acc.tilt_rms_deg(), kTiltTargetDeg);
+  expect_consistent(acc);
+  std::printf("walk aided: %s\n", acc.describe_rms().c_str());
+}
+
+}  // namespace
+}  // namespace gfins::sim
