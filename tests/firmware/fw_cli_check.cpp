@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -179,6 +180,27 @@ TEST_F(FwCli, TwoOutputsOnOneFileAreRefusedBeforeTheRun) {
   }
   const test::CliResult ok = fw(sim_run({"--latency-csv", "/dev/null"}, "rest", "/dev/null"));
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
+}
+
+// A simulated run faster than real time (the default pacing) reports how far it got, every
+// interval of wall-clock time ($GFINS_PROGRESS_INTERVAL_S, documented for tests; 5 s otherwise);
+// real-time pacing, whose run takes the scenario's own time, does not. Oracle: the run's length
+// (20 s of scenario at 1 kHz: tens of thousands of 4096-cycle checks at a 1 ms interval) and the
+// line's documented text.
+TEST_F(FwCli, AFastSimulatedRunReportsItsProgress) {
+  ASSERT_EQ(setenv("GFINS_PROGRESS_INTERVAL_S", "0.001", 1), 0);
+  auto args = sim_run({});
+  const auto d = std::find(args.begin(), args.end(), "--duration");
+  ASSERT_NE(d, args.end());
+  *(d + 1) = "20";
+  const test::CliResult r = fw(args);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("progress: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" of 20.0 s of the scenario)"), std::string::npos) << r.output;
+  const test::CliResult paced = fw(sim_run({"--pacing", "realtime"}));
+  unsetenv("GFINS_PROGRESS_INTERVAL_S");
+  EXPECT_EQ(paced.exit_code, 0) << paced.output;
+  EXPECT_EQ(paced.output.find("progress: "), std::string::npos) << paced.output;
 }
 
 TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {

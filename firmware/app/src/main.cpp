@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <exception>
@@ -23,6 +24,18 @@
 namespace {
 
 std::atomic<bool> g_stop{false};
+
+// Seconds between two progress lines of a simulated run: 5, or $GFINS_PROGRESS_INTERVAL_S (> 0,
+// for tests; the same variable as gfins-sim's).
+double progress_interval_s() {
+  const char* env = std::getenv("GFINS_PROGRESS_INTERVAL_S");
+  if (env != nullptr) {
+    char* end = nullptr;
+    const double v = std::strtod(env, &end);
+    if (end != env && *end == '\0' && v > 0.0 && v < 1e6) return v;
+  }
+  return 5.0;
+}
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 // Writes text whole, NULs and all (fputs would stop at the first), with control characters
@@ -108,7 +121,22 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   std::signal(SIGTERM, on_signal);
   const std::clock_t cpu0 = std::clock();
   const auto wall0 = std::chrono::steady_clock::now();
-  while (!g_stop.load(std::memory_order_relaxed) && !board.finished()) loop->step();
+  if (board.progress) {
+    // A progress line every interval of wall-clock time, looked at every 4096 cycles (a clock
+    // read per cycle would cost the loop more than the line is worth).
+    const auto interval = std::chrono::duration<double>(progress_interval_s());
+    auto next = wall0 + interval;
+    for (std::uint32_t n = 1; !g_stop.load(std::memory_order_relaxed) && !board.finished(); ++n) {
+      loop->step();
+      if ((n & 4095U) != 0 || std::chrono::steady_clock::now() < next) continue;
+      next += interval;
+      const BoardProgress p = board.progress();
+      spdlog::info("progress: {:.0f} % (t = {:.1f} of {:.1f} s of the scenario)",
+                   100.0 * p.fraction, p.fraction * p.duration_s, p.duration_s);
+    }
+  } else {
+    while (!g_stop.load(std::memory_order_relaxed) && !board.finished()) loop->step();
+  }
   const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

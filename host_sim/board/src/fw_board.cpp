@@ -81,6 +81,12 @@ app::BoardResult make_board(const app::FwConfig& c) {
   }
   const SimSampleSource* src = source.get();
   b->finished = [src] { return src->finished(); };
+  if (fast) {
+    // Faster than real time, a long scenario runs for minutes: gfins-fw reports how far it got.
+    b->progress = [src, samples, duration] {
+      return app::BoardProgress{1.0 - static_cast<double>(src->remaining()) / samples, duration};
+    };
+  }
   b->source = std::move(source);
   if (std::string e = app::open_can_output(c, *b->clock, *b); !e.empty()) {
     out.error = e;

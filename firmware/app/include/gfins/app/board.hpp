@@ -23,6 +23,12 @@
 
 namespace gfins::app {
 
+/// How far a board with a known end (the simulated board running faster than real time) is.
+struct BoardProgress {
+  double fraction = 0.0;    // 0..1 of its samples delivered
+  double duration_s = 0.0;  // the whole run, in the board's time
+};
+
 struct Board {
   // Declaration order is destruction order reversed: what others refer to comes first (the
   // simulated parts and the clock outlive the source and the bus, whose destructor flushes a
@@ -37,6 +43,8 @@ struct Board {
   calib_file::CalibrationData defaults;                // nominal calibration of this board
   std::optional<calib_file::CalibrationData> factory;  // used when no file is configured
   std::function<bool()> finished = [] { return false; };
+  /// Null: no known end (a real board), nothing to report.
+  std::function<BoardProgress()> progress;
   /// SCHED_FIFO + mlockall as configured; returns a warning when not permitted ("" when done).
   std::function<std::string(const FwConfig&)> enter_realtime = [](const FwConfig&) {
     return std::string();

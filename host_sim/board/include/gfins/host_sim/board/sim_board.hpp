@@ -120,6 +120,8 @@ class SimSampleSource final : public app::SampleSource {
   void set_faults(const FaultPlan& f) { faults_ = f; }
   /// True once every sample of the run was delivered.
   bool finished() const { return remaining_ == 0; }
+  /// Samples of the run not delivered yet.
+  std::uint32_t remaining() const { return remaining_; }
   std::uint32_t next_seq() const { return next_seq_; }
 
  private:
