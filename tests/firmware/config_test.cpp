@@ -108,6 +108,10 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[can]\nnode_id = \"1\"\n", {"can.node_id", "integer"}},
       {"[adc]\nsample_rate_hz = 1234\n",
        {"bad.toml:2: adc.sample_rate_hz = 1234", "500, 1000, 2000 or 4000"}},
+      // A value a hair off an allowed one is shown as it was read, not rounded onto it.
+      {"[adc]\nsample_rate_hz = 1000.0000001\n",
+       {"bad.toml:2: adc.sample_rate_hz = 1000.0000001: must be 500, 1000"}},
+      {"[navigation]\nalignment_s = 600.0000001\n", {"navigation.alignment_s = 600.0000001"}},
       {"[board]\nkind = \"arm\"\n", {"board.kind = \"arm\"", "\"linux\", \"sim\" or \"hil\""}},
       {"[navigation]\ncompensator = \"best\"\n", {"navigation.compensator", "\"paper\""}},
       {"[navigation]\nposition_m = [1, 2]\n", {"navigation.position_m", "3 numbers"}},

@@ -2,8 +2,10 @@
 // rules between keys, and every rule the board's backends apply to a value when the run opens
 // them, so that a configuration check() accepts is not refused later for its values.
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
-#include <sstream>
+#include <string>
 
 #include "gfins/app/config.hpp"
 
@@ -55,10 +57,12 @@ std::string drdy_line_problem(const std::string& s) {
   return "";
 }
 
+// The shortest text that reads back as x (std::to_chars): 1000.0000001 is not shown as "1000",
+// which an ostream's default six digits made of it (a refusal of a value the message called valid).
 std::string num(double x) {
-  std::ostringstream o;
-  o << x;
-  return o.str();
+  std::array<char, 32> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), x);
+  return std::string(buf.data(), r.ptr);
 }
 
 constexpr const char* kPathRule = "must be a path of valid UTF-8 without control characters";
