@@ -93,7 +93,7 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   // The propagation keeps decimated envelopes only; the reference run holds its series.
   print_estimate(sample_count(s), 1,
                  static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
-                 static_cast<double>(sample_count(s)) * kMcSecondsPerSampleRun,
+                 static_cast<double>(sample_count(s)) * kInMemoryRunSecondsPerSample,
                  "the reference run; the propagation adds its own time");
   // Ctrl-C/SIGTERM are taken between the phases (propagation, files, reference run), so every
   // file written is whole; the phases themselves run to their end (seconds for the built-ins).

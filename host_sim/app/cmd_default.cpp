@@ -88,11 +88,11 @@ int cmd_default(const DefaultOptions& o) {
   std::printf("gfins-sim: scenario %s, %.1f s at %.0f Hz, rho %.3f m, %s navigation core\n",
               s.trajectory.kind.c_str(), o.duration_s, o.rate_hz, o.rho_m, o.scalar.c_str());
   // Two runs (ideal, noisy), one after the other, each held in memory (run_memory_bytes).
-  print_estimate(
-      sample_count(s), o.noise_mg > 0 ? 2 : 1,
-      static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
-      static_cast<double>(sample_count(s)) * (o.noise_mg > 0 ? 2.0 : 1.0) * kMcSecondsPerSampleRun,
-      "");
+  print_estimate(sample_count(s), o.noise_mg > 0 ? 2 : 1,
+                 static_cast<double>(run_memory_bytes(s, false) + kProcessBaseBytes),
+                 static_cast<double>(sample_count(s)) * (o.noise_mg > 0 ? 2.0 : 1.0) *
+                     kInMemoryRunSecondsPerSample,
+                 "");
   s.noise_mps2 = 0.0;
   const auto ideal = run(s, scalar, csv, s.name + ", ideal");
   if (csv != nullptr) {

@@ -22,6 +22,11 @@ inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures a
 // (128 + SIGINT, the shells' convention for a program ended by Ctrl-C).
 inline constexpr int kExitInterrupted = 130;
 
+/// Cost of one sample of a run held in memory and written as CSV afterwards (the default command,
+/// covariance's reference run): 60 s of `rest` at 1 kHz took 1.60 s on the 2-core development
+/// machine (`drive` 1.38 s): 13 µs. A Monte-Carlo run writes no rows: kMcSecondsPerSampleRun.
+inline constexpr double kInMemoryRunSecondsPerSample = 13e-6;
+
 /// Prints "gfins-sim: <message>" on stderr and returns `exit_code`.
 int fail(const HostError& e, int exit_code);
 

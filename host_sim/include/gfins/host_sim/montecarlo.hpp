@@ -70,9 +70,10 @@ HostStatus check_montecarlo_size(const Scenario& s, std::size_t runs, std::size_
 /// kMcSecondsPerSampleRun.
 double montecarlo_seconds_estimate(const Scenario& s, std::size_t runs, std::size_t jobs);
 /// Measured cost of one sample of one Monte-Carlo run (simulation, ADC model, float32 core,
-/// statistics): 60 s of `rest` at 1 kHz, 2 runs, -j 1, took 1.60 s on the 2-core development
-/// machine (1.38 s for `drive`): 13 µs.
-inline constexpr double kMcSecondsPerSampleRun = 13e-6;
+/// statistics; Release build, -j 1, 100 runs, the 2-core development machine otherwise idle):
+/// `rest` 1.40 s for 10,001 × 100 samples (1.40 µs), `drive` 3.38 s for 20,001 × 100 (1.69 µs),
+/// `spin` 0.71 s for 5,001 × 100 (1.42 µs): 2 µs, the slowest rounded up.
+inline constexpr double kMcSecondsPerSampleRun = 2e-6;
 
 /// Least-squares slope of log y against log t over the samples with t in [t_lo, t_hi] and y > 0.
 /// Returns NaN with fewer than two such samples.
