@@ -16,7 +16,8 @@ namespace {
 
 using test::CliResult;
 
-constexpr int kExitBadInput = 2;  // gfins-sim and gfins-replay --help
+constexpr int kExitBadInput = 2;        // gfins-sim and gfins-replay --help
+constexpr int kCalibrateExitInput = 1;  // gfins-calibrate --help: input rejected
 
 struct Case {
   const char* exe;
@@ -49,6 +50,27 @@ TEST_F(AbsurdArgsCli, NonFiniteAndAbsurdNumbersAreRefusedNamingTheOption) {
     EXPECT_EQ(r.exit_code, kExitBadInput) << what << "\n" << r.output;
     EXPECT_NE(r.output.find(c.option), std::string::npos) << what << "\n" << r.output;
     EXPECT_EQ(r.output.find("nan\n"), std::string::npos) << what << "\n" << r.output;
+  }
+}
+
+// gfins-calibrate: NaN used to stand for "no --latitude given", so --latitude nan was taken as
+// absent and the run asked for the gravity it had just been given; a NaN nominal scale factor was
+// taken. Both are refused naming the value (exit 1, gfins-calibrate --help).
+TEST_F(AbsurdArgsCli, CalibrateRefusesANaNItUsedToTakeForAbsent) {
+  const std::vector<std::string> base = {
+      "--means", GFINS_GOLDEN_MEANS, "--adc-lsb", "1e-6", "--device-id", "b1", "--dry-run"};
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--latitude", "nan"}, "--latitude nan: the geodetic latitude must be between -90 and 90"},
+      {{"--gravity", "9.79", "--nominal-sf", "nan"},
+       "--nominal-sf nan: a nominal scale factor must be between 1e-06 and 1e+06 V/g"},
+  };
+  for (const auto& [extra, message] : cases) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CliResult r = run(GFINS_CALIBRATE_BIN, args);
+    EXPECT_EQ(r.exit_code, kCalibrateExitInput) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("is required"), std::string::npos) << r.output;
   }
 }
 

@@ -7,7 +7,9 @@
 #include <sys/stat.h>
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -91,17 +93,18 @@ struct Options {
   double rho_m = 0.1;
   double adc_lsb = 0.0;
   double gravity_mps2 = 0.0;
-  double latitude_deg = std::numeric_limits<double>::quiet_NaN();
+  std::optional<double> latitude_deg;  // given or not: NaN is a value to refuse, not "absent"
   double height_m = 0.0;
   double location_prior_m = 1e-3;
   bool force = false;
   bool dry_run = false;
 };
 
+// The shortest text that reads back as x: a refused value is shown as given, not rounded.
 std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
+  std::array<char, 32> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), x);
+  return std::string(buf.data(), r.ptr);
 }
 
 // Numeric options checked before anything is read or solved, with their bounds as plain numbers.
@@ -124,8 +127,14 @@ int check_numbers(const Options& o) {
                                 ": the local gravity must be between 9.7 and 9.9 m/s² (give "
                                 "m/s², not g or Gal)");
   }
-  if (!std::isnan(o.latitude_deg) && outside(o.latitude_deg, -90.0, 90.0)) {
-    return fail(kExitInput, "--latitude " + num(o.latitude_deg) +
+  for (const double sf : o.nominal_sf) {
+    if (outside(sf, calib_file::kMinScaleVPerG, calib_file::kMaxScaleVPerG)) {
+      return fail(kExitInput, "--nominal-sf " + num(sf) +
+                                  ": a nominal scale factor must be between 1e-06 and 1e+06 V/g");
+    }
+  }
+  if (o.latitude_deg && outside(*o.latitude_deg, -90.0, 90.0)) {
+    return fail(kExitInput, "--latitude " + num(*o.latitude_deg) +
                                 ": the geodetic latitude must be between -90 and 90 degrees");
   }
   if (outside(o.height_m, -500.0, 9000.0)) {
@@ -144,7 +153,7 @@ int check_numbers(const Options& o) {
     return fail(kExitInput,
                 "--location-prior " + num(o.location_prior_m) + ": must be between 0 and 0.05 m");
   }
-  if (o.gravity_mps2 != 0.0 && !std::isnan(o.latitude_deg)) {
+  if (o.gravity_mps2 != 0.0 && o.latitude_deg) {
     return fail(kExitInput, "give the local gravity once: --gravity or --latitude, not both");
   }
   return kExitOk;
@@ -158,11 +167,11 @@ bool gravity_from_options(const Options& o, FileSettings& s) {
     s.gravity_source = "given (--gravity)";
     return true;
   }
-  if (!std::isnan(o.latitude_deg)) {
+  if (o.latitude_deg) {
     s.gravity_mps2 = static_cast<double>(
-        nav::GravityModel<double>::normal(o.latitude_deg * std::numbers::pi / 180.0, o.height_m)
+        nav::GravityModel<double>::normal(*o.latitude_deg * std::numbers::pi / 180.0, o.height_m)
             .magnitude_at_origin());
-    s.gravity_source = "WGS-84 normal gravity at latitude " + num(o.latitude_deg) +
+    s.gravity_source = "WGS-84 normal gravity at latitude " + num(*o.latitude_deg) +
                        " deg, height " + num(o.height_m) + " m";
     return true;
   }
@@ -340,7 +349,7 @@ int run(const Options& o) {
     data.source = "gfins-calibrate location from " +
                   std::filesystem::path(o.location_runs).filename().string() + " on " +
                   std::filesystem::path(o.base).filename().string();
-    if (o.gravity_mps2 != 0.0 || !std::isnan(o.latitude_deg)) {
+    if (o.gravity_mps2 != 0.0 || o.latitude_deg) {
       std::cout << "note: --gravity/--latitude ignored: the scale factors of --base are in units "
                    "of its own local gravity, "
                 << num(data.gravity_mps2) << " m/s²\n";
