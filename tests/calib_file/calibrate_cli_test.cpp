@@ -177,6 +177,21 @@ TEST(CalibrateCli, AWrongHeaderIsNamed) {
                                   "sensor, attitude, mean_v (required), std_v, count (optional)"));
 }
 
+// The paper's tables saved by a spreadsheet as "CSV UTF-8" (a byte-order mark first): the same
+// result as the plain file, where the mark used to make the first comment line an unknown header
+// column. Oracle: the report of the plain file, line for line.
+TEST(CalibrateCli, AByteOrderMarkBeforeTheFirstLineIsSkipped) {
+  const TempDir dir;
+  const auto bom = dir.path() / "bom.csv";
+  write_text(bom, "\xEF\xBB\xBF" + read_text(kGolden));
+  const RunResult plain = run_cli(dir, "--means " + kGolden + " --dry-run");
+  const RunResult marked = run_cli(dir, "--means " + bom.string() + " --dry-run");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(marked.exit_code, 0) << marked.output;
+  EXPECT_THAT(marked.output, HasSubstr("verdict: good"));
+  EXPECT_EQ(marked.output.find("not a known column"), std::string::npos) << marked.output;
+}
+
 TEST(CalibrateCli, AHeaderDifferingInOneNameSaysWhichNamesAreAccepted) {
   const TempDir dir;
   const auto bad = dir.path() / "header.csv";

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <utility>
 
 #include "gfins/drivers/lnx/text_file.hpp"
@@ -123,6 +124,10 @@ HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
         drivers::lnx::text_file_error(t.file, read, drivers::lnx::kMaxTableBytes, "a CSV table"),
         0};
   }
+  // A spreadsheet's "CSV UTF-8" starts with a byte-order mark (EF BB BF): it is not part of the
+  // first line (a comment or the header), so it is dropped.
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  if (std::string_view(text).substr(0, kBom.size()) == kBom) text.erase(0, kBom.size());
   std::istringstream in(text);
   std::string line;
   int n = 0;
