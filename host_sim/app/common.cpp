@@ -52,6 +52,42 @@ HostStatus close_output(std::FILE* f, const std::string& path) {
   return Done{};
 }
 
+namespace {
+// Waits for a plot script, polling so that a stop signal taken by this program's handler is
+// noticed (a SA_RESTART handler never wakes a blocking wait): the script gets SIGTERM, then
+// SIGKILL after a grace period if it ignores that.
+HostStatus wait_for_script(drivers::lnx::ChildProcess& child, const std::string& script,
+                           drivers::lnx::ProcessExit& ended) {
+  namespace lnx = gfins::drivers::lnx;
+  constexpr auto kPoll = std::chrono::milliseconds(20);
+  constexpr auto kGrace = std::chrono::seconds(5);
+  std::chrono::steady_clock::time_point stop_sent{};
+  bool term_sent = false;
+  bool kill_sent = false;
+  for (;;) {
+    auto polled = lnx::poll_program(child);
+    if (!polled.is_ok()) {
+      return HostError{ErrorCode::kIoError, "plotting failed: waiting for " + script + ": " +
+                                                polled.status().message() + ": " +
+                                                std::strerror(polled.status().os_error())};
+    }
+    if (polled.value()) {
+      ended = *polled.value();
+      return Done{};
+    }
+    if (g_stop_signal != 0 && !term_sent) {
+      (void)lnx::signal_program(child, SIGTERM);
+      term_sent = true;
+      stop_sent = std::chrono::steady_clock::now();
+    } else if (term_sent && !kill_sent && std::chrono::steady_clock::now() - stop_sent > kGrace) {
+      (void)lnx::signal_program(child, SIGKILL);
+      kill_sent = true;
+    }
+    std::this_thread::sleep_for(kPoll);
+  }
+}
+}  // namespace
+
 HostStatus plot(const std::string& script, const std::vector<std::string>& args) {
   namespace lnx = gfins::drivers::lnx;
   const char* env = std::getenv("GFINS_PYTHON");
@@ -88,33 +124,8 @@ HostStatus plot(const std::string& script, const std::vector<std::string>& args)
                          "; the CSV files are written"};
   }
   lnx::ChildProcess child = started.value();
-  constexpr auto kPoll = std::chrono::milliseconds(20);
-  constexpr auto kGrace = std::chrono::seconds(5);  // then SIGKILL: a script that ignores SIGTERM
-  std::chrono::steady_clock::time_point stop_sent{};
-  bool term_sent = false;
-  bool kill_sent = false;
   lnx::ProcessExit ended;
-  for (;;) {
-    auto polled = lnx::poll_program(child);
-    if (!polled.is_ok()) {
-      return HostError{ErrorCode::kIoError, "plotting failed: waiting for " + script + ": " +
-                                                polled.status().message() + ": " +
-                                                std::strerror(polled.status().os_error())};
-    }
-    if (polled.value()) {
-      ended = *polled.value();
-      break;
-    }
-    if (g_stop_signal != 0 && !term_sent) {
-      (void)lnx::signal_program(child, SIGTERM);
-      term_sent = true;
-      stop_sent = std::chrono::steady_clock::now();
-    } else if (term_sent && !kill_sent && std::chrono::steady_clock::now() - stop_sent > kGrace) {
-      (void)lnx::signal_program(child, SIGKILL);
-      kill_sent = true;
-    }
-    std::this_thread::sleep_for(kPoll);
-  }
+  if (HostStatus w = wait_for_script(child, script, ended); !w.is_ok()) return w;
   if (g_stop_signal != 0) {
     return HostError{ErrorCode::kUnavailable,
                      "interrupted (signal " + std::to_string(static_cast<int>(g_stop_signal)) +
