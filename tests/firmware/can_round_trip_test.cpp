@@ -5,6 +5,8 @@
 // frames out.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -175,7 +177,9 @@ class CanCommands : public ::testing::Test {
             ("gfins_fw_cal_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
              ".toml");
     rig_->config.calibration_file = path_.string();
-    worker_ = std::make_unique<ReloadWorker>(calibration_reloader(rig_->config));
+    // The board runs on its factory calibration: a reload must be of the same device.
+    worker_ = std::make_unique<ReloadWorker>(
+        calibration_reloader(rig_->config, std::nullopt, rig_->factory.device_id));
     rig_->loop->set_reload_worker(worker_.get());
     rig_->configure();
     rig_->run_cycles(1500);
@@ -322,10 +326,12 @@ TEST_F(CanCommands, CaptureSendsTheResultFrames) {
 }
 
 TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
-  // Given a valid calibration file (the factory one with another device id)
+  // Given a valid calibration file of this board (the factory one, recalibrated: a new date and
+  // a slightly different bias, so a new calibration id)
   calib_file::CalibrationData d = rig_->factory;
-  d.device_id = "reloaded-board";
   d.created_utc = "2026-01-01T00:00:00Z";
+  d.sensors[0].bias_g += 1e-5;
+  ASSERT_NE(calib_file::cal_id_of(d), calib_file::cal_id_of(rig_->factory));
   ASSERT_TRUE(calib_file::save_calibration_file(path_, d).is_ok());
   auto r = reload(17);
   ASSERT_NE(part(r, 0), nullptr);
@@ -344,6 +350,21 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);
   EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(d));
+}
+
+// Another board's calibration file put at this board's path, reloaded mid-navigation: refused
+// (Failed), the calibration in use stays. Before, it was taken
+// and the board navigated with the other board's scale factors and misalignments.
+TEST_F(CanCommands, ReloadOfAnotherBoardsFileIsRefused) {
+  const std::uint32_t before = rig_->loop->cal_id();
+  calib_file::CalibrationData other = rig_->factory;
+  other.device_id = "other-board-9";
+  ASSERT_TRUE(calib_file::save_calibration_file(path_, other).is_ok());
+  const auto r = reload(21);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);
+  EXPECT_EQ(rig_->loop->cal_id(), before);
+  EXPECT_TRUE(rig_->loop->calibrated());
 }
 
 TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {

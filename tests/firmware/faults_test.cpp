@@ -684,6 +684,32 @@ TEST_F(Faults, ACalibrationOfAnotherConverterIsRefusedAtStartAndOnReload) {
   static_cast<void>(std::remove(bad.c_str()));
 }
 
+// The reload's device rule: a board on its nominal defaults takes the first file whatever its
+// device id; from then on (and from a start with a file) only files of that device. Oracle: the
+// ids the test writes.
+TEST_F(Faults, AReloadKeepsToTheDeviceOfTheCalibrationInUse) {
+  SimRig& rig = make();
+  const std::string path = ::testing::TempDir() + "gfins_device_rule_cal.toml";
+  FwConfig c = rig.config;
+  c.calibration_file = path;
+  const auto save_as = [&](const std::string& id, double bias) {
+    calib_file::CalibrationData d = rig.factory;
+    d.device_id = id;
+    d.sensors[2].bias_g = bias;
+    return calib_file::save_calibration_file(path, d).is_ok();
+  };
+  auto from_defaults = calibration_reloader(c, converter_lsb(rig.factory), "");
+  ASSERT_TRUE(save_as("board-a", 1e-4));
+  EXPECT_TRUE(from_defaults(rig.cal.config).has_value()) << "the first file of a nominal board";
+  ASSERT_TRUE(save_as("board-b", 1e-4));
+  EXPECT_FALSE(from_defaults(rig.cal.config).has_value()) << "board-a's calibration is in use";
+  ASSERT_TRUE(save_as("board-a", 2e-4));
+  EXPECT_TRUE(from_defaults(rig.cal.config).has_value()) << "board-a recalibrated";
+  auto from_file = calibration_reloader(c, converter_lsb(rig.factory), "board-b");
+  EXPECT_FALSE(from_file(rig.cal.config).has_value()) << "started on board-b's file";
+  static_cast<void>(std::remove(path.c_str()));
+}
+
 // A calibration that loads (every value in range) but that the navigation core refuses: a custom
 // geometry whose six axes are all x sees no rotation about x and no y/z specific force, so the
 // array's solve is singular. Like any bad file it leaves the board on its flagged defaults

@@ -89,7 +89,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   auto log_queue = std::make_unique<FwLogQueue>();
   LogDrain drain(*log_queue);
   drain.start();
-  ReloadWorker reload(calibration_reloader(cfg, converter_lsb(board.defaults)));
+  ReloadWorker reload(calibration_reloader(cfg, converter_lsb(board.defaults), cal.device_id));
 
   auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
                                            *log_queue);

@@ -129,6 +129,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
     out.set.calibrated = true;
     out.from_file = true;  // a real calibration, not the flagged defaults
     out.message = "factory calibration of the board (" + factory->source + ")";
+    out.device_id = factory->device_id;
     return out;
   }
   if (c.calibration_file.empty()) {
@@ -144,6 +145,7 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
       out.set.cal_id = calib_file::cal_id_of(loaded.value());
       out.set.calibrated = true;
       out.from_file = true;
+      out.device_id = loaded.value().device_id;
       char id[16];
       std::snprintf(id, sizeof id, "%08x", out.set.cal_id);
       out.message = "calibration " + c.calibration_file + " (device " + loaded.value().device_id +
@@ -161,8 +163,10 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
 }
 
 ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
-                                          std::optional<std::array<double, 6>> board_lsb) {
-  return [c, board_lsb](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> {
+                                          std::optional<std::array<double, 6>> board_lsb,
+                                          std::string device_in_use) {
+  return [c, board_lsb, in_use = std::move(device_in_use)](
+             const nav::PipelineConfig<float>&) mutable -> std::optional<CalibrationSet> {
     if (c.calibration_file.empty()) {
       spdlog::error("calibration reload: no calibration file configured");
       return std::nullopt;
@@ -178,10 +182,22 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
                     c.calibration_file, *why);
       return std::nullopt;
     }
+    // Another board's file at this path (copied over it, a mixed-up deployment) would scale and
+    // align every channel with that board's errors while the navigation runs: refused. A board on
+    // its nominal defaults takes its first calibration whatever its id.
+    const std::string& id = loaded.value().device_id;
+    if (!in_use.empty() && id != in_use) {
+      spdlog::error(
+          "calibration reload refused, the calibration in use stays: {}: device_id \"{}\" is not "
+          "this board's (\"{}\"); restart the board to change to another board's calibration",
+          c.calibration_file, printable_text(id), printable_text(in_use));
+      return std::nullopt;
+    }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());
     s.cal_id = calib_file::cal_id_of(loaded.value());
     s.calibrated = true;
+    in_use = id;
     return s;
   };
 }

@@ -31,7 +31,8 @@ LoopOptions loop_options(const FwConfig& c);
 struct StartupCalibration {
   CalibrationSet set;
   bool from_file = false;
-  std::string message;  // what happened (a loud warning when !from_file)
+  std::string message;    // what happened (a loud warning when !from_file)
+  std::string device_id;  // of the calibration in use; empty on the nominal defaults
 };
 
 /// Reads `c.calibration_file`. Missing, invalid, of another converter setting than `defaults`
@@ -50,9 +51,12 @@ calib_file::CalibrationData nominal_calibration(double volts_per_count);
 
 /// The ReloadWorker's loader for the configured file: a new set on success; logs and nullopt on
 /// failure (the calibration in use stays). With `board_lsb` (the board's converter, from
-/// converter_lsb(defaults)) a file of another converter setting is such a failure too.
+/// converter_lsb(defaults)) a file of another converter setting is such a failure too. With
+/// `device_in_use` (StartupCalibration::device_id) a file of another device_id is refused; a
+/// board on its nominal defaults ("") takes the first file, whose id is then the one in use.
 ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
-                                          std::optional<std::array<double, 6>> board_lsb = {});
+                                          std::optional<std::array<double, 6>> board_lsb = {},
+                                          std::string device_in_use = {});
 
 /// Why the board cannot run with a calibration that loaded: another converter setting than
 /// `board_lsb` (when given), or a set the navigation core refuses (a singular custom geometry, a
