@@ -30,8 +30,11 @@ std::string block(const std::string& doc, const std::string& begin, const std::s
 TEST(GeneratedFiles, CommittedDbcIsWhatTheTableGenerates) {
   const std::string committed = read_file(GFINS_SOURCE_DIR "/docs/can/gfins.dbc");
   ASSERT_FALSE(committed.empty());
-  EXPECT_EQ(committed, generate_dbc(0))
+  // The committed DBC decodes a stock board: the node of can.node_id's default (node 1), not 0.
+  static_assert(can::kDefaultNodeId == 1);
+  EXPECT_EQ(committed, generate_dbc(can::kDefaultNodeId))
       << "docs/can/gfins.dbc is stale: regenerate it with `gfins-can-gen dbc > docs/can/gfins.dbc`";
+  EXPECT_NE(committed.find("BO_ 257 GfinsEpoch"), std::string::npos) << "0x100 + node 1";
 }
 
 TEST(GeneratedFiles, IcdTablesAreWhatTheTableGenerates) {

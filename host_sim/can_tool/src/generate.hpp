@@ -6,10 +6,12 @@
 #include <cstdint>
 #include <string>
 
+#include "gfins/can/message_table.hpp"
+
 namespace gfins::can_tool {
 
 /// The DBC of one node (identifiers = base + node_id).
-std::string generate_dbc(std::uint8_t node_id = 0);
+std::string generate_dbc(std::uint8_t node_id = can::kDefaultNodeId);
 
 /// Markdown: one table per message with every signal's type, factor, offset, unit, range,
 /// not-available value and instant.

@@ -1,5 +1,5 @@
 // gfins-can-gen: the small generator of the CAN interface's derived files. Writes to stdout:
-//   gfins-can-gen dbc [node]   docs/can/gfins.dbc (node 0 is the committed one)
+//   gfins-can-gen dbc [node]   docs/can/gfins.dbc (node 1, a stock board's, is the committed one)
 //   gfins-can-gen icd          the signal tables of docs/can-interface.md
 //   gfins-can-gen budget       the bus budget table of docs/can-interface.md
 //   gfins-can-gen log SECONDS  a candump log of a synthetic moving board (tests, benchmarks)
@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: gfins-can-gen dbc [node] | icd | budget | log SECONDS | --help | --version\n"
-    "  dbc [node]    the DBC of the CAN interface for node id 0..15 (default 0)\n"
+    "  dbc [node]    the DBC of the CAN interface for node id 0..15 (default 1, a stock board)\n"
     "  icd           the signal tables of docs/can-interface.md\n"
     "  budget        the bus budget table of docs/can-interface.md\n"
     "  log SECONDS   a candump log of a synthetic moving board, (0, 86400] s\n"
@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
   }
   std::string text;
   if (std::strcmp(argv[1], "dbc") == 0) {
-    int node = 0;
+    int node = gfins::can::kDefaultNodeId;
     if (argc > 2 && !parse_int(argv[2], 0, gfins::can::kMaxNodeId, node)) {
       std::fprintf(stderr, "gfins-can-gen: node id '%s': must be a whole number 0..15\n", argv[2]);
       return 1;

@@ -783,10 +783,11 @@ int main_impl(int argc, char** argv) {
                    "log time of scenario time 0, s (default 0: log time = scenario time)")
       ->check(CLI::Range(0.0, 4.0e9));
 
-  std::uint8_t dbc_node = 0;
+  std::uint8_t dbc_node = can::kDefaultNodeId;
   std::string dbc_out;
   auto* dbc = app.add_subcommand("dbc", "print the DBC generated from the message table");
-  dbc->add_option("--node", dbc_node, "node id")->check(CLI::Range(0, 15));
+  dbc->add_option("--node", dbc_node, "node id (default 1, a stock board)")
+      ->check(CLI::Range(0, 15));
   dbc->add_option("-o,--output", dbc_out, "write here instead of stdout");
 
   try {

@@ -4,15 +4,16 @@
 A candump log is read with python-can (Debian python3-can: can.CanutilsLogReader), each frame's
 CRC-8/SAE-J1850 and epoch counter are checked by code written here from the ICD, the frames are
 decoded with candied (a third-party DBC decoder from npm, pinned by package-lock.json) using the
-committed docs/can/gfins.dbc (node 0; `gfins-can dbc --node N` for other nodes), and every signal
+committed docs/can/gfins.dbc (node 1, a stock board's; `gfins-can dbc --node N` for the synthetic
+board's node 0), and every signal
 value is compared with what `gfins-can decode --view json` printed for the same epoch.
 
 Two logs: the synthetic one of `gfins-can-gen log`, and an extended one this script builds from
 it with frames encoded here from the ICD's byte layout: the optional compensated-accelerometer
 frames (GfinsSensorsA/B) in every epoch, values at the documented saturation limits and at the
 not-available raw value, GNSS fixes and external headings (the aiding input frames, packed by a
-generic encoder written from the ICD's signal tables), and every frame copied to node 3
-(identifier + 3, CRC recomputed).
+generic encoder written from the ICD's signal tables), and every frame copied to node 1
+(identifier + 1, CRC recomputed), which the committed DBC decodes.
 
 The signal tables of docs/can-interface.md (the ICD) give this script each signal's bits, type,
 factor, multiplexor value and not-available code. A value gfins-can shows as not available must
@@ -110,7 +111,7 @@ def ensure_candied():
     subprocess.run([npm, 'ci', '--no-audit', '--no-fund'], cwd=HERE, check=True)
 
 
-NODE_COPY = 3                  # the extended log's second node
+NODE_COPY = 1                  # the extended log's second node: the committed DBC's
 NA_RAW16 = -32768               # not-available raw value of a signed 16-bit signal (ICD)
 RATE_LIMIT_RAW = 32000          # GfinsAngularRate: +-16 rad/s limit / 5e-4 rad/s per bit (ICD)
 SENSOR_LIMIT_RAW = 30000        # GfinsSensorsA/B: +-600 m/s^2 limit / 0.02 m/s^2 per bit (ICD)
@@ -363,6 +364,7 @@ def main():
     ap.add_argument('--gfins-can', required=True)
     ap.add_argument('--gen', required=True)
     ap.add_argument('--dbc', required=True)
+    ap.add_argument('--dbc-node', type=int, default=1, help='the node --dbc is for (default 1)')
     ap.add_argument('--workdir', required=True)
     ap.add_argument('--log')
     ap.add_argument('--icd', help='docs/can-interface.md (default: next to the DBC\'s folder)')
@@ -382,7 +384,7 @@ def main():
         with open(log, 'wb') as f:
             subprocess.run([a.gen, 'log', str(a.seconds)], stdout=f, check=True)
 
-    dbcs = {0: a.dbc}
+    dbcs = {a.dbc_node: a.dbc}
 
     def dbc_for_node(node):
         if node not in dbcs:

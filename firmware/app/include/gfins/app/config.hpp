@@ -58,7 +58,7 @@ struct FwConfig {
   // [can]
   std::string can_interface = "can0";
   std::string can_log;  // non-empty: write a candump log file instead of using an interface
-  int node_id = 1;
+  int node_id = can::kDefaultNodeId;
 
   // [output]
   std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;

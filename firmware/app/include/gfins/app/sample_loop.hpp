@@ -136,7 +136,8 @@ struct LoopOptions {
   double sample_rate_hz = 1000.0;
   float initial_heading_rad = 0;
   nav::Vec3<float> initial_position_n = nav::Vec3<float>::Zero();
-  std::uint8_t node_id = 1;    // the input frames (GNSS, heading) addressed to this node
+  std::uint8_t node_id =
+      can::kDefaultNodeId;     // the input frames (GNSS, heading) addressed to this node
   bool aiding_inputs = false;  // decode them and offer them to the filter
 };
 

@@ -19,6 +19,9 @@
 namespace gfins::can {
 
 inline constexpr std::uint8_t kMaxNodeId = 15;
+/// The node id of a board out of the box (can.node_id's default): the node the committed DBC and
+/// the tools' defaults are for, so that they decode a stock board.
+inline constexpr std::uint8_t kDefaultNodeId = 1;
 inline constexpr std::uint32_t kNodeIdSpan = 16;  // base IDs are 16 apart
 inline constexpr std::uint32_t kDefaultBitRate = 500000;
 inline constexpr double kDefaultSampleRateHz = 1000.0;  // the dividers' defaults assume 1 kHz
