@@ -192,6 +192,28 @@ TEST(CalibrateCli, AByteOrderMarkBeforeTheFirstLineIsSkipped) {
   EXPECT_EQ(marked.output.find("not a known column"), std::string::npos) << marked.output;
 }
 
+// Finite but absurd: a standard deviation of 1e308 V squared to inf in the fit's σ, the verdict
+// said "good" and the file was then refused as holding NaN. A mean in millivolts (362 for
+// 0.362 V) is named too. Both are refused at the row, before solving, writing nothing.
+TEST(CalibrateCli, AbsurdVoltsAreRefusedAtTheirRow) {
+  const TempDir dir;
+  const auto big_std = dir.path() / "big_std.csv";
+  write_text(big_std, "sensor,attitude,mean_v,std_v,count\n1,1,0.36,1e308,1000\n");
+  const auto out = dir.path() / "cal.toml";
+  RunResult r = run_cli(dir, "--means " + big_std.string() +
+                                 " --gravity 9.79 --device-id b --adc-lsb 1e-7 -o " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(":2: std_v must be at most 100 V"));
+  EXPECT_THAT(r.output, Not(HasSubstr("verdict")));
+  const auto millivolts = dir.path() / "mv.csv";
+  write_text(millivolts, "sensor,attitude,mean_v\n1,1,362.5\n");
+  r = run_cli(dir, "--means " + millivolts.string() +
+                       " --gravity 9.79 --device-id b --adc-lsb 1e-7 -o " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(":2: mean_v must be within ±100 V"));
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(CalibrateCli, AHeaderDifferingInOneNameSaysWhichNamesAreAccepted) {
   const TempDir dir;
   const auto bad = dir.path() / "header.csv";

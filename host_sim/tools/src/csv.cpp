@@ -152,6 +152,10 @@ HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
   return t;
 }
 
+// Largest |mean| and standard deviation of a sensor output accepted, V: ten times the ±10 V a
+// load resistor or converter front end gives; beyond it the column is in another unit.
+constexpr double kMaxMeanVolts = 100.0;  // the messages say 100 V
+
 HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
   GFINS_TRY(const CsvTable t, read_csv(path));
   GFINS_TRY_STATUS(check_header(t, {"sensor", "attitude", "mean_v"}, {"std_v", "count"}));
@@ -171,6 +175,11 @@ HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
     GFINS_TRY(const auto sensor, t.integer(r, c_sensor, 1, 6));
     GFINS_TRY(const auto attitude, t.integer(r, c_attitude, 1, 1000));
     GFINS_TRY(const auto mean, t.number(r, c_mean));
+    if (std::fabs(mean) > kMaxMeanVolts) {
+      return bad(t.where(r) +
+                 "mean_v must be within ±100 V (a sensor output in volts: millivolts "
+                 "given as volts?)");
+    }
     m.sensor = static_cast<int>(sensor);
     m.attitude = static_cast<int>(attitude);
     m.mean_v = mean;
@@ -178,6 +187,13 @@ HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
       GFINS_TRY(const auto sd, t.number(r, c_std));
       GFINS_TRY(const auto count, t.integer(r, c_count, 1, 1'000'000'000));
       if (sd < 0.0) return bad(t.where(r) + "std_v must not be negative");
+      // Finite is not enough: 1e308 V squares to inf in the σ of the fit, and the file was then
+      // refused after a "good" verdict. No output of a sensor varies by more than its range.
+      if (sd > kMaxMeanVolts) {
+        return bad(t.where(r) +
+                   "std_v must be at most 100 V (a standard deviation of a sensor output "
+                   "in volts)");
+      }
       m.std_v = sd;
       m.count = static_cast<std::uint32_t>(count);
     }
