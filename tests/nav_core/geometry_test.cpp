@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 namespace gfins::nav {
@@ -70,7 +71,17 @@ TEST(ArraySolverTest, RefusesSingularAndIllConditionedGeometries) {
   EXPECT_EQ(ArraySolver<double>::create(scaled).status().code(), ErrorCode::kInvalidArgument);
   auto point = table1_geometry(0.1);
   for (auto& r : point.rho_b) r.setZero();
-  EXPECT_EQ(ArraySolver<double>::create(point).status().code(), ErrorCode::kInvalidArgument);
+  const auto r4 = ArraySolver<double>::create(point);
+  EXPECT_EQ(r4.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(std::string(r4.status().message()).find("no lever arm"), std::string::npos);
+  // A NaN position is named as such, not as "no lever arm" (the NaN mean it made).
+  auto nan_rho = table1_geometry(0.1);
+  nan_rho.rho_b[3].y() = std::nan("");
+  const auto r5 = ArraySolver<double>::create(nan_rho);
+  EXPECT_EQ(r5.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(std::string(r5.status().message()).find("position is not a finite number"),
+            std::string::npos)
+      << r5.status().message();
 }
 
 }  // namespace

@@ -88,7 +88,15 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   using HMatrix = Eigen::Matrix<T, N, 6>;
 
   T lever_sum = T(0);
-  for (int j = 0; j < N; ++j) lever_sum += g.rho_b[static_cast<std::size_t>(j)].norm();
+  for (int j = 0; j < N; ++j) {
+    const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
+    if (!rho.allFinite()) {
+      // Checked first: a NaN position made the mean lever arm NaN, reported as "no lever arm".
+      return Status(ErrorCode::kInvalidArgument,
+                    "array geometry: a sensor position is not a finite number");
+    }
+    lever_sum += rho.norm();
+  }
   const T lever = lever_sum / T(N);
   if (!(lever > T(0)) || !std::isfinite(lever)) {
     return Status(ErrorCode::kInvalidArgument,
