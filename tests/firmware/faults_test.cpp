@@ -139,6 +139,15 @@ Bus decode(const std::vector<hal::CanFrame>& frames) {
 
 Bus decode(const SimRig& rig) { return decode(rig.bus->sent()); }
 
+// The rig's board started afresh on `cal` (what gfins-fw does after load_calibration), run to
+// its end, its bus decoded.
+Bus run_from_start(SimRig& rig, const StartupCalibration& cal, const FwConfig& c) {
+  rig.loop = std::make_unique<SampleLoop>(*rig.tap, *rig.bus, *rig.recording, rig.clock, *rig.log);
+  EXPECT_TRUE(rig.loop->configure(cal.set, loop_options(c)).is_ok());
+  rig.run();
+  return decode(rig);
+}
+
 /// The bus epoch whose SampleCount is `seq` (mod 2^16); fails the test when there is none.
 const BusEpoch& on_bus(const Bus& bus, std::uint32_t seq) {
   for (const BusEpoch& e : bus.epochs) {
@@ -637,10 +646,7 @@ TEST_F(Faults, MissingCalibrationIsFlaggedOnTheBus) {
   EXPECT_FALSE(cal.from_file);
   EXPECT_NE(cal.message.find("UNCALIBRATED"), std::string::npos) << cal.message;
   EXPECT_NE(cal.message.find("/nonexistent/gfins-calibration.toml"), std::string::npos);
-  rig.loop = std::make_unique<SampleLoop>(*rig.tap, *rig.bus, *rig.recording, rig.clock, *rig.log);
-  ASSERT_TRUE(rig.loop->configure(cal.set, loop_options(c)).is_ok());
-  rig.run();
-  const Bus bus = decode(rig);
+  const Bus bus = run_from_start(rig, cal, c);
   const BusEpoch& e = on_bus(bus, 3000);
   EXPECT_EQ(e.flags & kBitNominalCal, kBitNominalCal);
   EXPECT_EQ(e.cal_id, 0u);
@@ -737,10 +743,7 @@ TEST_F(Faults, ACalibrationTheCoreRefusesLeavesTheBoardOnItsDefaults) {
             std::string::npos)
       << cal.message;
   // The defaults it falls back to are the ones the core takes: the run goes on.
-  rig.loop = std::make_unique<SampleLoop>(*rig.tap, *rig.bus, *rig.recording, rig.clock, *rig.log);
-  ASSERT_TRUE(rig.loop->configure(cal.set, loop_options(c)).is_ok());
-  rig.run();
-  const Bus bus = decode(rig);
+  const Bus bus = run_from_start(rig, cal, c);
   const BusEpoch& e = on_bus(bus, 3000);
   EXPECT_EQ(e.flags & kBitNominalCal, kBitNominalCal);
   EXPECT_EQ(e.mode, kModeNavigating);
