@@ -430,6 +430,14 @@ void SampleLoop::check_gravity(std::int64_t t_ns) {
               std::llround(f * 1e6), std::llround(g_model * 1e6), std::llround(allowed * 1e6));
 }
 
+namespace {
+// Time of validity of an aiding input on the loop's clock: its reception less the age the sender
+// stated (docs/can-interface.md, "Time of validity").
+std::int64_t valid_at(std::int64_t received_ns, double age_s) {
+  return received_ns - static_cast<std::int64_t>(std::llround(age_s * 1e9));
+}
+}  // namespace
+
 bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
   const Result<can::InputEvent> ev = inputs_.add(f);
   if (!ev.is_ok()) {
@@ -457,7 +465,7 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
   if (e.kind == can::InputEventKind::kGnssFix) {
     const can::GnssFix& g = e.gnss;
     nav::GnssFix<float> fix;
-    fix.t_valid_ns = t_ns - static_cast<std::int64_t>(std::llround(g.age_s * 1e9));
+    fix.t_valid_ns = valid_at(t_ns, g.age_s);
     if (g.has_position) {
       fix.value_n = nav::Vec3<double>(g.r_n_m[0], g.r_n_m[1], g.r_n_m[2]).cast<float>();
       fix.sigma =
@@ -471,7 +479,7 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
     }
   } else {
     nav::HeadingFix<float> fix;
-    fix.t_valid_ns = t_ns - static_cast<std::int64_t>(std::llround(e.heading.age_s * 1e9));
+    fix.t_valid_ns = valid_at(t_ns, e.heading.age_s);
     fix.yaw_rad = static_cast<float>(e.heading.heading_rad);
     fix.sigma_rad = static_cast<float>(e.heading.sigma_rad);
     note(pipeline_.offer_heading(fix));

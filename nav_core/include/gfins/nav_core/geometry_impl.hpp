@@ -90,7 +90,7 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   T lever_sum = T(0);
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
-    if (!rho.allFinite()) {
+    if (!std::isfinite(rho.squaredNorm())) {
       // Checked first: a NaN position made the mean lever arm NaN, reported as "no lever arm".
       return Status(ErrorCode::kInvalidArgument,
                     "array geometry: a sensor position is not a finite number");
@@ -109,10 +109,9 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
     const Vec3<T>& th = g.theta_b[static_cast<std::size_t>(j)];
-    if (!std::isfinite(rho.squaredNorm()) || !(std::abs(th.norm() - T(1)) <= T(0.1))) {
+    if (!(std::abs(th.norm() - T(1)) <= T(0.1))) {  // NaN fails the comparison too
       return Status(ErrorCode::kInvalidArgument,
-                    "array geometry: a sensitive axis is not near unit length or a value is not "
-                    "finite");
+                    "array geometry: a sensitive axis is not near unit length or not finite");
     }
     a.row(j) << rho.cross(th).transpose() / lever, th.transpose();
     const T tr = th.dot(rho);
