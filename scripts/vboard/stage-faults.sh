@@ -36,6 +36,14 @@ window() {
 # bitname FLAGS N: "set" or "clear". Each check tests it inside its one `check` command (a
 # `check ... && bit ...` would decide outside check and throw the result away).
 bitname() { [ $(($1 / (1 << $2) % 2)) -eq 1 ] && echo set || echo clear; }
+# toggler_irregular: the toggler's running bound on edges a timestamp-based receiver may count as
+# missed although it wrote them (its writes landing over half a period late on a loaded VM;
+# drdy-toggle.c says how it is bounded), read from the line SIGUSR1 makes it print.
+toggler_irregular() {
+  kill -USR1 $toggle_pid
+  sleep 0.2
+  sed -n 's/.*irregular=\([0-9]*\).*/\1/p' /tmp/faults-toggle.log | tail -n 1
+}
 
 drdy-toggle "$pull" "$rate" >/tmp/faults-toggle.log &
 toggle_pid=$!
@@ -43,8 +51,11 @@ fw_start /tmp/faults-fw.log
 check faults-fw-start "gfins-fw runs on vcan0 with data-ready edges" [ $? -eq 0 ]
 sleep 1
 window baseline 2
-check faults-baseline "$w_epochs epochs in 2 s, $w_jumps counter jumps, flags $w_flags, missed $w_missed, dropped $w_dropped" \
-  [ "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 -a "$w_missed" -eq 0 -a "$w_dropped" -eq 0 ]
+# Missed edges: none beyond what the toggler's own lateness can explain (0 when it kept time; the
+# firmware inventing a gap, or counting each edge twice, is caught either way).
+irregular=$(toggler_irregular)
+check faults-baseline "$w_epochs epochs in 2 s, $w_jumps counter jumps, flags $w_flags, missed $w_missed (toggler writes that may look missed: ${irregular:-?}), dropped $w_dropped" \
+  [ "$w_epochs" -gt 0 -a "$w_jumps" -eq 0 -a "$w_missed" -le "${irregular:-0}" -a "$w_dropped" -eq 0 ]
 
 ip link set down vcan0
 sleep 1
