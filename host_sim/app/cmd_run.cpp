@@ -44,6 +44,26 @@ std::string parent_dir(const std::string& file) {
   return p.empty() ? std::string(".") : p.string();
 }
 
+/// A run that stops on an error keeps no partial table (a CSV cut short reads like a complete
+/// run) and says in summary.txt what happened; the recording, closed by the run even after an
+/// error, stays a valid file of the samples written before it.
+int fail_after_start(const std::string& out_dir, const StreamTargets& t, const HostError& e) {
+  std::error_code ec;
+  for (const std::string* csv : {&t.uncompensated_csv, &t.compensated_csv}) {
+    if (!csv->empty()) std::filesystem::remove(*csv, ec);
+  }
+  const std::string summary_path = out_dir + "/summary.txt";
+  if (std::FILE* f = std::fopen(summary_path.c_str(), "w"); f != nullptr) {
+    std::fprintf(
+        f, "failed: %s\nno table kept (a run stopped by an error leaves no partial CSV)%s\n",
+        e.message.c_str(),
+        t.recording.empty() ? "" : "; the recording holds the samples written before the error");
+    if (auto c = close_output(f, summary_path); !c.is_ok()) fail(c.error(), kExitError);
+  }
+  std::fprintf(stderr, "gfins-sim: %s (%s)\n", e.message.c_str(), summary_path.c_str());
+  return kExitError;
+}
+
 }  // namespace
 
 int cmd_run(const std::string& name, const OutputOptions& out) {
@@ -111,7 +131,7 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
     const StopSignals handlers;
     return run_scenario_streamed(s, targets, run_progress(s.name, s.duration_s), scalar.value());
   }();
-  if (!outcome.is_ok()) return fail(outcome.error(), kExitError);
+  if (!outcome.is_ok()) return fail_after_start(out_dir, targets, outcome.error());
   const StreamedOutcome& o = outcome.value();
   if (!out.record.empty()) {
     std::printf("recorded: %s (%llu samples at %g Hz, %s)\n", out.record.c_str(),

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/scenario.hpp"
@@ -488,6 +490,49 @@ TEST_F(RecordReplay, EveryNavigationCommandHonoursScalar) {
 }
 
 // ---- 4. inputs checked before work -----------------------------------------------------------
+
+// A run stopped by an error leaves no table cut short and a summary that says why
+// (docs/simulation.md, "An error during a run"). Both triggers are deterministic.
+TEST_F(RecordReplay, ARunStoppedByAnErrorLeavesASummaryAndNoPartialTable) {
+  constexpr int kExitError = 1;
+  const auto expect_failed_folder = [](const fs::path& out, const std::string& cause) {
+    EXPECT_FALSE(fs::exists(out / "uncompensated.csv"));
+    EXPECT_FALSE(fs::exists(out / "compensated.csv"));
+    const std::string summary = test::slurp((out / "summary.txt").string());
+    EXPECT_EQ(summary.rfind("failed: ", 0), 0U) << summary;
+    EXPECT_NE(summary.find(cause), std::string::npos) << summary;
+  };
+  // 1. The recording onto /dev/full: every write fails with ENOSPC (the kernel's disk full).
+  if (::access("/dev/full", W_OK) == 0) {
+    const std::string rest = file("rest.toml", kRestTable6);
+    const CliResult r = sim({"run", rest, "-o", path("full"), "--record", "/dev/full"});
+    EXPECT_EQ(r.exit_code, kExitError) << r.output;
+    EXPECT_NE(r.output.find("No space left on device"), std::string::npos) << r.output;
+    expect_failed_folder(path("full"), "No space left on device");
+  }
+  // 2. A calibration the core refuses: 0.1 g of noise on each pose's mean (the scenario's
+  // largest) gives orientation estimates beyond the compensator's 0.2 rad small-angle model. The
+  // first run's pipeline is accepted, the second's refused: before, its table was already open
+  // and stayed behind with a header and no row.
+  const std::string wild = file("wild.toml", R"TOML([scenario]
+duration_s = 2.0
+rate_hz = 100.0
+[trajectory]
+kind = "rest"
+[sensors]
+orientation = "paper_table6"
+[compensator]
+kind = "exact"
+misalignment = "calibrated"
+[calibration]
+mean_noise_g = 0.1
+)TOML");
+  const CliResult r = sim({"run", wild, "-o", path("wild"), "--no-plot"});
+  EXPECT_EQ(r.exit_code, kExitError) << r.output;
+  EXPECT_NE(r.output.find("navigation core rejected the configuration"), std::string::npos)
+      << r.output;
+  expect_failed_folder(path("wild"), "0.2 rad");
+}
 
 TEST_F(RecordReplay, InputsAreRefusedBeforeWorkWithAMessageNamingWhatIsWrong) {
   struct Case {

@@ -664,6 +664,7 @@ struct StreamedSeries {
   std::unique_ptr<nav::NavPipeline<T>> pipeline;
   std::unique_ptr<NavLoop<T>> loop;
   std::optional<SeriesCsvWriter> csv;
+  const std::string* csv_path = nullptr;
   SeriesStats* stats = nullptr;
   AccuracyTracker* accuracy = nullptr;
   std::array<double, 6> bias_mps2{};
@@ -712,10 +713,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
       r->stats = sp.stats;
       r->bias_mps2 = sp.bias;
       r->gnss = std::make_unique<GnssFeeder>(gnss_fixes, s.gnss);
-      if (!sp.csv->empty()) {
-        GFINS_TRY(auto w, SeriesCsvWriter::open(*sp.csv, targets.decimate));
-        r->csv.emplace(std::move(w));
-      }
+      r->csv_path = sp.csv;
       StreamedSeries<T>* self = r.get();
       r->loop = std::make_unique<NavLoop<T>>(
           *r->pipeline, [self, &current](std::uint64_t, const nav::NavState<T>&) {
@@ -724,6 +722,13 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
             self->sink_status = self->take(record_of(*current, *self->pipeline));
           });
       runs.push_back(std::move(r));
+    }
+    // The tables are opened once every run's pipeline is accepted: a geometry or calibration the
+    // core refuses leaves no header-only CSV behind.
+    for (auto& r : runs) {
+      if (r->csv_path->empty()) continue;
+      GFINS_TRY(auto w, SeriesCsvWriter::open(*r->csv_path, targets.decimate));
+      r->csv.emplace(std::move(w));
     }
   }
   const auto specific_force = [&](const SourceSample& x, const std::array<double, 6>& bias) {
