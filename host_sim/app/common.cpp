@@ -12,6 +12,7 @@
 
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/host_sim/data_paths.hpp"
+#include "gfins/host_sim/progress_interval.hpp"
 
 namespace gfins::sim::app {
 
@@ -200,12 +201,7 @@ ProgressFn run_progress(const std::string& what, double duration_s) {
 
 ProgressFn log_progress(const std::string& what, double total, const std::string& unit) {
   if (isatty(fileno(stderr)) != 0) return tty_progress(what);
-  double interval = kProgressIntervalS;
-  if (const char* v = std::getenv("GFINS_PROGRESS_INTERVAL_S"); v != nullptr && *v != '\0') {
-    char* end = nullptr;
-    const double x = std::strtod(v, &end);
-    if (*end == '\0' && x > 0) interval = x;
-  }
+  const double interval = paths::progress_interval_s();
   using Clock = std::chrono::steady_clock;
   const auto every =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(interval));

@@ -65,15 +65,13 @@ ProgressFn tty_progress(const std::string& what);
 
 /// Progress of a long run on stderr: on a terminal the percentage (\r line, as tty_progress);
 /// otherwise (a log file, a pipe) one line "progress: NAME: P % (t = X of D s)" every
-/// kProgressIntervalS seconds of wall-clock time, none for a run that ends sooner.
-/// $GFINS_PROGRESS_INTERVAL_S (seconds, > 0) changes the interval: for tests, which wait for the
-/// first line before they interrupt a run.
+/// paths::progress_interval_s() seconds of wall-clock time (5, or $GFINS_PROGRESS_INTERVAL_S:
+/// for tests, which wait for the first line before they interrupt a run), none for a run that
+/// ends sooner.
 ProgressFn run_progress(const std::string& what, double duration_s);
-inline constexpr double kProgressIntervalS = 5.0;
 
 /// The same for work counted in other units (montecarlo: runs; replay: samples): off a terminal
-/// "progress: NAME: P % (X of TOTAL UNIT)" every kProgressIntervalS (or
-/// $GFINS_PROGRESS_INTERVAL_S) seconds.
+/// "progress: NAME: P % (X of TOTAL UNIT)" every paths::progress_interval_s() seconds.
 ProgressFn log_progress(const std::string& what, double total, const std::string& unit);
 
 /// Set to the signal's number by the handler StopSignals installs; the long commands (run,

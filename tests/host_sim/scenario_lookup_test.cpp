@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gfins/host_sim/data_paths.hpp"
+#include "gfins/host_sim/progress_interval.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
 namespace gfins::sim {
@@ -158,6 +159,24 @@ TEST_F(ScenarioLookupFs, EnvironmentOverrideIsUsedAsGiven) {
   EXPECT_FALSE(b.found());
   EXPECT_NE(b.explain("scenario", "").find("GFINS_SCENARIO_DIR"), std::string::npos);
   ASSERT_EQ(::unsetenv(paths::kScenarioEnv), 0);
+}
+
+// One reading of $GFINS_PROGRESS_INTERVAL_S for gfins-sim, gfins-replay and gfins-fw's simulated
+// board: a number in (0, 1e6) is taken, anything else falls back to the documented 5 s
+// (docs/simulation.md).
+TEST(ProgressInterval, ANumberInRangeIsTakenAnythingElseFallsBackToFiveSeconds) {
+  ASSERT_EQ(::unsetenv(paths::kProgressIntervalEnv), 0);
+  EXPECT_EQ(paths::progress_interval_s(), 5.0);
+  const auto with = [](const char* text) {
+    EXPECT_EQ(::setenv(paths::kProgressIntervalEnv, text, 1), 0);
+    return paths::progress_interval_s();
+  };
+  EXPECT_EQ(with("0.05"), 0.05);
+  EXPECT_EQ(with("2"), 2.0);
+  for (const char* bad : {"", "0", "-1", "nan", "inf", "1e6", "0.1s", "abc", " "}) {
+    EXPECT_EQ(with(bad), 5.0) << "'" << bad << "'";
+  }
+  ASSERT_EQ(::unsetenv(paths::kProgressIntervalEnv), 0);
 }
 
 }  // namespace

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <exception>
@@ -25,17 +24,6 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
-// Seconds between two progress lines of a simulated run: 5, or $GFINS_PROGRESS_INTERVAL_S (> 0,
-// for tests; the same variable as gfins-sim's).
-double progress_interval_s() {
-  const char* env = std::getenv("GFINS_PROGRESS_INTERVAL_S");
-  if (env != nullptr) {
-    char* end = nullptr;
-    const double v = std::strtod(env, &end);
-    if (end != env && *end == '\0' && v > 0.0 && v < 1e6) return v;
-  }
-  return 5.0;
-}
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 // Writes text whole, NULs and all (fputs would stop at the first), with control characters
@@ -124,7 +112,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   // A board with a known end (the simulated board, fast) reports how far it got: a line every
   // interval of wall-clock time, looked at every 4096 cycles (a clock read per cycle would cost
   // the loop more than the line is worth).
-  const auto interval = std::chrono::duration<double>(progress_interval_s());
+  const auto interval = std::chrono::duration<double>(board.progress_interval_s);
   auto next = wall0 + interval;
   for (std::uint32_t n = 1; !g_stop.load(std::memory_order_relaxed) && !board.finished(); ++n) {
     loop->step();

@@ -8,6 +8,7 @@
 #include "gfins/app/board.hpp"
 #include "gfins/app/sample_clock.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
+#include "gfins/host_sim/progress_interval.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
 namespace gfins::sim_board {
@@ -86,6 +87,7 @@ app::BoardResult make_board(const app::FwConfig& c) {
     b->progress = [src, samples, duration] {
       return app::BoardProgress{1.0 - static_cast<double>(src->remaining()) / samples, duration};
     };
+    b->progress_interval_s = paths::progress_interval_s();
   }
   b->source = std::move(source);
   if (std::string e = app::open_can_output(c, *b->clock, *b); !e.empty()) {

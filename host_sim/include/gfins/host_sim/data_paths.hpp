@@ -1,6 +1,7 @@
 // Where the installed programs find their data (scenarios, plot scripts, examples): relative to
 // their own executable, never through a path of the source or build tree compiled into them
-// (docs/install.md, "Where the programs find their data").
+// (docs/install.md, "Where the programs find their data"). The same library holds the other
+// setting the host programs read from the environment (progress_interval.hpp).
 //
 // Search order for a data folder `sub` (e.g. "scenarios"):
 //   1. the environment variable named for it (GFINS_SCENARIO_DIR, GFINS_SCRIPTS_DIR,

@@ -45,6 +45,8 @@ struct Board {
   std::function<bool()> finished = [] { return false; };
   /// Null: no known end (a real board), nothing to report.
   std::function<BoardProgress()> progress;
+  /// Wall-clock seconds between two progress lines (set by the board that reports progress).
+  double progress_interval_s = 5.0;
   /// SCHED_FIFO + mlockall as configured; returns a warning when not permitted ("" when done).
   std::function<std::string(const FwConfig&)> enter_realtime = [](const FwConfig&) {
     return std::string();
