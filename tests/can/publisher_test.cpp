@@ -36,7 +36,7 @@ TEST(Publisher, DefaultsSendTheDocumentedFramesPerSecond) {
 
 TEST(Publisher, EachEpochOpensWithEpochThenStatusAndSharesOneCounter) {
   ArrayBus<256> bus;
-  Publisher pub(bus, PublisherConfig{.node_id = 5});
+  Publisher pub(bus, PublisherConfig{.node_id = 5, .dividers = default_dividers(), .budget = {}});
   for (std::uint32_t seq = 0; seq < 100; ++seq) pub.publish(epoch_at(seq));
   std::uint8_t expected_counter = 0;
   std::size_t i = 0;
@@ -95,6 +95,31 @@ TEST(Publisher, NavStatusBitsReachTheStatusFrame) {
   EXPECT_EQ(extract_bits(p, status.signals[0]),
             status_bits::kAligned | status_bits::kCompensated | status_bits::kAdcCrcError);
   EXPECT_EQ(extract_bits(p, status.signals[1]), 0xDEADBEEFu);
+}
+
+// The budget: the table's defaults at 1 kHz (aiding messages included: 909.5 frames/s x 135
+// worst-case bits = 122,782.5 bit/s, docs/can-interface.md) on a 250 kbit/s bus are 49.1 %;
+// with a 50 % budget one more message at 100 Hz (+13,500 bit/s, 54.5 %) is refused and changes
+// nothing, one at 10 Hz (+1,350 bit/s, 49.65 %) is accepted. A construction over budget falls
+// back to the defaults with the status.
+TEST(Publisher, DividersBeyondTheBusBudgetAreRefused) {
+  ArrayBus<8> bus;
+  PublisherConfig c;
+  c.budget = BusBudget{1000.0, 250000, 0.5};
+  Publisher pub(bus, c);
+  ASSERT_TRUE(pub.init_status().is_ok());
+  EXPECT_NEAR(c.budget.load(pub.dividers()), 909.5 * 135.0 / 250000.0, 1e-12);
+  EXPECT_EQ(pub.set_divider(MessageId::kSensorsA, 10).code(), ErrorCode::kResourceExhausted);
+  EXPECT_EQ(pub.divider(MessageId::kSensorsA), 0);
+  EXPECT_TRUE(pub.set_divider(MessageId::kSensorsA, 100).is_ok());
+  EXPECT_NEAR(c.budget.load(pub.dividers()), 919.5 * 135.0 / 250000.0, 1e-12);
+  // The rules come first: a divider that breaks them is refused for that, not for the load.
+  EXPECT_EQ(pub.set_divider(MessageId::kSensorsB, 15).code(), ErrorCode::kInvalidArgument);
+  PublisherConfig over = c;
+  over.dividers[static_cast<std::size_t>(MessageId::kSensorsB)] = 10;
+  Publisher refused(bus, over);
+  EXPECT_EQ(refused.init_status().code(), ErrorCode::kResourceExhausted);
+  EXPECT_EQ(refused.dividers(), default_dividers());
 }
 
 TEST(Publisher, DividerRules) {

@@ -17,6 +17,7 @@
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -44,6 +45,56 @@ def expected(path):
             # "LINE epoch drop 16": the trailing count is checked by corpus_test.cpp
             issues.append((int(n), kind.rstrip('0123456789').rstrip()))
     return epochs, issues
+
+
+def dbc_cycle_times(text):
+    """{message name: GenMsgCycleTime ms} and {name: identifier} of a DBC, read with the DBC
+    grammar's own keywords (BO_ id name: dlc sender; BA_ "GenMsgCycleTime" BO_ id value;)."""
+    names, ids, cycle = {}, {}, {}
+    for line in text.splitlines():
+        m = re.match(r'BO_ (\d+) (\w+):', line)
+        if m:
+            names[int(m.group(1))] = m.group(2)
+            ids[m.group(2)] = int(m.group(1))
+        m = re.match(r'BA_ "GenMsgCycleTime" BO_ (\d+) (\d+);', line)
+        if m:
+            cycle[names[int(m.group(1))]] = int(m.group(2))
+    return cycle, ids
+
+
+def check_dbc_for_a_configured_board(exe, workdir):
+    """gfins-can dbc --config: the DBC of the board a gfins-fw configuration describes. The
+    expected cycle times are the documented dividers (docs/can-interface.md) at 2 kHz, written
+    out here: 10 -> 5 ms, 20 -> 10 ms, 1000 -> 500 ms; Euler switched off has none."""
+    cfg = os.path.join(workdir, 'board3.toml')
+    with open(cfg, 'w') as f:
+        f.write('[adc]\nsample_rate_hz = 2000\n[can]\nnode_id = 3\n[output]\neuler = 0\n')
+    out = os.path.join(workdir, 'board3.dbc')
+    r = run([exe, 'dbc', '--config', cfg, '-o', out])
+    check(r.returncode == 0, f'dbc --config: exit {r.returncode}: {r.stderr.decode()}')
+    cycle, ids = dbc_cycle_times(open(out).read() if os.path.exists(out) else '')
+    want = {'GfinsEpoch': 5, 'GfinsStatus': 5, 'GfinsQuaternion': 5, 'GfinsAngularRate': 5,
+            'GfinsAngularAccel': 10, 'GfinsAccel': 5, 'GfinsVelocity': 5, 'GfinsPositionNE': 5,
+            'GfinsPositionD': 5, 'GfinsHealthAdc': 500, 'GfinsHealthSystem': 500}
+    check(cycle == want, f'dbc --config: cycle times {cycle}, expected {want}')
+    check(ids.get('GfinsEpoch') == 0x100 + 3, f'dbc --config: epoch id {ids.get("GfinsEpoch")}')
+    # --node overrides the file's node id; the cycle times stay the file's.
+    r = run([exe, 'dbc', '--config', cfg, '--node', '7'])
+    cycle7, ids7 = dbc_cycle_times(r.stdout.decode())
+    check(ids7.get('GfinsEpoch') == 0x100 + 7 and cycle7 == want,
+          f'dbc --config --node 7: epoch id {ids7.get("GfinsEpoch")}, cycle times {cycle7}')
+    # A configuration the firmware refuses is refused here too, and nothing is written: a node
+    # out of range, and the default dividers at 4 kHz (97.4 % of 500 kbit/s, over the budget).
+    for name, text, why in (('bad-node', '[can]\nnode_id = 40\n', 'can.node_id = 40'),
+                            ('over-budget', '[adc]\nsample_rate_hz = 4000\n', '97.4 %')):
+        bad = os.path.join(workdir, name + '.toml')
+        with open(bad, 'w') as f:
+            f.write(text)
+        dbc = os.path.join(workdir, name + '.dbc')
+        r = run([exe, 'dbc', '--config', bad, '-o', dbc])
+        err = r.stderr.decode()
+        check(r.returncode == 2 and why in err and not os.path.exists(dbc),
+              f'dbc --config {name}: exit {r.returncode}, written {os.path.exists(dbc)}: {err}')
 
 
 def main():
@@ -255,6 +306,8 @@ def main():
         if code == 1:
             check(r.stderr.decode().startswith('gfins-can-gen: '),
                   f'gfins-can-gen {argv}: no message naming the tool: {r.stderr.decode()!r}')
+
+    check_dbc_for_a_configured_board(exe, a.workdir)
 
     print(f'cli: {len(failures)} failed checks')
     for f in failures:

@@ -51,7 +51,8 @@ TEST(EndToEnd, CoreStatesSurviveTheBusWithinQuantisation) {
   const auto& counts = w.samples;
   auto pipe = bench::make_pipeline<float>(nav::CompensatorKind::kExact, w);
   LineBus bus;
-  can::Publisher pub(bus, can::PublisherConfig{.node_id = kNode});
+  can::Publisher pub(bus, can::PublisherConfig{
+                              .node_id = kNode, .dividers = can::default_dividers(), .budget = {}});
   std::map<std::uint32_t, nav::NavState<float>> states;  // by seq
   for (std::uint32_t k = 1; k < counts.size(); ++k) {
     RawSample s = counts[k];

@@ -120,6 +120,34 @@ TEST_F(Commands, SetDividerValidAndOutOfRange) {
   EXPECT_EQ(rig_->bus->total(), frames + 20);
 }
 
+// The rig's budget is the board's default (1 kHz, 500 kbit/s, 50 %: 250,000 bit/s, 1,851.85
+// frames/s of 135 worst-case bits). Aiding off, the defaults send 902 frames/s. Epoch (and status)
+// at divider 5: 200 + 200 + 6 x 100 + 2 x 50 + 2 x 1 = 1,102 frames/s (29.8 %); five of the six
+// 100 Hz messages to 200 Hz: 1,602 (43.3 %); the sixth: 1,702 (46.0 %) still fits, a seventh
+// message on at 200 Hz (sensors A, +200: 1,902, 51.4 %) does not: refused with BusLoad, counted,
+// its divider unchanged.
+TEST_F(Commands, SetDividerBeyondTheBusBudgetIsRefusedWithBusLoad) {
+  can::Command c;
+  c.opcode = can::Opcode::kSetDivider;
+  c.message = can::MessageId::kEpoch;
+  c.divider = 5;
+  ASSERT_EQ(exec(c).result, can::ResultCode::kOk);
+  for (const can::MessageId m :
+       {can::MessageId::kQuaternion, can::MessageId::kRate, can::MessageId::kAccel,
+        can::MessageId::kVelocity, can::MessageId::kPositionNE, can::MessageId::kPositionD}) {
+    c.message = m;
+    ASSERT_EQ(exec(c).result, can::ResultCode::kOk) << static_cast<int>(m);
+  }
+  const std::uint32_t errors = rig_->loop->health().command_errors;
+  c.message = can::MessageId::kSensorsA;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kBusLoad);
+  EXPECT_EQ(rig_->loop->health().command_errors, errors + 1);
+  EXPECT_EQ(rig_->publisher->publisher().divider(can::MessageId::kSensorsA), 0);
+  // At 10 ms it fits (+100: 1,802 frames/s, 48.7 %).
+  c.divider = 10;
+  EXPECT_EQ(exec(c).result, can::ResultCode::kOk);
+}
+
 TEST_F(Commands, ReportCalibrationGivesTheIdentityInUse) {
   can::Command c;
   c.opcode = can::Opcode::kReportCalibrationId;

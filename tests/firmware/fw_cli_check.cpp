@@ -35,6 +35,10 @@ class FwCli : public test::CliTest {
 
 // The run's own start-up line: present only when the run got as far as starting.
 constexpr const char* kStarted = "sample loop running";
+// --check-config's bus line for the defaults: 902 frames/s (aiding off) x 135 worst-case bits
+// of an 8-byte base frame = 121,770 bit/s, 24.35 % of 500 kbit/s (docs/can-interface.md).
+constexpr const char* kDefaultLoadLine =
+    "gfins-fw: worst-case bus load 24.35 % of 500000 bit/s (limit 50 %)\n";
 
 TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
   struct Case {
@@ -50,6 +54,12 @@ TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
       {sim_run({"--sample-rate", "2000"}),
        "gfins-fw: built-in defaults + command line: sim.scenario = \"rest\": runs at 1000 Hz: "
        "adc.sample_rate_hz must be the same\n"},
+      // The bus budget: the default dividers at 4 kHz send 3608 frames/s of 135 worst-case bits,
+      // 97.4 % of 500 kbit/s (docs/can-interface.md), over the default 50 %.
+      {sim_run({"--sample-rate", "4000"}),
+       "gfins-fw: command line: output = a worst-case bus load of 97.4 % of 500000 bit/s at "
+       "adc.sample_rate_hz = 4000: must be at most can.max_bus_load_percent = 50 %: raise the "
+       "dividers of [output], switch messages off, or raise can.bit_rate\n"},
       {sim_run({}, "nosuchscenario"), ""},  // the loader's message, checked by prefix
       {sim_run({}, "rest", "/nonexistent-gfins/out.log"),
        "gfins-fw: built-in defaults + command line: can.log_file = "
@@ -85,7 +95,8 @@ TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
   const test::CliResult checked = fw(good);
   EXPECT_EQ(checked.exit_code, 0) << checked.output;
   EXPECT_EQ(checked.output,
-            "gfins-fw: configuration (built-in defaults + command line) is valid\n");
+            "gfins-fw: configuration (built-in defaults + command line) is valid\n" +
+                std::string(kDefaultLoadLine));
   EXPECT_EQ(ran.exit_code, 0) << ran.output;
   EXPECT_NE(ran.output.find(kStarted), std::string::npos) << ran.output;
 }
@@ -138,15 +149,16 @@ TEST_F(FwCli, CheckConfigNamesWhatTheConfigurationIsMadeOf) {
                                  "\"\"\n[sim]\nscenario_dir = \"") +
                          GFINS_SCENARIO_DIR + "\"\n");
   EXPECT_EQ(fw({"-c", cfg, "--check-config"}).output,
-            "gfins-fw: configuration (" + cfg + ") is valid\n");
+            "gfins-fw: configuration (" + cfg + ") is valid\n" + kDefaultLoadLine);
   EXPECT_EQ(fw({"-c", cfg, "--node-id", "3", "--check-config"}).output,
-            "gfins-fw: configuration (" + cfg + " + command line) is valid\n");
+            "gfins-fw: configuration (" + cfg + " + command line) is valid\n" + kDefaultLoadLine);
   // A UTF-8 path is a path (item 2); the missing file is a note, not an error: the run would
   // start flagged uncalibrated.
   const std::string cafe = path("caf\xC3\xA9.toml");
   const test::CliResult c = fw({"--calibration", cafe, "--check-config"});
   EXPECT_EQ(c.exit_code, 0) << c.output;
-  EXPECT_NE(c.output.find("is valid\ngfins-fw: note: calibration.file = \"" + cafe + "\": "),
+  EXPECT_NE(c.output.find(kDefaultLoadLine + std::string("gfins-fw: note: calibration.file = \"") +
+                          cafe + "\": "),
             std::string::npos)
       << c.output;
   EXPECT_NE(c.output.find("a run would navigate UNCALIBRATED"), std::string::npos) << c.output;

@@ -143,7 +143,8 @@ struct SimRig {
     faulty = std::make_unique<FaultySource>(*source, clock);
     tap = std::make_unique<TapSource>(*faulty, samples);
     bus = std::make_unique<sim_board::MemoryCanBus>(can_capacity);
-    publisher = std::make_unique<app::PublisherSink>(*bus, kNode, app::bus_dividers(config));
+    publisher = std::make_unique<app::PublisherSink>(*bus, kNode, app::bus_dividers(config),
+                                                     app::bus_budget(config));
     stalling = std::make_unique<StallingSink>(*publisher, clock);
     // Twice the samples: cycles without a sample publish epochs too (one per period).
     recording = std::make_unique<app::RecordingSink>(stalling.get(), 2 * std::size_t{samples});

@@ -90,7 +90,7 @@ std::string open_watchdog(const FwConfig& c, hal::Clock& clock, Board& b) {
 
 void add_can_protocol(const FwConfig& c, Board& b) {
   const auto node = static_cast<std::uint8_t>(c.node_id);
-  b.sink = std::make_unique<PublisherSink>(*b.bus, node, bus_dividers(c));
+  b.sink = std::make_unique<PublisherSink>(*b.bus, node, bus_dividers(c), bus_budget(c));
   b.commands = true;
 }
 

@@ -5,9 +5,11 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "gfins/app/config.hpp"
+#include "gfins/app/publisher_sink.hpp"
 
 namespace gfins::app {
 namespace {
@@ -128,6 +130,26 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
       return P{"output." + std::string(kMessageNames[m]), std::to_string(c.dividers[m]),
                "must be 0 (off) or a multiple of output.epoch (" + std::to_string(epoch_div) + ")"};
     }
+  }
+  if (std::find(kCanBitRates.begin(), kCanBitRates.end(), c.can_bit_rate) == kCanBitRates.end()) {
+    return P{"can.bit_rate", std::to_string(c.can_bit_rate),
+             "must be one of 10000, 20000, 50000, 100000, 125000, 250000, 500000, 800000, "
+             "1000000 bit/s (the bus's, as `ip link set ... bitrate` sets it)"};
+  }
+  if (!(c.max_bus_load_percent > 0.0 && c.max_bus_load_percent <= 100.0)) {
+    return P{"can.max_bus_load_percent", num(c.max_bus_load_percent), "must be in (0, 100]"};
+  }
+  // The bus budget (docs/can-interface.md, "Rates, dividers and bus load"): a configuration
+  // whose frames would take more than the allowed share in the worst case is refused with the
+  // figure, here and by --check-config, before it can crowd the other nodes off the bus.
+  if (const double load = worst_case_bus_load(c); !(load * 100.0 <= c.max_bus_load_percent)) {
+    char figure[160];
+    std::snprintf(figure, sizeof figure,
+                  "a worst-case bus load of %.1f %% of %d bit/s at adc.sample_rate_hz = %s",
+                  load * 100.0, c.can_bit_rate, num(c.sample_rate_hz).c_str());
+    return P{"output", figure,
+             "must be at most can.max_bus_load_percent = " + num(c.max_bus_load_percent) +
+                 " %: raise the dividers of [output], switch messages off, or raise can.bit_rate"};
   }
   if (!(c.gravity_mps2 >= 9.7 && c.gravity_mps2 <= 9.9)) {
     return P{"navigation.gravity_mps2", num(c.gravity_mps2),

@@ -205,6 +205,12 @@ int main(int argc, char** argv) {
     }
     if (cli.check_only) {
       print(stdout, "gfins-fw: configuration (" + cli.origin + ") is valid\n");
+      char load[160];
+      std::snprintf(load, sizeof load,
+                    "gfins-fw: worst-case bus load %.2f %% of %d bit/s (limit %g %%)\n",
+                    100.0 * gfins::app::worst_case_bus_load(*cli.config), cli.config->can_bit_rate,
+                    cli.config->max_bus_load_percent);
+      print(stdout, load);
       if (const std::string note = gfins::app::calibration_note(*cli.config); !note.empty()) {
         print(stdout, "gfins-fw: note: " + note + "\n");
       }

@@ -561,8 +561,11 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
       if (static_cast<std::size_t>(c.message) >= kNumMessages || c.divider > kMaxDivider) {
         return reject(ResultCode::kOutOfRange);
       }
-      if (!out_.set_divider(static_cast<std::size_t>(c.message), c.divider).is_ok())
-        return reject(ResultCode::kOutOfRange);
+      if (const Status s = out_.set_divider(static_cast<std::size_t>(c.message), c.divider);
+          !s.is_ok()) {
+        return reject(s.code() == ErrorCode::kResourceExhausted ? ResultCode::kBusLoad
+                                                                : ResultCode::kOutOfRange);
+      }
       r.response.value = c.divider;
       break;
     case can::Opcode::kReportCalibrationId:

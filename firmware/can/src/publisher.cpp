@@ -98,9 +98,32 @@ Status check_dividers(const Dividers& d) {
   return Status::ok();
 }
 
+double worst_case_bits_per_s(const Dividers& d, double sample_rate_hz) {
+  double bits = 0.0;
+  for (const MessageDef& m : kMessages) {
+    const std::uint16_t v = d[idx(m.id)];
+    if (m.kind != MessageKind::kData || v == 0) continue;
+    bits += sample_rate_hz / v * worst_case_frame_bits(kFrameLength);
+  }
+  return bits;
+}
+
+namespace {
+
+Status check_budget(const Dividers& d, const BusBudget& b) {
+  if (!(b.load(d) <= b.max_load)) {
+    return Status(ErrorCode::kResourceExhausted,
+                  "can: the worst-case bus load of these dividers exceeds the budget");
+  }
+  return Status::ok();
+}
+
+}  // namespace
+
 Status check_config(const PublisherConfig& c) {
   if (c.node_id > kMaxNodeId) return Status(ErrorCode::kInvalidArgument, "can: node id > 15");
-  return check_dividers(c.dividers);
+  if (const Status s = check_dividers(c.dividers); !s.is_ok()) return s;
+  return check_budget(c.dividers, c.budget);
 }
 
 double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
@@ -224,6 +247,7 @@ Publisher::Publisher(hal::CanBus& bus, const PublisherConfig& c) : bus_(&bus) {
   if (init_status_.is_ok()) {
     node_id_ = c.node_id;
     dividers_ = c.dividers;
+    budget_ = c.budget;
   } else {
     dividers_ = default_dividers();
   }
@@ -280,7 +304,8 @@ Status Publisher::set_divider(MessageId m, std::uint16_t divider) {
   if (m == MessageId::kStatus) {
     return Status(ErrorCode::kInvalidArgument, "can: the Status divider follows the Epoch's");
   }
-  const Status s = check_dividers(d);
+  Status s = check_dividers(d);
+  if (s.is_ok()) s = check_budget(d, budget_);
   if (s.is_ok()) dividers_ = d;
   return s;
 }

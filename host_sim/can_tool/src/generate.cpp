@@ -1,10 +1,12 @@
 #include "generate.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
 
 #include "gfins/can/message_table.hpp"
+#include "gfins/can/publisher.hpp"
 
 namespace gfins::can_tool {
 namespace {
@@ -52,14 +54,7 @@ std::string type_of(const SignalDef& s) {
 
 }  // namespace
 
-int worst_case_frame_bits(int data_bytes) {
-  // SOF, 11-bit identifier, RTR, IDE, r0, DLC(4), data, CRC(15) are stuffed; worst case one stuff
-  // bit per 4 bits after the first. Then CRC delimiter, ACK slot, ACK delimiter, EOF(7), IFS(3).
-  const int stuffed = 1 + 11 + 1 + 1 + 1 + 4 + 8 * data_bytes + 15;
-  return stuffed + (stuffed - 1) / 4 + 1 + 1 + 1 + 7 + 3;
-}
-
-std::string generate_dbc(std::uint8_t node_id) {
+std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
   std::ostringstream o;
   o << "VERSION \"gfins CAN interface, generated from firmware/can message_table.hpp, node "
     << int{node_id} << "\"\n\n\n";
@@ -92,9 +87,11 @@ std::string generate_dbc(std::uint8_t node_id) {
   o << "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\n";
   o << "BA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n";
   for (const MessageDef& m : can::kMessages) {
-    if (m.default_divider == 0) continue;
-    const double ms = 1000.0 * m.default_divider / can::kDefaultSampleRateHz;
-    o << "BA_ \"GenMsgCycleTime\" BO_ " << m.base_id + node_id << " " << std::lround(ms) << ";\n";
+    const std::uint16_t divider = rates.dividers[static_cast<std::size_t>(m.id)];
+    if (m.kind != can::MessageKind::kData || divider == 0) continue;
+    const double ms = 1000.0 * divider / rates.sample_rate_hz;
+    o << "BA_ \"GenMsgCycleTime\" BO_ " << m.base_id + node_id << " "
+      << std::max<long>(1, std::lround(ms)) << ";\n";
   }
   // Value descriptions: the enumerations, and the not-available raw code of every signal that has
   // one, so a DBC tool shows "NotAvailable" instead of a reading (Qw -1.00024).
@@ -159,7 +156,7 @@ std::string generate_signal_tables() {
 
 std::string generate_budget_table(double sample_rate_hz, std::uint32_t bit_rate) {
   std::ostringstream o;
-  const int bits = worst_case_frame_bits(can::kFrameLength);
+  const int bits = can::worst_case_frame_bits(can::kFrameLength);
   o << "| message | divider | frames/s | worst-case bits/s | share of " << bit_rate / 1000
     << " kbit/s |\n|---|---|---|---|---|\n";
   double total_frames = 0;

@@ -7,11 +7,21 @@
 #include <string>
 
 #include "gfins/can/message_table.hpp"
+#include "gfins/can/publisher.hpp"
 
 namespace gfins::can_tool {
 
-/// The DBC of one node (identifiers = base + node_id).
-std::string generate_dbc(std::uint8_t node_id = can::kDefaultNodeId);
+/// The rates a DBC's GenMsgCycleTime attributes state: the table's defaults at 1 kHz, or what a
+/// configured board sends (gfins-can dbc --config).
+struct DbcRates {
+  double sample_rate_hz = can::kDefaultSampleRateHz;
+  can::Dividers dividers = can::default_dividers();
+};
+
+/// The DBC of one node (identifiers = base + node_id). GenMsgCycleTime of each periodic message
+/// is 1000 x divider / sample rate in whole milliseconds (at least 1); a message switched off
+/// has none.
+std::string generate_dbc(std::uint8_t node_id = can::kDefaultNodeId, const DbcRates& rates = {});
 
 /// Markdown: one table per message with every signal's type, factor, offset, unit, range,
 /// not-available value and instant.
@@ -19,10 +29,6 @@ std::string generate_signal_tables();
 
 /// Markdown: frames/s and worst-case share of the bit rate per message at the default dividers.
 std::string generate_budget_table(double sample_rate_hz, std::uint32_t bit_rate);
-
-/// Worst-case length in bits of a base-format (11-bit) data frame with `data_bytes` bytes,
-/// including stuff bits, the fixed tail and the 3-bit interframe space.
-int worst_case_frame_bits(int data_bytes);
 
 /// Marker lines delimiting generated blocks in docs/can-interface.md.
 inline constexpr const char* kSignalsBegin =

@@ -25,6 +25,8 @@
 #include "decode_session.hpp"
 #include "decoder.hpp"
 #include "generate.hpp"
+#include "gfins/app/config.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
 #include "gfins/drivers/lnx/file_parameter_store.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
@@ -789,6 +791,11 @@ int main_impl(int argc, char** argv) {
   dbc->add_option("--node", dbc_node, "node id (default 1, a stock board)")
       ->check(CLI::Range(0, 15));
   dbc->add_option("-o,--output", dbc_out, "write here instead of stdout");
+  std::string dbc_config;
+  auto* dbc_config_opt = dbc->add_option(
+      "--config", dbc_config,
+      "a gfins-fw configuration file: the DBC of that board (its can.node_id unless --node "
+      "is given; cycle times from its adc.sample_rate_hz and [output] dividers)");
 
   try {
     app.parse(argc, argv);
@@ -805,13 +812,25 @@ int main_impl(int argc, char** argv) {
   if (plot->parsed()) return run_plot(plot_log, plot_png, plot_node, plot_script);
   if (gnss->parsed()) return run_gnss(go);
   if (dbc->parsed()) {
+    // The configuration first: a file that does not load leaves the output untouched.
+    DbcRates rates;
+    if (dbc_config_opt->count() != 0) {
+      const app::ConfigResult r = app::load_config(dbc_config);
+      if (!r.ok()) {
+        std::fprintf(stderr, "gfins-can: dbc --config: %s\n", r.error.c_str());
+        return kExitInput;
+      }
+      rates.sample_rate_hz = r.config->sample_rate_hz;
+      rates.dividers = app::bus_dividers(*r.config);
+      if (dbc->count("--node") == 0) dbc_node = static_cast<std::uint8_t>(r.config->node_id);
+    }
     std::FILE* out = open_output(dbc_out);
     if (out == nullptr) {
       std::fprintf(stderr, "gfins-can: cannot create '%s': %s\n", dbc_out.c_str(),
                    std::strerror(errno));
       return kExitInput;
     }
-    const std::string text = generate_dbc(dbc_node);
+    const std::string text = generate_dbc(dbc_node, rates);
     const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
     return close_output(out, dbc_out) && written ? kExitOk : kExitInput;
   }

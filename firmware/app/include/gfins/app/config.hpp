@@ -43,8 +43,15 @@ inline constexpr std::uint16_t kMaxDivider = can::kMaxDivider;
 /// 1024..8192 → f_MOD / OSR with f_MOD = 4.096 MHz).
 inline constexpr std::array<double, 4> kSampleRatesHz = {500.0, 1000.0, 2000.0, 4000.0};
 inline constexpr int kMaxNodeId =
-    can::kMaxNodeId;                       // 4 bits of the identifier (docs/can-interface.md)
-inline constexpr int kMaxRtPriority = 99;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
+    can::kMaxNodeId;  // 4 bits of the identifier (docs/can-interface.md)
+inline constexpr int kMaxRtPriority = 99;
+/// CAN bit rates of the common classes (CiA 102 / SAE J1939 / ISO 11898 practice), bit/s.
+inline constexpr std::array<int, 9> kCanBitRates = {10000,  20000,  50000,  100000, 125000,
+                                                    250000, 500000, 800000, 1000000};
+/// The share of the bus the board's periodic frames may take in the worst case (every frame
+/// stuffed to its longest): half, leaving the rest to the other nodes and to arbitration.
+inline constexpr double kDefaultMaxBusLoadPercent =
+    50.0;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
 
 struct FwConfig {
   BoardKind board = BoardKind::kLinux;
@@ -59,6 +66,8 @@ struct FwConfig {
   std::string can_interface = "can0";
   std::string can_log;  // non-empty: write a candump log file instead of using an interface
   int node_id = can::kDefaultNodeId;
+  int can_bit_rate = static_cast<int>(can::kDefaultBitRate);  // bit/s of the bus (ip link's)
+  double max_bus_load_percent = kDefaultMaxBusLoadPercent;    // the board's worst-case share
 
   // [output]
   std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;
@@ -111,6 +120,10 @@ struct FwConfig {
   int hil_port = 7476;                    // 0: an ephemeral port (written to hil_port_file)
   std::string hil_port_file;              // non-empty: the bound port is written here
 };
+
+/// The worst-case share (0..1) of can.bit_rate that the board's periodic frames take with the
+/// configuration's sample rate and dividers (can::worst_case_bits_per_s; docs/can-interface.md).
+double worst_case_bus_load(const FwConfig& c);
 
 /// Outcome of loading: the configuration, or the first problem.
 struct ConfigResult {

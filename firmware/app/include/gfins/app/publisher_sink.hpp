@@ -14,10 +14,14 @@ namespace gfins::app {
 /// Publisher dividers from the configuration's [output] (index = can::MessageId), with the
 /// filter's messages at the table's rates when aiding is on.
 can::Dividers bus_dividers(const FwConfig& c);
+/// The bus the configuration describes (adc.sample_rate_hz, can.bit_rate,
+/// can.max_bus_load_percent): SetDivider is refused beyond it, as the configuration is.
+can::BusBudget bus_budget(const FwConfig& c);
 
 class PublisherSink final : public EpochSink {
  public:
-  PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers);
+  PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers,
+                const can::BusBudget& budget = {});
   std::uint32_t publish(const can::Epoch& e) override;
   Status set_divider(std::size_t message, std::uint16_t divider) override;
   const can::Publisher& publisher() const { return publisher_; }

@@ -36,7 +36,8 @@ enum class ResultCode : std::uint8_t {
   kFailed = 7,     // valid command, execution failed (e.g. calibration file unreadable)
   // 8 was "NotReady" in the first drafts of the ICD; no command depends on the mode (every one
   // is valid while aligning or navigating), so it is not a result the board gives.
-  kMoving = 9,  // re-align or reset refused: the board is moving (send it forced to insist)
+  kMoving = 9,    // re-align or reset refused: the board is moving (send it forced to insist)
+  kBusLoad = 10,  // SetDivider refused: the worst-case bus load would exceed the board's budget
 };
 
 const char* to_string(ResultCode r);

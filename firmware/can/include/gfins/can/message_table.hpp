@@ -206,15 +206,16 @@ inline constexpr std::array<ValueName, 7> kOpcodeValues{{{1, "Realign"},
 inline constexpr std::array<ValueName, 3> kCompensatorValues{
     {{0, "None"}, {1, "Paper"}, {2, "Exact"}}};
 
-inline constexpr std::array<ValueName, 9> kResultValues{{{0, "Ok"},
-                                                         {1, "UnknownOpcode"},
-                                                         {2, "BadLength"},
-                                                         {3, "BadCrc"},
-                                                         {4, "OutOfRange"},
-                                                         {5, "Malformed"},
-                                                         {6, "Busy"},
-                                                         {7, "Failed"},
-                                                         {9, "Moving"}}};
+inline constexpr std::array<ValueName, 10> kResultValues{{{0, "Ok"},
+                                                          {1, "UnknownOpcode"},
+                                                          {2, "BadLength"},
+                                                          {3, "BadCrc"},
+                                                          {4, "OutOfRange"},
+                                                          {5, "Malformed"},
+                                                          {6, "Busy"},
+                                                          {7, "Failed"},
+                                                          {9, "Moving"},
+                                                          {10, "BusLoad"}}};
 
 inline constexpr std::array<ValueName, 18> kMessageIdValues{{{0, "Epoch"},
                                                              {1, "Status"},

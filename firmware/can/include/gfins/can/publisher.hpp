@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "gfins/can/epoch.hpp"
 #include "gfins/can/message_table.hpp"
@@ -22,9 +23,36 @@ constexpr Dividers default_dividers() {
   return d;
 }
 
+/// Worst-case length in bits of a base-format (11-bit identifier) data frame of `data_bytes`
+/// bytes (ISO 11898-1): SOF, identifier, RTR, IDE, r0, DLC (4), data and CRC (15) are subject to
+/// bit stuffing, at worst one stuff bit per 4 bits after the first; then CRC delimiter, ACK slot,
+/// ACK delimiter, EOF (7) and the 3-bit interframe space. 135 bits for 8 data bytes.
+constexpr int worst_case_frame_bits(int data_bytes) {
+  const int stuffed = 1 + 11 + 1 + 1 + 1 + 4 + 8 * data_bytes + 15;
+  return stuffed + (stuffed - 1) / 4 + 1 + 1 + 1 + 7 + 3;
+}
+
+/// Bits per second the board's periodic frames take in the worst case (every frame at its
+/// stuffed length) with dividers `d` of `sample_rate_hz`. Command responses (one per command
+/// received) are not periodic and not counted.
+double worst_case_bits_per_s(const Dividers& d, double sample_rate_hz);
+
+/// The share of the bus the board may take: set_divider and the configuration refuse dividers
+/// whose worst-case load exceeds max_load x bit_rate. The default (no limit) is for host tools
+/// that make logs; the firmware sets its configured bus (can.bit_rate, can.max_bus_load_percent).
+struct BusBudget {
+  double sample_rate_hz = kDefaultSampleRateHz;
+  std::uint32_t bit_rate = kDefaultBitRate;
+  double max_load = std::numeric_limits<double>::infinity();  // fraction of bit_rate
+  [[nodiscard]] double load(const Dividers& d) const {
+    return worst_case_bits_per_s(d, sample_rate_hz) / static_cast<double>(bit_rate);
+  }
+};
+
 struct PublisherConfig {
   std::uint8_t node_id = 0;  // 0..kMaxNodeId: added to every base identifier
   Dividers dividers = default_dividers();
+  BusBudget budget;
 };
 
 struct PublisherCounters {
@@ -39,6 +67,7 @@ struct PublisherCounters {
 /// data message a multiple of the Epoch divider (so its frames always follow an Epoch frame);
 /// command/response entries 0.
 [[nodiscard]] Status check_dividers(const Dividers& d);
+/// check_dividers, the node id, and the dividers' load within the budget (kResourceExhausted).
 [[nodiscard]] Status check_config(const PublisherConfig& c);
 
 /// Values of one epoch as the bus carries them, before quantisation: what the encoder reads for a
@@ -69,8 +98,9 @@ class Publisher {
   /// this epoch was clipped / not available. Send failures are counted, never retried here.
   void publish(const Epoch& e);
 
-  /// Changes one data message's divider (0 = off) under the rules of check_dividers;
-  /// kInvalidArgument (and nothing changed) otherwise.
+  /// Changes one data message's divider (0 = off) under the rules of check_dividers
+  /// (kInvalidArgument / kOutOfRange otherwise) and within the budget (kResourceExhausted);
+  /// nothing changes when refused.
   [[nodiscard]] Status set_divider(MessageId m, std::uint16_t divider);
 
   std::uint16_t divider(MessageId m) const { return dividers_[static_cast<std::size_t>(m)]; }
@@ -83,6 +113,7 @@ class Publisher {
   hal::CanBus* bus_;
   std::uint8_t node_id_ = 0;
   Dividers dividers_{};
+  BusBudget budget_{};
   std::uint8_t counter_ = 0;                            // epoch counter, mod 16
   std::array<std::uint8_t, kMessageCount> selector_{};  // next selector of multiplexed messages
   Status init_status_{};
