@@ -269,7 +269,9 @@ def main():
     if r.returncode == 0:
         lines = open(gnss_log).read().splitlines()
         check(len(lines) == 4 * 161, f'gnss: {len(lines)} frames, expected 4 x 161 fixes')
-        check(lines[0].startswith('(0000000000.060000) can0 0C2#'), f'gnss: first line {lines[0]}')
+        # Log time = 1700000000 s (the documented epoch of simulated logs) + the scenario time of
+        # the first fix's transmission, 0.06 s.
+        check(lines[0].startswith('(1700000000.060000) can0 0C2#'), f'gnss: first line {lines[0]}')
         d = run([exe, 'decode', gnss_log, '--view', 'json'])
         recs = [json.loads(l) for l in d.stdout.decode().splitlines()]
         check(d.returncode == 0, f'gnss decode: exit {d.returncode}: {d.stderr.decode()}')

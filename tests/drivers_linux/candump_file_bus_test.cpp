@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "gfins/drivers/lnx/candump.hpp"
 #include "support/fake_clock.hpp"
 #include "support/temp_dir.hpp"
 
@@ -133,6 +134,39 @@ TEST(CandumpFileBus, CanUtilsLog2ascReadsTheLogBackToTheSameFrames) {
             "   0.000000 1  123             Rx   d 4 01 02 A0 FF\n"
             "   0.499750 1  1ABCDEF0x       Rx   d 0\n"
             "   0.999751 1  7FF             Rx   d 8 00 11 22 33 44 55 66 77\n");
+}
+
+// A simulation's offset: its clock starts at 0, its log at kSimulatedLogEpochS. log2asc (can-utils)
+// writes its "date" header once for such a log; for one starting at 0 it repeated it (903 times
+// for 2 s of gfins-fw --sim). An offset that could overflow the nanoseconds is refused.
+TEST(CandumpFileBus, ASimulationsLogStartsAtTheDocumentedEpochAndLog2ascReadsItWithOneHeader) {
+  const TempDir dir;
+  const auto log = (dir.path() / "sim.log").string();
+  const auto asc = (dir.path() / "sim.asc").string();
+  SimClock clock;
+  const std::int64_t epoch_ns = kSimulatedLogEpochS * 1000000000;
+  {
+    auto bus =
+        CandumpFileBus::open({.path = log, .interface = "can0", .time_offset_ns = epoch_ns}, clock);
+    ASSERT_TRUE(bus.is_ok()) << bus.status().message();
+    send_three(*bus.value(), clock);
+  }
+  EXPECT_EQ(read_text(log),
+            "(1700000001.000250) can0 123#0102A0FF\n"
+            "(1700000001.500000) can0 1ABCDEF0#\n"
+            "(1700000002.000001) can0 7FF#0011223344556677\n");
+  ASSERT_EQ(run({GFINS_LOG2ASC, "-I", log, "-O", asc, "can0"}), 0);
+  const std::string text = read_text(asc);
+  std::size_t headers = 0;
+  for (std::size_t at = text.find("date "); at != std::string::npos;
+       at = text.find("date ", at + 1)) {
+    ++headers;
+  }
+  EXPECT_EQ(headers, 1U) << text;
+  for (const std::int64_t bad : {std::int64_t{-1}, std::int64_t{4000000001} * 1000000000}) {
+    EXPECT_EQ(CandumpFileBus::open({.path = log, .time_offset_ns = bad}, clock).status().code(),
+              ErrorCode::kInvalidArgument);
+  }
 }
 
 TEST(CandumpFileBus, ADiskThatIsFullDropsAndCountsTheFramesAndNeverCrashes) {

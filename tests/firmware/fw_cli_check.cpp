@@ -215,6 +215,20 @@ TEST_F(FwCli, AFastSimulatedRunReportsItsProgress) {
   EXPECT_EQ(paced.output.find("progress: "), std::string::npos) << paced.output;
 }
 
+// The simulated board's log starts at the documented epoch of simulated logs, 1700000000 s
+// (docs/firmware.md), not at 0: the first epoch, at scenario time 0, is stamped
+// (1700000000.000000), the last of a 1.2 s run (samples 0..1200 at 1 kHz, an epoch every 10)
+// at 1.2 s.
+TEST_F(FwCli, ASimulatedLogStartsAtTheDocumentedEpoch) {
+  const test::CliResult r = fw(sim_run({}));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string log = test::slurp(path("out.log"));
+  EXPECT_EQ(log.rfind("(1700000000.000000) can0 101#", 0), 0U) << log.substr(0, 80);
+  const std::size_t last = log.rfind("\n(");
+  ASSERT_NE(last, std::string::npos);
+  EXPECT_EQ(log.substr(last + 1, 20), "(1700000001.200000) ");
+}
+
 TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {
   if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
   // /dev/full refuses every write with ENOSPC: every frame is lost.

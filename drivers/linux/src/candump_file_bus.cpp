@@ -12,6 +12,11 @@ namespace gfins::drivers::lnx {
 Result<std::unique_ptr<CandumpFileBus>> CandumpFileBus::open(const CandumpFileBusConfig& config,
                                                              hal::Clock& clock, Os& os) {
   if (config.path.empty()) return Status(ErrorCode::kInvalidArgument, "candump file: empty path");
+  // 0 .. 4e9 s: the log's seconds stay within int64 nanoseconds with any clock time of a run.
+  if (config.time_offset_ns < 0 ||
+      config.time_offset_ns > std::int64_t{4'000'000'000} * 1000000000) {
+    return Status(ErrorCode::kInvalidArgument, "candump file: time offset outside 0..4e9 s");
+  }
   hal::CanFrame probe;
   char line[kMaxCandumpLine];
   if (format_candump_line(line, 0, 0, config.interface, probe) == 0) {
@@ -36,6 +41,7 @@ CandumpFileBus::CandumpFileBus(Os& os, hal::Clock& clock, int fd,
       interface_(config.interface),
       capacity_(config.buffer_bytes),
       flush_interval_ns_(config.flush_interval_ns),
+      time_offset_ns_(config.time_offset_ns),
       last_flush_ns_(clock.now_ns()),
       background_(config.background_writer) {
   buffers_[0].reset(new char[config.buffer_bytes]);
@@ -168,7 +174,7 @@ Status CandumpFileBus::do_send(const hal::CanFrame& f) {
   }
   char* buffer = buffers_[active_].get();
   // candump prints the kernel's struct timeval: whole microseconds, the rest truncated.
-  const std::int64_t t_ns = std::max<std::int64_t>(clock_.now_ns(), 0);
+  const std::int64_t t_ns = std::max<std::int64_t>(clock_.now_ns(), 0) + time_offset_ns_;
   const std::size_t n =
       format_candump_line(std::span<char>(buffer + used_, capacity_ - used_ - 1), t_ns / 1000000000,
                           static_cast<std::uint32_t>(t_ns % 1000000000 / 1000), interface_, f);

@@ -3,6 +3,7 @@
 #include "boards.hpp"
 #include "gfins/app/board.hpp"
 #include "gfins/app/publisher_sink.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 #include "gfins/drivers/lnx/candump_file_bus.hpp"
 #include "gfins/drivers/lnx/dev_watchdog.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
@@ -53,6 +54,9 @@ std::string open_can_output(const FwConfig& c, hal::Clock& clock, Board& b) {
     // File writes off the loop thread, except in fast pacing, whose output must be the same on
     // every run (a writer thread that falls behind drops frames: a matter of scheduling).
     bc.background_writer = !(c.board == BoardKind::kSim && c.pacing == Pacing::kFast);
+    // The simulated board's clock starts at 0 with the scenario: its log starts at the documented
+    // epoch of simulated logs. A board's clock is its own (CLOCK_MONOTONIC).
+    if (c.board == BoardKind::kSim) bc.time_offset_ns = lnx::kSimulatedLogEpochS * 1000000000;
     auto bus = lnx::CandumpFileBus::open(bc, clock);
     if (!bus.is_ok()) return lnx::describe(c.can_log, bus.status());
     lnx::CandumpFileBus* file = bus.value().get();

@@ -223,7 +223,7 @@ bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,
   cfg.node_id = node_id;
   can::Publisher pub(bus, cfg);
   const auto n = static_cast<std::uint64_t>(seconds * sample_rate_hz);
-  constexpr std::int64_t kLogStartUs = 1'700'000'000'000'000;
+  constexpr std::int64_t kLogStartUs = drivers::lnx::kSimulatedLogEpochS * 1000000;
   can::Epoch e;
   e.mode = can::Mode::kNavigating;
   e.cal_id = 0x00C0FFEE;

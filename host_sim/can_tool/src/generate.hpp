@@ -46,8 +46,8 @@ namespace gfins::can_tool {
 /// Writes a candump log of `seconds` of a synthetic, smoothly moving board (closed-form attitude,
 /// velocity and position; filter σ, mode and aiding counters, one σ beyond its range at times, one
 /// aiding kind never accepted) published by the real Publisher at the default dividers, sample rate
-/// `sample_rate_hz`, node `node_id`, on interface "can0", log time starting at 1700000000 s.
-/// Returns false when writing failed.
+/// `sample_rate_hz`, node `node_id`, on interface "can0", log time starting at
+/// drivers::lnx::kSimulatedLogEpochS (1700000000 s). Returns false when writing failed.
 bool write_synthetic_log(std::FILE* out, double seconds, double sample_rate_hz,
                          std::uint8_t node_id);
 

@@ -27,6 +27,7 @@
 #include "generate.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/publisher_sink.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 #include "gfins/drivers/lnx/error_text.hpp"
 #include "gfins/drivers/lnx/file_parameter_store.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
@@ -196,7 +197,7 @@ struct GnssOptions {
   std::string iface;
   int node = 0;
   double duration_s = 0.0;
-  double log_start_s = 0.0;
+  double log_start_s = static_cast<double>(drivers::lnx::kSimulatedLogEpochS);
 };
 
 /// gfins-can gnss: the scenario's [gnss] receiver as input frames.
@@ -782,7 +783,8 @@ int main_impl(int argc, char** argv) {
   gnss->add_option("--duration", go.duration_s, "seconds of fixes (0 = the scenario's duration)")
       ->check(CLI::Range(0.0, 86400.0));
   gnss->add_option("--log-start", go.log_start_s,
-                   "log time of scenario time 0, s (default 0: log time = scenario time)")
+                   "log time of scenario time 0, s (default 1700000000, the epoch of every "
+                   "simulated log)")
       ->check(CLI::Range(0.0, 4.0e9));
 
   std::uint8_t dbc_node = can::kDefaultNodeId;

@@ -25,6 +25,11 @@ namespace gfins::drivers::lnx {
 inline constexpr std::uint32_t kCanErrFlag = 0x20000000u;  // linux/can.h CAN_ERR_FLAG
 inline constexpr std::size_t kMaxCandumpLine = 96;         // enough for any classic frame line
 inline constexpr std::size_t kMaxInterfaceName = 15;       // IFNAMSIZ - 1
+/// Log time of simulated time 0 in every log a simulation writes (gfins-fw on the simulated
+/// board, gfins-can-gen log, gfins-can gnss): 1700000000 s = 2023-11-14 22:13:20 UTC. A log
+/// starting at 0 makes tools that expect wall-clock times misbehave (log2asc repeats its
+/// header); a fixed epoch keeps a simulated run's file the same on every run.
+inline constexpr std::int64_t kSimulatedLogEpochS = 1700000000;
 
 struct CandumpRecord {
   std::int64_t seconds = 0;

@@ -43,6 +43,8 @@ struct CandumpFileBusConfig {
   std::size_t buffer_bytes = std::size_t{64} * 1024;  // at least CandumpFileBus::kLineMax
   std::int64_t flush_interval_ns = 1000000000;        // service() writes at most this late
   bool background_writer = false;                     // file writes on a thread of its own
+  std::int64_t time_offset_ns = 0;  // added to the clock's time on every line (a simulation's
+                                    // kSimulatedLogEpochS; 0 on a board: its own clock)
 };
 
 class CandumpFileBus final : public hal::CanBus {
@@ -94,6 +96,7 @@ class CandumpFileBus final : public hal::CanBus {
   std::uint32_t pending_frames_ = 0;  // lines in the active buffer
   long committed_bytes_ = 0;          // file length up to the last complete line (writer side)
   std::int64_t flush_interval_ns_;
+  std::int64_t time_offset_ns_;
   std::int64_t last_flush_ns_ = 0;
   hal::CanCounters counters_;  // caller side: frames refused before reaching a buffer
   // Writer side, read by the caller: frames written, frames lost to failed writes, errors.
