@@ -8,7 +8,7 @@
 #   N1, N2     call counts of the two runs (default 200 and 1200)
 #
 # Ir per call = (Ir(N2) − Ir(N1)) / (N2 − N1): the process start, the configuration and the
-# filter's start are the same for any N and cancel (tests/bench/filter_ops.hpp).
+# filter's start are the same for any N and cancel (nav_core/baremetal/filter_rig.hpp).
 set -euo pipefail
 
 # shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR

@@ -153,19 +153,24 @@ def cost(mn, ops, taken, prev_mem):
         return 1, "multiply"
     return 1, "integer"
 
-steps = []
-i = 0
-while i < len(pcs):
-    if pcs[i] != step_addr:
-        i += 1
-        continue
-    j = i
-    seq = []
-    while j < len(pcs) and not (main_lo <= pcs[j] < main_lo + main_size):
-        seq.append(j)
-        j += 1
-    steps.append(seq)
-    i = j
+def segments(entry, caller_lo, caller_size):
+    """Index runs of the trace from each entry to `entry` until the PC is back in the caller."""
+    out = []
+    i = 0
+    while i < len(pcs):
+        if pcs[i] != entry:
+            i += 1
+            continue
+        j = i
+        seq = []
+        while j < len(pcs) and not (caller_lo <= pcs[j] < caller_lo + caller_size):
+            seq.append(j)
+            j += 1
+        out.append(seq)
+        i = j
+    return out
+
+steps = segments(step_addr, main_lo, main_size)
 
 if len(steps) < 10:
     sys.exit("m4f_step_cycles.sh: fewer than 10 steps in the trace (%d)" % len(steps))
@@ -212,6 +217,31 @@ print()
 print("%-28s %8s %8s" % ("class (median step)", "instr", "cycles"))
 for cls, c in sorted(classes.items(), key=lambda kv: -kv[1]):
     print("%-28s %8d %8d" % (cls, ccount[cls], c))
+print()
+# The aided filter's operations (filter_rig.hpp), traced after the steps: the run announces them
+# as "FILTER-OPS calls name name ...", then makes `calls` calls of gfins_filter_op per operation
+# in that order.
+announced = None
+for line in open(out_path):
+    if line.startswith("FILTER-OPS "):
+        announced = line.split()[1:]
+if announced is None or "gfins_filter_op" not in sym or "gfins_run_filter_ops" not in sym:
+    sys.exit("m4f_step_cycles.sh: the run traced no filter operations (an old image?)")
+calls, op_names = int(announced[0]), announced[1:]
+runner_lo, runner_size = sym["gfins_run_filter_ops"]
+op_runs = segments(sym["gfins_filter_op"][0], runner_lo, runner_size)
+if len(op_runs) != calls * len(op_names):
+    sys.exit("m4f_step_cycles.sh: %d filter operation calls in the trace, %d announced"
+             % (len(op_runs), calls * len(op_names)))
+print("aided filter, one call (18 states, float32; %d calls of each, the same rig as the host's"
+      " callgrind figures):" % calls)
+print("%-16s %12s %12s %12s %10s" % ("operation", "instructions", "est. cycles", "spread", "us@168MHz"))
+for k, name in enumerate(op_names):
+    res = [analyse(s) for s in op_runs[k * calls:(k + 1) * calls]]
+    ins = sorted(r[0] for r in res)
+    cyc = sorted(r[1] for r in res)
+    print("%-16s %12d %12d %12s %10.1f" % (name, ins[len(ins) // 2], cyc[len(cyc) // 2],
+                                            "%d..%d" % (cyc[0], cyc[-1]), cyc[len(cyc) // 2] / 168.0))
 print()
 print("assumptions: zero-wait-state memory (code and data in SRAM, or flash behind a prefetch")
 print("accelerator that hits); taken branch 1+P with P = %d; LDR/STR 2 cycles, 1 when it follows" % P)

@@ -16,8 +16,12 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 
 #include "gfins/nav_core/pipeline.hpp"
+#ifdef GFINS_PROBE_STEPS
+#include "filter_rig.hpp"
+#endif
 #include "probe_config.hpp"
 #include "probe_samples.hpp"
 
@@ -110,6 +114,45 @@ extern "C" [[gnu::noinline]] void gfins_filter_step() {
 // qemu_startup.cpp: the QEMU build (gfins_nav_qemu) runs a bounded number of steps and exits.
 extern "C" [[noreturn]] void gfins_probe_exit(int code);
 extern "C" void gfins_probe_report(const volatile float* values, int n);
+extern "C" void gfins_probe_print(const char* text);
+
+// The filter's operations one at a time (filter_rig.hpp: the rig the host's callgrind and Google
+// Benchmark figures use), each call in gfins_filter_op so that m4f_step_cycles.sh finds them in
+// the trace: kFilterOpCalls calls of each operation, in the order of kFilterOps, which the run
+// announces on a line "FILTER-OPS calls name name ..." before the first.
+constexpr int kFilterOpCalls = 5;
+gfins::bench::FilterRig<float>* g_rig = nullptr;
+volatile int g_filter_accepted;
+
+extern "C" [[gnu::noinline]] void gfins_filter_op(gfins::bench::FilterOp op) {
+  g_filter_accepted = g_filter_accepted + (g_rig->run(op) ? 1 : 0);
+}
+
+// Out of line and named: the trace's segments of gfins_filter_op end when the PC is back here.
+extern "C" [[gnu::noinline]] void gfins_run_filter_ops() {
+  static gfins::bench::FilterRig<float> rig;
+  g_rig = &rig;
+  if (!rig.ok()) gfins_probe_exit(4);
+  char line[160] = "FILTER-OPS 5";
+  static_assert(kFilterOpCalls == 5, "the announced count");
+  std::size_t pos = 12;
+  for (const gfins::bench::FilterOp op : gfins::bench::kFilterOps) {
+    line[pos++] = ' ';
+    for (const char* c = gfins::bench::to_string(op); *c != 0 && pos + 2 < sizeof line; ++c) {
+      line[pos++] = *c;
+    }
+  }
+  line[pos++] = '\n';
+  line[pos] = 0;
+  gfins_probe_print(line);
+  for (const gfins::bench::FilterOp op : gfins::bench::kFilterOps) {
+    for (int k = 0; k < kFilterOpCalls; ++k) gfins_filter_op(op);
+  }
+  // Every update accepted, as on the host (the rig is at rest: zero innovations).
+  if (g_filter_accepted != kFilterOpCalls * static_cast<int>(std::size(gfins::bench::kFilterOps))) {
+    gfins_probe_exit(5);
+  }
+}
 static_assert(GFINS_PROBE_STEPS < gfins::probe::kSamples, "one recorded sample per step");
 static_assert(GFINS_PROBE_STEPS == gfins::probe::kExpectedSteps,
               "the expected result in probe_samples.hpp is for this many steps");
@@ -145,6 +188,7 @@ int main() {
   // The state after the last step (attitude, velocity, position), for m4f_step_cycles.sh to
   // compare with the x86 float pipeline on the same samples (probe_samples.hpp kExpectedOut).
   gfins_probe_report(g_out, 10);
+  gfins_run_filter_ops();
   gfins_probe_exit(0);
 #endif
 }

@@ -11,6 +11,7 @@ void _start();  // newlib crt0: zero .bss, run constructors, call main
 [[noreturn]] void gfins_qemu_fault();
 [[noreturn]] void gfins_probe_exit(int code);
 void gfins_probe_report(const volatile float* values, int n);
+void gfins_probe_print(const char* text);
 }
 
 // ARMv7-M vector table (ARMv7-M ARM, B1.5.3): initial SP, then reset, NMI, HardFault,
@@ -59,8 +60,13 @@ extern "C" void gfins_probe_report(const volatile float* values, int n) {
   }
   line[pos++] = '\n';
   line[pos] = 0;
+  gfins_probe_print(line);
+}
+
+// A NUL-terminated text on QEMU's standard output (SYS_WRITE0).
+extern "C" void gfins_probe_print(const char* text) {
   register std::uint32_t r0 asm("r0") = 0x04;
-  register const char* r1 asm("r1") = line;
+  register const char* r1 asm("r1") = text;
   asm volatile("bkpt 0xab" : : "r"(r0), "r"(r1) : "memory");
 }
 
