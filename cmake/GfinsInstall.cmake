@@ -93,6 +93,71 @@ if(gfins_tool_targets)
   install(FILES README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/gfins-tools COMPONENT tools)
 endif()
 
+# --- manual pages: each program's --help as a man page, made at build time --------------------
+# help2man (Debian package help2man) runs the program; a cross-built one runs through the
+# toolchain's emulator (CMAKE_CROSSCOMPILING_EMULATOR, qemu-user) by a wrapper script of the
+# program's name. Without help2man (or a cross build without an emulator) there are none, and
+# scripts/package.sh, which needs them, refuses to package.
+find_program(GFINS_HELP2MAN help2man)
+set(gfins_man_ok FALSE)
+if(GFINS_HELP2MAN AND (NOT CMAKE_CROSSCOMPILING OR CMAKE_CROSSCOMPILING_EMULATOR))
+  set(gfins_man_ok TRUE)
+elseif(gfins_components)
+  message(STATUS "gfins: no manual pages (help2man not found, or a cross build without an "
+                 "emulator): apt-get install help2man")
+endif()
+function(gfins_man_page target component summary see_also)
+  set(dir ${PROJECT_BINARY_DIR}/man)
+  set(run $<TARGET_FILE:${target}>)
+  if(CMAKE_CROSSCOMPILING)
+    list(JOIN CMAKE_CROSSCOMPILING_EMULATOR " " emulator)
+    file(GENERATE OUTPUT ${dir}/run/${target}
+         CONTENT "#!/bin/sh\nexec ${emulator} $<TARGET_FILE:${target}> \"$@\"\n"
+         FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE
+                          WORLD_READ WORLD_EXECUTE)
+    set(run ${dir}/run/${target})
+  endif()
+  file(WRITE ${dir}/${target}.h2m "[SEE ALSO]\n${see_also}\n")
+  add_custom_command(
+    OUTPUT ${dir}/${target}.1.gz
+    COMMAND ${GFINS_HELP2MAN} --no-info --no-discard-stderr --version-string=${PROJECT_VERSION}
+            --name=${summary} --include=${dir}/${target}.h2m --output=${dir}/${target}.1 ${run}
+    COMMAND gzip -9n -f ${dir}/${target}.1
+    DEPENDS ${target} ${dir}/${target}.h2m VERBATIM)
+  add_custom_target(gfins_man_${target} ALL DEPENDS ${dir}/${target}.1.gz)
+  add_dependencies(gfins_man_${component} gfins_man_${target})
+  install(FILES ${dir}/${target}.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1
+          COMPONENT ${component})
+endfunction()
+if(gfins_man_ok)
+  foreach(c IN LISTS gfins_components)
+    add_custom_target(gfins_man_${c})
+  endforeach()
+  set(gfins_board_docs "The deployment guide: /usr/share/doc/gfins-fw/deploy.md (docs/deploy.md \
+of the source tree); the CAN interface, the configuration keys and the simulation: \
+docs/can-interface.md, docs/firmware.md, docs/simulation.md (also in /usr/share/doc/gfins-tools).")
+  set(gfins_tools_docs "The documentation in /usr/share/doc/gfins-tools (docs/ of the source \
+tree): README.md, simulation.md, replay.md, calibration.md, can-interface.md.")
+  if(TARGET gfins-fw)
+    gfins_man_page(gfins-fw board "gyro-free inertial navigation firmware" "${gfins_board_docs}")
+  endif()
+  set(gfins_tool_summaries
+      "gfins-can=decode, plot and command the gfins CAN interface"
+      "gfins-can-gen=generate the gfins DBC, ICD tables, bus budget and synthetic CAN logs"
+      "gfins-sim=simulate the gyro-free INS: scenarios, Monte-Carlo, covariance"
+      "gfins-calibrate=compute a gfins calibration file from pose means or recordings"
+      "gfins-replay=navigate, print or average a gfins raw-sample recording")
+  foreach(entry IN LISTS gfins_tool_summaries)
+    string(FIND "${entry}" "=" eq)
+    string(SUBSTRING "${entry}" 0 ${eq} t)
+    math(EXPR from "${eq} + 1")
+    string(SUBSTRING "${entry}" ${from} -1 summary)
+    if(TARGET ${t})
+      gfins_man_page(${t} tools "${summary}" "${gfins_tools_docs}")
+    endif()
+  endforeach()
+endif()
+
 # --- Debian packages (CPack DEB) ---------------------------------------------------------------
 if(NOT gfins_components)
   return()
@@ -133,6 +198,9 @@ if(TARGET gfins-fw)
 endif()
 foreach(c IN LISTS gfins_components)
   list(APPEND gfins_package_deps gfins_changelog_${c})
+  if(gfins_man_ok)
+    list(APPEND gfins_package_deps gfins_man_${c})
+  endif()
 endforeach()
 add_custom_target(gfins_package_programs DEPENDS ${gfins_package_deps})
 

@@ -16,6 +16,7 @@ packages=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
   qemu-system-arm  # scripts/m4f_step_cycles.sh: the Cortex-M4F step traced on mps2-an386
   lintian dpkg-dev  # scripts/package.sh: lintian on the .debs; dpkg-shlibdeps for CPack's Depends
+  help2man  # the manual pages, made from each program's --help at build time
 )
 
 # npm installs the CAN test's third-party DBC reader (tests/can/independent): Debian's package,

@@ -18,6 +18,8 @@ presets=("$@")
 [ ${#presets[@]} -gt 0 ] || presets=(host-release aarch64-linux armhf-linux)
 out=out/deb
 mkdir -p "$out"
+command -v help2man >/dev/null ||
+  { echo "package.sh: help2man missing: install Debian package 'help2man' (the manual pages; scripts/install-deps.sh does)" >&2; exit 1; }
 command -v lintian >/dev/null ||
   { echo "package.sh: lintian missing: install Debian package 'lintian' (scripts/install-deps.sh does)" >&2; exit 1; }
 command -v dpkg-shlibdeps >/dev/null ||
@@ -29,7 +31,7 @@ for spec in "${presets[@]}"; do
   part=${spec#"$p"}
   case "$part" in
     "") targets=(gfins_package_programs) cpack_args=() ;;
-    :board) targets=(gfins-fw gfins_changelog_board) cpack_args=(-D CPACK_COMPONENTS_ALL=board) ;;
+    :board) targets=(gfins-fw gfins_changelog_board gfins_man_board) cpack_args=(-D CPACK_COMPONENTS_ALL=board) ;;
     *) echo "package.sh: $spec: expected PRESET or PRESET:board" >&2; exit 2 ;;
   esac
   echo "=== package: $spec"
@@ -53,6 +55,12 @@ for spec in "${presets[@]}"; do
 done
 
 echo "=== lintian ${#made[@]} package(s) made by this run"
-# --fail-on error: warnings are shown but only errors fail the build.
-lintian --fail-on error --tag-display-limit 0 "${made[@]}"
-echo "package.sh: ${#made[@]} package(s) in $out, lintian: no errors"
+# --fail-on error: warnings are shown but only errors fail the build, except a program without
+# its manual page (made from its --help at build time: a missing one is a broken build step).
+lintian_log="$out/lintian.log"
+lintian --fail-on error --tag-display-limit 0 "${made[@]}" | tee "$lintian_log"
+if grep -q 'no-manual-page' "$lintian_log"; then
+  echo "package.sh: a program has no manual page (is help2man installed, and the cross emulator?)" >&2
+  exit 1
+fi
+echo "package.sh: ${#made[@]} package(s) in $out, lintian: no errors, every program has its manual page"

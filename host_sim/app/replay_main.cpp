@@ -16,7 +16,9 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common.hpp"
@@ -79,6 +81,18 @@ std::string printable(const std::string& text) {
   }
   return out;
 }
+
+// The usage lines of all three forms: dump and means are parsed before CLI11 sees the command
+// line (they are not CLI11 subcommands), so its own usage line would name the first form only.
+class ReplayUsage final : public CLI::Formatter {
+ public:
+  std::string make_usage(const CLI::App* app, std::string name) const override {
+    return CLI::Formatter::make_usage(app, std::move(name)) +
+           "       gfins-replay dump RECORDING.gfr\n"
+           "       gfins-replay means RECORDING.gfr --mounting K --up X Y Z --rate-rad-s W "
+           "[--header]\n";
+  }
+};
 
 // ---- dump -------------------------------------------------------------------------------------
 
@@ -579,6 +593,7 @@ int replay_main(int argc, char** argv) {
       "gfins-replay: navigate a raw-sample recording (.gfr) through the navigation core, or "
       "print it (gfins-replay dump FILE.gfr), or average a rate-table run (gfins-replay means)",
       "gfins-replay"};
+  cli.formatter(std::make_shared<ReplayUsage>());
   cli.footer(footer);
   cli.set_version_flag("--version", gfins::version::version_line("gfins-replay"));
   ReplayOptions o;

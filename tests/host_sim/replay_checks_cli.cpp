@@ -184,5 +184,20 @@ TEST_F(ReplayChecksCli, DumpKeepsANewlineInTheFileNameOutOfItsHeader) {
   EXPECT_NE(r.output.find("odd\\x0aname.gfr"), std::string::npos);
 }
 
+// The usage names all three forms (docs/replay.md): dump and means are read before CLI11 parses,
+// so its generated usage line alone named only the first.
+TEST_F(ReplayChecksCli, UsageNamesNavigationDumpAndMeans) {
+  const CliResult r = run(GFINS_REPLAY_BIN, {"--help"});
+  EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+  EXPECT_NE(r.output.find("Usage: gfins-replay [OPTIONS] recording"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("       gfins-replay dump RECORDING.gfr\n"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("       gfins-replay means RECORDING.gfr --mounting K --up X Y Z "
+                          "--rate-rad-s W [--header]\n"),
+            std::string::npos)
+      << r.output;
+}
+
 }  // namespace
 }  // namespace gfins::sim

@@ -68,6 +68,13 @@ outer() {
     for tree in "$src" "$build"; do
       if grep -q -a -F "$tree" "$prefix/bin/$p"; then fail "$p contains the path $tree"; fi
     done
+    # Its manual page, made from its --help (help2man): the NAME line and the help's exit codes.
+    local man=$prefix/share/man/man1/$p.1.gz
+    if [ ! -s "$man" ]; then
+      fail "$p has no manual page $man"
+    elif ! zcat "$man" | grep -q "^$p \\\\- " || ! zcat "$man" | grep -q "Exit codes"; then
+      fail "$p: $man is not its --help (no NAME line for $p, or no exit codes)"
+    fi
   done
 
   # The oracle for --version: git's own description of the checkout (build and test run on the
