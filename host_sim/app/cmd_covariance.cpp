@@ -113,17 +113,21 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   if (auto w = write_budget_csv(b, out_dir + "/budget.csv"); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }
-  const std::size_t last = r.t_s.size() - 1;
-  const auto block = [&](std::size_t off) {
-    return std::sqrt(r.sigma[off][last] * r.sigma[off][last] +
-                     r.sigma[off + 1][last] * r.sigma[off + 1][last] +
-                     r.sigma[off + 2][last] * r.sigma[off + 2][last]);
+  // The predicted σ at each budget time (--at, or T/4, T/2, T): the nearest kept sample, as the
+  // budget takes it.
+  const auto block = [&](std::size_t off, std::size_t k) {
+    return std::sqrt(r.sigma[off][k] * r.sigma[off][k] + r.sigma[off + 1][k] * r.sigma[off + 1][k] +
+                     r.sigma[off + 2][k] * r.sigma[off + 2][k]);
   };
-  std::printf(
-      "predicted 1 sigma at t = %.3g s: |phi| %.4g deg, |dr| %.4g m, |dv| %.4g m/s, "
-      "|dw| %.4g rad/s\nwritten: %s/covariance.csv, %s/budget.csv\n",
-      r.t_s[last], block(0) * 180.0 / M_PI, block(3), block(6), block(9), out_dir.c_str(),
-      out_dir.c_str());
+  std::printf("predicted 1 sigma, all sources together (budget.csv splits them):\n");
+  for (const double t : b.t_s) {
+    const auto it = std::lower_bound(r.t_s.begin(), r.t_s.end(), t);
+    std::size_t k = static_cast<std::size_t>(it - r.t_s.begin());
+    if (k == r.t_s.size() || (k > 0 && t - r.t_s[k - 1] < r.t_s[k] - t)) k = k == 0 ? 0 : k - 1;
+    std::printf("  t = %.4g s: |phi| %.4g deg, |dr| %.4g m, |dv| %.4g m/s, |dw| %.4g rad/s\n",
+                r.t_s[k], block(0, k) * 180.0 / M_PI, block(3, k), block(6, k), block(9, k));
+  }
+  std::printf("written: %s/covariance.csv, %s/budget.csv\n", out_dir.c_str(), out_dir.c_str());
   // One run of the scenario (its own sensor errors) through the navigation core in the chosen
   // scalar: a sample of what the envelopes predict, written next to them. The propagation
   // above is the linear error model in double whatever the core's scalar.

@@ -8,13 +8,18 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gfins/host_sim/montecarlo.hpp"
 #include "gfins/host_sim/scenario.hpp"
@@ -214,6 +219,38 @@ TEST_F(MontecarloCli, CovarianceShowsProgressInALogAndStopsBetweenPhasesOnSigint
     const auto lines = test::lines_of(text);
     const std::size_t cells = test::cells_of(lines.front()).size();
     for (const auto& l : lines) ASSERT_EQ(test::cells_of(l).size(), cells) << name << ": " << l;
+  }
+}
+
+// covariance prints the predicted σ at every budget time asked with --at (it printed the final
+// time alone): one line per time, each the total of budget.csv at that time (|φ| the norm of the
+// three components, in degrees; the print has 4 significant digits, so 1e-3 relative).
+TEST_F(MontecarloCli, CovariancePrintsThePredictionAtEveryTimeAsked) {
+  const CliResult r = run(GFINS_SIM_BIN, {"covariance", "rest-calibrated", "--at", "0.5", "--at",
+                                          "1.5", "--no-plot", "-o", path("cov")});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::map<double, double> total_phi_deg;  // budget.csv "total" rows: t -> |φ|
+  std::istringstream budget(test::slurp(path("cov") + "/budget.csv"));
+  for (std::string line; std::getline(budget, line);) {
+    if (line.rfind("total,", 0) != 0) continue;
+    std::istringstream cells(line.substr(6));
+    std::array<double, 4> v{};  // t, φx, φy, φz
+    char comma = 0;
+    cells >> v[0] >> comma >> v[1] >> comma >> v[2] >> comma >> v[3];
+    total_phi_deg[v[0]] = std::sqrt(v[1] * v[1] + v[2] * v[2] + v[3] * v[3]) * 180.0 / M_PI;
+  }
+  ASSERT_EQ(total_phi_deg.size(), 2U) << test::slurp(path("cov") + "/budget.csv");
+  const std::regex line_re(R"(  t = ([0-9.e+-]+) s: \|phi\| ([0-9.e+-]+) deg)");
+  std::vector<std::pair<double, double>> printed;
+  for (auto it = std::sregex_iterator(r.output.begin(), r.output.end(), line_re);
+       it != std::sregex_iterator(); ++it) {
+    printed.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]));
+  }
+  ASSERT_EQ(printed.size(), 2U) << r.output;
+  EXPECT_EQ(printed[0].first, 0.5);
+  EXPECT_EQ(printed[1].first, 1.5);
+  for (const auto& [t, phi] : printed) {
+    EXPECT_NEAR(phi, total_phi_deg[t], 1e-3 * total_phi_deg[t]) << "t = " << t;
   }
 }
 
