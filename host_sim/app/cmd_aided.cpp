@@ -129,7 +129,10 @@ int cmd_aided(const std::string& name, const OutputOptions& out) {
   if (auto c = check_run_size(s, false, /*in_memory=*/false); !c.is_ok()) {
     return fail(c.error(), kExitBadInput);
   }
-  if (auto d = make_dir(dir.value()); !d.is_ok()) return fail(d.error(), kExitError);
+  if (auto d = make_dir(dir.value(), "gfins-sim", {"summary.txt", "aided.csv", "unaided.csv"});
+      !d.is_ok()) {
+    return fail(d.error(), kExitError);
+  }
   std::printf("gfins-sim aided %s\n  navigation: %s\n", describe(s).c_str(),
               scalar_text(scalar.value()));
   AccuracyTracker trackers[2] = {make_tracker(s), make_tracker(s)};

@@ -64,7 +64,11 @@ int cmd_covariance(const std::string& name, const CovarianceOptions& c, const Ou
   }
   if (auto k = check_run_size(s, false); !k.is_ok()) return fail(k.error(), kExitBadInput);
   const std::string& out_dir = dir.value();
-  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  if (auto d =
+          make_dir(out_dir, "gfins-sim", {"covariance.csv", "budget.csv", "reference_run.csv"});
+      !d.is_ok()) {
+    return fail(d.error(), kExitError);
+  }
   auto traj = make_trajectory(s.trajectory);
   if (!traj.is_ok()) return fail(traj.error(), kExitBadInput);
   CovarianceSpec spec;

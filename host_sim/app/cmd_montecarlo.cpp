@@ -28,7 +28,9 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
     return fail(c.error(), kExitBadInput);
   }
   const std::string& out_dir = dir.value();
-  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  if (auto d = make_dir(out_dir, "gfins-sim", {"montecarlo.csv", "slopes.txt"}); !d.is_ok()) {
+    return fail(d.error(), kExitError);
+  }
   if (auto w = check_writable({out_dir + "/montecarlo.csv", out_dir + "/slopes.txt"}); !w.is_ok()) {
     return fail(w.error(), kExitError);
   }

@@ -26,7 +26,9 @@ int cmd_paper63(const OutputOptions& out) {
   const auto scalar = nav_scalar(out.scalar);
   if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
   const std::string& out_dir = dir.value();
-  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  if (auto d = make_dir(out_dir, "gfins-sim", {"bounds.csv", "calibration.txt"}); !d.is_ok()) {
+    return fail(d.error(), kExitError);
+  }
   // The paper's quoted bounds (§6.3, Figs. 7-10), docs/simulation.md.
   const double paper[8] = {-8, 2, -0.1, 0.5, -0.002, 0.003, -0.003, 0.003};
   const Paper63Config configs[] = {

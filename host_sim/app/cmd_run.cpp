@@ -111,7 +111,12 @@ int cmd_run(const std::string& name, const OutputOptions& out) {
       return fail(c.error(), kExitBadInput);
     }
   }
-  if (auto d = make_dir(out_dir); !d.is_ok()) return fail(d.error(), kExitError);
+  if (auto d = make_dir(out_dir, "gfins-sim",
+                        {"summary.txt", "uncompensated.csv", "compensated.csv", "accel_errors.png",
+                         "nav_errors.png"});
+      !d.is_ok()) {
+    return fail(d.error(), kExitError);
+  }
   std::printf("gfins-sim run %s\n  navigation: %s\n", describe(s).c_str(),
               scalar_text(scalar.value()));
   print_estimate(

@@ -23,10 +23,20 @@ int fail(const HostError& e, int exit_code) {
 
 HostResult<Scenario> load(const std::string& file_or_name) { return load_scenario(file_or_name); }
 
-HostStatus make_dir(const std::string& dir) {
+HostStatus make_dir(const std::string& dir, const char* program,
+                    std::initializer_list<const char*> outputs) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return HostError{ErrorCode::kIoError, "cannot create " + dir + ": " + ec.message()};
+  std::string there;
+  for (const char* name : outputs) {
+    if (!std::filesystem::exists(std::filesystem::path(dir) / name, ec)) continue;
+    there += (there.empty() ? "" : ", ") + std::string(name);
+  }
+  if (!there.empty()) {
+    std::fprintf(stderr, "%s: note: %s already holds %s: replaced by this run\n", program,
+                 dir.c_str(), there.c_str());
+  }
   return Done{};
 }
 

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -34,8 +35,12 @@ int fail(const HostError& e, int exit_code);
 /// found relative to the program (sim::load_scenario; $GFINS_SCENARIO_DIR overrides).
 HostResult<Scenario> load(const std::string& file_or_name);
 
-/// Creates the output folder (and its parents).
-HostStatus make_dir(const std::string& dir);
+/// Creates the output folder (and its parents). `outputs` are the files the command writes into
+/// it: those already there (an earlier run's, perhaps of another scenario or command) are named
+/// in a note on stderr, "<program>: note: DIR already holds A, B: replaced by this run", so that
+/// two runs into one folder do not overwrite each other silently.
+HostStatus make_dir(const std::string& dir, const char* program = "gfins-sim",
+                    std::initializer_list<const char*> outputs = {});
 
 /// Before the work: each of `paths` can be created for writing (a read-only folder, a name that
 /// is a folder, a full disk's quota fail here, not after minutes of work). The probe files are

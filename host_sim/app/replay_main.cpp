@@ -534,7 +534,8 @@ int run_navigate(ReplayOptions& o) {
       return fail(st.error().message, app::kExitBadInput);
     }
   }
-  if (auto d = app::make_dir(dir.value()); !d.is_ok()) {
+  if (auto d = app::make_dir(dir.value(), "gfins-replay", {"summary.txt", "navigation.csv"});
+      !d.is_ok()) {
     return fail(d.error().message, app::kExitError);
   }
   return scalar.value() == sim::NavScalar::kFloat

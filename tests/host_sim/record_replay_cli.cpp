@@ -534,6 +534,32 @@ mean_noise_g = 0.1
   expect_failed_folder(path("wild"), "0.2 rad");
 }
 
+// Two runs into one folder: the second names the files of the first it replaces (a note on
+// stderr; the folder is the user's choice, so it is not refused). The first run, into a new
+// folder, has no note; replay says the same of its own files.
+TEST_F(RecordReplay, ASecondRunIntoTheSameFolderSaysWhichFilesItReplaces) {
+  const std::string rest = file("rest.toml", kRestTable6);
+  const std::string out = path("same");
+  const CliResult first = sim({"run", rest, "-o", out, "--no-plot", "--record", path("r.gfr")});
+  ASSERT_EQ(first.exit_code, kExitOk) << first.output;
+  EXPECT_EQ(first.err.find("note:"), std::string::npos) << first.err;
+  const CliResult second = sim({"run", rest, "-o", out, "--no-plot"});
+  ASSERT_EQ(second.exit_code, kExitOk) << second.output;
+  EXPECT_NE(second.err.find("gfins-sim: note: " + out +
+                            " already holds summary.txt, uncompensated.csv, compensated.csv: "
+                            "replaced by this run"),
+            std::string::npos)
+      << second.err;
+  const CliResult r1 = replay({path("r.gfr"), "-o", path("rp"), "--no-plot"});
+  ASSERT_EQ(r1.exit_code, kExitOk) << r1.output;
+  EXPECT_EQ(r1.err.find("note:"), std::string::npos) << r1.err;
+  const CliResult r2 = replay({path("r.gfr"), "-o", path("rp"), "--no-plot"});
+  EXPECT_NE(r2.err.find("gfins-replay: note: " + path("rp") +
+                        " already holds summary.txt, navigation.csv: replaced by this run"),
+            std::string::npos)
+      << r2.err;
+}
+
 TEST_F(RecordReplay, InputsAreRefusedBeforeWorkWithAMessageNamingWhatIsWrong) {
   struct Case {
     std::vector<std::string> args;
