@@ -59,6 +59,12 @@ TEST(CalibrateCli, PaperTablesGiveAFileCarryingTable6) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("verdict: good"));
   EXPECT_THAT(r.output, HasSubstr("largest condition number of a sensor's design: 3.2"));
+  // And the report says how weak residual σ are here: Tables 2/3 give each sensor 6 of the 12
+  // poses, 4 unknowns, 2 degrees of freedom; for Student's t with 2 dof P(|t| <= 3) = 3/√11 =
+  // 0.9045 (closed form, the t(2) distribution function).
+  EXPECT_THAT(r.output, HasSubstr("each sensor is fitted from 6 of the 12 poses, 4 unknowns, so 2 "
+                                  "degrees of freedom (a Student-t with 2 dof puts 90.5 % of true "
+                                  "values within 3σ"));
   // And the file loads and holds Table 6
   const auto loaded = load_calibration_file(out);
   ASSERT_TRUE(loaded.is_ok()) << loaded.status().message();
