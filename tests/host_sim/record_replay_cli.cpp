@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -326,6 +327,38 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
   EXPECT_LT(r_with, bound) << with.output;
   // Uncompensated, Table 6's angles (up to 2.7°) give errors orders of magnitude larger.
   EXPECT_GT(r_without, 100 * bound) << without.output;
+}
+
+// calibration-board records the twelve poses of Tables 2/3 and then a verification pose
+// (extra_poses_g, 14.7° from T3.2 by the nominal scale factors): without --poses it is the
+// nearest to T3.2 but is not T3.2. Taken as a second T3.2 it broke the fit (residuals of 10-97 mg,
+// angles off by degrees); it is skipped, and the angles are the scenario's. Tolerance: 0.5 mg
+// noise over a 2.8 s pose (2,800 samples) leaves 9.4e-6 g on each mean, i.e. 9.4e-6 rad of angle;
+// the least squares over 12 poses (condition number 1.73) amplify it by 1.73: a bound of ten
+// times that, 1.6e-4 rad, is 0.0093°, and a pose taken with the wrong attitude is off by degrees.
+TEST_F(RecordReplay, AVerificationPoseNearAnExpectedOneIsNotTakenForIt) {
+  const std::string rec = path("board.gfr");
+  const auto r =
+      sim({"run", "calibration-board", "-o", path("board"), "--no-plot", "--record", rec});
+  ASSERT_EQ(r.exit_code, kExitOk) << r.output;
+  const std::string cal = path("board.toml");
+  const auto c = calibrate({"--recording", rec, "--gravity", "9.789262", "--device-id", "board",
+                            "--nominal-sf", "1.33", "-o", cal});
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("interval 13: 54.10-69.90 s, nearest to pose T3.2"), std::string::npos)
+      << c.output;
+  EXPECT_NE(c.output.find("not that pose, skipped"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("poses: 12,"), std::string::npos) << c.output;
+  const auto data = calib_file::load_calibration_file(cal);
+  ASSERT_TRUE(data.is_ok()) << data.status().message();
+  // The scenario's orientation errors (host_sim/scenarios/calibration-board.toml), Table 6 order.
+  constexpr std::array<double, 6> kBetaDeg = {0.8, -1.2, 0.5, 1.5, -0.7, 0.9};
+  constexpr std::array<double, 6> kAlphaDeg = {-1.1, 0.6, 1.3, -0.4, 0.2, -1.6};
+  constexpr double kTolDeg = 10.0 * 1.73 * 0.5e-3 / 52.915 * 180.0 / M_PI;  // √2800 = 52.9
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(data.value().beta.angle_deg[i], kBetaDeg[i], kTolDeg) << "beta " << i;
+    EXPECT_NEAR(data.value().alpha.angle_deg[i], kAlphaDeg[i], kTolDeg) << "alpha " << i;
+  }
 }
 
 TEST_F(RecordReplay, LocationCalibrationFromRecordedRateTableRunsRecoversTheLocationErrors) {

@@ -334,20 +334,70 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   assign.nominal_scale_v_per_g = options.nominal_scale_v_per_g;
   std::vector<calib::AttitudeObservation<double>> obs(usable.size());
   std::vector<int> attitude_of(usable.size(), -1);
-  const auto n = calib::intervals_to_observations<double>(
-      std::span<const calib::StaticInterval<double>>(usable.data(), usable.size()),
-      std::span<const std::array<double, 3>>(expected.data(), expected.size()), assign,
-      std::span<calib::AttitudeObservation<double>>(obs.data(), obs.size()),
-      std::span<int>(attitude_of.data(), attitude_of.size()));
-  if (!n.is_ok()) return bad(recording_file + ": " + n.status().message());
-  obs.resize(n.value());
+  const auto assign_all = [&]() -> Status {
+    obs.assign(usable.size(), {});
+    attitude_of.assign(usable.size(), -1);
+    const auto n = calib::intervals_to_observations<double>(
+        std::span<const calib::StaticInterval<double>>(usable.data(), usable.size()),
+        std::span<const std::array<double, 3>>(expected.data(), expected.size()), assign,
+        std::span<calib::AttitudeObservation<double>>(obs.data(), obs.size()),
+        std::span<int>(attitude_of.data(), attitude_of.size()));
+    if (n.is_ok()) obs.resize(n.value());
+    return n.status();
+  };
+  if (const Status st = assign_all(); !st.is_ok()) {
+    return bad(recording_file + ": " + st.message());
+  }
+  // Two intervals nearest to one expected pose: a repeat of that pose (their directions agree
+  // within kRepeatDeg, far above the repositioning of a fixture, far below the 45° between the
+  // poses of Tables 2/3) is kept; otherwise only the closer one is that pose, and the other (a
+  // verification pose, say, 20-30° away) would enter the fit with the wrong attitude: skipped.
+  constexpr double kRepeatDeg = 5.0;
+  const auto direction = [&](std::size_t k) {
+    return calib::specific_force_estimate<double>(usable[k], assign).normalized();
+  };
+  const auto degrees = [](const nav::Vec3<double>& a, const nav::Vec3<double>& b) {
+    return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / std::numbers::pi;
+  };
+  std::vector<std::string> not_repeats(usable.size());
   for (std::size_t k = 0; k < usable.size(); ++k) {
-    const auto& it = usable[k];
-    const int a = attitude_of[k];
+    if (attitude_of[k] < 0) continue;
+    const auto a = static_cast<std::size_t>(attitude_of[k]);
+    const nav::Vec3<double> e = nav::Vec3<double>(expected[a][0], expected[a][1], expected[a][2]);
+    for (std::size_t m = 0; m < usable.size(); ++m) {
+      if (m == k || attitude_of[m] != attitude_of[k]) continue;
+      const double dk = degrees(direction(k), e);
+      const double dm = degrees(direction(m), e);
+      const double apart = degrees(direction(k), direction(m));
+      if (apart > kRepeatDeg && (dk > dm || (dk == dm && k > m))) {
+        not_repeats[k] = "nearest to pose " + labels[a] + " (" + fmt("%.1f", dk) +
+                         " degrees) but " + fmt("%.1f", apart) + " degrees from interval " +
+                         std::to_string(m + 1) + ", which is closer to it: not that pose, skipped";
+      }
+    }
+  }
+  std::vector<calib::StaticInterval<double>> all = usable;
+  std::vector<std::string> fate(usable.size());
+  {
+    std::vector<calib::StaticInterval<double>> kept;
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      if (not_repeats[k].empty()) kept.push_back(all[k]);
+    }
+    if (kept.size() != all.size()) {
+      usable = kept;
+      if (const Status st = assign_all(); !st.is_ok()) {
+        return bad(recording_file + ": " + st.message());
+      }
+    }
+  }
+  for (std::size_t k = 0, u = 0; k < all.size(); ++k) {
+    const auto& it = all[k];
+    const int a = not_repeats[k].empty() ? attitude_of[u++] : -1;
+    const std::string what = !not_repeats[k].empty() ? not_repeats[k]
+                             : a >= 0                ? "pose " + labels[static_cast<std::size_t>(a)]
+                                      : std::string("no expected pose within 20 degrees: skipped");
     run.notes.push_back("interval " + std::to_string(k + 1) + ": " +
-                        span_text(it.start_index, it.end_index, options.rate_hz) + ", " +
-                        (a >= 0 ? "pose " + labels[static_cast<std::size_t>(a)]
-                                : std::string("no expected pose within 20 degrees: skipped")));
+                        span_text(it.start_index, it.end_index, options.rate_hz) + ", " + what);
     if (a >= 0) {
       run.pose_labels.push_back(labels[static_cast<std::size_t>(a)]);
       run.pose_f_b_g.push_back(expected[static_cast<std::size_t>(a)]);
