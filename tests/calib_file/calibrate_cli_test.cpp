@@ -74,6 +74,12 @@ TEST(CalibrateCli, PaperTablesGiveAFileCarryingTable6) {
     EXPECT_NEAR(d.sensors[j].scale_v_per_g, t6.sensors[j].scale_v_per_g, kScaleTolVPerG) << j;
     EXPECT_NEAR(d.sensors[j].bias_g, t6.sensors[j].bias_g, kBiasTolG) << j;
     EXPECT_GT(d.sensors[j].bias_sigma_g, 0.0) << "six poses, four unknowns: σ from residuals";
+    // No location runs: Δρ = 0 is written as not known exactly, with the documented mechanical
+    // prior (--location-prior, default 1 mm) as its σ, never 0.
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(d.sensors[j].location_error_m[k], 0.0) << j;
+      EXPECT_EQ(d.sensors[j].location_error_sigma_m[k], 1e-3) << j;
+    }
     EXPECT_EQ(d.sensors[j].adc_lsb_v_per_count, 1.2 / 8388608.0);
   }
   for (std::size_t i = 0; i < 6; ++i) {

@@ -369,8 +369,15 @@ int run(const Options& o) {
       data.sensors[j].location_error_sigma_m = loc.value().sigma_m[j];
     }
   } else if (o.base.empty()) {
-    std::cout << "  note: location errors are not part of this calibration: Δρ = 0 written "
-                 "(give --location-runs, or --base to keep a previous location calibration)\n";
+    // Not calibrated is not known exactly: Δρ = 0 (the nominal geometry) with the mechanical
+    // prior as its σ, as the location solver writes for a direction its runs cannot observe.
+    for (std::size_t j = 0; j < 6; ++j)
+      data.sensors[j].location_error_sigma_m.fill(o.location_prior_m);
+    std::cout << "  note: location errors are not part of this calibration: Δρ = 0 written with "
+                 "σ = the mechanical prior, "
+              << num(o.location_prior_m * 1e3)
+              << " mm per component (--location-prior; give --location-runs, or --base to keep "
+                 "a previous location calibration)\n";
   }
 
   if (o.dry_run) {
