@@ -531,6 +531,7 @@ TEST_F(RecordReplay, ARunStoppedByAnErrorLeavesASummaryAndNoPartialTable) {
   const auto expect_failed_folder = [](const fs::path& out, const std::string& cause) {
     EXPECT_FALSE(fs::exists(out / "uncompensated.csv"));
     EXPECT_FALSE(fs::exists(out / "compensated.csv"));
+    EXPECT_FALSE(fs::exists(out / "nav_errors.png"));  // an earlier run's figure (below)
     const std::string summary = test::slurp((out / "summary.txt").string());
     EXPECT_EQ(summary.rfind("failed: ", 0), 0U) << summary;
     EXPECT_NE(summary.find(cause), std::string::npos) << summary;
@@ -538,6 +539,8 @@ TEST_F(RecordReplay, ARunStoppedByAnErrorLeavesASummaryAndNoPartialTable) {
   // 1. The recording onto /dev/full: every write fails with ENOSPC (the kernel's disk full).
   if (::access("/dev/full", W_OK) == 0) {
     const std::string rest = file("rest.toml", kRestTable6);
+    fs::create_directories(path("full"));
+    file("full/nav_errors.png", "an earlier run's figure");
     const CliResult r = sim({"run", rest, "-o", path("full"), "--record", "/dev/full"});
     EXPECT_EQ(r.exit_code, kExitError) << r.output;
     EXPECT_NE(r.output.find("No space left on device"), std::string::npos) << r.output;
