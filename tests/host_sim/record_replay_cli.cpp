@@ -83,6 +83,17 @@ class RecordReplay : public test::CliTest {
   CliResult calibrate(const std::vector<std::string>& args) const {
     return run(GFINS_CALIBRATE_BIN, args);
   }
+  /// Records the built-in `scenario` with gfins-sim into NAME.gfr and calibrates that recording
+  /// without --poses (local gravity `g`, the QA-1100's 1.33 V/g nominal) into NAME.toml.
+  CliResult record_and_calibrate(const std::string& scenario, const std::string& name,
+                                 const std::string& g) const {
+    const std::string rec = path(name + ".gfr");
+    const CliResult r =
+        sim({"run", scenario, "-o", path(name + "-run"), "--no-plot", "--record", rec});
+    EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+    return calibrate({"--recording", rec, "--gravity", g, "--device-id", name, "--nominal-sf",
+                      "1.33", "-o", path(name + ".toml")});
+  }
 };
 
 Csv read_csv(const std::string& p) { return test::parse_csv(test::slurp(p)); }
@@ -255,15 +266,10 @@ TEST_F(RecordReplay, ReplayRefusesACorruptRecordingNamingTheOffset) {
 TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNavigates) {
   // Given the built-in calibration scenario (Tables 2/3 poses, Table 6 truth, no noise)
   // recorded by gfins-sim,
-  const std::string poses = path("poses.gfr");
-  const auto rec =
-      sim({"run", "calibration-tables23", "-o", path("cal-run"), "--no-plot", "--record", poses});
-  ASSERT_EQ(rec.exit_code, kExitOk) << rec.output;
   // when gfins-calibrate solves it,
-  const std::string cal = path("cal.toml");
-  const auto c = calibrate({"--recording", poses, "--gravity", "9.80665", "--device-id", "sim-1",
-                            "--nominal-sf", "1.33", "-o", cal});
+  const auto c = record_and_calibrate("calibration-tables23", "cal", "9.80665");
   ASSERT_EQ(c.exit_code, 0) << c.output;
+  const std::string cal = path("cal.toml");
   const auto data = calib_file::load_calibration_file(cal);
   ASSERT_TRUE(data.is_ok()) << data.status().message();
 
@@ -337,14 +343,9 @@ TEST_F(RecordReplay, CalibrationFromARecordedPoseSequenceRecoversTable6AndNaviga
 // the least squares over 12 poses (condition number 1.73) amplify it by 1.73: a bound of ten
 // times that, 1.6e-4 rad, is 0.0093°, and a pose taken with the wrong attitude is off by degrees.
 TEST_F(RecordReplay, AVerificationPoseNearAnExpectedOneIsNotTakenForIt) {
-  const std::string rec = path("board.gfr");
-  const auto r =
-      sim({"run", "calibration-board", "-o", path("board"), "--no-plot", "--record", rec});
-  ASSERT_EQ(r.exit_code, kExitOk) << r.output;
-  const std::string cal = path("board.toml");
-  const auto c = calibrate({"--recording", rec, "--gravity", "9.789262", "--device-id", "board",
-                            "--nominal-sf", "1.33", "-o", cal});
+  const auto c = record_and_calibrate("calibration-board", "board", "9.789262");
   ASSERT_EQ(c.exit_code, 0) << c.output;
+  const std::string cal = path("board.toml");
   EXPECT_NE(c.output.find("interval 13: 54.10-69.90 s, nearest to pose T3.2"), std::string::npos)
       << c.output;
   EXPECT_NE(c.output.find("not that pose, skipped"), std::string::npos) << c.output;
@@ -363,16 +364,8 @@ TEST_F(RecordReplay, AVerificationPoseNearAnExpectedOneIsNotTakenForIt) {
 
 TEST_F(RecordReplay, LocationCalibrationFromRecordedRateTableRunsRecoversTheLocationErrors) {
   // Given an orientation calibration from the recorded pose sequence (as above),
-  const std::string poses = path("poses.gfr");
-  ASSERT_EQ(
-      sim({"run", "calibration-tables23", "-o", path("cal-run"), "--no-plot", "--record", poses})
-          .exit_code,
-      kExitOk);
+  ASSERT_EQ(record_and_calibrate("calibration-tables23", "cal", "9.80665").exit_code, 0);
   const std::string cal = path("cal.toml");
-  ASSERT_EQ(calibrate({"--recording", poses, "--gravity", "9.80665", "--device-id", "sim-1",
-                       "--nominal-sf", "1.33", "-o", cal})
-                .exit_code,
-            0);
   // and rate-table runs of the same array with location errors Δρ (the truth, mm), recorded in
   // the five mountings of docs/calibration.md §5 at 2, 6 and 10 rad/s, two whole turns each,
   const double drho_mm[18] = {0.5,  -0.3, 0.2, -0.4, 0.6, 0.1,  0.3,  0.2, -0.5,
