@@ -23,14 +23,12 @@ can::Dividers bus_dividers(const FwConfig& c) {
   return d;
 }
 
-double worst_case_bus_load(const FwConfig& c) {
-  return can::worst_case_bits_per_s(bus_dividers(c), c.sample_rate_hz) / c.can_bit_rate;
-}
-
 can::BusBudget bus_budget(const FwConfig& c) {
   return can::BusBudget{c.sample_rate_hz, static_cast<std::uint32_t>(c.can_bit_rate),
                         c.max_bus_load_percent / 100.0};
 }
+
+double worst_case_bus_load(const FwConfig& c) { return bus_budget(c).load(bus_dividers(c)); }
 
 PublisherSink::PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers,
                              const can::BusBudget& budget)

@@ -353,9 +353,10 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   // poses of Tables 2/3) is kept; otherwise only the closer one is that pose, and the other (a
   // verification pose, say, 20-30° away) would enter the fit with the wrong attitude: skipped.
   constexpr double kRepeatDeg = 5.0;
-  const auto direction = [&](std::size_t k) {
-    return calib::specific_force_estimate<double>(usable[k], assign).normalized();
-  };
+  std::vector<nav::Vec3<double>> direction(usable.size());
+  for (std::size_t k = 0; k < usable.size(); ++k) {
+    direction[k] = calib::specific_force_estimate<double>(usable[k], assign).normalized();
+  }
   const auto degrees = [](const nav::Vec3<double>& a, const nav::Vec3<double>& b) {
     return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / std::numbers::pi;
   };
@@ -366,9 +367,9 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
     const nav::Vec3<double> e = nav::Vec3<double>(expected[a][0], expected[a][1], expected[a][2]);
     for (std::size_t m = 0; m < usable.size(); ++m) {
       if (m == k || attitude_of[m] != attitude_of[k]) continue;
-      const double dk = degrees(direction(k), e);
-      const double dm = degrees(direction(m), e);
-      const double apart = degrees(direction(k), direction(m));
+      const double dk = degrees(direction[k], e);
+      const double dm = degrees(direction[m], e);
+      const double apart = degrees(direction[k], direction[m]);
       if (apart > kRepeatDeg && (dk > dm || (dk == dm && k > m))) {
         not_repeats[k] = "nearest to pose " + labels[a] + " (" + fmt("%.1f", dk) +
                          " degrees) but " + fmt("%.1f", apart) + " degrees from interval " +
