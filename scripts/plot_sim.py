@@ -263,8 +263,21 @@ AIDED_ROWS = [
 ]
 
 
+def shade_unavailable(ax, t, sigma):
+    """Grey spans where the filter publishes no σ (before it starts, and after a divergence
+    restart until the fixes set the quantity again): the values are marked not available."""
+    missing = ~np.isfinite(sigma)
+    if not missing.any():
+        return
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], missing.astype(int), [0]))))
+    for n, (a, b) in enumerate(zip(edges[::2], edges[1::2])):
+        ax.axvspan(t[a], t[b - 1], color="0.88", lw=0,
+                   label="σ not available" if n == 0 else None)
+
+
 def cmd_aided(d, title):
-    runs = [(load(d + "/unaided.csv"), "unaided"), (load(d + "/aided.csv"), "aided, ±3σ dashed")]
+    runs = [(load(d + "/unaided.csv"), "unaided"),
+            (load(d + "/aided.csv"), "aided, ±3σ dashed (grey: σ not available)")]
     fig, axs = plt.subplots(len(AIDED_ROWS), 2, figsize=(12, 10), sharex=True)
     for r, (label, cols, k) in enumerate(AIDED_ROWS):
         for c, (data, which) in enumerate(runs):
@@ -273,6 +286,8 @@ def cmd_aided(d, title):
             for i, (err, sig, name) in enumerate(cols):
                 ax.plot(t, data[err] * k, color=COLORS[i], lw=1, label=name)
                 if c == 1:
+                    if i == 0:
+                        shade_unavailable(ax, t, data[sig])
                     s3 = 3 * data[sig] * k
                     ax.plot(t, s3, color=COLORS[i], lw=0.8, ls="--")
                     ax.plot(t, -s3, color=COLORS[i], lw=0.8, ls="--")

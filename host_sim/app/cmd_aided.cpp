@@ -64,6 +64,30 @@ ErrorSnapshot rms_row(const AccuracyTracker& t) {
   return e;
 }
 
+/// Each component's share within 3σ, and where the filter marked σ not available (after a
+/// divergence restart), the share of the samples that published it: once when every component
+/// shares it (the usual case: the groups come back within a fix of each other), else each.
+void print_coverage(std::FILE* f, const Coverage& c) {
+  const auto share = [&c](std::size_t k) {
+    return 100.0 * static_cast<double>(c.published(k)) / static_cast<double>(c.offered());
+  };
+  bool same = true;
+  for (std::size_t k = 1; k < kConsistencyComponents; ++k) {
+    same = same && c.published(k) == c.published(0);
+  }
+  for (std::size_t k = 0; k < kConsistencyComponents; ++k) {
+    std::fprintf(f, "%s %s %.1f %%", k == 0 ? "" : ",", kConsistencyNames[k],
+                 100.0 * c.fraction(k));
+    if (!same && c.published(k) < c.offered()) {
+      std::fprintf(f, " (sigma published in %.1f %% of the samples)", share(k));
+    }
+  }
+  if (same && c.published(0) < c.offered()) {
+    std::fprintf(f, "; sigma published in %.1f %% of the samples", share(0));
+  }
+  std::fprintf(f, "\n");
+}
+
 void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& u) {
   std::fprintf(f, "%-26s | %-38s | %-38s\n", "", "aided", "unaided");
   std::fprintf(f, "%-26s", "error");
@@ -104,11 +128,12 @@ void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& 
   }
   std::fprintf(f, "aided errors within the filter's 3 sigma (%llu samples, t >= %g s):",
                static_cast<unsigned long long>(a.sigma_samples()), a.rms_from_s());
-  for (std::size_t k = 0; k < kConsistencyComponents; ++k) {
-    std::fprintf(f, "%s %s %.1f %%", k == 0 ? "" : ",", kConsistencyNames[k],
-                 100.0 * a.within_3sigma(k));
+  print_coverage(f, a.coverage());
+  for (const auto& w : a.windows()) {
+    std::fprintf(f, "  inside the outage %g-%g s:", w.start_s, w.end_s);
+    print_coverage(f, w.inside);
   }
-  std::fprintf(f, "\n(a consistent filter: about 99.7 %% each)\n");
+  std::fprintf(f, "(a consistent filter: about 99.7 %% each)\n");
 }
 
 }  // namespace

@@ -59,6 +59,38 @@ TEST(AccuracyTracker, HeadingErrorInDegreesAndWithin3Sigma) {
   EXPECT_DOUBLE_EQ(a.within_3sigma(6), 1.0);  // r_N: zero error
 }
 
+// A σ marked not available (NaN, after a divergence restart) leaves its component out of the
+// coverage, not the sample: the others still count, and the window's own coverage sees only its
+// samples.
+TEST(AccuracyTracker, CoverageCountsOnlyPublishedSigma) {
+  AccuracyTracker a({}, 0.0, {{1.0, 3.0}}, 1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  a.add(record(0.0, 1, 0, 0.0, 1.0));  // r_N 1σ: within; before the window
+  SampleRecord lost = record(1.0, 50, 0, 0.0, 1.0);
+  lost.r_sigma_n.setConstant(nan);  // position σ not available: r_N 50 m not counted
+  a.add(lost);
+  a.add(record(2.0, 5, 0, 0.0, 1.0));  // r_N 5σ: outside, inside the window
+  EXPECT_EQ(a.sigma_samples(), 3u);
+  EXPECT_EQ(a.coverage().offered(), 3u);
+  EXPECT_EQ(a.coverage().published(6), 2u);  // r_N
+  EXPECT_EQ(a.coverage().published(3), 3u);  // v_N
+  EXPECT_DOUBLE_EQ(a.within_3sigma(6), 0.5);
+  EXPECT_DOUBLE_EQ(a.within_3sigma(3), 1.0);
+  ASSERT_EQ(a.windows().size(), 1u);
+  const Coverage& in = a.windows()[0].inside;
+  EXPECT_EQ(in.samples(), 2u);
+  EXPECT_EQ(in.published(6), 1u);
+  EXPECT_DOUBLE_EQ(in.fraction(6), 0.0);
+  // No σ of a component ever published: its fraction is not a number, not 0 or 1.
+  AccuracyTracker none({}, 0.0);
+  none.add(lost);
+  EXPECT_TRUE(std::isnan(none.within_3sigma(6)));
+  SampleRecord nothing = record(0.0, 1, 0);  // no σ at all (no filter): offered, not counted
+  none.add(nothing);
+  EXPECT_EQ(none.coverage().offered(), 2u);
+  EXPECT_EQ(none.sigma_samples(), 1u);
+}
+
 TEST(AccuracyTracker, NonFiniteErrorIsTheWorst) {
   AccuracyTracker a({}, 0.0);
   a.add(record(0.0, 1, 0));

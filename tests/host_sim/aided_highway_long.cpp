@@ -16,6 +16,11 @@
 //    99.1-100 %). A consistent filter has 99.7 % per component; the samples are correlated in
 //    time (hundreds of independent stretches), so 98 % leaves room for that and still fails an
 //    optimistic filter (the control: 47-81 %).
+//  - inside the outage the solution diverges (the filter restarts, measured 13 times): from the
+//    first restart (17 s into the outage) to the first fixes after it every σ is not available,
+//    and where a σ is published each error lies within its 3σ in ≥ 98 % of the samples
+//    (measured 100 %). Published through the restart, the σ the filter kept covered the position
+//    error in only 83 % (down) and 86 % (east) of the outage's samples.
 //  - no sample is non-finite (the unaided solution of the same sensors leaves the finite numbers
 //    within 100 s; the divergence restart keeps the aided one finite through the outage).
 #include <gtest/gtest.h>
@@ -80,6 +85,16 @@ TEST(AidedHighway, BoundedThroughTheOutageAndConsistent) {
   EXPECT_GT(
       r.out.compensated.report.filter.accepted[static_cast<std::size_t>(nav::AidingKind::kHeading)],
       1000u);
+  // Inside the outage the solution diverges and the filter restarts; from the restart until the
+  // fixes set each quantity again its σ is not available, and where a σ is published the error
+  // lies within its 3σ.
+  EXPECT_GE(r.out.compensated.report.filter.divergence_restarts, 1u);
+  const Coverage& inside = w.inside;
+  for (std::size_t k = 0; k < kConsistencyComponents; ++k) {
+    EXPECT_LT(inside.published(k), inside.offered()) << kConsistencyNames[k];
+    EXPECT_GT(inside.published(k), inside.offered() / 4) << kConsistencyNames[k];
+    EXPECT_GE(inside.fraction(k), kWithin3SigmaMin) << kConsistencyNames[k];
+  }
   std::printf(
       "highway aided: %s; outside the outage: pos %.3f m, vel %.3f m/s, tilt %.3f deg, "
       "heading %.3f deg; 10 s after it %.3f m; outage worst %.1f m\n",

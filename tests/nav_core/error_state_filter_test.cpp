@@ -172,6 +172,51 @@ TEST(ErrorStateFilterTest, DivergedSolutionRestarts) {
   EXPECT_FALSE(f.filter.restart_if_diverged(f.nav));
 }
 
+// After a restart the covariance no longer describes the errors (the linear model failed before
+// the test fired): every σ is not available (NaN, no valid bit) until a fix sets its quantity
+// again — position with a GNSS position fix, velocity with a velocity fix, the attitude with the
+// heading alignment that follows (here an external heading).
+TEST(ErrorStateFilterTest, SigmaIsNotAvailableAfterARestartUntilFixesSetTheQuantities) {
+  FilterConfig<double> config;
+  RestFilter f(config);
+  NavAccuracy<double> a = f.filter.accuracy(f.nav.state());
+  ASSERT_TRUE(a.euler_sigma_rad.allFinite() && a.vel_sigma_mps.allFinite() &&
+              a.pos_sigma_m.allFinite());
+  f.nav.apply_correction(Vec3<double>::Zero(), Vec3<double>::Zero(), Vec3<double>::Zero(),
+                         Vec3<double>(0, -20.0, 0));
+  ASSERT_TRUE(f.filter.restart_if_diverged(f.nav));
+  a = f.filter.accuracy(f.nav.state());
+  EXPECT_TRUE(a.euler_sigma_rad.array().isNaN().all());
+  EXPECT_TRUE(a.vel_sigma_mps.array().isNaN().all());
+  EXPECT_TRUE(a.pos_sigma_m.array().isNaN().all());
+  EXPECT_EQ(a.valid, 0);
+
+  ASSERT_EQ(f.filter.update_gnss_position(f.nav, f.fix_at(Vec3<double>(3, 4, 0))).status,
+            UpdateStatus::kReset);
+  a = f.filter.accuracy(f.nav.state());
+  EXPECT_NEAR(a.pos_sigma_m.x(), 1.5, 1e-9);  // the fix's σ (no lever arm)
+  EXPECT_TRUE(a.vel_sigma_mps.array().isNaN().all());
+  EXPECT_TRUE(a.euler_sigma_rad.array().isNaN().all());
+
+  GnssFix<double> vel = f.fix_at(Vec3<double>::Zero());  // at rest: below the track speed
+  vel.sigma = Vec3<double>::Constant(0.1);
+  ASSERT_EQ(f.filter.update_gnss_velocity(f.nav, vel).status, UpdateStatus::kReset);
+  a = f.filter.accuracy(f.nav.state());
+  EXPECT_NEAR(a.vel_sigma_mps.x(), 0.1, 1e-9);
+  EXPECT_TRUE(a.euler_sigma_rad.array().isNaN().all());  // no heading yet
+  EXPECT_FALSE(f.filter.heading_aligned());
+
+  ASSERT_EQ(
+      f.filter.update_heading(f.nav, HeadingFix<double>{f.nav.state().t_ns, 0.0, 0.01}).status,
+      UpdateStatus::kReset);
+  a = f.filter.accuracy(f.nav.state());
+  ASSERT_TRUE(a.euler_sigma_rad.allFinite());
+  EXPECT_NEAR(a.euler_sigma_rad.z(), 0.01, 1e-6);
+  // The tilt keeps the restart's width (half the divergence limit) until updates narrow it.
+  EXPECT_NEAR(a.euler_sigma_rad.x(), config.diverged_sigma_tilt_rad / 2, 1e-6);
+  EXPECT_EQ(f.filter.counters().divergence_restarts, 1u);
+}
+
 // Lever arm of 1 m (0.6 m forward, 0.8 m up: the up part offsets the height by 0.8 m whatever the
 // heading) and 100 ms latency (1 m along track at 10 m/s). Modelled, the errors stay within 3σ
 // (≥ 95 % of the epoch-axis pairs after the first 10 s; for a consistent filter the expected

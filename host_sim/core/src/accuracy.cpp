@@ -94,11 +94,32 @@ void AccuracyTracker::add(const SampleRecord& x) {
       x.euler_sigma_rad.x(), x.euler_sigma_rad.y(), x.euler_sigma_rad.z(),
       x.v_sigma_n.x(),       x.v_sigma_n.y(),       x.v_sigma_n.z(),
       x.r_sigma_n.x(),       x.r_sigma_n.y(),       x.r_sigma_n.z()};
-  if (!std::isfinite(sig[0])) return;  // no filter at this sample
-  ++sigma_n_;
-  for (std::size_t i = 0; i < kConsistencyComponents; ++i) {
-    if (std::abs(err[i]) <= 3.0 * sig[i]) ++within_[i];
+  coverage_.add(err, sig);
+  for (Window& w : windows_) {
+    if (x.t_s >= w.start_s && x.t_s < w.end_s) w.inside.add(err, sig);
   }
+}
+
+void Coverage::add(const std::array<double, kConsistencyComponents>& err,
+                   const std::array<double, kConsistencyComponents>& sigma) {
+  ++all_;
+  bool any = false;
+  for (std::size_t i = 0; i < kConsistencyComponents; ++i) {
+    if (!std::isfinite(sigma[i])) continue;  // not available here (no filter, or marked)
+    any = true;
+    ++n_[i];
+    if (std::abs(err[i]) <= 3.0 * sigma[i]) ++within_[i];
+  }
+  if (any) ++any_;
+}
+
+std::uint64_t Coverage::published(std::size_t component) const {
+  return component < kConsistencyComponents ? n_[component] : 0;
+}
+
+double Coverage::fraction(std::size_t component) const {
+  if (component >= kConsistencyComponents || n_[component] == 0) return std::nan("");
+  return static_cast<double>(within_[component]) / static_cast<double>(n_[component]);
 }
 
 namespace {
@@ -120,11 +141,6 @@ ErrorSnapshot AccuracyTracker::rms_outside() const {
   e.vel_mps = rms(vel2_out_, n_out_);
   e.pos_h_m = rms(pos2_out_, n_out_);
   return e;
-}
-
-double AccuracyTracker::within_3sigma(std::size_t component) const {
-  if (sigma_n_ == 0 || component >= kConsistencyComponents) return std::nan("");
-  return static_cast<double>(within_[component]) / static_cast<double>(sigma_n_);
 }
 
 std::string AccuracyTracker::describe_rms() const {

@@ -30,6 +30,29 @@ struct ErrorSnapshot {
 inline constexpr std::size_t kConsistencyComponents = 9;
 extern const std::array<const char*, kConsistencyComponents> kConsistencyNames;
 
+/// How often each component's error lies within 3σ, over the samples that published that
+/// component's σ (a σ the filter marks not available, NaN, is not counted: the quantity was
+/// marked not available, which is what a user reading it sees).
+class Coverage {
+ public:
+  void add(const std::array<double, kConsistencyComponents>& err,
+           const std::array<double, kConsistencyComponents>& sigma);
+  /// Samples offered, with or without σ.
+  std::uint64_t offered() const { return all_; }
+  /// Samples that published at least one σ.
+  std::uint64_t samples() const { return any_; }
+  /// Samples that published the σ of `component`.
+  std::uint64_t published(std::size_t component) const;
+  /// within / published for `component` (NaN when none was published).
+  double fraction(std::size_t component) const;
+
+ private:
+  std::uint64_t all_ = 0;
+  std::uint64_t any_ = 0;
+  std::array<std::uint64_t, kConsistencyComponents> n_{};
+  std::array<std::uint64_t, kConsistencyComponents> within_{};
+};
+
 class AccuracyTracker {
  public:
   /// checkpoints_s: instants whose errors are kept (the first sample at or after each);
@@ -58,13 +81,15 @@ class AccuracyTracker {
     double start_s = 0, end_s = 0;
     ErrorSnapshot worst_inside;  // each field its own worst inside [start, end)
     ErrorSnapshot after;         // at end + after_s
+    Coverage inside;             // 3σ coverage inside [start, end), t ≥ rms_from_s
   };
   const std::vector<Window>& windows() const { return windows_; }
 
-  /// Samples (t ≥ rms_from_s) that carried the filter's σ, and of those how many had each
-  /// component within 3σ.
-  std::uint64_t sigma_samples() const { return sigma_n_; }
-  double within_3sigma(std::size_t component) const;
+  /// Samples (t ≥ rms_from_s) that carried the filter's σ, and of those that published each
+  /// component's σ, the share with the error within 3σ.
+  std::uint64_t sigma_samples() const { return coverage_.samples(); }
+  double within_3sigma(std::size_t component) const { return coverage_.fraction(component); }
+  const Coverage& coverage() const { return coverage_; }
 
   /// One-line summaries for a terminal (what `gfins-sim aided` prints).
   std::string describe_rms() const;
@@ -83,8 +108,7 @@ class AccuracyTracker {
   std::uint64_t n_out_ = 0;
   double tilt2_out_ = 0, heading2_out_ = 0, vel2_out_ = 0, pos2_out_ = 0;
   ErrorSnapshot worst_{};
-  std::uint64_t sigma_n_ = 0;
-  std::array<std::uint64_t, kConsistencyComponents> within_{};
+  Coverage coverage_;
 };
 
 }  // namespace gfins::sim

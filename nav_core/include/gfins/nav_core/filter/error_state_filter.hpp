@@ -10,11 +10,13 @@
 //   ẋ_nav = F_nav x_nav + G_u (δβ + M n),  G_u = ∂ẋ_nav/∂δ[ω̇; f] (ErrorModel::array_input_matrix)
 //   δβ̇ = w_β,  Cov(M n) = M diag(σ² h) Mᵀ,  Cov(w_β) = M diag(q_rw) Mᵀ   (correlated 6×6)
 // Propagation runs at a decimated rate (every D samples, dt = D/rate): Φ = I + F h + F² h²/2 from
-// F at the current navigation state, Q_d by Van Loan's series to h³ (as ErrorModel does).
+// F at the current navigation state, Q_d by Van Loan's series to h³ (as ErrorModel does), every
+// product with F or Φ block-sparse (block_sparse.hpp: F has 8 non-zero 3×3 blocks of 36, Φ 18).
 // Updates: generic linearised update with a χ² innovation gate (NIS against the configured
-// quantile for the measurement's dimension), Joseph form, symmetrisation, a floor and a check on
-// the diagonal (non-finite or negative → covariance reset to the initial one, counted), and
-// closed-loop feedback into the Strapdown (apply_correction, set_bias), after which x = 0.
+// quantile for the measurement's dimension), Joseph form (as rank-M corrections), symmetrisation, a
+// floor and a check on the diagonal (non-finite or negative → covariance reset to the initial one,
+// counted), and closed-loop feedback into the Strapdown (apply_correction, set_bias), after which x
+// = 0.
 //
 // Static allocation (P, 18×18, is 1.3 kB in float; the history 64 × 60 B), no heap, no
 // exceptions; float on the board, double as the reference (explicit instantiations in
@@ -27,8 +29,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "gfins/nav_core/error_model.hpp"
+#include "gfins/nav_core/filter/block_sparse.hpp"
 #include "gfins/nav_core/filter/chi_square.hpp"
 #include "gfins/nav_core/filter/euler_error.hpp"
 #include "gfins/nav_core/filter/gnss_update.hpp"
@@ -114,7 +118,9 @@ inline constexpr std::uint8_t kVelocity = 1u << 2;
 inline constexpr std::uint8_t kPosition = 1u << 3;
 }  // namespace filter_valid
 
-/// 1σ of the published quantities, from the filter covariance (never an optimistic guess).
+/// 1σ of the published quantities, from the filter covariance (never an optimistic guess); NaN
+/// where the covariance no longer describes the error (after a divergence restart, until a fix
+/// sets the quantity again).
 template <typename T>
 struct NavAccuracy {
   Vec3<T> euler_sigma_rad = Vec3<T>::Zero();  // roll, pitch, heading
@@ -188,6 +194,23 @@ class ErrorStateFilter {
 
   /// The covariance the filter starts from and resets to.
   StateMat initial_covariance() const;
+
+  /// The continuous process model at the strapdown's current state: F = [F_nav G_u; 0 0] and
+  /// Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)], from ErrorModel on the strapdown's own solver and
+  /// gravity.
+  void process_model(const Nav& strapdown, StateMat& f, StateMat& qc) const;
+
+  /// The blocks of F that process_model can fill (block_sparse.hpp: 0 φ, 1 δr, 2 δv, 3 δω,
+  /// 4 δβ_ω̇, 5 δβ_f): eq. (8) φ̇ = −C δω; eq. (10) δṙ = δv; eq. (12) δv̇ from φ, from δr (the
+  /// gravity gradient), from δω (the centripetal term) and from δβ_f; eq. (13) δω̇ from δω and
+  /// from δβ_ω̇. The bias rows are zero (random walk). A test checks every other entry of F is
+  /// zero at random states.
+  static constexpr blocks::Mask kFMask = blocks::bit(0, 3) | blocks::bit(1, 2) | blocks::bit(2, 0) |
+                                         blocks::bit(2, 1) | blocks::bit(2, 3) | blocks::bit(2, 5) |
+                                         blocks::bit(3, 3) | blocks::bit(3, 4);
+  /// The blocks of Φ = I + F h + F² h²/2.
+  static constexpr blocks::Mask kPhiMask =
+      blocks::identity() | kFMask | blocks::product(kFMask, kFMask);
 
   /// One covariance step over dt_s (the D samples since the previous call) at the strapdown's
   /// current state, which is also stored in the history. F, the noise through M and the gravity
@@ -286,18 +309,31 @@ class ErrorStateFilter {
     const Eigen::Matrix<T, kStates, M> k = pht.lazyProduct(s_inv);
     StateVec dx = k * m.y;
     if (!heading_aligned_) dx(filt_idx::kPhi + 2) = T(0);  // heading is not estimated yet
-    // Joseph form: P = (I − KH) P (I − KH)ᵀ + K R Kᵀ, symmetric and positive for any K.
-    StateMat a = StateMat::Identity();
-    a.noalias() -= k.lazyProduct(m.h);
-    const StateMat ap = a.lazyProduct(p_);
-    p_.noalias() = ap.lazyProduct(a.transpose());
+    // Joseph form: P = (I − KH) P (I − KH)ᵀ + K R Kᵀ, symmetric and positive for any K. I − KH
+    // differs from I by a rank-M term, so its two products are taken as rank-M corrections, the
+    // same products re-associated (18·18·M multiply-adds each instead of 18³):
+    //   A P = P − K (H P), H P = (P Hᵀ)ᵀ;   (A P) Aᵀ = A P − ((A P) Hᵀ) Kᵀ.
+    p_.noalias() -= k.lazyProduct(pht.transpose());
+    const Eigen::Matrix<T, kStates, M> aph = p_.lazyProduct(m.h.transpose());
+    p_.noalias() -= aph.lazyProduct(k.transpose());
     p_.noalias() += k.lazyProduct(m.r).lazyProduct(k.transpose());
     if (!heading_aligned_) decouple_heading();
     condition_covariance();
     feed_back(dx, nav);
+    found(kind);
     ++counters_.accepted[k_idx];
     last_accepted_ns_[k_idx] = nav.state().t_ns;
     return UpdateOutcome{UpdateStatus::kAccepted, static_cast<float>(nis)};
+  }
+
+  /// An accepted fix of `kind` sets the quantity it measures again after a divergence restart:
+  /// its σ describe its error from now on (lost_).
+  void found(AidingKind kind) {
+    if (kind == AidingKind::kGnssPosition)
+      lost_ &= static_cast<std::uint8_t>(~filter_valid::kPosition);
+    if (kind == AidingKind::kGnssVelocity || kind == AidingKind::kZupt) {
+      lost_ &= static_cast<std::uint8_t>(~filter_valid::kVelocity);
+    }
   }
 
   /// Closed loop: the estimated errors leave the strapdown (and the history), x returns to 0.
@@ -315,6 +351,7 @@ class ErrorStateFilter {
 
   UpdateOutcome accepted_reset(AidingKind kind, const Nav& nav) {
     const auto k_idx = static_cast<std::size_t>(kind);
+    found(kind);
     ++counters_.accepted[k_idx];
     last_accepted_ns_[k_idx] = nav.state().t_ns;
     condition_covariance();
@@ -405,6 +442,8 @@ class ErrorStateFilter {
     p_(kPhi + 1, kPhi + 1) = tilt2;
     p_(kPhi + 2, kPhi + 2) = kPi * kPi;
     heading_aligned_ = false;
+    lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
+            filter_valid::kPosition;
     const T rate2 = config_.restart_sigma_rate_rps * config_.restart_sigma_rate_rps;
     for (int i = 0; i < 3; ++i) {
       p_(kRate + i, kRate + i) = rate2;
@@ -472,6 +511,7 @@ class ErrorStateFilter {
     p_.col(kD).setZero();
     p_(kD, kD) = sigma_rad * sigma_rad;
     heading_aligned_ = true;
+    lost_ &= static_cast<std::uint8_t>(~(filter_valid::kRollPitch | filter_valid::kHeading));
   }
 
   /// While the heading is unknown its error is a nuisance of variance π² outside the linear
@@ -511,6 +551,12 @@ class ErrorStateFilter {
   bool configured_ = false;
   bool started_ = false;
   bool heading_aligned_ = true;
+  // filter_valid bits of the quantities whose σ are not available: after a divergence restart
+  // the covariance no longer describes their errors (the linear model had failed before the test
+  // fired, and the restart widens the attitude and rate only). Each comes back when a fix sets
+  // it again: position and velocity with an accepted GNSS fix (or a ZUPT), the attitude with the
+  // heading alignment that follows (the GNSS track or an external heading).
+  std::uint8_t lost_ = 0;
 };
 
 // ---- ErrorStateFilter: member functions defined outside the class, so not inline: a translation
@@ -528,6 +574,7 @@ void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
   heading_aligned_ = config_.heading_known;
   last_accepted_ns_.fill(kNever);
   gnss_rejected_run_.fill(0);
+  lost_ = 0;
   started_ = configured_;
 }
 
@@ -553,39 +600,53 @@ ErrorStateFilter<T, HistoryCapacity>::initial_covariance() const {
 }
 
 template <typename T, int HistoryCapacity>
-Status ErrorStateFilter<T, HistoryCapacity>::propagate(const Nav& strapdown, T dt_s) {
-  if (!started_) return Status(ErrorCode::kFailedPrecondition, "filter: not started");
-  if (!(dt_s > T(0)) || !std::isfinite(dt_s)) {
-    return Status(ErrorCode::kInvalidArgument, "filter: dt_s must be positive");
-  }
+void ErrorStateFilter<T, HistoryCapacity>::process_model(const Nav& strapdown, StateMat& f,
+                                                         StateMat& qc) const {
   using namespace filt_idx;
   const NavState<T>& nav = strapdown.state();
   const Model model(strapdown.solver(), strapdown.gravity());
-  const T h = dt_s;
-  // Continuous model: F = [F_nav G_u; 0 0], Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)].
-  // The 18×18 products are coefficient-based (lazyProduct): small code on the M4F, no GEMM.
-  StateMat f = StateMat::Zero();
+  f.setZero();
   f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = model.navigation_continuous(nav);
   const typename Model::NavInputMat g = model.array_input_matrix(nav);
   f.template block<err_idx::kNav, 6>(0, kBiasWdot) = g;
-  StateMat qc = StateMat::Zero();
+  qc.setZero();
   const Mat6<T> noise_u =
       model.array_noise(config_.noise.white_sigma_mps2, T(1) / config_.sample_rate_hz);
   qc.template topLeftCorner<err_idx::kNav, err_idx::kNav>() =
       g.lazyProduct(noise_u).lazyProduct(g.transpose());
   qc.template block<6, 6>(kBiasWdot, kBiasWdot) =
       model.array_noise(config_.noise.bias_rw_mps2_sqrt_s, T(1));
+}
+
+template <typename T, int HistoryCapacity>
+Status ErrorStateFilter<T, HistoryCapacity>::propagate(const Nav& strapdown, T dt_s) {
+  if (!started_) return Status(ErrorCode::kFailedPrecondition, "filter: not started");
+  if (!(dt_s > T(0)) || !std::isfinite(dt_s)) {
+    return Status(ErrorCode::kInvalidArgument, "filter: dt_s must be positive");
+  }
+  const NavState<T>& nav = strapdown.state();
+  const T h = dt_s;
+  StateMat f;
+  StateMat qc;
+  process_model(strapdown, f, qc);
   // Van Loan's series to h³ (error_model.hpp): Q_d = Q_c h + (F Q_c + Q_c Fᵀ) h²/2 +
-  // F Q_c Fᵀ h³/3; Φ = I + F h + F² h²/2; P ← Φ P Φᵀ + Q_d.
-  StateMat tmp = f.lazyProduct(qc);  // F Q_c
-  StateMat qd = qc * h + (tmp + tmp.transpose()) * (h * h / T(2));
-  qd.noalias() += tmp.lazyProduct(f.transpose()) * (h * h * h / T(3));
-  tmp = f * h;
-  StateMat phi = StateMat::Identity() + tmp;
-  phi.noalias() += tmp.lazyProduct(tmp) / T(2);
-  tmp.noalias() = phi.lazyProduct(p_);
-  p_.noalias() = tmp.lazyProduct(phi.transpose());
-  p_ += qd;
+  // F Q_c Fᵀ h³/3; Φ = I + F h + F² h²/2; P ← Φ P Φᵀ + Q_d. Every product has F or Φ on the
+  // left and is block-sparse (block_sparse.hpp); a product with them on the right is taken as
+  // the transpose of one on the left (Q_c and P are symmetric: Q_c Fᵀ = (F Q_c)ᵀ, and
+  // Φ P Φᵀ = Φ (Φ P)ᵀ). Q_d is built in the storage of Q_c and Φ in that of F.
+  StateMat tmp;
+  StateMat tmp2;
+  blocks::multiply(kFMask, f.data(), qc.data(), tmp.data());  // F Q_c
+  qc = qc * h + (tmp + tmp.transpose()) * (h * h / T(2));
+  tmp.transposeInPlace();                                       // Q_c Fᵀ
+  blocks::multiply(kFMask, f.data(), tmp.data(), tmp2.data());  // F Q_c Fᵀ
+  qc += tmp2 * (h * h * h / T(3));
+  blocks::multiply(kFMask, f.data(), f.data(), tmp2.data());    // F²
+  f = StateMat::Identity() + f * h + tmp2 * (h * h / T(2));     // Φ
+  blocks::multiply(kPhiMask, f.data(), p_.data(), tmp.data());  // Φ P
+  tmp.transposeInPlace();                                       // P Φᵀ
+  blocks::multiply(kPhiMask, f.data(), tmp.data(), p_.data());  // Φ P Φᵀ
+  p_ += qc;
   if (!heading_aligned_) decouple_heading();
   condition_covariance();
   history_.push(nav);
@@ -663,6 +724,11 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
     a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i));
     a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
   }
+  constexpr T kNotAvailable = std::numeric_limits<T>::quiet_NaN();
+  if ((lost_ & filter_valid::kRollPitch) != 0) a.euler_sigma_rad.setConstant(kNotAvailable);
+  if ((lost_ & filter_valid::kVelocity) != 0) a.vel_sigma_mps.setConstant(kNotAvailable);
+  if ((lost_ & filter_valid::kPosition) != 0) a.pos_sigma_m.setConstant(kNotAvailable);
+  // A NaN σ fails every comparison below: the quantity is not valid.
   const bool aligned = started_ && (nav.status & nav_status::kAligned) != 0;
   const bool located = aligned && heading_aligned_;
   if (aligned && a.euler_sigma_rad.template head<2>().maxCoeff() <= config_.valid_sigma_tilt_rad) {
