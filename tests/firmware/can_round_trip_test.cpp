@@ -4,6 +4,7 @@
 // limit for a clipped value). And each command, valid and malformed, as frames in and response
 // frames out.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <optional>
 
@@ -173,9 +174,11 @@ class CanCommands : public ::testing::Test {
  protected:
   void SetUp() override {
     rig_ = std::make_unique<SimRig>("rest", 10.0);
-    path_ = std::filesystem::temp_directory_path() /
-            ("gfins_fw_cal_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-             ".toml");
+    // One file per test and process: ctest runs the cases of this fixture in parallel, and a
+    // shared name let one case's save land in another's reload.
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = std::filesystem::temp_directory_path() / ("gfins_fw_cal_" + std::string(info->name()) +
+                                                      "_" + std::to_string(::getpid()) + ".toml");
     rig_->config.calibration_file = path_.string();
     // The board runs on its factory calibration: a reload must be of the same device.
     worker_ = std::make_unique<ReloadWorker>(
