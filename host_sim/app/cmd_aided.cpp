@@ -134,6 +134,12 @@ void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& 
     print_coverage(f, w.inside);
   }
   std::fprintf(f, "(a consistent filter: about 99.7 %% each)\n");
+  const AccuracyTracker::RollPitch rp = a.roll_pitch();
+  std::fprintf(f,
+               "aided roll / pitch error RMS %.3g / %.3g deg%s; the filter's own 1 sigma, RMS: "
+               "%.3g / %.3g deg (what its covariance predicts for them)\n",
+               rp.roll_rms_deg, rp.pitch_rms_deg, a.windows().empty() ? "" : " outside outages",
+               rp.roll_sigma_rms_deg, rp.pitch_sigma_rms_deg);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 //    Measured 0.21 m, 0.082 m/s, 0.43°, 0.18°. Without the heading of the GNSS track (the
 //    negative control below) the heading is lost at constant speed and every one of these fails
 //    (measured 9.9 m, 9.7 m/s, 57°, 93°).
-//  - 10 s after the outage the position error is back under 1.5 m (measured 0.22 m): a filter
+//  - 10 s after the outage the position error is back under 1.5 m (measured 0.19 m): a filter
 //    whose gate keeps out the first fixes after an outage (the solution is then hundreds of
 //    metres off) never comes back.
 //  - every error component within the filter's 3σ in ≥ 98 % of the samples after 10 s (measured
@@ -21,6 +21,10 @@
 //    and where a σ is published each error lies within its 3σ in ≥ 98 % of the samples
 //    (measured 100 %). Published through the restart, the σ the filter kept covered the position
 //    error in only 83 % (down) and 86 % (east) of the outage's samples.
+//  - roll and pitch RMS outside the outage (measured 0.338° / 0.328°) miss the 0.3° target, and
+//    the filter's covariance predicts it: the RMS of its own 1σ is 0.317° / 0.314°, above the
+//    target, and the errors are within 1.25 times it (docs/navigation-accuracy.md: the floor is
+//    the receiver's 0.1 m/s).
 //  - no sample is non-finite (the unaided solution of the same sensors leaves the finite numbers
 //    within 100 s; the divergence restart keeps the aided one finite through the outage).
 #include <gtest/gtest.h>
@@ -41,6 +45,8 @@ constexpr double kVelRmsMaxMps = 0.1;
 constexpr double kAngleRmsMaxDeg = 1.0;
 constexpr double kAfterOutagePosMaxM = 1.5;
 constexpr double kWithin3SigmaMin = 0.98;
+constexpr double kTiltTargetDeg = 0.3;
+constexpr double kFloorRatioMax = 1.25;
 
 struct HighwayRun {
   AccuracyTracker acc;
@@ -85,6 +91,13 @@ TEST(AidedHighway, BoundedThroughTheOutageAndConsistent) {
   EXPECT_GT(
       r.out.compensated.report.filter.accepted[static_cast<std::size_t>(nav::AidingKind::kHeading)],
       1000u);
+  // Roll and pitch miss the 0.3° target at 30 m/s, and the covariance says so: the filter's own
+  // 1σ RMS is above it, the floor for this receiver's 0.1 m/s, and the errors meet that floor.
+  const AccuracyTracker::RollPitch rp = r.acc.roll_pitch();
+  EXPECT_GT(rp.roll_sigma_rms_deg, kTiltTargetDeg);
+  EXPECT_GT(rp.pitch_sigma_rms_deg, kTiltTargetDeg);
+  EXPECT_LE(rp.roll_rms_deg, kFloorRatioMax * rp.roll_sigma_rms_deg);
+  EXPECT_LE(rp.pitch_rms_deg, kFloorRatioMax * rp.pitch_sigma_rms_deg);
   // Inside the outage the solution diverges and the filter restarts; from the restart until the
   // fixes set each quantity again its σ is not available, and where a σ is published the error
   // lies within its 3σ.

@@ -10,10 +10,15 @@
 //    for a 1.5 m / 0.1 m/s receiver; the walk's receiver is worse, the same bounds hold), heading
 //    ≤ 1° (the target after the first turn). Measured urban 0.21 m, 0.066 m/s, 0.29°; walk 0.55 m,
 //    0.018 m/s, 0.28°.
-//  - tilt RMS: the walk meets the 0.3° target (0.11°); the urban drive misses it (0.34°: the
-//    sensor model's scale-factor drift under acceleration is not among the filter's states,
-//    docs/navigation-accuracy.md), so its bound is 0.5°, the measured figure with room for the
-//    float core's rounding, and still failed by a filter that loses its tilt in the stops' braking.
+//  - roll and pitch RMS, each ≤ 0.3° (the target; measured urban 0.275° / 0.255°, walk 0.083° /
+//    0.082°), and the tilt (the larger of the two at each sample) ≤ 0.5° on the drive (measured
+//    0.34°) and ≤ 0.3° on the walk (0.10°): a filter that loses its tilt in the stops' braking
+//    fails them.
+//  - roll and pitch RMS within 1.25 times what the filter's covariance predicts for them (the RMS
+//    of its own 1σ; measured ratios 1.10 and 1.05 urban, 0.94 walk): the covariance is a floor the
+//    error meets, and with a receiver of 0.02 m/s instead of 0.1 m/s both the floor and the
+//    error fall below 0.15° (measured 0.111° / 0.099°) — the tilt on a drive is set by the
+//    receiver's velocity accuracy, not by the sensors (docs/navigation-accuracy.md).
 //  - bounded over ten minutes (urban): the instantaneous errors at 60 s and 600 s, position ≤ 1.5 m
 //    and velocity ≤ 0.3 m/s (one sample of an error whose RMS target is 0.1 m/s: three times it;
 //    measured 0.101 m/s at 60 s, in a braking, and 0.042 m/s at 600 s); an error that grows with
@@ -45,12 +50,17 @@ constexpr double kUrbanTiltRmsMaxDeg = 0.5;
 constexpr double kWithin3SigmaMin = 0.98;
 constexpr double kUnaidedOffAt60sMinM = 1000.0;
 
-AccuracyTracker run_aided(const std::string& name, bool aided) {
+constexpr double kFloorRatioMax = 1.25;
+constexpr double kBetterReceiverMps = 0.02;
+constexpr double kBetterReceiverTiltMaxDeg = 0.15;
+
+AccuracyTracker run_aided(const std::string& name, bool aided, double sigma_vel_mps = 0) {
   auto s = load_scenario(name, kScenarioDir);
   EXPECT_TRUE(s.is_ok()) << s.error().message;
   Scenario sc = s.value();
   EXPECT_TRUE(sc.gnss.has_value()) << name;
   sc.aiding.enabled = aided;
+  if (sigma_vel_mps > 0 && sc.gnss.has_value()) sc.gnss->sigma_vel_mps = sigma_vel_mps;
   AccuracyTracker acc({60.0, 600.0}, 10.0);
   StreamTargets t;
   t.uncompensated_run = false;
@@ -58,6 +68,16 @@ AccuracyTracker run_aided(const std::string& name, bool aided) {
   auto o = run_scenario_streamed(sc, t, {}, NavScalar::kFloat);
   EXPECT_TRUE(o.is_ok()) << o.error().message;
   return acc;
+}
+
+void expect_roll_pitch(const AccuracyTracker& acc, double max_deg) {
+  const AccuracyTracker::RollPitch rp = acc.roll_pitch();
+  EXPECT_LE(rp.roll_rms_deg, max_deg);
+  EXPECT_LE(rp.pitch_rms_deg, max_deg);
+  EXPECT_LE(rp.roll_rms_deg, kFloorRatioMax * rp.roll_sigma_rms_deg);
+  EXPECT_LE(rp.pitch_rms_deg, kFloorRatioMax * rp.pitch_sigma_rms_deg);
+  std::printf("roll / pitch RMS %.3f / %.3f deg, covariance %.3f / %.3f deg\n", rp.roll_rms_deg,
+              rp.pitch_rms_deg, rp.roll_sigma_rms_deg, rp.pitch_sigma_rms_deg);
 }
 
 void expect_consistent(const AccuracyTracker& acc) {
@@ -74,6 +94,7 @@ TEST(AidedUrban, TenMinutesOfStopAndGoStayWithinTheTargets) {
   EXPECT_LE(acc.vel_rms_mps(), kVelRmsMaxMps);
   EXPECT_LE(acc.heading_rms_deg(), kHeadingRmsMaxDeg);
   EXPECT_LE(acc.tilt_rms_deg(), kUrbanTiltRmsMaxDeg);
+  expect_roll_pitch(acc, kTiltTargetDeg);
   ASSERT_EQ(acc.checkpoints().size(), 2u);
   for (const ErrorSnapshot& at : acc.checkpoints()) {
     ASSERT_TRUE(at.seen) << at.t_s;
@@ -84,6 +105,15 @@ TEST(AidedUrban, TenMinutesOfStopAndGoStayWithinTheTargets) {
   expect_consistent(acc);
   std::printf("urban aided: %s; at 600 s pos %.3f m, vel %.3f m/s\n", acc.describe_rms().c_str(),
               acc.checkpoints()[1].pos_h_m, acc.checkpoints()[1].vel_mps);
+}
+
+TEST(AidedUrban, TheTiltFloorFollowsTheReceiversVelocityAccuracy) {
+  // Not checked for consistency here: with a receiver five times better the sensor model's
+  // scale-factor drift at 40 °C (not among the filter's states) shows as 95.5 % coverage of the
+  // down velocity and 95.9 % of the north position; at the calibration temperature, 25 °C, every
+  // component is at 99.4 % or more (docs/navigation-accuracy.md).
+  const AccuracyTracker acc = run_aided("urban-stop-and-go", true, kBetterReceiverMps);
+  expect_roll_pitch(acc, kBetterReceiverTiltMaxDeg);
 }
 
 TEST(AidedUrban, UnaidedTheSameDriveIsKilometresOff) {
@@ -103,6 +133,7 @@ TEST(AidedWalk, AStopEveryFourSecondsAndAHandheldReceiver) {
   EXPECT_LE(acc.vel_rms_mps(), kVelRmsMaxMps);
   EXPECT_LE(acc.heading_rms_deg(), kHeadingRmsMaxDeg);
   EXPECT_LE(acc.tilt_rms_deg(), kTiltTargetDeg);
+  expect_roll_pitch(acc, kTiltTargetDeg);
   expect_consistent(acc);
   std::printf("walk aided: %s\n", acc.describe_rms().c_str());
 }

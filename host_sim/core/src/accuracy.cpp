@@ -95,6 +95,16 @@ void AccuracyTracker::add(const SampleRecord& x) {
       x.v_sigma_n.x(),       x.v_sigma_n.y(),       x.v_sigma_n.z(),
       x.r_sigma_n.x(),       x.r_sigma_n.y(),       x.r_sigma_n.z()};
   coverage_.add(err, sig);
+  if (outside || windows_.empty()) {
+    ++rp_n_;
+    roll2_ += err[0] * err[0];
+    pitch2_ += err[1] * err[1];
+    if (std::isfinite(sig[0]) && std::isfinite(sig[1])) {
+      ++rp_sigma_n_;
+      roll_sigma2_ += sig[0] * sig[0];
+      pitch_sigma2_ += sig[1] * sig[1];
+    }
+  }
   for (Window& w : windows_) {
     if (x.t_s >= w.start_s && x.t_s < w.end_s) w.inside.add(err, sig);
   }
@@ -129,6 +139,14 @@ double rms(double sum2, std::uint64_t n) {
 }  // namespace
 
 double AccuracyTracker::tilt_rms_deg() const { return rms(tilt2_, n_); }
+AccuracyTracker::RollPitch AccuracyTracker::roll_pitch() const {
+  RollPitch r;
+  r.roll_rms_deg = rms(roll2_, rp_n_) * kDeg;
+  r.pitch_rms_deg = rms(pitch2_, rp_n_) * kDeg;
+  r.roll_sigma_rms_deg = rms(roll_sigma2_, rp_sigma_n_) * kDeg;
+  r.pitch_sigma_rms_deg = rms(pitch_sigma2_, rp_sigma_n_) * kDeg;
+  return r;
+}
 double AccuracyTracker::heading_rms_deg() const { return rms(heading2_, n_); }
 double AccuracyTracker::vel_rms_mps() const { return rms(vel2_, n_); }
 double AccuracyTracker::pos_h_rms_m() const { return rms(pos2_, n_); }

@@ -68,6 +68,16 @@ class AccuracyTracker {
   double rms_from_s() const { return rms_from_s_; }
   std::uint64_t rms_samples() const { return n_; }
   double tilt_rms_deg() const;
+
+  /// Roll and pitch each: the error's RMS and the filter's own 1σ RMS over the samples that
+  /// published it (what its covariance predicts for that error, given the sensor model and the
+  /// aiding), over t ≥ rms_from_s outside the windows and the after_s past each (all of t ≥
+  /// rms_from_s without windows). NaN where there is no sample.
+  struct RollPitch {
+    double roll_rms_deg = 0, pitch_rms_deg = 0;
+    double roll_sigma_rms_deg = 0, pitch_sigma_rms_deg = 0;
+  };
+  RollPitch roll_pitch() const;
   double heading_rms_deg() const;
   double vel_rms_mps() const;
   double pos_h_rms_m() const;
@@ -109,6 +119,8 @@ class AccuracyTracker {
   double tilt2_out_ = 0, heading2_out_ = 0, vel2_out_ = 0, pos2_out_ = 0;
   ErrorSnapshot worst_{};
   Coverage coverage_;
+  std::uint64_t rp_n_ = 0, rp_sigma_n_ = 0;
+  double roll2_ = 0, pitch2_ = 0, roll_sigma2_ = 0, pitch_sigma2_ = 0;
 };
 
 }  // namespace gfins::sim

@@ -380,26 +380,67 @@ class ErrorStateFilter {
   /// is the track atan2(v_E, v_N) (the vehicle moves along its x axis: no side slip; the body x
   /// axis projects on the horizontal at the yaw angle whatever roll and pitch), with
   /// σ_ψ = σ_v,horizontal / speed.
-  UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix,
-                                         const HistoryEntry<T>& at) {
+  UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix, HistoryEntry<T> at) {
+    // The re-levelled attitude at the fix instant is read back for the track's heading. While the
+    // tilt is lost (a divergence restart) and not re-levelled yet, the heading waits: a track
+    // heading on a body tilted by tens of degrees would start the linear filter outside its model.
+    const bool relevelled = relevel_from_gnss(nav, fix, at);
+    if (relevelled) (void)history_.at(fix.t_valid_ns, nav.state(), at);
+    const bool tilt_known = relevelled || (lost_ & filter_valid::kRollPitch) == 0;
     const T speed = fix.value_n.template head<2>().norm();
+    const bool track = tilt_known && speed >= config_.track_min_speed_mps;
     Vec3<T> phi = Vec3<T>::Zero();
-    if (speed >= config_.track_min_speed_mps) {
-      const T track = std::atan2(fix.value_n.y(), fix.value_n.x());
+    if (track) {
+      const T course = std::atan2(fix.value_n.y(), fix.value_n.x());
       // A rotation about the down axis changes the yaw by its angle whatever roll and pitch, and
-      // the yaw error is −φ_D there (euler_error.hpp): φ_D = track − ψ̂ at the fix instant.
-      phi.z() = wrap_pi(track - euler_from_quat(at.q_nb).z());
+      // the yaw error is −φ_D there (euler_error.hpp): φ_D = course − ψ̂ at the fix instant.
+      phi.z() = wrap_pi(course - euler_from_quat(at.q_nb).z());
     }
     // The velocity error at the fix instant, then rotated with the heading correction.
     const Vec3<T> dv = at.v_n - fix.value_n;
     nav.apply_correction(phi, Vec3<T>::Zero(), dv, Vec3<T>::Zero());
     history_.shift(phi, Vec3<T>::Zero(), dv);
     reset_block(filt_idx::kVel, fix.sigma.cwiseProduct(fix.sigma));
-    if (speed >= config_.track_min_speed_mps) {
+    if (track) {
       const T sigma_h = fix.sigma.template head<2>().maxCoeff() / speed;
       set_heading_variance(sigma_h);
     }
     return accepted_reset(AidingKind::kGnssVelocity, nav);
+  }
+
+  /// After a divergence restart the tilt can be tens of degrees off, outside what the linear
+  /// update can bring back (it then converges to a wrong attitude with a small σ). Two GNSS
+  /// velocity fixes dt apart give the mean specific force in the true n frame, f_n = Δv/dt − g,
+  /// and the strapdown's own velocity over the same span gives it in the estimated frame,
+  /// f̂_n = Δv̂/dt − g (Δv̂ is the integral of Ĉ f_b + g; the resets in between shift v̂ as a
+  /// whole and leave it). The rotation taking f̂_n onto f_n is the tilt error (its part about f,
+  /// mostly the heading, is left to the track): applied, with the tilt 1σ that the fixes' noise
+  /// gives, σ = √2 σ_v / (dt |f|). Once per velocity fix while the attitude is lost.
+  bool relevel_from_gnss(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
+    if ((lost_ & filter_valid::kRollPitch) == 0 || prev_vel_t_ns_ == kNever) return false;
+    const T dt = static_cast<T>(fix.t_valid_ns - prev_vel_t_ns_) * T(1e-9);
+    if (!(dt >= T(0.05) && dt <= T(2))) return false;
+    HistoryEntry<T> before;
+    if (!history_.at(prev_vel_t_ns_, nav.state(), before)) return false;
+    const Vec3<T> g = nav.gravity().g_n(at.r_n);
+    const Vec3<T> f_est = (at.v_n - before.v_n) / dt - g;
+    const Vec3<T> f_true = (fix.value_n - prev_vel_n_) / dt - g;
+    const Vec3<T> axis = f_est.cross(f_true);
+    const T sin_a = axis.norm();
+    const T cos_a = f_est.dot(f_true);
+    if (!(sin_a > T(0)) || !(cos_a > T(0)) || !std::isfinite(sin_a)) return false;
+    const Vec3<T> phi = axis * (std::atan2(sin_a, cos_a) / sin_a);
+    nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
+    history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
+    const T sigma_f = T(1.41421356) * fix.sigma.maxCoeff() / dt;
+    const T sigma_tilt = sigma_f / f_true.norm();
+    using namespace filt_idx;
+    for (int i = 0; i < 2; ++i) {
+      p_.row(kPhi + i).setZero();
+      p_.col(kPhi + i).setZero();
+      p_(kPhi + i, kPhi + i) = sigma_tilt * sigma_tilt;
+    }
+    return true;
   }
 
   /// The heading of the GNSS track (FilterConfig::track_heading_sigma_rad), valid at the fix's
@@ -557,6 +598,9 @@ class ErrorStateFilter {
   // it again: position and velocity with an accepted GNSS fix (or a ZUPT), the attitude with the
   // heading alignment that follows (the GNSS track or an external heading).
   std::uint8_t lost_ = 0;
+  // The previous usable GNSS velocity fix (relevel_from_gnss), kNever when none.
+  Vec3<T> prev_vel_n_ = Vec3<T>::Zero();
+  std::int64_t prev_vel_t_ns_ = kNever;
 };
 
 // ---- ErrorStateFilter: member functions defined outside the class, so not inline: a translation
@@ -575,6 +619,7 @@ void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
   last_accepted_ns_.fill(kNever);
   gnss_rejected_run_.fill(0);
   lost_ = 0;
+  prev_vel_t_ns_ = kNever;
   started_ = configured_;
 }
 
@@ -684,16 +729,22 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& na
                                                                          const GnssFix<T>& fix) {
   HistoryEntry<T> at;
   if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
-  if (!heading_aligned_) return reset_velocity_and_track(nav, fix, at);
-  const UpdateOutcome o = apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
-                                AidingKind::kGnssVelocity, gate_3_, nav);
-  const UpdateOutcome out = after_gnss(o, AidingKind::kGnssVelocity, nav, fix, at);
-  if (config_.track_heading_sigma_rad > T(0)) {
-    // The history entry was shifted by the velocity update's feedback: read it again.
-    HistoryEntry<T> now_at;
-    if (history_.at(fix.t_valid_ns, nav.state(), now_at))
-      (void)update_track_heading(nav, fix, now_at);
+  UpdateOutcome out;
+  if (!heading_aligned_) {
+    out = reset_velocity_and_track(nav, fix, at);
+  } else {
+    const UpdateOutcome o = apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
+                                  AidingKind::kGnssVelocity, gate_3_, nav);
+    out = after_gnss(o, AidingKind::kGnssVelocity, nav, fix, at);
+    if (config_.track_heading_sigma_rad > T(0)) {
+      // The history entry was shifted by the velocity update's feedback: read it again.
+      HistoryEntry<T> now_at;
+      if (history_.at(fix.t_valid_ns, nav.state(), now_at))
+        (void)update_track_heading(nav, fix, now_at);
+    }
   }
+  prev_vel_n_ = fix.value_n;  // relevel_from_gnss
+  prev_vel_t_ns_ = fix.t_valid_ns;
   return out;
 }
 
