@@ -9,54 +9,11 @@ set -euo pipefail
 source "$(dirname "$0")/common.sh"
 vb_require apt-get:apt dpkg:dpkg
 
-# The five packages of kernel ABI $1 at Debian version $2 (the headers, kbuild and source must be
-# the image's own build).
-kernel_packages() {
-  local kver=$1 debver=$2 series
-  series=$(echo "$debver" | sed -n 's/^\([0-9]*\.[0-9]*\)\..*/\1/p')   # e.g. 6.1
-  [ -n "$series" ] || return 1
-  printf '%s\n' "linux-image-$kver=$debver" "linux-headers-$kver=$debver" \
-    "linux-headers-${kver%-amd64}-common=$debver" "linux-kbuild-$series=$debver" \
-    "linux-source-$series=$debver"
-}
-
-# True when apt's lists hold every package of the set at its exact version.
-all_listed() {
-  local spec
-  for spec in "$@"; do
-    apt-cache madison "${spec%%=*}" 2>/dev/null | awk -F'|' '{gsub(/ /, "", $2); print $2}' |
-      grep -qxF "${spec#*=}" || return 1
-  done
-}
-
-kver=$(vb_kernel_abi)                     # e.g. 6.1.0-56-amd64
+kver=$(vb_kernel_abi)                       # e.g. 6.1.0-56-amd64
 debver=$(vb_candidate "linux-image-$kver")   # e.g. 6.1.192-2
-list=$(kernel_packages "$kver" "$debver") ||
+list=$(vb_kernel_packages "$kver" "$debver") ||
   vb_die "cannot read the kernel series from version '$debver' of linux-image-$kver"
 mapfile -t wanted <<<"$list"
-# A mirror in mid-sync can list the image of one upload and the kbuild or source of the next
-# (seen: linux-image 6.1.192-2 with linux-kbuild 6.1.192-3 only). Unless the kernel is pinned or
-# already cached, take then the newest ABI whose five packages are all listed at one version.
-if [ -z "${GFINS_VBOARD_KVER:-}" ] && ! compgen -G "$vboard_cache/debs/$kver/*.deb" >/dev/null &&
-  ! all_listed "${wanted[@]}"; then
-  vb_log "the mirror lists no complete set for kernel $kver ($debver): looking for an older one"
-  found=
-  while read -r abi; do
-    v=$(apt-cache policy "linux-image-$abi" 2>/dev/null | sed -n 's/^ *Candidate: //p' | head -n 1)
-    [ -n "$v" ] && [ "$v" != "(none)" ] || continue
-    list=$(kernel_packages "$abi" "$v") || continue
-    mapfile -t set <<<"$list"
-    if all_listed "${set[@]}"; then
-      kver=$abi debver=$v found=1
-      wanted=("${set[@]}")
-      break
-    fi
-  done < <(apt-cache search --names-only '^linux-image-[0-9.]+-[0-9]+-amd64$' |
-    sed -n 's/^linux-image-\([^ ]*\) .*/\1/p' | sort -rV)
-  [ -n "$found" ] ||
-    vb_die "the mirror lists no kernel whose image, headers, kbuild and source share a version (try apt-get update later)"
-  vb_log "using kernel $kver ($debver), the newest the mirror lists completely"
-fi
 image=linux-image-$kver
 series=$(echo "$debver" | sed -n 's/^\([0-9]*\.[0-9]*\)\..*/\1/p')   # e.g. 6.1
 
