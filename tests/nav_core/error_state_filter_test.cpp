@@ -218,49 +218,64 @@ TEST(ErrorStateFilterTest, SigmaIsNotAvailableAfterARestartUntilFixesSetTheQuant
 
 // After a restart the tilt can be tens of degrees off (a long outage), outside what the linear
 // update can bring back. Two GNSS velocity fixes re-level it: Δv/dt − g from the fixes against
-// the strapdown's own Δv̂/dt − g. Here the board is at rest and level, the estimate is rolled by
-// 30° and pitched by −20° (the highway outage's restart left 32° and 20°); the fixes (zero
-// velocity, 5 Hz) re-level it to within 0.5° (the data are exact: what is left is the
-// propagation's rate error over the fixes' 0.2 s), with the tilt σ the fixes' noise gives
-// (√2 · 0.1 m/s / 0.2 s / g = 4.1°). The heading waits for the re-levelling (and at rest for a
-// track that never comes). Control: fixes 3 s apart are too far apart to difference, and the
-// tilt stays off.
+// the strapdown's own Δv̂/dt − g. The true board is level with heading north, at rest or moving
+// north (constant speed or acceleration, so its sensor outputs are constant); the estimate is
+// rolled by 30° and pitched by −20° (the highway outage's restart left 32° and 20°), or turned
+// 90° in heading. Fixes are exact at 5 Hz: the re-levelling leaves the propagation's rate
+// error over 0.2 s, well below 0.5°, with the tilt σ the fixes' noise gives
+// (√2 · 0.1 m/s / 0.2 s / |f|: 4.1° at rest).
 struct TiltedRestart {
   static constexpr double kRate = 200;
   ArraySolver<double> solver = ArraySolver<double>::create(table1_geometry(0.1)).value();
   Strapdown<double> nav{solver, GravityModel<double>::constant(testing::kG)};
   ErrorStateFilter<double> filter;
-  Vec6<double> level_outputs;
+  Vec6<double> outputs;
+  Vec3<double> v0 = Vec3<double>::Zero();
+  Vec3<double> a_n = Vec3<double>::Zero();
   int k = 0;
 
-  TiltedRestart() {
-    const testing::Truth level = testing::rest(Quat<double>::Identity());
-    level_outputs = testing::ideal_outputs(solver.geometry(), level);
-    testing::Truth tilted = level;
-    tilted.q_nb = Quat<double>(Eigen::AngleAxisd(-20 * kPi / 180, Vec3<double>::UnitY()) *
-                               Eigen::AngleAxisd(30 * kPi / 180, Vec3<double>::UnitX()));
-    nav.initialize(testing::nav_state_of<double>(tilted), level_outputs);
+  static Quat<double> tilted() {
+    return Quat<double>(Eigen::AngleAxisd(-20 * kPi / 180, Vec3<double>::UnitY()) *
+                        Eigen::AngleAxisd(30 * kPi / 180, Vec3<double>::UnitX()));
+  }
+
+  explicit TiltedRestart(const Quat<double>& estimate = tilted(),
+                         const Vec3<double>& velocity = Vec3<double>::Zero(),
+                         const Vec3<double>& accel = Vec3<double>::Zero())
+      : v0(velocity), a_n(accel) {
+    testing::Truth truth = testing::rest(Quat<double>::Identity());
+    truth.v_n = v0;
+    truth.a_n = a_n;
+    outputs = testing::ideal_outputs(solver.geometry(), truth);
+    testing::Truth est = truth;
+    est.q_nb = estimate;
+    nav.initialize(testing::nav_state_of<double>(est), outputs);
     EXPECT_TRUE(filter.configure(FilterConfig<double>{}).is_ok());
     filter.start(nav);
+    restart();
+  }
+
+  void restart() {
     nav.apply_correction(Vec3<double>::Zero(), Vec3<double>::Zero(), Vec3<double>::Zero(),
                          Vec3<double>(0, -20.0, 0));  // a runaway rate: the restart fires
     EXPECT_TRUE(filter.restart_if_diverged(nav));
   }
 
-  /// Steps for `seconds` with propagation at 20 Hz and a zero-velocity fix every `fix_every_s`.
+  /// Steps for `seconds` with propagation at 20 Hz and a velocity fix every `fix_every_s`.
   void run(double seconds, double fix_every_s) {
     const int n = static_cast<int>(seconds * kRate);
     const int fix_every = static_cast<int>(fix_every_s * kRate);
     for (int i = 0; i < n; ++i, ++k) {
-      const auto t_ns = static_cast<std::int64_t>(std::llround(k / kRate * 1e9));
-      nav.step(level_outputs, 1 / kRate, t_ns, static_cast<std::uint32_t>(k));
+      const double t = k / kRate;
+      const auto t_ns = static_cast<std::int64_t>(std::llround(t * 1e9));
+      nav.step(outputs, 1 / kRate, t_ns, static_cast<std::uint32_t>(k));
       if (k % 10 == 9) {
         EXPECT_TRUE(filter.propagate(nav, 10 / kRate).is_ok());
       }
       if (k % fix_every == fix_every - 1) {
         GnssFix<double> fix;
         fix.t_valid_ns = t_ns;
-        fix.value_n = Vec3<double>::Zero();
+        fix.value_n = v0 + a_n * t;
         fix.sigma = Vec3<double>::Constant(0.1);
         (void)filter.update_gnss_velocity(nav, fix);
       }
@@ -286,10 +301,35 @@ TEST(ErrorStateFilterTest, TwoVelocityFixesRelevelALostTilt) {
   EXPECT_FALSE(r.filter.heading_aligned());  // at rest: no track
 }
 
-TEST(ErrorStateFilterTest, FixesTooFarApartDoNotRelevel) {
-  TiltedRestart r;
+// A heading error under horizontal acceleration turns f̂ about the vertical; the smallest rotation
+// onto f would read that as tilt (23° for 90° of heading at 3 m/s²). Level estimate, heading
+// 90° off, the board accelerating north at 3 m/s²: the re-levelling leaves the tilt level.
+TEST(ErrorStateFilterTest, ReLevellingDoesNotTurnAHeadingErrorIntoTilt) {
+  const Quat<double> turned(Eigen::AngleAxisd(kPi / 2, Vec3<double>::UnitZ()));
+  TiltedRestart r(turned, Vec3<double>::Zero(), Vec3<double>(3.0, 0, 0));
+  ASSERT_LT(r.tilt_deg(), 1e-6);
+  r.run(0.45, 0.2);
+  EXPECT_LT(r.tilt_deg(), 0.5);
+}
+
+// Fixes 3 s apart cannot be differenced (beyond the 2 s limit): the tilt stays off, and on a
+// moving board the heading is still taken from the track (the re-levelling does not hold it
+// back when it cannot be made, as for a receiver slower than the history spans).
+TEST(ErrorStateFilterTest, FixesTooFarApartDoNotRelevelButTheTrackStillSetsTheHeading) {
+  TiltedRestart r(TiltedRestart::tilted(), Vec3<double>(10.0, 0, 0));
   r.run(6.1, 3.0);  // fixes at 3 and 6 s
   EXPECT_GT(r.tilt_deg(), 15.0);
+  EXPECT_TRUE(r.filter.heading_aligned());
+}
+
+// A restart forgets the fix before it: a velocity difference across the diverged stretch means
+// nothing. One fix at 0.2 s, a second restart, one fix at 0.4 s: no re-levelling.
+TEST(ErrorStateFilterTest, ARestartForgetsThePreviousFix) {
+  TiltedRestart r;
+  r.run(0.25, 0.2);
+  r.restart();
+  r.run(0.2, 0.2);
+  EXPECT_GT(r.tilt_deg(), 25.0);
 }
 
 // Lever arm of 1 m (0.6 m forward, 0.8 m up: the up part offsets the height by 0.8 m whatever the

@@ -18,7 +18,8 @@
 // counted), and closed-loop feedback into the Strapdown (apply_correction, set_bias), after which x
 // = 0.
 //
-// Static allocation (P, 18×18, is 1.3 kB in float; the history 64 × 60 B), no heap, no
+// Static allocation (P, 18×18, is 1.3 kB in float; the history HistoryCapacity entries of
+// attitude, rate, velocity and position), no heap, no
 // exceptions; float on the board, double as the reference (explicit instantiations in
 // src/error_state_filter.cpp).
 #pragma once
@@ -382,11 +383,13 @@ class ErrorStateFilter {
   /// σ_ψ = σ_v,horizontal / speed.
   UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix, HistoryEntry<T> at) {
     // The re-levelled attitude at the fix instant is read back for the track's heading. While the
-    // tilt is lost (a divergence restart) and not re-levelled yet, the heading waits: a track
-    // heading on a body tilted by tens of degrees would start the linear filter outside its model.
-    const bool relevelled = relevel_from_gnss(nav, fix, at);
-    if (relevelled) (void)history_.at(fix.t_valid_ns, nav.state(), at);
-    const bool tilt_known = relevelled || (lost_ & filter_valid::kRollPitch) == 0;
+    // tilt is lost (a divergence restart) the heading waits one fix for the re-levelling: a track
+    // heading on a body tilted by tens of degrees would start the linear filter outside its
+    // model. When the re-levelling cannot be made (a receiver slower than the history spans) the
+    // heading is taken from the track as without it.
+    const Relevel relevel = relevel_from_gnss(nav, fix, at);
+    if (relevel == Relevel::kDone) (void)history_.at(fix.t_valid_ns, nav.state(), at);
+    const bool tilt_known = relevel != Relevel::kNotYet;
     const T speed = fix.value_n.template head<2>().norm();
     const bool track = tilt_known && speed >= config_.track_min_speed_mps;
     Vec3<T> phi = Vec3<T>::Zero();
@@ -408,39 +411,67 @@ class ErrorStateFilter {
     return accepted_reset(AidingKind::kGnssVelocity, nav);
   }
 
+  /// What relevel_from_gnss did.
+  enum class Relevel : std::uint8_t {
+    kNotNeeded,  // the tilt is not lost
+    kDone,       // re-levelled
+    kNotYet,     // no previous velocity fix since the restart: the next fix may re-level
+    kUnable,     // the two fixes cannot be differenced (too far apart for the history, dt out
+                 // of 0.05-2 s, f too small or the result no better than the restart's tilt σ)
+  };
+
   /// After a divergence restart the tilt can be tens of degrees off, outside what the linear
   /// update can bring back (it then converges to a wrong attitude with a small σ). Two GNSS
   /// velocity fixes dt apart give the mean specific force in the true n frame, f_n = Δv/dt − g,
   /// and the strapdown's own velocity over the same span gives it in the estimated frame,
   /// f̂_n = Δv̂/dt − g (Δv̂ is the integral of Ĉ f_b + g; the resets in between shift v̂ as a
-  /// whole and leave it). The rotation taking f̂_n onto f_n is the tilt error (its part about f,
-  /// mostly the heading, is left to the track): applied, with the tilt 1σ that the fixes' noise
-  /// gives, σ = √2 σ_v / (dt |f|). Once per velocity fix while the attitude is lost.
-  bool relevel_from_gnss(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
-    if ((lost_ & filter_valid::kRollPitch) == 0 || prev_vel_t_ns_ == kNever) return false;
+  /// whole and leave it). The heading is unknown too, so f̂_n is first turned about the down axis
+  /// to f_n's azimuth (a heading change, which the track then sets anyway); what remains is a
+  /// rotation about a horizontal axis, the tilt error, so a heading error never becomes tilt.
+  /// Both are applied, with the tilt 1σ that the fixes' noise gives, σ = √2 σ_v / (dt |f|), unless
+  /// that σ is no better than the restart's own (half the divergence limit).
+  Relevel relevel_from_gnss(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
+    if ((lost_ & filter_valid::kRollPitch) == 0) return Relevel::kNotNeeded;
+    if (prev_vel_t_ns_ == kNever) return Relevel::kNotYet;
     const T dt = static_cast<T>(fix.t_valid_ns - prev_vel_t_ns_) * T(1e-9);
-    if (!(dt >= T(0.05) && dt <= T(2))) return false;
     HistoryEntry<T> before;
-    if (!history_.at(prev_vel_t_ns_, nav.state(), before)) return false;
+    if (!(dt >= T(0.05) && dt <= T(2)) || !history_.at(prev_vel_t_ns_, nav.state(), before)) {
+      return Relevel::kUnable;
+    }
     const Vec3<T> g = nav.gravity().g_n(at.r_n);
     const Vec3<T> f_est = (at.v_n - before.v_n) / dt - g;
     const Vec3<T> f_true = (fix.value_n - prev_vel_n_) / dt - g;
-    const Vec3<T> axis = f_est.cross(f_true);
+    const T sigma_tilt = T(1.41421356) * fix.sigma.maxCoeff() / dt / f_true.norm();
+    if (!(sigma_tilt < config_.diverged_sigma_tilt_rad / T(2))) return Relevel::kUnable;
+    // The turn about down from f̂'s azimuth to f's: c = cos, s = sin of it (none when either has
+    // no horizontal part).
+    const T c = f_est.x() * f_true.x() + f_est.y() * f_true.y();
+    const T s = f_est.x() * f_true.y() - f_est.y() * f_true.x();
+    const T r = std::sqrt(c * c + s * s);
+    Vec3<T> f_turned = f_est;
+    Vec3<T> yaw = Vec3<T>::Zero();
+    if (r > T(0)) {
+      f_turned.x() = (c * f_est.x() - s * f_est.y()) / r;
+      f_turned.y() = (s * f_est.x() + c * f_est.y()) / r;
+      yaw.z() = std::atan2(s, c);
+    }
+    const Vec3<T> axis = f_turned.cross(f_true);  // horizontal: the two share an azimuth
     const T sin_a = axis.norm();
-    const T cos_a = f_est.dot(f_true);
-    if (!(sin_a > T(0)) || !(cos_a > T(0)) || !std::isfinite(sin_a)) return false;
-    const Vec3<T> phi = axis * (std::atan2(sin_a, cos_a) / sin_a);
-    nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
-    history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
-    const T sigma_f = T(1.41421356) * fix.sigma.maxCoeff() / dt;
-    const T sigma_tilt = sigma_f / f_true.norm();
+    const T cos_a = f_turned.dot(f_true);
+    if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return Relevel::kUnable;
+    const Vec3<T> tilt =
+        sin_a > T(0) ? Vec3<T>(axis * (std::atan2(sin_a, cos_a) / sin_a)) : Vec3<T>::Zero();
+    for (const Vec3<T>& phi : {yaw, tilt}) {  // q ← exp(tilt) ⊗ exp(yaw) ⊗ q̂
+      nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
+      history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
+    }
     using namespace filt_idx;
     for (int i = 0; i < 2; ++i) {
       p_.row(kPhi + i).setZero();
       p_.col(kPhi + i).setZero();
       p_(kPhi + i, kPhi + i) = sigma_tilt * sigma_tilt;
     }
-    return true;
+    return Relevel::kDone;
   }
 
   /// The heading of the GNSS track (FilterConfig::track_heading_sigma_rad), valid at the fix's
@@ -483,6 +514,7 @@ class ErrorStateFilter {
     p_(kPhi + 1, kPhi + 1) = tilt2;
     p_(kPhi + 2, kPhi + 2) = kPi * kPi;
     heading_aligned_ = false;
+    prev_vel_t_ns_ = kNever;  // a velocity difference across the diverged stretch means nothing
     lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
             filter_valid::kPosition;
     const T rate2 = config_.restart_sigma_rate_rps * config_.restart_sigma_rate_rps;
