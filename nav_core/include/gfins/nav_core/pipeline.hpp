@@ -41,6 +41,14 @@ struct PipelineConfig {
   T align_max_f_noise_mps2 = T(0.05);
   T align_max_wdot_rms_rps2 = T(0.5);
   T align_gravity_tolerance_mps2 = T(0.1);
+  // With aiding on, a GNSS velocity fix faster than aiding.gnss_moving_speed_mps refuses the
+  // window in progress (kGnssMotion: a smooth acceleration reads like a tilt to accelerometers).
+  // For a vehicle (aiding.filter.track_heading_sigma_rad > 0), a fix at least as fast as the
+  // track's threshold (aiding.filter.track_min_speed_mps) starts navigation in motion at the next
+  // sample: attitude, rate and heading unknown, every σ not available, until the fixes that
+  // follow re-level the tilt and set the heading from the track (docs/math.md, "In-motion
+  // alignment"). false: the board waits for a standstill.
+  bool align_in_motion = true;
 };
 
 /// Why the last alignment window was refused (PipelineCounters::alignment_restarts counts them).
@@ -50,21 +58,23 @@ enum class AlignmentRefusal : std::uint8_t {
   kSpecificForce,     // f scattered beyond align_max_f_noise_mps2: the board moved
   kAngularAccel,      // ω̇ beyond align_max_wdot_rms_rps2: the board turned
   kGravityMagnitude,  // |f̄| differs from the gravity model: accelerating, or a wrong calibration
+  kGnssMotion,        // a GNSS velocity fix said the board moves (align_in_motion)
 };
 
 enum class PipelinePhase : std::uint8_t { kAligning, kNavigating };
 
 /// Counters a pipeline keeps; they only grow (the firmware publishes them).
 struct PipelineCounters {
-  std::uint32_t samples = 0;             // samples offered
-  std::uint32_t gaps = 0;                // jumps of the sample counter (counted here only)
-  std::uint32_t missed_samples = 0;      // samples lost in those jumps
-  std::uint32_t saturated = 0;           // samples with a channel at ADC full scale
-  std::uint32_t rejected = 0;            // samples not integrated (saturated, kCrcError, or
-                                         // out of order while navigating)
-  std::uint32_t alignment_restarts = 0;  // alignment windows refused (last_refusal says why)
-  std::uint32_t out_of_order = 0;        // samples whose counter repeated or went back: not
-                                         // integrated (is_behind)
+  std::uint32_t samples = 0;               // samples offered
+  std::uint32_t gaps = 0;                  // jumps of the sample counter (counted here only)
+  std::uint32_t missed_samples = 0;        // samples lost in those jumps
+  std::uint32_t saturated = 0;             // samples with a channel at ADC full scale
+  std::uint32_t rejected = 0;              // samples not integrated (saturated, kCrcError, or
+                                           // out of order while navigating)
+  std::uint32_t alignment_restarts = 0;    // alignment windows refused (last_refusal says why)
+  std::uint32_t out_of_order = 0;          // samples whose counter repeated or went back: not
+                                           // integrated (is_behind)
+  std::uint32_t in_motion_alignments = 0;  // navigation started in motion (align_in_motion)
   AlignmentRefusal last_refusal = AlignmentRefusal::kNone;
 };
 
@@ -126,6 +136,8 @@ class NavPipeline {
   // kInvalid.
 
   UpdateOutcome offer_gnss_position(const GnssFix<T>& fix);
+  /// While aligning (aiding on), a fix is not applied (kInvalid) but read for motion
+  /// (PipelineConfig::align_in_motion).
   UpdateOutcome offer_gnss_velocity(const GnssFix<T>& fix);
   UpdateOutcome offer_heading(const HeadingFix<T>& fix);
   /// The filter, the detector and the accuracy of state(); aiding().started() says whether the
@@ -174,6 +186,10 @@ class NavPipeline {
   /// check of StaticAligner::finish applies.
   AlignmentRefusal refusal(const AlignmentResult<T>& a) const;
 
+  /// A GNSS velocity fix while aligning: refuses a window that moved, arms the in-motion start
+  /// (align() makes it at the next sample).
+  void note_motion(const GnssFix<T>& fix);
+
   void mark_compensated() {
     if (compensator_.kind() != CompensatorKind::kNone) {
       strapdown_.mutable_state().status |= nav_status::kCompensated;
@@ -194,6 +210,8 @@ class NavPipeline {
   bool have_seen_ = false;
   PipelinePhase phase_ = PipelinePhase::kAligning;
   bool configured_ = false;
+  bool in_motion_pending_ = false;           // note_motion: start in motion at the next sample
+  Vec3<T> in_motion_v_n_ = Vec3<T>::Zero();  // the fix that armed it: velocity, m/s NED
 };
 
 // ---- NavPipeline: member functions defined outside the class, so not inline: a translation unit
@@ -223,6 +241,7 @@ Status NavPipeline<T>::configure(const PipelineConfig<T>& config) {
   strapdown_ = Strapdown<T, 6>(solver.value(), config.gravity);
   aiding_ = aiding;
   aligner_.reset();
+  in_motion_pending_ = false;
   have_seen_ = false;
   period_s_ = T(1) / config.sample_rate_hz;
   phase_ = PipelinePhase::kAligning;
@@ -289,7 +308,26 @@ UpdateOutcome NavPipeline<T>::offer_gnss_position(const GnssFix<T>& fix) {
 
 template <typename T>
 UpdateOutcome NavPipeline<T>::offer_gnss_velocity(const GnssFix<T>& fix) {
+  if (phase_ == PipelinePhase::kAligning && aiding_.enabled()) note_motion(fix);
   return aiding_.offer_gnss_velocity(strapdown_, fix);
+}
+
+template <typename T>
+void NavPipeline<T>::note_motion(const GnssFix<T>& fix) {
+  if (!fix.value_n.allFinite()) return;
+  const T speed = fix.value_n.template head<2>().norm();
+  if (!(speed > config_.aiding.gnss_moving_speed_mps)) return;
+  if (aligner_.count() > 0) {
+    aligner_.reset();
+    ++counters_.alignment_restarts;
+    counters_.last_refusal = AlignmentRefusal::kGnssMotion;
+  }
+  const FilterConfig<T>& f = config_.aiding.filter;
+  if (config_.align_in_motion && f.track_heading_sigma_rad > T(0) &&
+      speed >= f.track_min_speed_mps) {
+    in_motion_pending_ = true;
+    in_motion_v_n_ = fix.value_n;
+  }
 }
 
 template <typename T>
@@ -337,22 +375,38 @@ template <typename T>
 void NavPipeline<T>::align(const Outputs& s_raw, std::int64_t t_ns, std::uint32_t seq) {
   Outputs s;
   compensator_.apply(s_raw, Vec3<T>::Zero(), Vec3<T>::Zero(), s);
+  // In motion (note_motion armed it): this sample alone gives a first guess of the tilt, as if at
+  // rest (level when it is no gravity vector), the fix's track the heading; the filter starts
+  // with the attitude lost and the fixes that follow align it.
+  const bool in_motion = in_motion_pending_;
+  if (in_motion) aligner_.reset();
   aligner_.add(strapdown_.solver(), s);
-  if (aligner_.count() < config_.alignment_samples) return;
-  const auto result = aligner_.finish(config_.alignment_samples);
-  const AlignmentRefusal why =
-      result.is_ok() ? refusal(result.value()) : AlignmentRefusal::kNotGravity;
+  if (!in_motion && aligner_.count() < config_.alignment_samples) return;
+  const auto result = aligner_.finish(in_motion ? 1 : config_.alignment_samples);
+  AlignmentRefusal why = result.is_ok() ? refusal(result.value()) : AlignmentRefusal::kNotGravity;
+  if (in_motion) why = AlignmentRefusal::kNone;
   if (why != AlignmentRefusal::kNone) {
     aligner_.reset();  // start over (board moving, not connected, or the wrong calibration)
     ++counters_.alignment_restarts;
     counters_.last_refusal = why;
     return;
   }
-  alignment_ = result.value();
-  NavState<T> init =
-      StaticAligner<T, 6>::initial_state(alignment_, config_.heading_rad, config_.r0_n, t_ns);
+  alignment_ = result.is_ok() ? result.value() : AlignmentResult<T>{};
+  const T heading =
+      in_motion ? std::atan2(in_motion_v_n_.y(), in_motion_v_n_.x()) : config_.heading_rad;
+  NavState<T> init = StaticAligner<T, 6>::initial_state(alignment_, heading, config_.r0_n, t_ns);
   init.seq = seq;
+  if (!in_motion) {
+    start_at_specific_force(init, s_raw);
+    return;
+  }
+  init.v_n = in_motion_v_n_;
+  alignment_ = AlignmentResult<T>{};  // no static alignment: nothing to check gravity against
+  aligner_.reset();
+  in_motion_pending_ = false;
+  ++counters_.in_motion_alignments;
   start_at_specific_force(init, s_raw);
+  aiding_.lose_attitude(strapdown_);
 }
 
 template <typename T>

@@ -65,6 +65,11 @@ class Aiding {
 
   /// At the end of alignment: the filter starts at the strapdown's solution.
   void start(Nav& nav);
+  /// After start() at an in-motion alignment: the attitude, rate and heading unknown
+  /// (ErrorStateFilter::lose_attitude); the GNSS fixes that follow align it.
+  void lose_attitude(Nav& nav) {
+    if (started_) filter_.lose_attitude(nav);
+  }
 
   /// After each integrated sample (dt_s: the step it integrated, gaps included).
   void after_step(Nav& nav, T dt_s);

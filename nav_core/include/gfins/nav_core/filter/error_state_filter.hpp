@@ -94,6 +94,13 @@ struct FilterConfig {
   T diverged_sigma_tilt_rad = T(0.35);  // 20°
   T max_rate_rps = T(10);
   T restart_sigma_rate_rps = T(0.3);
+  // The roll and pitch rate 1σ (body x and y) of an in-motion start (lose_attitude): the rate the
+  // strapdown starts from is zero, so its error is the vehicle's own rate at power-up, a few °/s
+  // about a land vehicle's x and y axes (0.05 rad/s: 2.9°/s). The yaw rate keeps
+  // restart_sigma_rate_rps (a turn). With 0.3 rad/s about every axis the tilt σ grows 17°/s
+  // between fixes, the GNSS velocity cannot hold it, and 23 of 300 simulated power-ups on a drive
+  // converged to a wrong attitude (tests/nav_core/pipeline_in_motion_test.cpp).
+  T in_motion_sigma_tilt_rate_rps = T(0.05);
   // An aiding kind counts in mode() for this long after its last accepted update.
   T aiding_timeout_s = T(2);
   // Validity horizons: a quantity is valid while aligned and its 1σ is at or below these.
@@ -177,7 +184,7 @@ class ErrorStateFilter {
         !(config.init_sigma_pos_m > T(0)) || !(config.init_sigma_vel_mps > T(0)) ||
         !(config.init_sigma_rate_rps > T(0)) || !(config.variance_floor > T(0)) ||
         !(config.diverged_sigma_tilt_rad > T(0)) || !(config.max_rate_rps > T(0)) ||
-        !(config.restart_sigma_rate_rps > T(0))) {
+        !(config.restart_sigma_rate_rps > T(0)) || !(config.in_motion_sigma_tilt_rate_rps > T(0))) {
       return Status(ErrorCode::kInvalidArgument, "filter: every sigma must be positive");
     }
     config_ = config;
@@ -192,6 +199,14 @@ class ErrorStateFilter {
   /// Starts estimating at the strapdown's current (aligned) solution: P ← P0, the bias estimate
   /// of the strapdown to zero, history cleared, heading aligned when the configuration gives it.
   void start(Nav& nav);
+
+  /// An in-motion start (the board powered up on a moving vehicle, NavPipeline), after start():
+  /// everything the static alignment would have measured is unknown, as after a divergence
+  /// restart (restart_after_divergence, not counted as one) but with the roll and pitch rate 1σ
+  /// in_motion_sigma_tilt_rate_rps: tilt 1σ half the divergence limit, heading unknown, every σ
+  /// not available until the GNSS fixes re-level the tilt, set the heading from the track and
+  /// reset velocity and position.
+  void lose_attitude(Nav& nav) { forget(nav, false); }
 
   /// The covariance the filter starts from and resets to.
   StateMat initial_covariance() const;
@@ -361,9 +376,18 @@ class ErrorStateFilter {
 
   /// Replaces rows/columns [i, i+3) of P by diag(var) (the quantity was just set from a fix).
   void reset_block(int i, const Vec3<T>& var) {
-    p_.template middleRows<3>(i).setZero();
-    p_.template middleCols<3>(i).setZero();
-    p_.template block<3, 3>(i, i).diagonal() = var;
+    for (int k = 0; k < 3; ++k) set_uncorrelated(i + k, var(k));
+  }
+
+  /// State i uncorrelated with every other, of variance var: row and column i zeroed. A loop, not
+  /// Eigen's row/column expressions: those unroll into one store per element (18 or 54 of them
+  /// per call site; 1 KB of flash for reset_block alone on the Cortex-M4F at -Os).
+  void set_uncorrelated(int i, T var) {
+    for (int r = 0; r < kStates; ++r) {
+      p_(i, r) = T(0);
+      p_(r, i) = T(0);
+    }
+    p_(i, i) = var;
   }
 
   /// Before heading alignment: position set from the fix. The lever arm is rotated with an
@@ -467,9 +491,7 @@ class ErrorStateFilter {
     }
     using namespace filt_idx;
     for (int i = 0; i < 2; ++i) {
-      p_.row(kPhi + i).setZero();
-      p_.col(kPhi + i).setZero();
-      p_(kPhi + i, kPhi + i) = sigma_tilt * sigma_tilt;
+      set_uncorrelated(kPhi + i, sigma_tilt * sigma_tilt);
     }
     return Relevel::kDone;
   }
@@ -498,34 +520,13 @@ class ErrorStateFilter {
   }
 
   /// The restart of FilterConfig (diverged_sigma_tilt_rad).
-  void restart_after_divergence(Nav& nav) {
-    using namespace filt_idx;
-    ++counters_.divergence_restarts;
-    const NavState<T>& x = nav.state();
-    const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
-    nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
-    const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
-    const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
-    p_ = initial_covariance();
-    // Half the limit: the restart must leave room before the test fires again.
-    const T tilt2 = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad / T(4);
-    constexpr T kPi = T(3.14159265358979323846);
-    p_(kPhi, kPhi) = tilt2;
-    p_(kPhi + 1, kPhi + 1) = tilt2;
-    p_(kPhi + 2, kPhi + 2) = kPi * kPi;
-    heading_aligned_ = false;
-    prev_vel_t_ns_ = kNever;  // a velocity difference across the diverged stretch means nothing
-    lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
-            filter_valid::kPosition;
-    const T rate2 = config_.restart_sigma_rate_rps * config_.restart_sigma_rate_rps;
-    for (int i = 0; i < 3; ++i) {
-      p_(kRate + i, kRate + i) = rate2;
-      p_(kPos + i, kPos + i) = std::max(p_(kPos + i, kPos + i), pos_var(i));
-      p_(kVel + i, kVel + i) = std::max(p_(kVel + i, kVel + i), vel_var(i));
-    }
-    if (!p_.allFinite()) p_ = initial_covariance();
-    gnss_rejected_run_.fill(0);
-  }
+  void restart_after_divergence(Nav& nav) { forget(nav, true); }
+
+  /// The attitude, rate and heading unknown, the position and velocity covariance kept (never
+  /// below P0), every group lost until a fix sets it: a divergence restart (counted; rate 1σ
+  /// restart_sigma_rate_rps) or an in-motion start (lose_attitude; roll and pitch rate 1σ
+  /// in_motion_sigma_tilt_rate_rps). One body for both: the image has one copy.
+  void forget(Nav& nav, bool divergence);
 
   /// Counts consecutive rejections of a GNSS kind; at FilterConfig::gnss_lockout_fixes the
   /// quantity is set from this fix (as before heading alignment, the lever arm's length added to
@@ -579,10 +580,7 @@ class ErrorStateFilter {
   }
 
   void set_heading_variance(T sigma_rad) {
-    constexpr int kD = filt_idx::kPhi + 2;
-    p_.row(kD).setZero();
-    p_.col(kD).setZero();
-    p_(kD, kD) = sigma_rad * sigma_rad;
+    set_uncorrelated(filt_idx::kPhi + 2, sigma_rad * sigma_rad);
     heading_aligned_ = true;
     lost_ &= static_cast<std::uint8_t>(~(filter_valid::kRollPitch | filter_valid::kHeading));
   }
@@ -591,10 +589,7 @@ class ErrorStateFilter {
   /// model: its correlations are dropped so no update moves it or is moved by it.
   void decouple_heading() {
     constexpr int kD = filt_idx::kPhi + 2;
-    const T var = p_(kD, kD);
-    p_.row(kD).setZero();
-    p_.col(kD).setZero();
-    p_(kD, kD) = var;
+    set_uncorrelated(kD, p_(kD, kD));
   }
 
   /// Symmetrise, floor the diagonal, and reset to P0 on a non-finite value or a negative
@@ -638,6 +633,37 @@ class ErrorStateFilter {
 // ---- ErrorStateFilter: member functions defined outside the class, so not inline: a translation
 // unit that uses the extern instantiation below calls them instead of instantiating them again to
 // inline them (nav_core/src instantiates each once per scalar type).
+
+template <typename T, int HistoryCapacity>
+void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
+  using namespace filt_idx;
+  if (divergence) ++counters_.divergence_restarts;
+  const NavState<T>& x = nav.state();
+  const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
+  nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
+  const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
+  const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
+  p_ = initial_covariance();
+  // Half the limit: the restart must leave room before the test fires again.
+  const T tilt2 = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad / T(4);
+  constexpr T kPi = T(3.14159265358979323846);
+  p_(kPhi, kPhi) = tilt2;
+  p_(kPhi + 1, kPhi + 1) = tilt2;
+  p_(kPhi + 2, kPhi + 2) = kPi * kPi;
+  heading_aligned_ = false;
+  prev_vel_t_ns_ = kNever;  // a velocity difference across the diverged stretch means nothing
+  lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
+          filter_valid::kPosition;
+  const T rate2 = config_.restart_sigma_rate_rps * config_.restart_sigma_rate_rps;
+  const T xy = divergence ? config_.restart_sigma_rate_rps : config_.in_motion_sigma_tilt_rate_rps;
+  for (int i = 0; i < 3; ++i) {
+    p_(kRate + i, kRate + i) = i < 2 ? xy * xy : rate2;
+    p_(kPos + i, kPos + i) = std::max(p_(kPos + i, kPos + i), pos_var(i));
+    p_(kVel + i, kVel + i) = std::max(p_(kVel + i, kVel + i), vel_var(i));
+  }
+  if (!p_.allFinite()) p_ = initial_covariance();
+  gnss_rejected_run_.fill(0);
+}
 
 template <typename T, int HistoryCapacity>
 void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
