@@ -17,8 +17,10 @@
 namespace gfins::nav::testing {
 
 inline constexpr double kDriveRateHz = 1000.0;
-inline constexpr double kDriveRadius = 150.0;  // figure eight: speed 6-9 m/s, ≤ 1.1 m/s² sideways
-inline constexpr double kDriveOmega = 0.06;
+// Figure eight: speed 5.3-10.6 m/s, turns up to 0.48 rad/s, up to 2.4 m/s² of acceleration.
+inline constexpr double kDriveRadius = 50.0;
+inline constexpr double kDriveOmega = 0.15;
+inline constexpr double kDrivePeriodS = 2.0 * 3.14159265358979323846 / kDriveOmega;  // 41.9 s
 inline constexpr double kGnssPeriodS = 0.2;
 inline constexpr double kGnssLatencyS = 0.1;
 inline constexpr double kGnssSigmaVel = 0.05;  // m/s per axis
@@ -28,9 +30,12 @@ inline constexpr double kArrayBiasMps2 = 2e-4;
 inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 /// The board's truth: the vehicle's (level, heading along the track) turned by the mount.
-inline Truth board_truth(double t) {
+/// t: time since power-up; t0: where on the figure eight the board powers up (s), its position
+/// there the origin.
+inline Truth board_truth(double t, double t0) {
   static const Quat<double> mount = quat_from_euler(2.0 * kDeg, -3.0 * kDeg, 0.0);
-  Truth x = figure_eight(t, kDriveRadius, kDriveOmega);
+  Truth x = figure_eight(t + t0, kDriveRadius, kDriveOmega);
+  x.r_n -= figure_eight(t0, kDriveRadius, kDriveOmega).r_n;
   x.q_nb = x.q_nb * mount;
   x.w_b = mount.conjugate() * x.w_b;
   x.wdot_b = mount.conjugate() * x.wdot_b;
@@ -50,7 +55,9 @@ class InMotionDrive {
  public:
   /// in_motion: PipelineConfig::align_in_motion; track_sigma_deg: the filter's
   /// track_heading_sigma_rad in degrees (0: not a vehicle, no heading from the track).
-  InMotionDrive(bool in_motion, unsigned seed, double track_sigma_deg = 0.5) : rng_(seed) {
+  /// t0: the power-up's place on the figure eight (board_truth).
+  InMotionDrive(bool in_motion, unsigned seed, double t0, double track_sigma_deg = 0.5)
+      : rng_(seed), t0_(t0) {
     config_.front_end.volts_per_count.fill(10.0 / 8388608.0);
     config_.front_end.scale_v_per_g.fill(1.33);
     config_.gravity = GravityModel<double>::constant(kG);
@@ -85,7 +92,7 @@ class InMotionDrive {
  private:
   RawSample sample(std::uint32_t k) {
     const Vec6<double> s =
-        ideal_outputs(pipeline_.solver().geometry(), board_truth(k / kDriveRateHz));
+        ideal_outputs(pipeline_.solver().geometry(), board_truth(k / kDriveRateHz, t0_));
     RawSample r;
     for (int j = 0; j < 6; ++j) {
       const double v = s(j) + bias_(j) + kArrayNoiseMps2 * unit_(rng_);
@@ -99,7 +106,7 @@ class InMotionDrive {
 
   // The fix valid at t_valid as the receiver reports it (noise of its stated σ).
   void offer_fix(double t_valid) {
-    const Truth x = board_truth(t_valid);
+    const Truth x = board_truth(t_valid, t0_);
     GnssFix<double> pos;
     pos.t_valid_ns = std::llround(t_valid * 1e9);
     pos.sigma.setConstant(kGnssSigmaPos);
@@ -114,7 +121,7 @@ class InMotionDrive {
   }
 
   DriveCheck compare(double t) const {
-    const Truth x = board_truth(t);
+    const Truth x = board_truth(t, t0_);
     const NavState<double>& e = pipeline_.state();
     DriveCheck c;
     c.t_s = t;
@@ -131,6 +138,7 @@ class InMotionDrive {
   std::mt19937 rng_;
   std::normal_distribution<double> unit_{0.0, 1.0};
   Vec6<double> bias_;
+  double t0_;
   bool configured_ = false;
 };
 

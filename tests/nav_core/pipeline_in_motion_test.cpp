@@ -1,6 +1,6 @@
 // The pipeline's alignment when the board powers up on a moving vehicle (docs/math.md,
-// "In-motion alignment"), on the drive of in_motion_drive.hpp (one run; the accuracy over 100
-// runs is pipeline_in_motion_long.cpp):
+// "In-motion alignment"), on the drive of in_motion_drive.hpp, powered up in a turn (one run; the
+// accuracy over 100 power-ups is pipeline_in_motion_long.cpp):
 //  - the static alignment never accepts a window while GNSS says the board moves (a smooth
 //    acceleration reads like a tilt to accelerometers); without the in-motion start the board
 //    keeps aligning, and says why (kGnssMotion); so does a board that is no vehicle (no track);
@@ -22,11 +22,13 @@ using testing::InMotionDrive;
 using testing::kDeg;
 
 constexpr unsigned kSeed = 20261128;
+// Powered up in a turn: 0.39 rad/s, 2.4 m/s² of acceleration (13° of false tilt at rest), 5.5 m/s.
+constexpr double kInATurn = 5.0;
 constexpr std::uint8_t kAllValid = filter_valid::kRollPitch | filter_valid::kHeading |
                                    filter_valid::kVelocity | filter_valid::kPosition;
 
 TEST(PipelineInMotion, WithoutTheInMotionStartAMovingBoardKeepsAligning) {
-  InMotionDrive d(false, kSeed);
+  InMotionDrive d(false, kSeed, kInATurn);
   ASSERT_TRUE(d.configured());
   d.run(0, 20'000, 1000, [](const DriveCheck&) {});
   EXPECT_EQ(d.pipeline().phase(), PipelinePhase::kAligning);
@@ -39,7 +41,7 @@ TEST(PipelineInMotion, WithoutTheInMotionStartAMovingBoardKeepsAligning) {
 
 TEST(PipelineInMotion, ABoardThatIsNoVehicleDoesNotStartInMotion) {
   // Without the track (a handheld board) nothing would set the heading: it waits for a standstill.
-  InMotionDrive d(true, kSeed, 0.0);
+  InMotionDrive d(true, kSeed, kInATurn, 0.0);
   ASSERT_TRUE(d.configured());
   d.run(0, 5'000, 1000, [](const DriveCheck&) {});
   EXPECT_EQ(d.pipeline().phase(), PipelinePhase::kAligning);
@@ -48,7 +50,7 @@ TEST(PipelineInMotion, ABoardThatIsNoVehicleDoesNotStartInMotion) {
 }
 
 TEST(PipelineInMotion, APowerUpWhileDrivingAlignsFromTheFixesAndSaysSoUntilThen) {
-  InMotionDrive d(true, kSeed);
+  InMotionDrive d(true, kSeed, kInATurn);
   ASSERT_TRUE(d.configured());
   // The first fix (valid at 0, sent at 0.1 s) arms the start; the sample after it starts.
   d.run(0, 100, 1000, [](const DriveCheck&) {});

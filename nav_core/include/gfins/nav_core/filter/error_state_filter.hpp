@@ -98,8 +98,8 @@ struct FilterConfig {
   // strapdown starts from is zero, so its error is the vehicle's own rate at power-up, a few °/s
   // about a land vehicle's x and y axes (0.05 rad/s: 2.9°/s). The yaw rate keeps
   // restart_sigma_rate_rps (a turn). With 0.3 rad/s about every axis the tilt σ grows 17°/s
-  // between fixes, the GNSS velocity cannot hold it, and 23 of 300 simulated power-ups on a drive
-  // converged to a wrong attitude (tests/nav_core/pipeline_in_motion_test.cpp).
+  // between fixes, the GNSS velocity cannot hold it, and 10 of 100 simulated power-ups on a drive
+  // converged to a wrong attitude (tests/nav_core/pipeline_in_motion_long.cpp).
   T in_motion_sigma_tilt_rate_rps = T(0.05);
   // An aiding kind counts in mode() for this long after its last accepted update.
   T aiding_timeout_s = T(2);
@@ -474,12 +474,16 @@ class ErrorStateFilter {
     const T r = std::sqrt(c * c + s * s);
     Vec3<T> f_turned = f_est;
     Vec3<T> yaw = Vec3<T>::Zero();
-    if (r > T(0)) {
+    if (r > T(0) && !heading_from_track_) {
       f_turned.x() = (c * f_est.x() - s * f_est.y()) / r;
       f_turned.y() = (s * f_est.x() + c * f_est.y()) / r;
       yaw.z() = std::atan2(s, c);
     }
-    const Vec3<T> axis = f_turned.cross(f_true);  // horizontal: the two share an azimuth
+    // Horizontal when the two share an azimuth; with the heading from the track its vertical part
+    // is dropped instead: in a turn, f's horizontal part is a few degrees of the vertical, the
+    // size of the tilt error, so its azimuth says nothing about the heading.
+    Vec3<T> axis = f_turned.cross(f_true);
+    if (heading_from_track_) axis.z() = T(0);
     const T sin_a = axis.norm();
     const T cos_a = f_turned.dot(f_true);
     if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return Relevel::kUnable;
@@ -625,6 +629,9 @@ class ErrorStateFilter {
   // it again: position and velocity with an accepted GNSS fix (or a ZUPT), the attitude with the
   // heading alignment that follows (the GNSS track or an external heading).
   std::uint8_t lost_ = 0;
+  // The heading is the GNSS track's (an in-motion start), not unknown (a divergence restart): the
+  // re-level then corrects the tilt alone (relevel_from_gnss).
+  bool heading_from_track_ = false;
   // The previous usable GNSS velocity fix (relevel_from_gnss), kNever when none.
   Vec3<T> prev_vel_n_ = Vec3<T>::Zero();
   std::int64_t prev_vel_t_ns_ = kNever;
@@ -638,6 +645,7 @@ template <typename T, int HistoryCapacity>
 void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
   using namespace filt_idx;
   if (divergence) ++counters_.divergence_restarts;
+  heading_from_track_ = !divergence;
   const NavState<T>& x = nav.state();
   const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
   nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
