@@ -288,9 +288,7 @@ TEST_F(FwAidedDrive, GnssInputFramesBoundPositionAndVelocityOnTheBus) {
 //    correlated, and allows none; the steps are the signals' resolution). Before 5 s the roll σ
 //    is optimistic (a known limit, docs/navigation-accuracy.md).
 TEST_F(FwAided, APowerUpWhileDrivingAlignsFromTheGnssFrames) {
-  // The first seconds after the level are not checked against σ: the roll σ then understates
-  // the error (docs/navigation-accuracy.md, "Powered up while driving": 4.8σ at 2 s here).
-  constexpr double kSettledS = 5.0;
+  // Every value whose σ is on the bus is checked against it, from the first.
   const std::string cfg = file("vehicle.toml",
                                "[aiding]\nenabled = true\ntrack_heading_sigma_deg = 0.5\n"
                                "gnss_lever_arm_m = [-1.0, 0.0, -1.2]\n");
@@ -314,7 +312,7 @@ TEST_F(FwAided, APowerUpWhileDrivingAlignsFromTheGnssFrames) {
   const auto at = [](const std::vector<std::string>& row, int c) -> const std::string& {
     return row[static_cast<std::size_t>(c)];
   };
-  double first_value_s = -1, first_roll_sigma_s = -1;
+  double first_value_s = -1, first_roll_sigma_s = -1, worst_pos = 0, worst_roll = 0;
   std::size_t pos_checks = 0, pos_outside = 0, roll_checks = 0, roll_outside = 0;
   std::string vel_accepted, vel_rejected, head_accepted, head_rejected, pos_rejected;
   for (const auto& row : t.rows) {
@@ -327,27 +325,29 @@ TEST_F(FwAided, APowerUpWhileDrivingAlignsFromTheGnssFrames) {
     }
     if (!at(row, cn).empty() && first_value_s < 0) first_value_s = t_s;
     if (!at(row, csr).empty() && first_roll_sigma_s < 0) first_roll_sigma_s = t_s;
-    if (t_s < kSettledS) continue;
     const sim::TruthState x = traj.value()->at(t_s);
     if (!at(row, cn).empty() && !at(row, cs).empty()) {
       ++pos_checks;
       const double eh =
           std::hypot(std::stod(at(row, cn)) - x.r_n[0], std::stod(at(row, ce)) - x.r_n[1]);
+      worst_pos = std::max(worst_pos, eh / std::stod(at(row, cs)));
       if (eh > 4.0 * std::stod(at(row, cs)) + 0.01) ++pos_outside;
     }
     if (!at(row, cr).empty() && !at(row, csr).empty()) {
       ++roll_checks;
       const double roll = nav::euler_from_quat(x.q_nb).x();
       const double er = std::remainder(std::stod(at(row, cr)) - roll, 2 * M_PI);
+      worst_roll = std::max(worst_roll, std::abs(er) / std::stod(at(row, csr)));
       if (std::abs(er) > 4.0 * std::stod(at(row, csr)) + 0.001) ++roll_outside;
     }
   }
   std::printf(
       "moving power-up: first value at %.3f s, first roll sigma at %.3f s; %zu position "
-      "and %zu roll checks, %zu and %zu outside 4 sigma; velocity fixes %s accepted %s "
-      "rejected, track headings %s accepted %s rejected\n",
+      "and %zu roll checks, %zu and %zu outside 4 sigma (worst %.2f and %.2f sigma); velocity "
+      "fixes %s accepted %s rejected, track headings %s accepted %s rejected\n",
       first_value_s, first_roll_sigma_s, pos_checks, roll_checks, pos_outside, roll_outside,
-      vel_accepted.c_str(), vel_rejected.c_str(), head_accepted.c_str(), head_rejected.c_str());
+      worst_pos, worst_roll, vel_accepted.c_str(), vel_rejected.c_str(), head_accepted.c_str(),
+      head_rejected.c_str());
   EXPECT_GE(first_value_s, 0.06);
   EXPECT_LT(first_value_s, 0.5);
   EXPECT_GE(first_roll_sigma_s, 0.2);
@@ -359,9 +359,11 @@ TEST_F(FwAided, APowerUpWhileDrivingAlignsFromTheGnssFrames) {
   // 10 Hz for 20 s less the 4 s outage and the fixes before the start: ~150 of each.
   EXPECT_GE(std::atoi(vel_accepted.c_str()), 140);
   EXPECT_GE(std::atoi(head_accepted.c_str()), 140);
-  EXPECT_EQ(vel_rejected, "0");
-  EXPECT_EQ(head_rejected, "0");
-  EXPECT_EQ(pos_rejected, "0");
+  // The gate passes 99.9 % of the fixes of a consistent filter: of ~150, 3 or more rejected has
+  // probability 5e-4 (1 velocity fix was rejected at 3.1 s in this run).
+  for (const std::string* n : {&vel_rejected, &head_rejected, &pos_rejected}) {
+    EXPECT_LE(std::atoi(n->c_str()), 2);
+  }
 }
 
 }  // namespace

@@ -63,13 +63,31 @@ struct MovingBoard {
   // Normal gravity at 24.8° and 50 m: the gravity gradient's entry of F is not zero.
   Strapdown<double> nav{solver, GravityModel<double>::normal(0.4328416544945937, 50.0)};
   Filter filter;
+  testing::Truth truth;
 
-  explicit MovingBoard(std::uint64_t seed)
+  explicit MovingBoard(std::uint64_t seed, bool heading_known = true)
       : rng(seed), solver(ArraySolver<double>::create(calibrated_cube(rng)).value()) {
-    const testing::Truth x = random_truth(rng);
-    nav.initialize(testing::nav_state_of<double>(x), testing::ideal_outputs(solver.geometry(), x));
-    EXPECT_TRUE(filter.configure(noisy_config()).is_ok());
+    truth = random_truth(rng);
+    nav.initialize(testing::nav_state_of<double>(truth),
+                   testing::ideal_outputs(solver.geometry(), truth));
+    FilterConfig<double> c = noisy_config();
+    c.heading_known = heading_known;
+    c.track_min_speed_mps = 1e9;  // no heading from the track: heading_known alone decides
+    EXPECT_TRUE(filter.configure(c).is_ok());
     filter.start(nav);
+  }
+
+  /// Four strapdown steps of 25 ms, each followed by a propagation (a history entry); returns the
+  /// state after the first, 75 ms before the last.
+  NavState<double> advance_100ms() {
+    const Vec6<double> s = testing::ideal_outputs(solver.geometry(), truth);
+    NavState<double> first;
+    for (int k = 1; k <= 4; ++k) {
+      nav.step(s, 0.025, nav.state().t_ns + 25'000'000, nav.state().seq + 1);
+      EXPECT_TRUE(filter.propagate(nav, 0.025).is_ok());
+      if (k == 1) first = nav.state();
+    }
+    return first;
   }
 
   /// Propagations and GNSS updates until every block of P is correlated with every other.
@@ -81,10 +99,13 @@ struct MovingBoard {
       fix.t_valid_ns = nav.state().t_ns;
       fix.value_n = nav.state().r_n + Vec3<double>(0.3, -0.2, 0.1);
       fix.sigma = Vec3<double>(1.5, 1.5, 3.0);
-      ASSERT_EQ(filter.update_gnss_position(nav, fix).status, UpdateStatus::kAccepted);
+      // Before the heading is aligned a fix sets the quantity instead (kReset).
+      const UpdateStatus applied =
+          filter.heading_aligned() ? UpdateStatus::kAccepted : UpdateStatus::kReset;
+      ASSERT_EQ(filter.update_gnss_position(nav, fix).status, applied);
       fix.value_n = nav.state().v_n + Vec3<double>(0.02, 0.01, -0.03);
       fix.sigma = Vec3<double>::Constant(0.1);
-      ASSERT_EQ(filter.update_gnss_velocity(nav, fix).status, UpdateStatus::kAccepted);
+      ASSERT_EQ(filter.update_gnss_velocity(nav, fix).status, applied);
     }
   }
 };
@@ -232,6 +253,69 @@ TEST(FilterAlgebraTest, JosephUpdateEqualsTheDenseProducts) {
       ASSERT_EQ(board.filter.update_heading(board.nav, fix).status, UpdateStatus::kAccepted);
       EXPECT_LT(max_scaled_difference(board.filter.covariance(), expected), kRoundingBound)
           << "heading, seed " << seed;
+    }
+  }
+}
+
+// A fix valid Δt before now (GNSS latency): the error it measures is Φ(now, t_v)⁻¹ x_now, so the
+// update must be the Joseph form with H (I − F Δt + F² Δt²/2), F the process model now; a
+// heading set from such a fix (before the heading is aligned) is the fix's at t_v carried to now,
+// P' = T P̃ Tᵀ with P̃ the covariance with φ_D independent of variance σ², T = I + Δt e_D F_D.
+// A correlated board moved on by 100 ms: the state 75 ms ago, P and F now.
+struct DelayedFix {
+  NavState<double> then;
+  StateMat p;
+  StateMat f;
+};
+DelayedFix delayed_fix(MovingBoard& board) {
+  board.correlate();
+  DelayedFix d;
+  d.then = board.advance_100ms();
+  d.p = board.filter.covariance();
+  StateMat qc;
+  board.filter.process_model(board.nav, d.f, qc);
+  return d;
+}
+
+TEST(FilterAlgebraTest, AFixValidEarlierIsReferredToNow) {
+  constexpr double kAge = 0.075;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    {
+      MovingBoard board(seed);
+      const DelayedFix d = delayed_fix(board);
+      const NavState<double>& then = d.then;
+      const StateMat& p = d.p;
+      const StateMat& f = d.f;
+      const HeadingFix<double> fix{then.t_ns, 0.3, 0.02};
+      Measurement<double, 1> m = heading_measurement(then.q_nb, fix.yaw_rad, fix.sigma_rad);
+      const Measurement<double, 1> at_tv = m;
+      m.h = m.h * (StateMat::Identity() - f * kAge + f * f * (kAge * kAge / 2));
+      const StateMat expected = dense_joseph(p, m);
+      ASSERT_EQ(board.filter.update_heading(board.nav, fix).status, UpdateStatus::kAccepted);
+      EXPECT_LT(max_scaled_difference(board.filter.covariance(), expected), kRoundingBound)
+          << "delayed heading update, seed " << seed;
+      // Referring to now matters here: the update with H at t_v differs by far more.
+      EXPECT_GT(max_scaled_difference(dense_joseph(p, at_tv), expected), 1e3 * kRoundingBound);
+    }
+    {
+      MovingBoard board(seed, false);
+      const DelayedFix d = delayed_fix(board);
+      const StateMat& p = d.p;
+      const StateMat& f = d.f;
+      const HeadingFix<double> fix{d.then.t_ns, 0.3, 0.02};
+      constexpr int kD = filt_idx::kPhi + 2;
+      StateMat independent = p;
+      independent.row(kD).setZero();
+      independent.col(kD).setZero();
+      independent(kD, kD) = fix.sigma_rad * fix.sigma_rad;
+      StateMat t = StateMat::Identity();
+      t.row(kD) += kAge * f.row(kD);
+      StateMat expected = t * independent * t.transpose();
+      expected = ((expected + expected.transpose()) / 2).eval();
+      ASSERT_EQ(board.filter.update_heading(board.nav, fix).status, UpdateStatus::kReset);
+      EXPECT_LT(max_scaled_difference(board.filter.covariance(), expected), kRoundingBound)
+          << "heading set from a delayed fix, seed " << seed;
+      EXPECT_GT(max_scaled_difference(independent, expected), 1e3 * kRoundingBound);
     }
   }
 }

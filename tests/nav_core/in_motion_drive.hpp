@@ -44,6 +44,7 @@ inline Truth board_truth(double t, double t0) {
 
 /// The navigation errors against the truth, and the σ the filter publishes for them.
 struct DriveCheck {
+  std::uint32_t sample = 0;  // index since power-up
   double t_s = 0;
   Vec3<double> euler_err_rad;  // roll, pitch, heading (wrapped)
   Vec3<double> vel_err_mps;
@@ -85,7 +86,7 @@ class InMotionDrive {
     for (std::uint32_t k = k0; k < k1; ++k) {
       if (k >= lag && (k - lag) % period == 0) offer_fix((k - lag) / kDriveRateHz);
       pipeline_.process(sample(k));
-      if (k % every == 0) check(compare(k / kDriveRateHz));
+      if (k % every == 0) check(compare(k));
     }
   }
 
@@ -120,10 +121,12 @@ class InMotionDrive {
     (void)pipeline_.offer_gnss_velocity(vel);
   }
 
-  DriveCheck compare(double t) const {
+  DriveCheck compare(std::uint32_t k) const {
+    const double t = k / kDriveRateHz;
     const Truth x = board_truth(t, t0_);
     const NavState<double>& e = pipeline_.state();
     DriveCheck c;
+    c.sample = k;
     c.t_s = t;
     const Vec3<double> de = euler_from_quat(e.q_nb) - euler_from_quat(x.q_nb);
     for (int i = 0; i < 3; ++i) c.euler_err_rad(i) = std::remainder(de(i), 360.0 * kDeg);

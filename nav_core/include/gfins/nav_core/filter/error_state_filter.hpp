@@ -97,9 +97,7 @@ struct FilterConfig {
   // The roll and pitch rate 1σ (body x and y) of an in-motion start (lose_attitude): the rate the
   // strapdown starts from is zero, so its error is the vehicle's own rate at power-up, a few °/s
   // about a land vehicle's x and y axes (0.05 rad/s: 2.9°/s). The yaw rate keeps
-  // restart_sigma_rate_rps (a turn). With 0.3 rad/s about every axis the tilt σ grows 17°/s
-  // between fixes, the GNSS velocity cannot hold it, and 10 of 100 simulated power-ups on a drive
-  // converged to a wrong attitude (tests/nav_core/pipeline_in_motion_long.cpp).
+  // restart_sigma_rate_rps (a turn).
   T in_motion_sigma_tilt_rate_rps = T(0.05);
   // An aiding kind counts in mode() for this long after its last accepted update.
   T aiding_timeout_s = T(2);
@@ -127,8 +125,8 @@ inline constexpr std::uint8_t kPosition = 1u << 3;
 }  // namespace filter_valid
 
 /// 1σ of the published quantities, from the filter covariance (never an optimistic guess); NaN
-/// where the covariance no longer describes the error (after a divergence restart, until a fix
-/// sets the quantity again).
+/// where the covariance does not describe the error (before the filter starts; after a
+/// divergence restart or an in-motion start, until a fix sets the quantity).
 template <typename T>
 struct NavAccuracy {
   Vec3<T> euler_sigma_rad = Vec3<T>::Zero();  // roll, pitch, heading
@@ -215,6 +213,15 @@ class ErrorStateFilter {
   /// Q_c = [G_u Cov(M n) G_uᵀ 0; 0 Cov(w_β)], from ErrorModel on the strapdown's own solver and
   /// gravity.
   void process_model(const Nav& strapdown, StateMat& f, StateMat& qc) const;
+
+  /// F of process_model alone.
+  void transition_model(const Nav& strapdown, StateMat& f) const;
+
+  /// A measurement valid at t_valid_ns, before the strapdown's current time (a GNSS fix's
+  /// latency): h (rows × kStates, column-major, rows ≤ 3) is turned from the error at t_valid
+  /// into the error now, H ← H Φ(now, t_v)⁻¹ with Φ⁻¹ ≈ I − F Δt + F² Δt²/2 at the current state.
+  /// Nothing happens for Δt ≤ 0.
+  void refer_to_now(T* h, int rows, const Nav& strapdown, std::int64_t t_valid_ns) const;
 
   /// The blocks of F that process_model can fill (block_sparse.hpp: 0 φ, 1 δr, 2 δv, 3 δω,
   /// 4 δβ_ω̇, 5 δβ_f): eq. (8) φ̇ = −C δω; eq. (10) δṙ = δv; eq. (12) δv̇ from φ, from δr (the
@@ -305,10 +312,13 @@ class ErrorStateFilter {
   }
 
   /// The linearised update: gate, gain, Joseph form, feedback.
+  /// t_valid_ns: when the measurement was valid (refer_to_now).
   template <int M>
-  UpdateOutcome apply(const Measurement<T, M>& m, AidingKind kind, T gate, Nav& nav) {
+  UpdateOutcome apply(Measurement<T, M> m, AidingKind kind, T gate, Nav& nav,
+                      std::int64_t t_valid_ns) {
     const auto k_idx = static_cast<std::size_t>(kind);
     if (!m.y.allFinite()) return invalid(kind);
+    refer_to_now(m.h.data(), M, nav, t_valid_ns);
     const Eigen::Matrix<T, kStates, M> pht = p_.lazyProduct(m.h.transpose());
     Eigen::Matrix<T, M, M> s = m.h.lazyProduct(pht) + m.r;
     s = (s + s.transpose()) / T(2);
@@ -374,9 +384,43 @@ class ErrorStateFilter {
     return UpdateOutcome{UpdateStatus::kReset, 0.0F};
   }
 
-  /// Replaces rows/columns [i, i+3) of P by diag(var) (the quantity was just set from a fix).
-  void reset_block(int i, const Vec3<T>& var) {
-    for (int k = 0; k < 3; ++k) set_uncorrelated(i + k, var(k));
+  /// A fix's age, now − t_valid, and the strapdown whose F carries it to now (set_at_fix).
+  struct FixAge {
+    const Nav* nav = nullptr;
+    T dt_s = T(0);
+  };
+  static FixAge age_of(const Nav& nav, std::int64_t t_valid_ns) {
+    return FixAge{&nav, static_cast<T>(nav.state().t_ns - t_valid_ns) * T(1e-9)};
+  }
+
+  /// Replaces rows/columns [i, i+3) of P: each state set from a fix (set_at_fix).
+  void reset_block(int i, const Vec3<T>& var, const FixAge& age) {
+    for (int k = 0; k < 3; ++k) set_at_fix(i + k, var(k), age);
+  }
+
+  /// State i set from a fix valid age.dt_s ago, with variance var then: x_i(t_v) is the fix's
+  /// error, independent of the rest, and x_i(now) = x_i(t_v) + Δt F_i x (F_ii = 0 for φ, δr and
+  /// δv, the states a fix sets), so row i of P becomes Δt F_i P and P_ii = var + Δt² F_i P F_iᵀ.
+  /// Set as if valid now, a heading taken 100 ms ago in a turn that the rate error (0.3 rad/s
+  /// after an in-motion start) has moved by 1.7° since would keep the fix's 0.6°.
+  void set_at_fix(int i, T var, const FixAge& age) {
+    set_uncorrelated(i, var);
+    if (!(age.dt_s > T(0)) || age.nav == nullptr) return;
+    StateMat f;  // F at the current state; a reset is rare, so F is not kept between calls
+    transition_model(*age.nav, f);
+    T row[kStates];
+    for (int j = 0; j < kStates; ++j) {
+      T sum = T(0);
+      for (int k = 0; k < kStates; ++k) sum += f(i, k) * p_(k, j);
+      row[j] = age.dt_s * sum;  // row[i] = 0: column i of P is zero but for P_ii, and F_ii = 0
+    }
+    T extra = T(0);
+    for (int k = 0; k < kStates; ++k) extra += f(i, k) * row[k];
+    for (int j = 0; j < kStates; ++j) {
+      p_(i, j) = row[j];
+      p_(j, i) = row[j];
+    }
+    p_(i, i) = var + age.dt_s * extra;
   }
 
   /// State i uncorrelated with every other, of variance var: row and column i zeroed. A loop, not
@@ -397,7 +441,8 @@ class ErrorStateFilter {
     nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
     history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
     const T l2 = config_.gnss_lever_arm_b.squaredNorm();
-    reset_block(filt_idx::kPos, fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(l2));
+    reset_block(filt_idx::kPos, fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(l2),
+                age_of(nav, fix.t_valid_ns));
     return accepted_reset(AidingKind::kGnssPosition, nav);
   }
 
@@ -411,29 +456,42 @@ class ErrorStateFilter {
     // heading on a body tilted by tens of degrees would start the linear filter outside its
     // model. When the re-levelling cannot be made (a receiver slower than the history spans) the
     // heading is taken from the track as without it.
-    const Relevel relevel = relevel_from_gnss(nav, fix, at);
+    const FixAge age = age_of(nav, fix.t_valid_ns);
+    const Relevel relevel = relevel_from_gnss(nav, fix, at, age);
     if (relevel == Relevel::kDone) (void)history_.at(fix.t_valid_ns, nav.state(), at);
     const bool tilt_known = relevel != Relevel::kNotYet;
-    const T speed = fix.value_n.template head<2>().norm();
+    // The array's velocity: the antenna moves with Ĉ(ω̂ × l) beside it (the GNSS velocity row of
+    // docs/math.md). ω̂ is uncertain by P_ωω (after a start in motion or a restart, by the
+    // vehicle's own rate) and, before the heading is set, Ĉ by any turn about down: per axis the
+    // array's velocity is uncertain by |l|² (tr P_ωω + |ω̂|²) more than the fix (|a × l| ≤ |a| |l|).
+    using namespace filt_idx;
+    const Vec3<T>& l = config_.gnss_lever_arm_b;
+    const Vec3<T> v = array_velocity(fix, at);
+    const T lever_var =
+        l.squaredNorm() * (p_(kRate, kRate) + p_(kRate + 1, kRate + 1) + p_(kRate + 2, kRate + 2) +
+                           (heading_aligned_ ? T(0) : at.w_b.squaredNorm()));
+    const Vec3<T> var = fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(lever_var);
+    const T speed = v.template head<2>().norm();
     const bool track = tilt_known && speed >= config_.track_min_speed_mps;
     Vec3<T> phi = Vec3<T>::Zero();
     if (track) {
-      const T course = std::atan2(fix.value_n.y(), fix.value_n.x());
+      const T course = std::atan2(v.y(), v.x());
       // A rotation about the down axis changes the yaw by its angle whatever roll and pitch, and
       // the yaw error is −φ_D there (euler_error.hpp): φ_D = course − ψ̂ at the fix instant.
       phi.z() = wrap_pi(course - euler_from_quat(at.q_nb).z());
     }
     // The velocity error at the fix instant, then rotated with the heading correction.
-    const Vec3<T> dv = at.v_n - fix.value_n;
+    const Vec3<T> dv = at.v_n - v;
     nav.apply_correction(phi, Vec3<T>::Zero(), dv, Vec3<T>::Zero());
     history_.shift(phi, Vec3<T>::Zero(), dv);
-    reset_block(filt_idx::kVel, fix.sigma.cwiseProduct(fix.sigma));
-    if (track) {
-      const T sigma_h = fix.sigma.template head<2>().maxCoeff() / speed;
-      set_heading_variance(sigma_h);
-    }
+    reset_block(kVel, var, age);
+    if (track) set_heading_variance(std::sqrt(var.template head<2>().maxCoeff()) / speed, age);
     return accepted_reset(AidingKind::kGnssVelocity, nav);
   }
+
+  /// The array's velocity from a fix of the antenna's: the antenna moves with Ĉ(ω̂ × l) beside
+  /// it (at the fix's instant). One body: the image has one copy.
+  Vec3<T> array_velocity(const GnssFix<T>& fix, const HistoryEntry<T>& at) const;
 
   /// What relevel_from_gnss did.
   enum class Relevel : std::uint8_t {
@@ -454,7 +512,8 @@ class ErrorStateFilter {
   /// rotation about a horizontal axis, the tilt error, so a heading error never becomes tilt.
   /// Both are applied, with the tilt 1σ that the fixes' noise gives, σ = √2 σ_v / (dt |f|), unless
   /// that σ is no better than the restart's own (half the divergence limit).
-  Relevel relevel_from_gnss(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
+  Relevel relevel_from_gnss(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at,
+                            const FixAge& age) {
     if ((lost_ & filter_valid::kRollPitch) == 0) return Relevel::kNotNeeded;
     if (prev_vel_t_ns_ == kNever) return Relevel::kNotYet;
     const T dt = static_cast<T>(fix.t_valid_ns - prev_vel_t_ns_) * T(1e-9);
@@ -495,7 +554,7 @@ class ErrorStateFilter {
     }
     using namespace filt_idx;
     for (int i = 0; i < 2; ++i) {
-      set_uncorrelated(kPhi + i, sigma_tilt * sigma_tilt);
+      set_at_fix(kPhi + i, sigma_tilt * sigma_tilt, age);
     }
     return Relevel::kDone;
   }
@@ -504,14 +563,14 @@ class ErrorStateFilter {
   /// instant; counted as a heading update. Below the speed threshold nothing happens (kInvalid,
   /// not counted: there is no track to read).
   UpdateOutcome update_track_heading(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at) {
-    const Vec3<T> v = fix.value_n - at.q_nb * at.w_b.cross(config_.gnss_lever_arm_b);
+    const Vec3<T> v = array_velocity(fix, at);
     const T speed = v.template head<2>().norm();
     if (!(speed >= config_.track_min_speed_mps)) return UpdateOutcome{};
     const T sv = fix.sigma.template head<2>().maxCoeff() / speed;
     const T sigma =
         std::sqrt(sv * sv + config_.track_heading_sigma_rad * config_.track_heading_sigma_rad);
     return apply(heading_measurement(at.q_nb, std::atan2(v.y(), v.x()), sigma),
-                 AidingKind::kHeading, gate_1_, nav);
+                 AidingKind::kHeading, gate_1_, nav, fix.t_valid_ns);
   }
 
   /// FilterConfig's divergence test, after each propagation.
@@ -556,19 +615,22 @@ class ErrorStateFilter {
     p_(kPhi + 2, kPhi + 2) = heading_var;
     const T l2 = config_.gnss_lever_arm_b.squaredNorm();
     const Vec3<T> fix_var = fix.sigma.cwiseProduct(fix.sigma);
+    // The quantity kept first, then the one set from the fix with its correlations (set_at_fix).
+    const FixAge now;
+    const FixAge age = age_of(nav, fix.t_valid_ns);
     if (kind == AidingKind::kGnssPosition) {
       const Vec3<T> dr = at.r_n + at.q_nb * config_.gnss_lever_arm_b - fix.value_n;
       nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
       history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
-      reset_block(kPos, fix_var + Vec3<T>::Constant(l2));
-      reset_block(kVel, vel_var.cwiseMax(p0.template block<3, 3>(kVel, kVel).diagonal()));
+      reset_block(kVel, vel_var.cwiseMax(p0.template block<3, 3>(kVel, kVel).diagonal()), now);
+      reset_block(kPos, fix_var + Vec3<T>::Constant(l2), age);
     } else {
       // The antenna moves with ω × l beside the array: |ω|²|l|² is added for the lever arm.
       const Vec3<T> dv = at.v_n - fix.value_n;
       nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), dv, Vec3<T>::Zero());
       history_.shift(Vec3<T>::Zero(), Vec3<T>::Zero(), dv);
-      reset_block(kVel, fix_var + Vec3<T>::Constant(at.w_b.squaredNorm() * l2));
-      reset_block(kPos, pos_var.cwiseMax(p0.template block<3, 3>(kPos, kPos).diagonal()));
+      reset_block(kPos, pos_var.cwiseMax(p0.template block<3, 3>(kPos, kPos).diagonal()), now);
+      reset_block(kVel, fix_var + Vec3<T>::Constant(at.w_b.squaredNorm() * l2), age);
     }
     condition_covariance();
     return o;
@@ -576,15 +638,15 @@ class ErrorStateFilter {
 
   /// Heading set directly (before alignment): dyaw = ψ̂ − ψ removed by the rotation about the
   /// down axis φ = [0, 0, −dyaw] (the yaw error is −φ_D, euler_error.hpp).
-  void set_heading(Nav& nav, T dyaw, T sigma_rad) {
+  void set_heading(Nav& nav, T dyaw, T sigma_rad, const FixAge& age) {
     const Vec3<T> phi(T(0), T(0), -dyaw);
     nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
     history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
-    set_heading_variance(sigma_rad);
+    set_heading_variance(sigma_rad, age);
   }
 
-  void set_heading_variance(T sigma_rad) {
-    set_uncorrelated(filt_idx::kPhi + 2, sigma_rad * sigma_rad);
+  void set_heading_variance(T sigma_rad, const FixAge& age) {
+    set_at_fix(filt_idx::kPhi + 2, sigma_rad * sigma_rad, age);
     heading_aligned_ = true;
     lost_ &= static_cast<std::uint8_t>(~(filter_valid::kRollPitch | filter_valid::kHeading));
   }
@@ -714,12 +776,9 @@ template <typename T, int HistoryCapacity>
 void ErrorStateFilter<T, HistoryCapacity>::process_model(const Nav& strapdown, StateMat& f,
                                                          StateMat& qc) const {
   using namespace filt_idx;
-  const NavState<T>& nav = strapdown.state();
   const Model model(strapdown.solver(), strapdown.gravity());
-  f.setZero();
-  f.template topLeftCorner<err_idx::kNav, err_idx::kNav>() = model.navigation_continuous(nav);
-  const typename Model::NavInputMat g = model.array_input_matrix(nav);
-  f.template block<err_idx::kNav, 6>(0, kBiasWdot) = g;
+  transition_model(strapdown, f);
+  const auto g = f.template block<err_idx::kNav, 6>(0, kBiasWdot);  // a view, not a copy
   qc.setZero();
   const Mat6<T> noise_u =
       model.array_noise(config_.noise.white_sigma_mps2, T(1) / config_.sample_rate_hz);
@@ -727,6 +786,57 @@ void ErrorStateFilter<T, HistoryCapacity>::process_model(const Nav& strapdown, S
       g.lazyProduct(noise_u).lazyProduct(g.transpose());
   qc.template block<6, 6>(kBiasWdot, kBiasWdot) =
       model.array_noise(config_.noise.bias_rw_mps2_sqrt_s, T(1));
+}
+
+template <typename T, int HistoryCapacity>
+Vec3<T> ErrorStateFilter<T, HistoryCapacity>::array_velocity(const GnssFix<T>& fix,
+                                                             const HistoryEntry<T>& at) const {
+  return fix.value_n - at.q_nb * at.w_b.cross(config_.gnss_lever_arm_b);
+}
+
+template <typename T, int HistoryCapacity>
+void ErrorStateFilter<T, HistoryCapacity>::transition_model(const Nav& strapdown,
+                                                            StateMat& f) const {
+  using namespace filt_idx;
+  const NavState<T>& nav = strapdown.state();
+  const Model model(strapdown.solver(), strapdown.gravity());
+  f.setZero();
+  // Loops: Eigen's block assignments unroll into one load and store per element at -Os.
+  const typename Model::NavMat fn = model.navigation_continuous(nav);
+  const typename Model::NavInputMat g = model.array_input_matrix(nav);
+  for (int r = 0; r < err_idx::kNav; ++r) {
+    for (int c = 0; c < err_idx::kNav; ++c) f(r, c) = fn(r, c);
+    for (int c = 0; c < 6; ++c) f(r, kBiasWdot + c) = g(r, c);
+  }
+}
+
+template <typename T, int HistoryCapacity>
+void ErrorStateFilter<T, HistoryCapacity>::refer_to_now(T* h, int rows, const Nav& strapdown,
+                                                        std::int64_t t_valid_ns) const {
+  // The error at t_v is Φ⁻¹ x_now (the process noise over Δt, a few ms of array noise, is left
+  // out). Φ ≈ I matters: an in-motion start leaves δω at the vehicle's turn rate, 0.3 rad/s, and
+  // 100 ms later φ has moved by 0.03 rad and δv by |f| φ Δt; with Φ ≈ I the published σ of the
+  // first ten seconds were optimistic (tests/nav_core/pipeline_in_motion_long.cpp).
+  const T dt = static_cast<T>(strapdown.state().t_ns - t_valid_ns) * T(1e-9);
+  if (!(dt > T(0))) return;
+  StateMat f;
+  transition_model(strapdown, f);
+  // hf = H F, then H ← H − Δt hf + Δt²/2 hf F. Loops, not Eigen products: one body for M = 1
+  // and 3 in the image.
+  T hf[3 * kStates];
+  const auto mult = [&](const T* a, T* out) {  // out = a F (rows × kStates, column-major)
+    for (int c = 0; c < kStates; ++c) {
+      for (int r = 0; r < rows; ++r) {
+        T sum = T(0);
+        for (int k = 0; k < kStates; ++k) sum += a[k * rows + r] * f(k, c);
+        out[c * rows + r] = sum;
+      }
+    }
+  };
+  mult(h, hf);
+  T hff[3 * kStates];
+  mult(hf, hff);
+  for (int i = 0; i < rows * kStates; ++i) h[i] += -dt * hf[i] + dt * dt / T(2) * hff[i];
 }
 
 template <typename T, int HistoryCapacity>
@@ -769,14 +879,14 @@ template <typename T, int HistoryCapacity>
 UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_zupt(Nav& nav) {
   if (!started_) return invalid(AidingKind::kZupt);
   return apply(zupt_measurement(nav.state(), config_.zupt_sigma_mps), AidingKind::kZupt, gate_3_,
-               nav);
+               nav, nav.state().t_ns);
 }
 
 template <typename T, int HistoryCapacity>
 UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_zaru(Nav& nav) {
   if (!started_) return invalid(AidingKind::kZaru);
   return apply(zaru_measurement(nav.state(), config_.zaru_sigma_rps), AidingKind::kZaru, gate_3_,
-               nav);
+               nav, nav.state().t_ns);
 }
 
 template <typename T, int HistoryCapacity>
@@ -786,7 +896,7 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_position(Nav& na
   if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssPosition);
   if (!heading_aligned_) return reset_position(nav, fix, at);
   const UpdateOutcome o = apply(gnss_position_measurement(at, config_.gnss_lever_arm_b, fix),
-                                AidingKind::kGnssPosition, gate_3_, nav);
+                                AidingKind::kGnssPosition, gate_3_, nav, fix.t_valid_ns);
   return after_gnss(o, AidingKind::kGnssPosition, nav, fix, at);
 }
 
@@ -800,7 +910,7 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& na
     out = reset_velocity_and_track(nav, fix, at);
   } else {
     const UpdateOutcome o = apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
-                                  AidingKind::kGnssVelocity, gate_3_, nav);
+                                  AidingKind::kGnssVelocity, gate_3_, nav, fix.t_valid_ns);
     out = after_gnss(o, AidingKind::kGnssVelocity, nav, fix, at);
     if (config_.track_heading_sigma_rad > T(0)) {
       // The history entry was shifted by the velocity update's feedback: read it again.
@@ -824,10 +934,10 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav,
   }
   const Measurement<T, 1> m = heading_measurement(at.q_nb, fix.yaw_rad, fix.sigma_rad);
   if (!heading_aligned_) {
-    set_heading(nav, m.y(0), fix.sigma_rad);
+    set_heading(nav, m.y(0), fix.sigma_rad, age_of(nav, fix.t_valid_ns));
     return accepted_reset(AidingKind::kHeading, nav);
   }
-  return apply(m, AidingKind::kHeading, gate_1_, nav);
+  return apply(m, AidingKind::kHeading, gate_1_, nav, fix.t_valid_ns);
 }
 
 template <typename T, int HistoryCapacity>
@@ -842,6 +952,12 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
     a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
   }
   constexpr T kNotAvailable = std::numeric_limits<T>::quiet_NaN();
+  if (!started_) {  // nothing estimated yet: no σ, not a zero one
+    a.euler_sigma_rad.setConstant(kNotAvailable);
+    a.vel_sigma_mps.setConstant(kNotAvailable);
+    a.pos_sigma_m.setConstant(kNotAvailable);
+    return a;
+  }
   if ((lost_ & filter_valid::kRollPitch) != 0) a.euler_sigma_rad.setConstant(kNotAvailable);
   if ((lost_ & filter_valid::kVelocity) != 0) a.vel_sigma_mps.setConstant(kNotAvailable);
   if ((lost_ & filter_valid::kPosition) != 0) a.pos_sigma_m.setConstant(kNotAvailable);
