@@ -209,10 +209,11 @@ TEST(ErrorStateFilterTest, SigmaIsNotAvailableAfterARestartUntilFixesSetTheQuant
       f.filter.update_heading(f.nav, HeadingFix<double>{f.nav.state().t_ns, 0.0, 0.01}).status,
       UpdateStatus::kReset);
   a = f.filter.accuracy(f.nav.state());
-  ASSERT_TRUE(a.euler_sigma_rad.allFinite());
-  EXPECT_NEAR(a.euler_sigma_rad.z(), 0.01, 1e-6);
-  // The tilt keeps the restart's width (half the divergence limit) until updates narrow it.
-  EXPECT_NEAR(a.euler_sigma_rad.x(), config.diverged_sigma_tilt_rad / 2, 1e-6);
+  // The heading is set, the tilt not found: only two velocity fixes re-level it
+  // (AHeadingFixAfterARestartLeavesTheTiltLostUntilTheFixesRelevelIt), so the Euler angles' σ
+  // stay not available.
+  EXPECT_TRUE(f.filter.heading_aligned());
+  EXPECT_TRUE(a.euler_sigma_rad.array().isNaN().all());
   EXPECT_EQ(f.filter.counters().divergence_restarts, 1u);
 }
 
@@ -320,6 +321,30 @@ TEST(ErrorStateFilterTest, FixesTooFarApartDoNotRelevelButTheTrackStillSetsTheHe
   r.run(6.1, 3.0);  // fixes at 3 and 6 s
   EXPECT_GT(r.tilt_deg(), 15.0);
   EXPECT_TRUE(r.filter.heading_aligned());
+}
+
+// A heading fix before the tilt is found (an external heading after a restart) sets the heading
+// alone: roll and pitch stay not available (the tilt is 30° off, the restart's σ 10°; the Euler
+// angles' σ go together, J of the heading needs the tilt), then two velocity fixes re-level the
+// tilt without turning the heading the fix set.
+TEST(ErrorStateFilterTest, AHeadingFixAfterARestartLeavesTheTiltLostUntilTheFixesRelevelIt) {
+  TiltedRestart r;
+  ASSERT_GT(r.tilt_deg(), 25.0);
+  const HeadingFix<double> heading{r.nav.state().t_ns, 0.0, 0.01};
+  ASSERT_EQ(r.filter.update_heading(r.nav, heading).status, UpdateStatus::kReset);
+  ASSERT_TRUE(r.filter.heading_aligned());
+  const NavAccuracy<double> before = r.filter.accuracy(r.nav.state());
+  EXPECT_TRUE(before.euler_sigma_rad.array().isNaN().all());
+  r.run(0.45, 0.2);  // fixes at 0.2 and 0.4 s
+  EXPECT_LT(r.tilt_deg(), 0.5);
+  const NavAccuracy<double> after = r.filter.accuracy(r.nav.state());
+  // The level's σ, √2·0.1/(0.2 g), grown by the propagation to 0.45 s (2 %).
+  const double sigma = std::sqrt(2.0) * 0.1 / 0.2 / testing::kG;
+  EXPECT_LE(after.euler_sigma_rad.x(), 1.05 * sigma);
+  EXPECT_LE(after.euler_sigma_rad.y(), 1.05 * sigma);
+  // The truth's heading is 0 (testing::rest, identity): the fix's 0 is kept, to 3 of its 0.01 rad
+  // (the level's turn about a horizontal axis alone moves it by 5.4°).
+  EXPECT_LT(std::abs(euler_from_quat(r.nav.state().q_nb).z()), 0.03);
 }
 
 // A restart forgets the fix before it: a velocity difference across the diverged stretch means

@@ -450,15 +450,25 @@ class ErrorStateFilter {
   /// is the track atan2(v_E, v_N) (the vehicle moves along its x axis: no side slip; the body x
   /// axis projects on the horizontal at the yaw angle whatever roll and pitch), with
   /// σ_ψ = σ_v,horizontal / speed.
-  UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix, HistoryEntry<T> at) {
+  /// What relevel_from_gnss did.
+  enum class Relevel : std::uint8_t {
+    kNotNeeded,  // the tilt is not lost
+    kDone,       // re-levelled
+    kNotYet,     // no previous velocity fix since the restart: the next fix may re-level
+    kUnable,     // the two fixes cannot be differenced (too far apart for the history, dt out
+                 // of 0.05-2 s, f too small or the result no better than the restart's tilt σ)
+  };
+
+  /// relevel: what relevel_from_gnss did with this fix (at is read after it).
+  UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at,
+                                         Relevel relevel) {
     // The re-levelled attitude at the fix instant is read back for the track's heading. While the
     // tilt is lost (a divergence restart) the heading waits one fix for the re-levelling: a track
     // heading on a body tilted by tens of degrees would start the linear filter outside its
     // model. When the re-levelling cannot be made (a receiver slower than the history spans) the
-    // heading is taken from the track as without it.
+    // heading is taken from the track as without it, and roll and pitch stay not available until
+    // two fixes can be differenced.
     const FixAge age = age_of(nav, fix.t_valid_ns);
-    const Relevel relevel = relevel_from_gnss(nav, fix, at, age);
-    if (relevel == Relevel::kDone) (void)history_.at(fix.t_valid_ns, nav.state(), at);
     const bool tilt_known = relevel != Relevel::kNotYet;
     // The array's velocity: the antenna moves with Ĉ(ω̂ × l) beside it (the GNSS velocity row of
     // docs/math.md). ω̂ is uncertain by P_ωω (after a start in motion or a restart, by the
@@ -493,15 +503,6 @@ class ErrorStateFilter {
   /// it (at the fix's instant). One body: the image has one copy.
   Vec3<T> array_velocity(const GnssFix<T>& fix, const HistoryEntry<T>& at) const;
 
-  /// What relevel_from_gnss did.
-  enum class Relevel : std::uint8_t {
-    kNotNeeded,  // the tilt is not lost
-    kDone,       // re-levelled
-    kNotYet,     // no previous velocity fix since the restart: the next fix may re-level
-    kUnable,     // the two fixes cannot be differenced (too far apart for the history, dt out
-                 // of 0.05-2 s, f too small or the result no better than the restart's tilt σ)
-  };
-
   /// After a divergence restart the tilt can be tens of degrees off, outside what the linear
   /// update can bring back (it then converges to a wrong attitude with a small σ). Two GNSS
   /// velocity fixes dt apart give the mean specific force in the true n frame, f_n = Δv/dt − g,
@@ -533,7 +534,10 @@ class ErrorStateFilter {
     const T r = std::sqrt(c * c + s * s);
     Vec3<T> f_turned = f_est;
     Vec3<T> yaw = Vec3<T>::Zero();
-    if (r > T(0) && !heading_from_track_) {
+    // The heading is kept when the track or an external heading sets it (heading_from_track_
+    // after an in-motion start; heading_aligned_ when a heading came before the tilt was found).
+    const bool keep_heading = heading_from_track_ || heading_aligned_;
+    if (r > T(0) && !keep_heading) {
       f_turned.x() = (c * f_est.x() - s * f_est.y()) / r;
       f_turned.y() = (s * f_est.x() + c * f_est.y()) / r;
       yaw.z() = std::atan2(s, c);
@@ -542,13 +546,20 @@ class ErrorStateFilter {
     // is dropped instead: in a turn, f's horizontal part is a few degrees of the vertical, the
     // size of the tilt error, so its azimuth says nothing about the heading.
     Vec3<T> axis = f_turned.cross(f_true);
-    if (heading_from_track_) axis.z() = T(0);
+    if (keep_heading) axis.z() = T(0);
     const T sin_a = axis.norm();
     const T cos_a = f_turned.dot(f_true);
     if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return Relevel::kUnable;
     const Vec3<T> tilt =
         sin_a > T(0) ? Vec3<T>(axis * (std::atan2(sin_a, cos_a) / sin_a)) : Vec3<T>::Zero();
-    for (const Vec3<T>& phi : {yaw, tilt}) {  // q ← exp(tilt) ⊗ exp(yaw) ⊗ q̂
+    // q ← exp(tilt) ⊗ exp(yaw) ⊗ q̂; a kept heading is then put back: a turn of tens of degrees
+    // about a horizontal axis moves the yaw angle too (by about roll × pitch: 5° for 30° and 20°).
+    const T yaw_kept = euler_from_quat(nav.state().q_nb).z();
+    Vec3<T> back = Vec3<T>::Zero();
+    for (int step = 0; step < 3; ++step) {
+      if (step == 2 && keep_heading)
+        back.z() = wrap_pi(yaw_kept - euler_from_quat(nav.state().q_nb).z());
+      const Vec3<T>& phi = step == 0 ? yaw : step == 1 ? tilt : back;
       nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
       history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
     }
@@ -556,6 +567,7 @@ class ErrorStateFilter {
     for (int i = 0; i < 2; ++i) {
       set_at_fix(kPhi + i, sigma_tilt * sigma_tilt, age);
     }
+    lost_ &= static_cast<std::uint8_t>(~filter_valid::kRollPitch);
     return Relevel::kDone;
   }
 
@@ -648,7 +660,9 @@ class ErrorStateFilter {
   void set_heading_variance(T sigma_rad, const FixAge& age) {
     set_at_fix(filt_idx::kPhi + 2, sigma_rad * sigma_rad, age);
     heading_aligned_ = true;
-    lost_ &= static_cast<std::uint8_t>(~(filter_valid::kRollPitch | filter_valid::kHeading));
+    // The tilt stays lost: only a re-level finds it (relevel_from_gnss). An external heading
+    // after a divergence restart says nothing about a tilt tens of degrees off.
+    lost_ &= static_cast<std::uint8_t>(~filter_valid::kHeading);
   }
 
   /// While the heading is unknown its error is a nuisance of variance π² outside the linear
@@ -905,9 +919,13 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_velocity(Nav& na
                                                                          const GnssFix<T>& fix) {
   HistoryEntry<T> at;
   if (!fix_usable(nav, fix, at)) return invalid(AidingKind::kGnssVelocity);
+  // A lost tilt is re-levelled first (relevel_from_gnss), with the heading unknown or known (a
+  // heading fix came first after a restart: it is kept); the state at the fix is read again.
+  const Relevel relevel = relevel_from_gnss(nav, fix, at, age_of(nav, fix.t_valid_ns));
+  if (relevel == Relevel::kDone) (void)history_.at(fix.t_valid_ns, nav.state(), at);
   UpdateOutcome out;
   if (!heading_aligned_) {
-    out = reset_velocity_and_track(nav, fix, at);
+    out = reset_velocity_and_track(nav, fix, at, relevel);
   } else {
     const UpdateOutcome o = apply(gnss_velocity_measurement(at, config_.gnss_lever_arm_b, fix),
                                   AidingKind::kGnssVelocity, gate_3_, nav, fix.t_valid_ns);
