@@ -145,6 +145,31 @@ TEST(ErrorStateFilterTest, LockOutRecoveryTakesThePositionFromTheFixAfterTheCoun
   EXPECT_LT(off.nav.state().r_n.norm(), 1e-9);
 }
 
+// The velocity lock-out with the antenna 1 m forward and the board turning at 0.5 rad/s: the
+// antenna moves at ω × l = (0, 0.5, 0) m/s beside the array, so the reset sets the array's
+// velocity, the fix's minus that, with |l|² (tr P₀,ωω + |ω̂|²) added to the fix's variance.
+TEST(ErrorStateFilterTest, LockOutRecoveryTakesTheArraysVelocityFromTheAntennasFix) {
+  FilterConfig<double> config;
+  config.gnss_lockout_fixes = 25;
+  config.gnss_lever_arm_b = Vec3<double>(1.0, 0.0, 0.0);
+  RestFilter r(config);
+  // ω̂ = (0, 0, 0.5) rad/s (apply_correction subtracts its rate term).
+  r.nav.apply_correction(Vec3<double>::Zero(), Vec3<double>::Zero(), Vec3<double>::Zero(),
+                         Vec3<double>(0, 0, -0.5));
+  ASSERT_NEAR(r.nav.state().w_b.z(), 0.5, 1e-12);
+  GnssFix<double> fix = r.fix_at(Vec3<double>(40.0, -30.0, 5.0));  // every one gated out
+  for (int i = 0; i < 25; ++i) {
+    fix.t_valid_ns = r.nav.state().t_ns;
+    EXPECT_EQ(r.filter.update_gnss_velocity(r.nav, fix).status, UpdateStatus::kRejected);
+  }
+  ASSERT_EQ(r.filter.counters().gnss_lockout_resets, 1u);
+  // Level, heading north: Ĉ = I, and ω̂ × l = (0, 0.5, 0).
+  EXPECT_LT((r.nav.state().v_n - Vec3<double>(40.0, -30.5, 5.0)).norm(), 1e-9);
+  const double rate_var = 3 * config.init_sigma_rate_rps * config.init_sigma_rate_rps;
+  const auto& p = r.filter.covariance();
+  EXPECT_NEAR(p(filt_idx::kVel, filt_idx::kVel), 1.5 * 1.5 + 1.0 * (rate_var + 0.25), 1e-9);
+}
+
 // Divergence: a rate of 20 rad/s (above max_rate_rps, 10) is a solution that has run away; the
 // restart zeroes the rate, forgets the heading and widens the tilt to half the limit. A rate of
 // 1 rad/s with the initial covariance is not a divergence.

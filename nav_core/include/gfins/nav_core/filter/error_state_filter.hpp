@@ -446,10 +446,6 @@ class ErrorStateFilter {
     return accepted_reset(AidingKind::kGnssPosition, nav);
   }
 
-  /// Before heading alignment: velocity set from the fix; above the speed threshold the heading
-  /// is the track atan2(v_E, v_N) (the vehicle moves along its x axis: no side slip; the body x
-  /// axis projects on the horizontal at the yaw angle whatever roll and pitch), with
-  /// σ_ψ = σ_v,horizontal / speed.
   /// What relevel_from_gnss did.
   enum class Relevel : std::uint8_t {
     kNotNeeded,  // the tilt is not lost
@@ -459,6 +455,10 @@ class ErrorStateFilter {
                  // of 0.05-2 s, f too small or the result no better than the restart's tilt σ)
   };
 
+  /// Before heading alignment: velocity set from the fix; above the speed threshold the heading
+  /// is the track atan2(v_E, v_N) (the vehicle moves along its x axis: no side slip; the body x
+  /// axis projects on the horizontal at the yaw angle whatever roll and pitch), with
+  /// σ_ψ = σ_v,horizontal / speed, σ_v that of the array's velocity (array_velocity_variance).
   /// relevel: what relevel_from_gnss did with this fix (at is read after it).
   UpdateOutcome reset_velocity_and_track(Nav& nav, const GnssFix<T>& fix, const HistoryEntry<T>& at,
                                          Relevel relevel) {
@@ -470,17 +470,9 @@ class ErrorStateFilter {
     // two fixes can be differenced.
     const FixAge age = age_of(nav, fix.t_valid_ns);
     const bool tilt_known = relevel != Relevel::kNotYet;
-    // The array's velocity: the antenna moves with Ĉ(ω̂ × l) beside it (the GNSS velocity row of
-    // docs/math.md). ω̂ is uncertain by P_ωω (after a start in motion or a restart, by the
-    // vehicle's own rate) and, before the heading is set, Ĉ by any turn about down: per axis the
-    // array's velocity is uncertain by |l|² (tr P_ωω + |ω̂|²) more than the fix (|a × l| ≤ |a| |l|).
     using namespace filt_idx;
-    const Vec3<T>& l = config_.gnss_lever_arm_b;
     const Vec3<T> v = array_velocity(fix, at);
-    const T lever_var =
-        l.squaredNorm() * (p_(kRate, kRate) + p_(kRate + 1, kRate + 1) + p_(kRate + 2, kRate + 2) +
-                           (heading_aligned_ ? T(0) : at.w_b.squaredNorm()));
-    const Vec3<T> var = fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(lever_var);
+    const Vec3<T> var = array_velocity_variance(fix, at, !heading_aligned_);
     const T speed = v.template head<2>().norm();
     const bool track = tilt_known && speed >= config_.track_min_speed_mps;
     Vec3<T> phi = Vec3<T>::Zero();
@@ -502,6 +494,19 @@ class ErrorStateFilter {
   /// The array's velocity from a fix of the antenna's: the antenna moves with Ĉ(ω̂ × l) beside
   /// it (at the fix's instant). One body: the image has one copy.
   Vec3<T> array_velocity(const GnssFix<T>& fix, const HistoryEntry<T>& at) const;
+
+  /// Per axis, the variance of array_velocity: the fix's, plus |l|² tr P_ωω for ω̂'s error
+  /// (after a start in motion or a restart, the vehicle's own rate) and, when the attitude is in
+  /// doubt (the heading unknown, a lock-out), |l|² |ω̂|² for Ĉ turned by anything
+  /// (|a × l| ≤ |a| |l|).
+  Vec3<T> array_velocity_variance(const GnssFix<T>& fix, const HistoryEntry<T>& at,
+                                  bool attitude_in_doubt) const {
+    using namespace filt_idx;
+    const T rate_var = p_(kRate, kRate) + p_(kRate + 1, kRate + 1) + p_(kRate + 2, kRate + 2);
+    const T lever_var = config_.gnss_lever_arm_b.squaredNorm() *
+                        (rate_var + (attitude_in_doubt ? at.w_b.squaredNorm() : T(0)));
+    return fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(lever_var);
+  }
 
   /// After a divergence restart the tilt can be tens of degrees off, outside what the linear
   /// update can bring back (it then converges to a wrong attitude with a small σ). Two GNSS
@@ -637,12 +642,12 @@ class ErrorStateFilter {
       reset_block(kVel, vel_var.cwiseMax(p0.template block<3, 3>(kVel, kVel).diagonal()), now);
       reset_block(kPos, fix_var + Vec3<T>::Constant(l2), age);
     } else {
-      // The antenna moves with ω × l beside the array: |ω|²|l|² is added for the lever arm.
-      const Vec3<T> dv = at.v_n - fix.value_n;
+      // The array's velocity, as for a reset before the heading is known (P_ωω is P0's here).
+      const Vec3<T> dv = at.v_n - array_velocity(fix, at);
       nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), dv, Vec3<T>::Zero());
       history_.shift(Vec3<T>::Zero(), Vec3<T>::Zero(), dv);
       reset_block(kPos, pos_var.cwiseMax(p0.template block<3, 3>(kPos, kPos).diagonal()), now);
-      reset_block(kVel, fix_var + Vec3<T>::Constant(at.w_b.squaredNorm() * l2), age);
+      reset_block(kVel, array_velocity_variance(fix, at, true), age);
     }
     condition_covariance();
     return o;
