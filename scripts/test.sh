@@ -66,6 +66,13 @@ cmake --build --preset host-debug -j "$jobs"
 step "host-debug (ASan + UBSan): unit tests"
 ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 
+# The libFuzzer targets (tests/fuzz, built with the sanitizer tree above) fuzz every parser of
+# outside input from its seed corpus for GFINS_FUZZ_SECONDS each (15 s: about 70 s on 2 cores);
+# a crash, a sanitizer report or a broken invariant fails the step and leaves the input in
+# build/host-debug/fuzz-findings/ (docs/reliability.md). Not the preset: it excludes the label.
+step "host-debug: fuzzing (libFuzzer, every parser of outside input)"
+ctest --test-dir build/host-debug -L fuzz -j "$jobs" --output-on-failure | tee "$log_dir/ctest-fuzz.log"
+
 # Every unit test ran above under the sanitizers; the release build adds what needs optimised
 # code: the hour-long simulations, the heap checks with NDEBUG defined, the resource figures of
 # gfins-sim montecarlo and covariance (label optimised, tests/CMakeLists.txt), the applications and

@@ -97,6 +97,10 @@ TEST(Candump, MalformedLinesNameWhatIsWrong) {
       {"1700000000.1 can0 123#00", "'('"},
       {"(abc.123456) can0 123#00", "seconds"},
       {"(1700000000123456) can0 123#00", "'.'"},
+      // The largest second whose time in µs fits an int64 is 9223372036853; one more is refused
+      // (it overflowed CandumpRecord::time_us).
+      {"(9223372036854.000000) can0 123#00", "beyond"},
+      {"(999999999999999999.000000) can0 123#00", "beyond"},
       {"(1.1234567) can0 123#00", "fraction"},
       {"(1.123456 can0 123#00", "')'"},
       {"(1.123456)can0 123#00", "space"},
@@ -112,6 +116,13 @@ TEST(Candump, MalformedLinesNameWhatIsWrong) {
       {"(1.123456) can0 123#00_C", "DLC"},
       {"(1.123456) can0 123##100", "FD"},
       {"(1.123456) averyveryverylongifname 123#00", "too long"},
+      // Linux interface names hold no '/', ':' or white space (dev_valid_name); control
+      // characters are refused too, so a log line cannot drive a terminal.
+      {"(1.123456) c\x01an0 123#00", "interface name holds"},
+      {"(1.123456) can\x1b[2J 123#00", "interface name holds"},
+      {"(1.123456) can\r0 123#00", "interface name holds"},
+      {"(1.123456) a/b 123#00", "interface name holds"},
+      {"(1.123456) vcan:0 123#00", "interface name holds"},
       {"(1.123456) can0 C0000000#00", "flag"},
   };
   for (const Case& c : cases) {
@@ -125,6 +136,12 @@ TEST(Candump, MalformedLinesNameWhatIsWrong) {
 // can-utils 2020.11 (Debian 12) canplayer and log2asc read with fgets and skip every line whose
 // first character is not '(' (checked: `log2asc -I` on a log with blank, '#' and text lines
 // prints only the frames). Binary junk is not a comment: it is reported.
+TEST(Candump, TheLastSecondAMicrosecondTimeHoldsIsAccepted) {
+  const auto r = parse_candump_line("(9223372036853.999999) can0 123#00");
+  ASSERT_TRUE(r.is_ok()) << r.status().message();
+  EXPECT_EQ(r->time_us(), 9'223'372'036'853'999'999);
+}
+
 TEST(Candump, CommentLinesAreWhatCanUtilsSkips) {
   for (const char* c : {"", "\n", "\r\n", "   ", "\t", "# recorded on the bench", "a note",
                         "  # indented comment\r\n"}) {

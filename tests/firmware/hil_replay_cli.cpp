@@ -83,6 +83,47 @@ TEST(HilWire, BadFramesAreNamed) {
   EXPECT_EQ(lnx::hil::parse(std::span(good).first(51)).error, lnx::hil::ParseError::kNeedMore);
 }
 
+// A frame whose CRC holds but whose fields the encoder never writes is refused, not read as
+// something else (the fuzzer found an acknowledgement verdict 0x40 taken as a verdict, and CAN
+// lengths over 8 clamped). The frames are resealed so only the field differs.
+TEST(HilWire, FieldsTheEncoderNeverWritesAreRefused) {
+  const auto reseal = [](auto w) {
+    const std::uint32_t c = lnx::hil::crc32(std::span(w).first(w.size() - 4));
+    for (std::size_t i = 0; i < 4; ++i)
+      w[w.size() - 4 + i] = static_cast<std::uint8_t>(c >> (8 * i));
+    return w;
+  };
+  const auto ack = lnx::hil::encode_ack(3, lnx::hil::AckVerdict::kBadCrc);
+  ASSERT_EQ(lnx::hil::parse(ack).error, lnx::hil::ParseError::kNone);
+  auto verdict = ack;
+  verdict[8] = 2;  // verdicts: 0 ok, 1 bad CRC
+  EXPECT_EQ(lnx::hil::parse(reseal(verdict)).error, lnx::hil::ParseError::kMalformed);
+  auto ack_pad = ack;
+  ack_pad[10] = 1;
+  EXPECT_EQ(lnx::hil::parse(reseal(ack_pad)).error, lnx::hil::ParseError::kMalformed);
+
+  hal::CanFrame f;
+  f.id = 0x7FF;
+  f.len = 8;
+  const auto can = lnx::hil::encode_can(f);
+  ASSERT_EQ(lnx::hil::parse(can).error, lnx::hil::ParseError::kNone);
+  auto len9 = can;
+  len9[8] = 9;
+  EXPECT_EQ(lnx::hil::parse(reseal(len9)).error, lnx::hil::ParseError::kMalformed);
+  auto id12 = can;
+  id12[5] = 0x08;  // identifier 0x800: beyond 11 bits without the extended flag
+  EXPECT_EQ(lnx::hil::parse(reseal(id12)).error, lnx::hil::ParseError::kMalformed);
+  auto id30 = can;
+  id30[7] = 0xA0;  // extended flag (bit 31) and bit 29: beyond 29 bits
+  EXPECT_EQ(lnx::hil::parse(reseal(id30)).error, lnx::hil::ParseError::kMalformed);
+  auto ext = can;
+  ext[7] = 0x9F;  // extended, identifier 0x1F0007FF: the largest 29-bit range holds it
+  EXPECT_EQ(lnx::hil::parse(reseal(ext)).error, lnx::hil::ParseError::kNone);
+  auto can_pad = can;
+  can_pad[11] = 0x80;
+  EXPECT_EQ(lnx::hil::parse(reseal(can_pad)).error, lnx::hil::ParseError::kMalformed);
+}
+
 // ---- End to end -------------------------------------------------------------------------------
 
 class HilReplay : public test::CliTest {

@@ -12,6 +12,21 @@ int hex_digit(char c) {
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
+// A character a Linux interface name can hold (net/core/dev.c, dev_valid_name: no '/', ':' or
+// white space; control characters are refused here too, so no log line drives a terminal).
+bool interface_char(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return u > 0x20 && u != 0x7F && c != '/' && c != ':';
+}
+
+bool valid_interface(std::string_view name) {
+  if (name.empty() || name.size() > kMaxInterfaceName) return false;
+  for (const char c : name) {
+    if (!interface_char(c)) return false;
+  }
+  return true;
+}
+
 Status bad(const char* what) { return Status(ErrorCode::kInvalidArgument, what); }
 
 /// Parses an unsigned decimal number of at most `max_digits` digits at the front of `s`.
@@ -138,11 +153,18 @@ Result<CandumpRecord> parse_candump_line(std::string_view line) {
   if (line.empty() || line.front() != ')') return bad("candump: timestamp has no ')'");
   line.remove_prefix(1);
   if (line.empty() || !is_space(line.front())) return bad("candump: no space after timestamp");
+  // CandumpRecord::time_us() is seconds · 10^6 + micros in an int64: 9,223,372,036,853 s (about
+  // 292,000 years) is the last second it holds.
+  constexpr std::uint64_t kMaxSeconds = 9'223'372'036'853;
+  if (sec > kMaxSeconds) return bad("candump: timestamp seconds beyond 9223372036853");
   r.seconds = static_cast<std::int64_t>(sec);
   r.micros = static_cast<std::uint32_t>(usec);
   r.interface = take_token(line);
   if (r.interface.empty()) return bad("candump: interface name missing");
   if (r.interface.size() > kMaxInterfaceName) return bad("candump: interface name too long");
+  if (!valid_interface(r.interface)) {
+    return bad("candump: interface name holds a control character, '/' or ':'");
+  }
   const std::string_view frame = take_token(line);
   if (frame.empty()) return bad("candump: frame missing");
   const Status s = parse_frame(frame, r);
@@ -154,13 +176,10 @@ Result<CandumpRecord> parse_candump_line(std::string_view line) {
 
 std::size_t format_candump_line(std::span<char> out, std::int64_t seconds, std::uint32_t micros,
                                 std::string_view interface, const hal::CanFrame& f) {
-  if (interface.empty() || interface.size() > kMaxInterfaceName || micros > 999999 || seconds < 0 ||
+  if (!valid_interface(interface) || micros > 999999 || seconds < 0 ||
       f.len > hal::CanFrame::kMaxLen ||
       f.id > (f.extended ? hal::CanFrame::kMaxExtendedId : hal::CanFrame::kMaxStandardId)) {
     return 0;
-  }
-  for (char c : interface) {
-    if (is_space(c) || c == '\n' || c == '\r') return 0;
   }
   static constexpr char kHex[] = "0123456789ABCDEF";
   char buf[kMaxCandumpLine];

@@ -114,6 +114,8 @@ const char* to_string(ParseError e) {
       return "frame length does not match its type";
     case ParseError::kBadCrc:
       return "CRC-32 mismatch";
+    case ParseError::kMalformed:
+      return "a field holds a value the protocol does not define";
   }
   return "?";
 }
@@ -160,14 +162,29 @@ ParseResult parse(std::span<const std::uint8_t> b) {
       r.frame.sample.flags = get_u32(p + 44);
       break;
     case FrameType::kAck:
+      // Exactly what encode_ack writes: a known verdict, zero padding.
+      if (p[8] > static_cast<std::uint8_t>(AckVerdict::kBadCrc) || p[9] != 0 || p[10] != 0 ||
+          p[11] != 0) {
+        r.error = ParseError::kMalformed;
+        return r;
+      }
       r.frame.verdict = static_cast<AckVerdict>(p[8]);
       break;
     case FrameType::kCan: {
+      // Exactly what encode_can writes: an 11-bit identifier, or a 29-bit one with the extended
+      // flag; at most 8 data bytes; zero padding.
       const std::uint32_t id = get_u32(p + 4);
+      const bool extended = (id & kExtendedFlag) != 0;
+      const std::uint32_t bare = id & ~kExtendedFlag;
+      if (bare > (extended ? 0x1FFFFFFFu : 0x7FFu) || p[8] > hal::CanFrame::kMaxLen || p[9] != 0 ||
+          p[10] != 0 || p[11] != 0) {
+        r.error = ParseError::kMalformed;
+        return r;
+      }
       r.frame.index = 0;
-      r.frame.can.extended = (id & kExtendedFlag) != 0;
-      r.frame.can.id = id & ~kExtendedFlag;
-      r.frame.can.len = p[8] > hal::CanFrame::kMaxLen ? hal::CanFrame::kMaxLen : p[8];
+      r.frame.can.extended = extended;
+      r.frame.can.id = bare;
+      r.frame.can.len = p[8];
       std::memcpy(r.frame.can.data.data(), p + 12, r.frame.can.data.size());
       break;
     }
@@ -351,7 +368,9 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
       ++counters_.frame_errors;
       drop(pr.error == hil::ParseError::kBadMagic  ? "hil: bad frame from the host: bad magic"
            : pr.error == hil::ParseError::kBadType ? "hil: bad frame from the host: unknown type"
-                                                   : "hil: bad frame from the host: bad length");
+           : pr.error == hil::ParseError::kBadLength
+               ? "hil: bad frame from the host: bad length"
+               : "hil: bad frame from the host: a field the protocol does not define");
       return Status(ErrorCode::kIoError, "hil: bad frame from the host (connection closed)");
     }
     if (!wait_fd(conn_fd_, POLLIN, deadline)) {

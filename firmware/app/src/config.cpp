@@ -11,6 +11,7 @@
 
 #include "gfins/app/config.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
+#include "gfins/toml/safe_parse.hpp"
 
 namespace gfins::app {
 
@@ -248,7 +249,7 @@ ConfigResult parse_config(std::string_view toml_text, const std::string& source,
   std::optional<ConfigProblem> problem;
   int line = 0;  // of the key the problem names, when it is in the text
   try {
-    const toml::table root = toml::parse(toml_text, source);
+    const toml::table root = toml_text::safe_parse(toml_text, source);
     Reader r(root, source);
     read_all(r, base);
     r.reject_unknown(root, "");
@@ -260,7 +261,9 @@ ConfigResult parse_config(std::string_view toml_text, const std::string& source,
     }
   } catch (const toml::parse_error& e) {
     std::ostringstream m;
-    m << source << ":" << e.source().begin.line << ": TOML syntax: " << e.description();
+    // The parser's description quotes the offending character raw: escaped for the terminal.
+    m << source << ":" << e.source().begin.line
+      << ": TOML syntax: " << printable_text(e.description());
     out.error = m.str();
     return out;
   } catch (const ConfigError& e) {

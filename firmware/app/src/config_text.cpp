@@ -1,113 +1,23 @@
 // Text rules of the configuration (gfins/app/config.hpp): UTF-8 paths without control
 // characters, and values shown in messages escaped so that no NUL cuts a message and no control
 // sequence reaches the terminal.
-#include <cstdio>
 #include <string>
 #include <string_view>
 
 #include "gfins/app/config.hpp"
+#include "gfins/drivers/lnx/printable.hpp"
 
 namespace gfins::app {
-namespace {
 
-// One UTF-8 sequence at s[i] (RFC 3629 §4: no overlong forms, no surrogates, at most U+10FFFF):
-// its length, or 0 when the bytes there are not valid UTF-8.
-std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& cp) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
-  const unsigned char c = b(0);
-  std::size_t n = 0;
-  char32_t min = 0;
-  if (c < 0x80) {
-    cp = c;
-    return 1;
-  }
-  if ((c & 0xE0) == 0xC0) {
-    n = 2, cp = c & 0x1F, min = 0x80;
-  } else if ((c & 0xF0) == 0xE0) {
-    n = 3, cp = c & 0x0F, min = 0x800;
-  } else if ((c & 0xF8) == 0xF0) {
-    n = 4, cp = c & 0x07, min = 0x10000;
-  } else {
-    return 0;
-  }
-  if (i + n > s.size()) return 0;
-  for (std::size_t k = 1; k < n; ++k) {
-    if ((b(k) & 0xC0) != 0x80) return 0;
-    cp = (cp << 6) | (b(k) & 0x3F);
-  }
-  if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
-  return n;
-}
+std::string quote_text(std::string_view s) { return drivers::lnx::quote_text(s); }
 
-// C0 controls, DEL and the C1 controls (U+0080..U+009F: 0x9B is a terminal's CSI).
-bool is_control(char32_t cp) { return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F); }
-
-// s with every control character and every byte of invalid UTF-8 escaped (TOML's \uXXXX
-// and short forms for controls, \xNN for a byte that is not UTF-8); `keep_layout` leaves '\n' and
-// '\t' as they are (multi-line messages, help text). Stops after `max_chars` characters with "...".
-std::string escaped(std::string_view s, bool quote, bool keep_layout, std::size_t max_chars) {
-  std::string out;
-  std::size_t shown = 0;
-  for (std::size_t i = 0; i < s.size();) {
-    if (shown == max_chars) {
-      out += "...";
-      break;
-    }
-    ++shown;
-    char32_t cp = 0;
-    const std::size_t n = utf8_sequence(s, i, cp);
-    char hex[8];
-    if (n == 0) {
-      std::snprintf(hex, sizeof hex, "\\x%02X", static_cast<unsigned char>(s[i]));
-      out += hex;
-      ++i;
-      continue;
-    }
-    if ((cp == '\n' || cp == '\t') && keep_layout) {
-      out += static_cast<char>(cp);
-    } else if (quote && (cp == '"' || cp == '\\')) {
-      out += '\\';
-      out += static_cast<char>(cp);
-    } else if (cp == '\n') {
-      out += "\\n";
-    } else if (cp == '\t') {
-      out += "\\t";
-    } else if (cp == '\r') {
-      out += "\\r";
-    } else if (is_control(cp)) {
-      std::snprintf(hex, sizeof hex, "\\u%04X", static_cast<unsigned>(cp));
-      out += hex;
-    } else {
-      out.append(s.substr(i, n));
-    }
-    i += n;
-  }
-  return out;
-}
-
-}  // namespace
-
-std::string quote_text(std::string_view s) {
-  // 60 characters name the value well enough; a longer one is cut (a message stays one line).
-  constexpr std::size_t kMaxShown = 60;
-  return "\"" + escaped(s, true, false, kMaxShown) + "\"";
-}
-
-std::string printable_text(std::string_view s) {
-  return escaped(s, false, true, std::string_view::npos);
-}
+std::string printable_text(std::string_view s) { return drivers::lnx::printable_text(s); }
 
 bool valid_path(std::string_view s) {
   // PATH_MAX (4096 with the NUL) bounds every path the kernel accepts.
   constexpr std::size_t kMaxPathBytes = 4095;
   if (s.empty() || s.size() > kMaxPathBytes) return false;
-  for (std::size_t i = 0; i < s.size();) {
-    char32_t cp = 0;
-    const std::size_t n = utf8_sequence(s, i, cp);
-    if (n == 0 || is_control(cp)) return false;
-    i += n;
-  }
-  return true;
+  return drivers::lnx::clean_utf8(s);
 }
 
 }  // namespace gfins::app

@@ -11,6 +11,8 @@
 
 #include "fields.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/drivers/lnx/printable.hpp"
+#include "gfins/toml/safe_parse.hpp"
 #include "toml_format.hpp"
 
 namespace gfins::calib_file {
@@ -329,14 +331,14 @@ FileResult<CalibrationData> parse_calibration_text(std::string_view text,
                                                 std::to_string(text.size()) + " bytes read)");
   }
   try {
-    const toml::table root = toml::parse(text, file_name);
+    const toml::table root = toml_text::safe_parse(text, file_name);
     return parse_table(root, prefix);
   } catch (const toml::parse_error& e) {
     const auto& at = e.source().begin;
     return FileStatus(ErrorCode::kDataLoss,
                       prefix + "line " + std::to_string(at.line) + ", column " +
                           std::to_string(at.column) +
-                          ": TOML syntax error: " + std::string(e.description()));
+                          ": TOML syntax error: " + drivers::lnx::printable_text(e.description()));
   } catch (const std::exception& e) {
     return FileStatus(ErrorCode::kInvalidArgument, prefix + "cannot be read: " + e.what());
   }

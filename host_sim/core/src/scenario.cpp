@@ -12,9 +12,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gfins/drivers/lnx/printable.hpp"
 #include "gfins/host_sim/chip/simulated_adc.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "gfins/nav_core/paper_table6.hpp"
+#include "gfins/toml/safe_parse.hpp"
 
 namespace gfins::sim {
 namespace {
@@ -583,11 +585,13 @@ std::string scenario_name_problem(const std::string& name) {
 
 HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source) {
   try {
-    const toml::table root = toml::parse(toml_text, source);
+    const toml::table root = toml_text::safe_parse(toml_text, source);
     return parse_root(root, Reader(source), source);
   } catch (const toml::parse_error& e) {
     std::ostringstream os;
-    os << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
+    // The parser's description quotes the offending character raw: escaped for the terminal.
+    os << source << ":" << e.source().begin.line
+       << ": TOML syntax error: " << drivers::lnx::printable_text(e.description());
     return HostError{ErrorCode::kInvalidArgument, os.str()};
   } catch (const ScenarioParseError& e) {
     return HostError{ErrorCode::kInvalidArgument, e.what()};

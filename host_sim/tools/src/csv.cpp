@@ -9,6 +9,7 @@
 #include <string_view>
 #include <utility>
 
+#include "gfins/drivers/lnx/printable.hpp"
 #include "gfins/drivers/lnx/text_file.hpp"
 #include "gfins/host_sim/recording.hpp"
 
@@ -35,9 +36,16 @@ std::vector<std::string> split(const std::string& line) {
 
 HostError bad(const std::string& what) { return HostError{ErrorCode::kInvalidArgument, what, 0}; }
 
+// A header name or cell from the file as a message shows it: control characters and invalid
+// UTF-8 escaped (nothing from the file drives the terminal), cut to 60 characters.
+std::string shown(std::string_view text) {
+  constexpr std::size_t kMaxShown = 60;
+  return drivers::lnx::escape_text(text, false, false, kMaxShown);
+}
+
 std::string join(const std::vector<std::string>& names) {
   std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + shown(n);
   return out;
 }
 
@@ -55,7 +63,7 @@ HostStatus check_header(const CsvTable& t, const std::vector<std::string>& requi
     bool known = false;
     for (const std::string& a : accepted) known = known || a == h;
     if (!known) {
-      std::string msg = t.file + ": header column '" + h + "' is not a known column; ";
+      std::string msg = t.file + ": header column '" + shown(h) + "' is not a known column; ";
       msg += names;
       msg += "; found: ";
       msg += join(t.header);
@@ -93,8 +101,8 @@ HostResult<double> CsvTable::number(const CsvRow& row, int col) const {
   const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
   if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
       !std::isfinite(x)) {
-    return bad(where(row) + "column '" + header[static_cast<std::size_t>(col)] + "': \"" + text +
-               "\" is not a finite number");
+    return bad(where(row) + "column '" + shown(header[static_cast<std::size_t>(col)]) + "': \"" +
+               shown(text) + "\" is not a finite number");
   }
   return x;
 }
@@ -106,15 +114,16 @@ HostResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int6
   const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
   if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() || x < lo ||
       x > hi) {
-    return bad(where(row) + "column '" + header[static_cast<std::size_t>(col)] + "': \"" + text +
-               "\" is not an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return bad(where(row) + "column '" + shown(header[static_cast<std::size_t>(col)]) + "': \"" +
+               shown(text) + "\" is not an integer in [" + std::to_string(lo) + ", " +
+               std::to_string(hi) + "]");
   }
   return x;
 }
 
 HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
   CsvTable t;
-  t.file = path.string();
+  t.file = drivers::lnx::printable_text(path.string());
   std::string text;
   const Status read =
       drivers::lnx::read_text_file(path.c_str(), drivers::lnx::kMaxTableBytes, text);

@@ -26,7 +26,7 @@ struct CsvRow {
 };
 
 struct CsvTable {
-  std::string file;  // as given, for messages
+  std::string file;  // as given, control characters escaped: for messages
   std::vector<std::string> header;
   std::vector<CsvRow> rows;
 

@@ -26,6 +26,7 @@
 #include "csv.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/drivers/lnx/output_paths.hpp"
+#include "gfins/drivers/lnx/printable.hpp"
 #include "gfins/nav_core/gravity.hpp"
 #include "gfins/version/version.hpp"
 
@@ -40,8 +41,9 @@ constexpr int kExitSolver = 2;
 constexpr int kExitVerdict = 3;
 constexpr int kExitWrite = 4;
 
+// Messages quote paths and file contents: printed with control characters escaped.
 int fail(int code, const std::string& message) {
-  std::cerr << "gfins-calibrate: error: " << message << "\n";
+  std::cerr << "gfins-calibrate: error: " << drivers::lnx::printable_text(message) << "\n";
   return code;
 }
 

@@ -54,7 +54,8 @@ bool is_candump_comment(std::string_view line);
 Result<CandumpRecord> parse_candump_line(std::string_view line);
 
 /// Writes "(sec.usec) iface ID#DATA" (no newline) into `out`; returns the length, or 0 when the
-/// buffer is too small, the interface name is empty/too long/contains a space, or the frame is
+/// buffer is too small, the interface name is empty, too long or holds a character no Linux
+/// interface name has (white space, a control character, '/', ':'), or the frame is
 /// invalid (len > 8, identifier too large).
 std::size_t format_candump_line(std::span<char> out, std::int64_t seconds, std::uint32_t micros,
                                 std::string_view interface, const hal::CanFrame& f);

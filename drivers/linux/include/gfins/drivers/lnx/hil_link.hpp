@@ -66,12 +66,22 @@ struct Frame {
   hal::CanFrame can{};
 };
 
-enum class ParseError : std::uint8_t { kNone, kNeedMore, kBadMagic, kBadType, kBadLength, kBadCrc };
+// kMalformed: the CRC holds but a field has a value the encoder never writes (an unknown
+// verdict, a CAN length over 8 or an identifier beyond its format, non-zero padding).
+enum class ParseError : std::uint8_t {
+  kNone,
+  kNeedMore,
+  kBadMagic,
+  kBadType,
+  kBadLength,
+  kBadCrc,
+  kMalformed,
+};
 const char* to_string(ParseError e);
 
 struct ParseResult {
   ParseError error = ParseError::kNone;
-  std::size_t used = 0;  // bytes consumed (the frame's length for kBadCrc; 0 for kNeedMore)
+  std::size_t used = 0;  // bytes consumed (the frame's length for kBadCrc and kMalformed)
   Frame frame{};
 };
 /// Parses the frame at the start of `bytes`.

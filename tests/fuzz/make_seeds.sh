@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Writes the seed corpora of tests/fuzz/corpus/ (docs/reliability.md) from the project's own
+# files and programs: usage `tests/fuzz/make_seeds.sh BUILD_DIR` (a release tree with gfins-sim,
+# gfins-calibrate and gfins-can-gen built). Findings kept as regression inputs are not touched:
+# only files named seed-* are rewritten.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+build=${1:?usage: make_seeds.sh BUILD_DIR}
+corpus=tests/fuzz/corpus
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+rm -f "$corpus"/*/seed-*
+
+# Text formats: the files the project ships or writes.
+cp firmware/app/gfins-fw.toml "$corpus/firmware_config/seed-default.toml"
+cp scripts/vboard/gfins-fw-vboard.toml "$corpus/firmware_config/seed-vboard.toml"
+for f in host_sim/scenarios/*.toml; do cp "$f" "$corpus/scenario/seed-$(basename "$f")"; done
+"$build/host_sim/tools/gfins-calibrate" --means tests/golden/paper_tables_4_5.csv --latitude 24.8 \
+  --adc-lsb 1.192e-6 --device-id board-001 --rho 0.1 -o "$tmp/cal.toml" >/dev/null
+cp "$tmp/cal.toml" "$corpus/calibration_file/seed-paper.toml"
+
+# Prefixed formats: the first byte picks the reader or the CRC sealing (see each target).
+prefixed() {  # prefixed BYTE_OCTAL FILE OUT
+  { printf "\\$1"; cat "$2"; } >"$3"
+}
+prefixed 000 tests/golden/paper_tables_4_5.csv "$corpus/calibration_tables/seed-means.csv"
+printf 'attitude,fx_g,fy_g,fz_g\n1,0,0,1\n2,0,0,-1\n3,1,0,0\n' >"$tmp/poses.csv"
+prefixed 001 "$tmp/poses.csv" "$corpus/calibration_tables/seed-poses.csv"
+printf 't,v1,v2,v3,v4,v5,v6\n0,0.1,0.2,0.3,0.4,0.5,0.6\n0.001,0.1,0.2,0.3,0.4,0.5,0.6\n' \
+  >"$tmp/volts.csv"
+prefixed 002 "$tmp/volts.csv" "$corpus/calibration_tables/seed-volts.csv"
+
+sed 's/^duration_s = .*/duration_s = 0.02/' host_sim/scenarios/rest.toml >"$tmp/short.toml"
+"$build/host_sim/app/gfins-sim" run "$tmp/short.toml" --record "$tmp/rest.gfr" --no-plot \
+  -o "$tmp/rest" >/dev/null
+prefixed 001 "$tmp/rest.gfr" "$corpus/recording/seed-rest.gfr"
+for f in clean restart bad_crc sample_back time_jump out_of_range malformed_lines; do
+  prefixed 001 "tests/golden/can/$f.log" "$corpus/can_log/seed-$f.log"
+done
+prefixed 000 tests/golden/can/crlf.log "$corpus/can_log/seed-crlf-unsealed.log"
+
+# Binary formats, written field by field (each target's comment gives the layout).
+python3 - "$corpus" <<'PY'
+import struct, sys
+corpus = sys.argv[1]
+def put(name, data):
+    open(f"{corpus}/{name}", "wb").write(data)
+# can_frames: selector, shape (0: 8 bytes, CRC sealed by the harness), 8 data bytes, 1 unused.
+# Selector i % 6: command, GNSS PositionNE, PositionD, Velocity, FixInfo, HeadingInput.
+commands = b"".join(bytes([0, 0, op, 7, 0, 0, 0, 0, 0, 0, 0]) for op in range(1, 9))
+put("can_frames/seed-commands", commands)
+fix = b"".join(bytes([sel, 0, 0x10, 0, 0x20, 0, 0x30, 0, 0x11, 0, 0]) for sel in (1, 2, 3, 4))
+put("can_frames/seed-gnss-fix", fix)
+put("can_frames/seed-heading", bytes([5, 0, 0x40, 0x1F, 0x10, 0, 0x01, 0, 0x10, 0, 0]))
+# hil_stream: byte 0 = 1 (the harness seals the CRC-32s), then frames 'G' 'H' type length ...
+def frame(kind, body):
+    n = 4 + len(body) + 4
+    return b"GH" + bytes([kind, n]) + body + b"\0\0\0\0"
+sample = struct.pack("<IIq6iI", 0, 100, 1_000_000, 1, -2, 3, -4, 5, -6, 0)
+last = struct.pack("<IIq6iI", 1, 101, 2_000_000, 0, 0, 0, 0, 0, 0, 0)
+ack = struct.pack("<IB3x", 0, 0)
+can = struct.pack("<IB3x8s", 0x101, 8, bytes(range(8)))
+put("hil_stream/seed-stream", b"\1" + frame(1, sample) + frame(2, last) + frame(3, ack) +
+    frame(4, can))
+# ads131m06: per transfer a mode byte (0: the chip's answer) and per data-ready wait a byte
+# (0x01: the next edge; 0x19: two edges missed first); alternating, then fuzzed frames with
+# sealed CRCs.
+put("ads131m06/seed-clean", bytes([0x01, 0x00] * 32))
+put("ads131m06/seed-fuzzed", bytes([0x01, 0x02] + list(range(24)) + [0x19, 0x06] +
+                                   [0xFF] * 24 + [0x01, 0x00] * 8))
+PY
+echo "seeds written to $corpus"
