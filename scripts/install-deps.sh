@@ -13,6 +13,8 @@ packages=(
   libtomlplusplus-dev libcli11-dev libspdlog-dev
   python3 python3-matplotlib python3-numpy python3-can nodejs
   clang lld clang-format clang-tidy valgrind  # clang, lld: the sanitizer preset (host-debug)
+  libclang-rt-14-dev  # the sanitizer runtimes and libFuzzer (host-debug, host-tsan, tests/fuzz)
+  cppcheck  # scripts/check-cppcheck.sh
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
   qemu-system-arm  # scripts/m4f_step_cycles.sh: the Cortex-M4F step traced on mps2-an386
   lintian dpkg-dev  # scripts/package.sh: lintian on the .debs; dpkg-shlibdeps for CPack's Depends

@@ -30,7 +30,8 @@ step_table() {
   printf '%6d s             total\n' $(($(date +%s) - start))
 }
 tidy_pid=""
-trap 'rc=$?; [ -z "$tidy_pid" ] || kill -- "-$tidy_pid" 2>/dev/null; step_table; rm -rf "$log_dir"; exit $rc' EXIT
+cppcheck_pid=""
+trap 'rc=$?; for p in $tidy_pid $cppcheck_pid; do kill -- "-$p" 2>/dev/null; done; step_table; rm -rf "$log_dir"; exit $rc' EXIT
 step() {
   step_close
   children_cpu
@@ -57,6 +58,9 @@ cmake --preset host-release >/dev/null
 set -m
 nice -n 19 ./scripts/check-tidy.sh build/host-release >"$log_dir/tidy.log" 2>&1 &
 tidy_pid=$!
+# cppcheck the same way, beside it (docs/ci.md): the two share what the steps leave idle.
+nice -n 19 ./scripts/check-cppcheck.sh build/host-release >"$log_dir/cppcheck.log" 2>&1 &
+cppcheck_pid=$!
 set +m
 
 step "host-debug (ASan + UBSan): build"
@@ -72,6 +76,15 @@ ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 # build/host-debug/fuzz-findings/ (docs/reliability.md). Not the preset: it excludes the label.
 step "host-debug: fuzzing (libFuzzer, every parser of outside input)"
 ctest --test-dir build/host-debug -L fuzz -j "$jobs" --output-on-failure | tee "$log_dir/ctest-fuzz.log"
+
+# The threaded parts (the Monte-Carlo pool, the candump log writer, the reload worker, the
+# status reporter, and gfins-fw as a process: logger thread, HIL link) under ThreadSanitizer:
+# preset host-tsan builds only their tests (label threads, tests/CMakeLists.txt); a race or a
+# lock-order inversion fails the test (TSAN_OPTIONS halt_on_error=1 in the test preset).
+step "host-tsan (ThreadSanitizer): the threaded parts' tests"
+cmake --preset host-tsan >/dev/null
+cmake --build --preset host-tsan -j "$jobs"
+ctest --preset host-tsan -j "$jobs" | tee "$log_dir/ctest-tsan.log"
 
 # Every unit test ran above under the sanitizers; the release build adds what needs optimised
 # code: the hour-long simulations, the heap checks with NDEBUG defined, the resource figures of
@@ -161,12 +174,21 @@ fw_deb=${fw_debs[0]}
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
   --deb "$fw_deb"
 
+# A background check's result: its log, and the run fails when it did.
+collect() {  # collect NAME PID LOG
+  local rc=0
+  wait "$2" || rc=$?
+  cat "$3"
+  [ "$rc" -eq 0 ] || { echo "test.sh: $1 failed (exit $rc)" >&2; exit 1; }
+}
+
 step "clang-tidy (started after the format check, at the lowest priority)"
-tidy_rc=0
-wait "$tidy_pid" || tidy_rc=$?
+collect clang-tidy "$tidy_pid" "$log_dir/tidy.log"
 tidy_pid=""
-cat "$log_dir/tidy.log"
-[ "$tidy_rc" -eq 0 ] || { echo "test.sh: clang-tidy failed (exit $tidy_rc)" >&2; exit 1; }
+
+step "cppcheck (started with clang-tidy, at the lowest priority)"
+collect cppcheck "$cppcheck_pid" "$log_dir/cppcheck.log"
+cppcheck_pid=""
 
 step "all checks passed"
 total=$(sed -n 's/.*tests passed, 0 tests failed out of \([0-9]*\).*/\1/p' "$log_dir"/ctest-*.log |

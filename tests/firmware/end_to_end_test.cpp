@@ -303,7 +303,7 @@ std::map<std::string, std::string> keys_of(const std::string& text) {
   std::istringstream in(text);
   std::string table;
   for (std::string line; std::getline(in, line);) {
-    line = line.substr(0, line.find('#'));
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
     const auto b = line.find_first_not_of(' ');
     if (b == std::string::npos) continue;
     line = line.substr(b, line.find_last_not_of(' ') + 1 - b);

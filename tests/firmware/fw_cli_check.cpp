@@ -178,7 +178,8 @@ TEST_F(FwCli, TwoOutputsOnOneFileAreRefusedBeforeTheRun) {
                   "can.log_file (--can-log) and calibration.file"}}) {
     SCOPED_TRACE(extra[1]);
     std::vector<std::string> args = sim_run({}, "rest", log);
-    if (const auto at = std::find(args.begin(), args.end(), extra[0]); at != args.end()) {
+    if (const auto at = std::find(args.begin(), args.end(), extra[0]);
+        at != args.end() && at + 1 != args.end()) {
       *(at + 1) = extra[1];  // sim_run's --calibration "" becomes the clashing path
     } else {
       args.insert(args.end(), extra.begin(), extra.end());

@@ -65,6 +65,25 @@ TEST(TomlGuard, FindsNonAsciiWhereTheParserTestsForWhitespace) {
   }
 }
 
+TEST(TomlGuard, FindsABraceWhereAnArrayExpectsAValue) {
+  for (const std::string_view text :
+       {"x = [1, }]\n", "x = [}]\n", "x = [1, # c\n}]\n", "x = [1 }]\n", "x = [{a = 1}, }]\n"}) {
+    EXPECT_EQ(unsafe_for_toml_parser(text).what, gfins::toml_text::kBraceInArray) << text;
+  }
+  // An inline table's own brace closes it, also inside an array.
+  EXPECT_EQ(unsafe_for_toml_parser("x = [{a = 1}, {b = [2]}]\n").what, nullptr);
+}
+
+TEST(TomlGuard, AQuoteAfterAMalformedValueStartsNoString) {
+  // The library reads "1g'..." as one malformed value up to the next space: the "string" there
+  // is part of it, and a non-ASCII character in it is refused like any outside a string.
+  const auto p = unsafe_for_toml_parser("eg=1g'avit\xD1\x88t'\n");
+  EXPECT_EQ(p.what, kNonAscii);
+  EXPECT_EQ(p.column, 11u);
+  // A string where a value starts is one.
+  EXPECT_EQ(unsafe_for_toml_parser("eg = 'avit\xD1\x88t'\n").what, nullptr);
+}
+
 TEST(TomlGuard, LeavesEveryValidHeaderValueAndCommentAlone) {
   for (const std::string_view text :
        {"[a]\n", "[ a ]\n", "[[a]]\n", "[[ a.b ]]\n", "[\"quoted\"]\n", "['literal']\n", "[_a]\n",

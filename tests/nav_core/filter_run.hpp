@@ -95,7 +95,7 @@ FilterConfig<T> cast_config(const FilterConfig<double>& d) {
 }
 
 template <typename T>
-RunResult<T> run_aided(const RunSpec& spec, FilterConfig<double> config_d) {
+RunResult<T> run_aided(const RunSpec& spec, const FilterConfig<double>& config_d) {
   using Filter = ErrorStateFilter<T>;
   static Filter filter;  // static: 18×18 matrices and the history stay off the test's stack
   const auto geometry = table1_geometry<double>(0.1);

@@ -10,10 +10,15 @@
 //    __builtin_unreachable for U+00A1..U+0499, U+2C8E..U+3087 and U+FC06..U+FEFE except
 //    U+3000, so "ra° = 1" is undefined behaviour in every build. It asks outside strings and
 //    comments, in keys (quoted ones too: they are recorded character by character), and in a
-//    multi-line basic string after a backslash and after a line-ending backslash. TOML 1.0 allows
-//    non-ASCII text only in strings and comments, and no key of the project's files is
-//    non-ASCII, so every non-ASCII byte in those places is refused (a continuation line of a
-//    multi-line string starting with one is the only valid TOML this refuses).
+//    multi-line basic string after a backslash and after a line-ending backslash, and in the
+//    rest of a malformed value, which it reads up to the next space, ']', '}', ',' or '#' (so a
+//    quote there starts no string). TOML 1.0 allows non-ASCII text only in strings and comments,
+//    and no key of the project's files is non-ASCII, so every non-ASCII byte in those places is
+//    refused (a continuation line of a multi-line string starting with one is the only valid
+//    TOML this refuses).
+// 3. '}' where an array expects a value ("x = [1, }]"): the library's value parser is called with
+//    a broken precondition (an assertion in debug builds, __builtin_assume in clang release
+//    builds).
 //
 // The scan follows TOML 1.0's lexical structure far enough for that: strings (basic, literal,
 // multi-line), comments, the brackets of array and inline-table values, and whether a string is
@@ -37,6 +42,8 @@ struct TextProblem {
 inline constexpr const char* kBadHeaderKey =
     "Error while parsing table header: expected a key (a letter, digit, '_', '-' or a quote) "
     "after '['";
+inline constexpr const char* kBraceInArray =
+    "Error while parsing array: '}' where a value or ']' was expected";
 inline constexpr const char* kNonAscii =
     "a non-ASCII character outside a string value or comment (in a key, a value that is not a "
     "string, or after a backslash in a multi-line string)";
@@ -55,6 +62,7 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
   bool header = false;        // inside a [table] header
   bool continuation = false;  // multi-line basic string: after a line-ending backslash
   bool line_start = true;
+  char prev = '\n';  // the last character of a token outside strings and comments
   std::size_t line = 1;
   std::size_t line_begin = 0;
   const auto at = [&](std::size_t i, const char* what) {
@@ -71,6 +79,7 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
       if (in == In::kValue && open.empty()) {
         expect_key = true;
         header = false;
+        prev = '\n';
       }
       continue;
     }
@@ -97,6 +106,7 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
           in = In::kValue;
           i += 2;
           while (i + 1 < s.size() && s[i + 1] == '"') ++i;  // up to two quotes of content
+          prev = '"';
         }
         continue;
       case In::kBasic:
@@ -106,17 +116,22 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
           if (string_key && static_cast<unsigned char>(s[i]) >= 0x80) return at(i, kNonAscii);
         } else if (c == '"') {
           in = In::kValue;
+          prev = c;
         }
         continue;
       case In::kLiteral:
         if (non_ascii && string_key) return at(i, kNonAscii);
-        if (c == '\'') in = In::kValue;
+        if (c == '\'') {
+          in = In::kValue;
+          prev = c;
+        }
         continue;
       case In::kMultiLiteral:
         if (s.substr(i, 3) == "'''") {
           in = In::kValue;
           i += 2;
           while (i + 1 < s.size() && s[i + 1] == '\'') ++i;
+          prev = '\'';
         }
         continue;
       case In::kValue:
@@ -127,9 +142,17 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
     const bool at_line_start = line_start;
     line_start = false;
     const bool key = expect_key || header;
-    if (c == '#') {
+    // A quote starts a string only where a string can start: the library reads one that follows
+    // other text as the rest of a malformed value.
+    const bool string_can_start =
+        prev == '\n' || prev == '=' || prev == '[' || prev == ',' || prev == '{' || prev == '.';
+    if (c == '#') {  // a comment is no token: `prev` stays
       in = In::kComment;
-    } else if (c == '"') {
+      continue;
+    }
+    prev = c;
+    if ((c == '"' || c == '\'') && !string_can_start) continue;
+    if (c == '"') {
       in = s.substr(i, 3) == "\"\"\"" ? In::kMultiBasic : In::kBasic;
       if (in == In::kMultiBasic) i += 2;
       string_key = key;
@@ -153,6 +176,8 @@ inline TextProblem unsafe_for_toml_parser(std::string_view s) {
     } else if (c == '[' || c == '{') {
       open.push_back(c);
       expect_key = c == '{';
+    } else if (c == '}' && !open.empty() && open.back() == '[') {
+      return at(i, kBraceInArray);
     } else if ((c == ']' || c == '}') && !open.empty()) {
       open.pop_back();
       expect_key = false;
