@@ -278,7 +278,14 @@ Status solve_sensor(int i, std::span<const AttitudeObservation<T>> obs,
   std::uint8_t flags = 0;
   if (sf < T(0)) flags |= kFlagNegativeScaleFactor;
   if (max_angle > cfg.max_angle_rad) flags |= kFlagLargeAngle;
-  if (out.rms_residual_g[si] > cfg.max_rms_residual_g) flags |= kFlagHighResidual;
+  // A residual beyond the limit says a pose was not still or its vector is wrong, unless the
+  // stated σ explain it (χ²/dof within its limit): the means are then noisy, the residual is that
+  // noise, and the covariance from the stated σ carries it already.
+  const bool noise_explains =
+      sigma_stated && dof > 0 && out.chi2_per_dof[si] <= cfg.max_chi2_per_dof;
+  if (out.rms_residual_g[si] > cfg.max_rms_residual_g && !noise_explains) {
+    flags |= kFlagHighResidual;
+  }
   if (out.chi2_per_dof[si] > cfg.max_chi2_per_dof) flags |= kFlagResidualsExceedNoise;
   if (dof == 0) flags |= kFlagNoRedundancy;
   out.sensor_flags[si] = flags;

@@ -99,7 +99,7 @@ enum class Verdict : std::uint8_t {
   kNegativeScaleFactor,   // a sensor reads opposite to its nominal axis (wiring, or gravity
                           // vectors given instead of specific force)
   kLargeAngle,            // an orientation error beyond max_angle_rad
-  kHighResidual,          // RMS residual beyond max_rms_residual_g
+  kHighResidual,          // RMS residual beyond max_rms_residual_g that stated σ do not explain
   kResidualsExceedNoise,  // weighted residuals beyond max_chi2_per_dof
   kNoRedundancy,          // exactly determined: nothing checks the fit
 };
