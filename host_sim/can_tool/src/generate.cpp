@@ -84,8 +84,24 @@ std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
       o << "CM_ SG_ " << id << " " << s.name << " \"" << signal_comment(s) << "\";\n";
     }
   }
+  // Attributes (Vector's conventions): the bus type, each message's send type (data messages
+  // cyclic at their divider, commands, responses and aiding inputs on event, a data message
+  // switched off by its divider not sent) and the cycle time of the cyclic ones.
+  o << "BA_DEF_ \"BusType\" STRING ;\n";
+  o << "BA_DEF_ BO_ \"GenMsgSendType\" ENUM \"Cyclic\",\"Event\",\"NoMsgSendType\";\n";
   o << "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\n";
+  o << "BA_DEF_DEF_ \"BusType\" \"CAN\";\n";
+  o << "BA_DEF_DEF_ \"GenMsgSendType\" \"NoMsgSendType\";\n";
   o << "BA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n";
+  o << "BA_ \"BusType\" \"CAN\";\n";
+  constexpr int kCyclic = 0;
+  constexpr int kEvent = 1;
+  constexpr int kNotSent = 2;
+  for (const MessageDef& m : can::kMessages) {
+    const std::uint16_t divider = rates.dividers[static_cast<std::size_t>(m.id)];
+    const int send = m.kind != can::MessageKind::kData ? kEvent : divider == 0 ? kNotSent : kCyclic;
+    o << "BA_ \"GenMsgSendType\" BO_ " << m.base_id + node_id << " " << send << ";\n";
+  }
   for (const MessageDef& m : can::kMessages) {
     const std::uint16_t divider = rates.dividers[static_cast<std::size_t>(m.id)];
     if (m.kind != can::MessageKind::kData || divider == 0) continue;

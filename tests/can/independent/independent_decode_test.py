@@ -359,6 +359,60 @@ def check_log(a, log, na_expected, dbc_for_node, icd):
     return len(frames), len(epochs), compared, failures
 
 
+def icd_rates(path):
+    """{message: default divider as the ICD states it: an int, 'off', 'on demand' or 'input'}."""
+    rates = {}
+    name = None
+    with open(path, encoding='utf-8') as f:
+        for line in f:
+            m = re.match(r'#### (\w+) ', line)
+            if m:
+                name = m.group(1)
+                continue
+            m = re.search(r'Default divider: (\d+|off|on demand|sent by the GNSS receiver)', line)
+            if name and m:
+                v = m.group(1)
+                rates[name] = int(v) if v.isdigit() else ('input' if v.startswith('sent') else v)
+                name = None
+    return rates
+
+
+def check_attributes(dbc, icd_path):
+    """The DBC's attributes as candied reads them against the ICD's default dividers (the DBC
+    is generated for 1 kHz): a message with a divider is Cyclic every divider ms, one switched
+    off is not sent, commands, responses and aiding inputs are sent on event; the bus is CAN."""
+    ensure_candied()
+    res = subprocess.run(['node', os.path.join(HERE, 'dbc_attributes_with_candied.cjs'), dbc],
+                         stdout=subprocess.PIPE, check=True,
+                         env=dict(os.environ, NODE_PATH=os.path.join(HERE, 'node_modules')))
+    got = json.loads(res.stdout)
+    failures = []
+    if got['bus_type'] != 'CAN':
+        failures.append(f'BusType {got["bus_type"]!r}, expected "CAN"')
+    rates = icd_rates(icd_path)
+    if len(rates) < 20:
+        failures.append(f'only {len(rates)} default dividers found in the ICD')
+    for name, rate in rates.items():
+        attrs = got['messages'].get(name)
+        if attrs is None:
+            failures.append(f'{name}: not in the DBC')
+            continue
+        if isinstance(rate, int):
+            want = ("Cyclic", rate)  # ms at 1 kHz
+        elif rate == 'off':
+            want = ('NoMsgSendType', 0)
+        else:
+            want = ('Event', 0)
+        have = (attrs['send'], attrs['cycle'] or 0)
+        if have != want:
+            failures.append(f'{name}: GenMsgSendType/GenMsgCycleTime {have}, the ICD says {want}')
+    print(f'independent DBC attributes: {len(rates)} messages checked, '
+          f'{len(failures)} disagreements')
+    for f in failures:
+        print('  ' + f)
+    return 1 if failures else 0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--gfins-can', required=True)
@@ -372,8 +426,9 @@ def main():
     a = ap.parse_args()
 
     os.makedirs(a.workdir, exist_ok=True)
-    icd = read_icd(a.icd or os.path.join(os.path.dirname(os.path.abspath(a.dbc)), '..',
-                                         'can-interface.md'))
+    icd_path = a.icd or os.path.join(os.path.dirname(os.path.abspath(a.dbc)), '..',
+                                     'can-interface.md')
+    icd = read_icd(icd_path)
     for need in ('GfinsEpoch', 'GfinsAccuracy', 'GfinsAidingCounters', 'GfinsGnssFixInfo',
                  'GfinsHeadingInput'):
         if need not in icd:
@@ -395,7 +450,7 @@ def main():
 
     extended = os.path.join(a.workdir, 'independent_extended.log')
     na = build_extended(log, extended, icd)
-    status = 0
+    status = check_attributes(a.dbc, icd_path)
     for name, path, na_expected in (('synthetic', log, set()), ('extended', extended, na)):
         n_frames, n_epochs, compared, failures = check_log(a, path, na_expected, dbc_for_node,
                                                           icd)
