@@ -84,6 +84,31 @@ TEST(TomlGuard, AQuoteAfterAMalformedValueStartsNoString) {
   EXPECT_EQ(unsafe_for_toml_parser("eg = 'avit\xD1\x88t'\n").what, nullptr);
 }
 
+// Found by an independent review, each passed by an earlier version of the scan and reaching the
+// library's undefined behaviour or an assertion.
+TEST(TomlGuard, FindsWhatAReviewFoundPast) {
+  using gfins::toml_text::kDateWithoutTime;
+  for (const std::string_view text :
+       {// White space after a backslash in a multi-line string, then non-ASCII on the same line.
+        "a = \"\"\"\\ \xC3\xA9\"\"\"\n",
+        "a = \"\"\"x\\\t\xC2\xB0"
+        "C\"\"\"\n",
+        // A quote after a malformed value's '.', '=', '[' or '{': no string starts there.
+        "a = 1.\"\xC3\xA9\"\n", "a = -.\"\xC3\xA9\"\n", "k = 1.'''\xC3\xA9'''\n",
+        "a = 1[\"\xC3\xA9\"]\n", "a = 1=\"\xC3\xA9\"\n", "a = 1{x=\"\xC3\xA9\"}\n",
+        "a = [1.\"\xC3\xA9\"]\n", "k = { a = 1, b = 2[\"\xCF\x83\"] }\n",
+        "a = 1979-05-27 07:32:00.\"\xC2\xB0\"\n"}) {
+    EXPECT_EQ(unsafe_for_toml_parser(text).what, kNonAscii) << text;
+  }
+  for (const std::string_view text :
+       {"k = 1979-05-27T:\n", "k=1979-05-27t:", "k = [1979-05-27T:]\n", "k={a=1979-05-27T:"}) {
+    EXPECT_EQ(unsafe_for_toml_parser(text).what, kDateWithoutTime) << text;
+  }
+  // A date-time with its time, and a bare key that looks like a date, are fine.
+  EXPECT_EQ(unsafe_for_toml_parser("k = 1979-05-27T07:32:00Z\n").what, nullptr);
+  EXPECT_EQ(unsafe_for_toml_parser("1979-05-27T = 1\n").what, nullptr);
+}
+
 TEST(TomlGuard, LeavesEveryValidHeaderValueAndCommentAlone) {
   for (const std::string_view text :
        {"[a]\n", "[ a ]\n", "[[a]]\n", "[[ a.b ]]\n", "[\"quoted\"]\n", "['literal']\n", "[_a]\n",
