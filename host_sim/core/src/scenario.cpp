@@ -586,7 +586,12 @@ std::string scenario_name_problem(const std::string& name) {
 HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::string& source) {
   try {
     const toml::table root = toml_text::safe_parse(toml_text, source);
-    return parse_root(root, Reader(source), source);
+    HostResult<Scenario> r = parse_root(root, Reader(source), source);
+    if (r.is_ok()) return r;
+    // Messages quote the file's values (an unknown kind, a name): escaped for the terminal.
+    HostError e = std::move(r).take_error();
+    e.message = drivers::lnx::printable_text(e.message);
+    return e;
   } catch (const toml::parse_error& e) {
     std::ostringstream os;
     // The parser's description quotes the offending character raw: escaped for the terminal.
@@ -594,7 +599,7 @@ HostResult<Scenario> parse_scenario(std::string_view toml_text, const std::strin
        << ": TOML syntax error: " << drivers::lnx::printable_text(e.description());
     return HostError{ErrorCode::kInvalidArgument, os.str()};
   } catch (const ScenarioParseError& e) {
-    return HostError{ErrorCode::kInvalidArgument, e.what()};
+    return HostError{ErrorCode::kInvalidArgument, drivers::lnx::printable_text(e.what())};
   }
 }
 
