@@ -1,7 +1,6 @@
 // TOML → FwConfig with every key checked (gfins/app/config.hpp). tomlplusplus is used header-only
 // here as in firmware/calib_file (same reasons); every toml:: call that can throw is inside the
 // try block of parse_config().
-#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // The one call into tomlplusplus's printer, in a translation unit of its own (see toml_format.cpp).
 #pragma once
 
-#include <toml++/toml.h>
 #include <string>
+#include "gfins/toml/toml.hpp"
 
 namespace gfins::calib_file::detail {
 

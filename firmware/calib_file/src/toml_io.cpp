@@ -1,6 +1,5 @@
 // TOML text ⇄ CalibrationData with tomlplusplus (Debian's libtomlplusplus, built with
 // exceptions: every toml:: call that can throw is inside a try block of this file).
-#include <toml++/toml.h>
 #include <cinttypes>
 #include <cstdio>
 #include <exception>

@@ -2,7 +2,6 @@
 // Every error message has the form "FILE:LINE: key 'table.key': what is wrong".
 #include "gfins/host_sim/scenario.hpp"
 
-#include <toml++/toml.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -7,10 +7,8 @@
 #include <string>
 #include <string_view>
 
-// tomlplusplus as the including target configures it (TOML_HEADER_ONLY, TOML_FLOAT_CHARCONV).
-#include <toml++/toml.h>
-
 #include "gfins/toml/header_check.hpp"
+#include "gfins/toml/toml.hpp"
 
 namespace gfins::toml_text {
 
