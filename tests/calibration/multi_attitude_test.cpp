@@ -59,6 +59,18 @@ std::vector<Obs> six_faces() {
   return poses({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}});
 }
 
+// The six faces and two diagonals: four redundant poses per sensor.
+std::vector<Obs> eight_poses() {
+  return poses({{1, 0, 0},
+                {-1, 0, 0},
+                {0, 1, 0},
+                {0, -1, 0},
+                {0, 0, 1},
+                {0, 0, -1},
+                {1, 1, 1},
+                {-1, 1, -1}});
+}
+
 Result<MultiAttitudeResult<double>> run(const std::vector<Obs>& obs,
                                         const MultiAttitudeConfig<double>& cfg = {}) {
   return calibrate_multi_attitude<double>(std::span<const Obs>(obs), cfg);
@@ -210,14 +222,7 @@ TEST(MultiAttitude, NegativeSigmaIsInvalidArgument) {
 
 TEST(MultiAttitude, ResidualsBeyondTheLimitGiveHighResidualVerdict) {
   // Given eight poses where one reading of sensor 5 is off by 10 mg (a pose not held still)
-  auto obs = poses({{1, 0, 0},
-                    {-1, 0, 0},
-                    {0, 1, 0},
-                    {0, -1, 0},
-                    {0, 0, 1},
-                    {0, 0, -1},
-                    {1, 1, 1},
-                    {-1, 1, -1}});
+  auto obs = eight_poses();
   obs[6].mean_v[4] += 0.010 * kScale[4];
   const auto r = run(obs);
   ASSERT_TRUE(r.is_ok());
@@ -233,14 +238,7 @@ TEST(MultiAttitude, AResidualTheStatedNoiseExplainsIsNotBlamedOnThePoses) {
   // noise. The verdict must not be "high residual". χ²/dof of pure noise exceeds its limit 9
   // with 4 dof with probability P(χ²₄ > 36) = 2.9e-7 per sensor: over 1200 sensors a false
   // failure has probability 3.5e-4.
-  const auto clean = poses({{1, 0, 0},
-                            {-1, 0, 0},
-                            {0, 1, 0},
-                            {0, -1, 0},
-                            {0, 0, 1},
-                            {0, 0, -1},
-                            {1, 1, 1},
-                            {-1, 1, -1}});
+  const auto clean = eight_poses();
   std::mt19937_64 rng(20261129);
   std::normal_distribution<double> unit(0.0, 1.0);
   constexpr double kNoiseG = 4e-3;
