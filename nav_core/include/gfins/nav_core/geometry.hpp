@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 
 #include "gfins/nav_core/math.hpp"
 #include "gfins/status/status.hpp"
@@ -28,10 +29,28 @@ namespace gfins::nav {
 /// Number of accelerometers of the paper's array; the solver accepts any N ≥ 6.
 inline constexpr int kNumSensors = 6;
 
+/// A set of an array's channels: bit j stands for sensor j (arrays of up to 32 sensors).
+using ChannelMask = std::uint32_t;
+
+/// Every channel of an N-sensor array.
+template <int N>
+constexpr ChannelMask all_channels() {
+  static_assert(N >= 1 && N <= 32, "a ChannelMask holds 32 channels");
+  return N == 32 ? ~ChannelMask{0} : ((ChannelMask{1} << static_cast<unsigned>(N)) - 1U);
+}
+
+/// Number of channels in a mask.
+constexpr int channel_count(ChannelMask mask) {
+  int n = 0;
+  for (; mask != 0U; mask &= mask - 1U) ++n;
+  return n;
+}
+
 /// Positions (m) and unit sensitive axes of an array of N accelerometers, body frame.
 template <typename T, int N = kNumSensors>
 struct ArrayGeometry {
   static_assert(N >= 6, "six outputs are the minimum that determine [ω̇; f]");
+  static_assert(N <= 32, "channel sets (ChannelMask) hold 32 sensors");
   std::array<Vec3<T>, N> rho_b = zero_vectors<T, static_cast<std::size_t>(N)>();
   std::array<Vec3<T>, N> theta_b = zero_vectors<T, static_cast<std::size_t>(N)>();
 
@@ -104,8 +123,14 @@ class ArraySolver {
   /// axes θ* of eq. (23) carry gains of a few percent, so they are not exactly unit) or the array
   /// has no size. The condition number is that of H with its ω̇ columns scaled by the mean lever
   /// arm, so it does not depend on the unit of length.
+  ///
+  /// `active` selects the sensors the solution uses (a redundant array that has excluded a failed
+  /// channel, redundancy/parity_monitor.hpp): the others get zero columns in M, so their outputs
+  /// do not enter [ω̇; f] whatever they read. At least six must remain (kInvalidArgument) and
+  /// their geometry must still determine [ω̇; f] (kSingular otherwise).
   static Result<ArraySolver> create(const ArrayGeometry<T, N>& geometry,
-                                    T max_condition = T(kDefaultMaxCondition));
+                                    T max_condition = T(kDefaultMaxCondition),
+                                    ChannelMask active = all_channels<N>());
 
   /// Angular acceleration ω̇ (rad/s², body) and specific force f (m/s², body, at o_b) from the
   /// outputs s (m/s², along each axis) and the current angular rate ω (rad/s, body).
@@ -135,6 +160,8 @@ class ArraySolver {
   /// Condition number of the column-scaled design (computed in T).
   double condition_number() const { return static_cast<double>(condition_); }
   const ArrayGeometry<T, N>& geometry() const { return geometry_; }
+  /// The sensors the solution uses (all of them unless create() was given a subset).
+  ChannelMask active() const { return active_; }
 
   /// [ω̇; f] (6 values) from the padded layout.
   static Vec6<T> unpad(const PaddedVec& u) {
@@ -159,6 +186,7 @@ class ArraySolver {
   PaddedKForce k_force_ = PaddedKForce::Zero();
   T condition_ = T(0);
   ArrayGeometry<T, N> geometry_{};
+  ChannelMask active_ = all_channels<N>();
 };
 
 extern template class ArraySolver<float, 6>;

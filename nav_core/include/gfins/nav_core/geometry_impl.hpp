@@ -84,9 +84,17 @@ void zero_rounding_noise(Eigen::Matrix<T, R, C>& m, const Eigen::Matrix<T, R, C>
 }  // namespace detail
 
 template <typename T, int N>
-Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g, T max_condition) {
+Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g, T max_condition,
+                                                    ChannelMask active) {
   using HMatrix = Eigen::Matrix<T, N, 6>;
 
+  active &= all_channels<N>();
+  if (channel_count(active) < 6) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "array geometry: fewer than six active sensors cannot determine [angular accel; "
+                  "specific force]");
+  }
+  const auto used = [active](int j) { return ((active >> static_cast<unsigned>(j)) & 1U) != 0U; };
   T lever_sum = T(0);
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
@@ -95,17 +103,17 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
       return Status(ErrorCode::kInvalidArgument,
                     "array geometry: a sensor position is not a finite number");
     }
-    lever_sum += rho.norm();
+    if (used(j)) lever_sum += rho.norm();
   }
-  const T lever = lever_sum / T(N);
+  const T lever = lever_sum / static_cast<T>(channel_count(active));
   if (!(lever > T(0)) || !std::isfinite(lever)) {
     return Status(ErrorCode::kInvalidArgument,
                   "array geometry: sensors have no lever arm (all positions at the centre), so "
                   "angular acceleration is unobservable");
   }
 
-  HMatrix a;  // H with its ω̇ columns divided by the mean lever arm (dimensionless)
-  HMatrix q;
+  HMatrix a = HMatrix::Zero();  // H with its ω̇ columns divided by the mean lever arm; rows of
+  HMatrix q = HMatrix::Zero();  // the sensors left out stay zero (zero columns of M = pinv(H))
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
     const Vec3<T>& th = g.theta_b[static_cast<std::size_t>(j)];
@@ -113,6 +121,7 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
       return Status(ErrorCode::kInvalidArgument,
                     "array geometry: a sensitive axis is not near unit length or not finite");
     }
+    if (!used(j)) continue;
     a.row(j) << rho.cross(th).transpose() / lever, th.transpose();
     const T tr = th.dot(rho);
     q.row(j) << th.x() * rho.x() - tr, th.y() * rho.y() - tr, th.z() * rho.z() - tr,
@@ -151,6 +160,7 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   solver.k_force_.template topRows<3>() = k.template bottomRows<3>();
   solver.condition_ = cond;
   solver.geometry_ = g;
+  solver.active_ = active;
   return solver;
 }
 

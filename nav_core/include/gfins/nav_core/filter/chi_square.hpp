@@ -11,6 +11,10 @@
 //       about +1.8 % at k = 3, p = 0.999 (16.55 for 16.266: a slightly wider gate), below 0.1 %
 //       for k ≥ 30 at p ≤ 0.999, and below 0.01 % for the detector's 6W − 3 ≥ 100
 //       (tests/nav_core/chi_square_test.cpp checks tabulated values).
+//   chi_square_upper_quantile(α, k): the x with P(χ²_k > x) = α, from the exact survival function
+//     (chi_square_survival, below) by bisection: for the tiny tail probabilities of a detector
+//     with a stated false-alarm rate per hour (α ~ 1e-7 per decision), where 1 − α is not
+//     representable in float and Wilson–Hilferty is several percent off at small k.
 #pragma once
 
 #include <cmath>
@@ -60,6 +64,59 @@ T chi_square_quantile(T p, int k) {
   const T v = T(2) / (T(9) * kk);
   const T c = T(1) - v + normal_quantile(p) * std::sqrt(v);  // Wilson–Hilferty
   return kk * c * c * c;
+}
+
+/// P(χ²_k > x), exact, for 1 ≤ k ≤ 200 (NaN outside, 1 for x ≤ 0). Abramowitz & Stegun 26.4.4
+/// and 26.4.5, in terms of y = x/2:
+///   even k = 2m:     Q = Σ_{i<m} e^(−y) yⁱ/i!
+///   odd k = 2m + 1:  Q = erfc(√y) + Σ_{i=1..m} e^(−y) y^(i−1/2) / (Γ(i + 1/2))
+/// (every term positive: no cancellation, so the relative accuracy holds deep in the tail). Each
+/// term is formed from its logarithm: e^(−y) underflows and y^i/i! overflows float long before
+/// their product does (y ≈ 160 at k = 198 and α = 1e-7).
+template <typename T>
+T chi_square_survival(T x, int k) {
+  if (k < 1 || k > 200 || std::isnan(x)) return std::numeric_limits<T>::quiet_NaN();
+  if (!(x > T(0))) return T(1);
+  const T y = x / T(2);
+  const T log_y = std::log(y);
+  T sum = T(0);
+  if (k % 2 == 0) {
+    T log_term = -y;  // i = 0
+    for (int i = 0; i < k / 2; ++i) {
+      sum += std::exp(log_term);
+      log_term += log_y - std::log(static_cast<T>(i + 1));
+    }
+    return sum;
+  }
+  // i = 1: e^(−y) y^(1/2) / Γ(3/2), Γ(3/2) = √π / 2.
+  T log_term = -y + log_y / T(2) - std::log(std::sqrt(T(3.14159265358979323846)) / T(2));
+  for (int i = 1; i <= k / 2; ++i) {
+    sum += std::exp(log_term);
+    log_term += log_y - std::log(static_cast<T>(i) + T(0.5));
+  }
+  return std::erfc(std::sqrt(y)) + sum;
+}
+
+/// The x with P(χ²_k > x) = alpha (0 < alpha < 1, 1 ≤ k ≤ 200; NaN otherwise), by bisection on
+/// chi_square_survival to the resolution of T. For start-up use (a hundred survival evaluations).
+template <typename T>
+T chi_square_upper_quantile(T alpha, int k) {
+  if (k < 1 || k > 200 || !(alpha > T(0) && alpha < T(1))) {
+    return std::numeric_limits<T>::quiet_NaN();
+  }
+  T lo = T(0);
+  T hi = static_cast<T>(k) + T(10);
+  while (chi_square_survival(hi, k) > alpha) {
+    lo = hi;
+    hi *= T(2);
+    if (!std::isfinite(hi)) return std::numeric_limits<T>::quiet_NaN();
+  }
+  for (int i = 0; i < 200; ++i) {
+    const T mid = (lo + hi) / T(2);
+    if (!(mid > lo && mid < hi)) break;  // converged to adjacent representable values
+    (chi_square_survival(mid, k) > alpha ? lo : hi) = mid;
+  }
+  return (lo + hi) / T(2);
 }
 
 }  // namespace gfins::nav

@@ -1,0 +1,502 @@
+// The parity monitor (redundancy/parity_monitor.hpp) against a forward model of the array written
+// here from the rigid-body equation (paper eq. (22), errata in docs/paper-errata.md):
+//   s_j = θ_j·(f + ω̇×ρ_j + ω×(ω×ρ_j)) + n_j + fault_j,
+// and against the projector's defining properties computed from a design matrix H built here.
+#include "gfins/nav_core/redundancy/parity_monitor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "gfins/nav_core/integrator.hpp"
+#include "gfins/nav_core/redundancy/layouts.hpp"
+
+namespace gfins::nav {
+namespace {
+
+constexpr double kRho = 0.1;     // m, half-size of the cube (the paper's array scale)
+constexpr double kSigma = 5e-4;  // m/s², white noise per sensor and sample (scenario files)
+constexpr double kRateHz = 1000.0;
+constexpr double kDt = 1.0 / kRateHz;
+constexpr double kG = 9.80665;
+
+template <int N>
+Eigen::Matrix<double, N, 6> design(const ArrayGeometry<double, N>& g) {
+  Eigen::Matrix<double, N, 6> h;
+  for (int j = 0; j < N; ++j) {
+    const auto& rho = g.rho_b[static_cast<std::size_t>(j)];
+    const auto& th = g.theta_b[static_cast<std::size_t>(j)];
+    h.row(j) << rho.cross(th).transpose(), th.transpose();
+  }
+  return h;
+}
+
+template <int N>
+Eigen::Matrix<double, N, 1> forward(const ArrayGeometry<double, N>& g, const Vec3<double>& wdot,
+                                    const Vec3<double>& f, const Vec3<double>& w) {
+  Eigen::Matrix<double, N, 1> s;
+  for (int j = 0; j < N; ++j) {
+    const auto& rho = g.rho_b[static_cast<std::size_t>(j)];
+    s(j) = g.theta_b[static_cast<std::size_t>(j)].dot(f + wdot.cross(rho) + w.cross(w.cross(rho)));
+  }
+  return s;
+}
+
+template <int N>
+ParityMonitor<double, N> monitor_for(const ArraySolver<double, N>& solver, ParityConfig<double> c) {
+  ParityMonitor<double, N> m;
+  EXPECT_TRUE(m.configure(solver, c).is_ok());
+  return m;
+}
+
+// --- the solver with a channel mask --------------------------------------------------------------
+
+TEST(ChannelMaskTest, ASevenSensorArrayWithoutItsCornerIsTheTable1Solver) {
+  // Paper eq. (4): for Table 1, M = [S/(2ρ); T/2]; the seven-sensor solver with the corner left
+  // out must give the six-sensor solution whatever the corner reads.
+  const auto g7 = table1_with_corners<double, 7>(kRho);
+  const auto s7 = ArraySolver<double, 7>::create(g7, 100.0, all_channels<7>() & ~(1U << 6U));
+  ASSERT_TRUE(s7.is_ok());
+  const auto s6 = ArraySolver<double, 6>::create(table1_geometry(kRho)).value();
+  EXPECT_LT((s7.value().m().leftCols<6>() - s6.m()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(s7.value().m().col(6).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(s7.value().active(), 0x3FU);
+}
+
+TEST(ChannelMaskTest, FewerThanSixActiveSensorsAreRefused) {
+  const auto r = ArraySolver<double, 6>::create(table1_geometry(kRho), 100.0, 0x1FU);
+  ASSERT_FALSE(r.is_ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  // Eight sensors, two excluded: six left, fine; three excluded: refused.
+  const auto g8 = table1_with_corners<double, 8>(kRho);
+  using Solver8 = ArraySolver<double, 8>;
+  EXPECT_TRUE(Solver8::create(g8, 100.0, 0xFCU).is_ok());
+  EXPECT_FALSE(Solver8::create(g8, 100.0, 0xF8U).is_ok());
+}
+
+// --- the projector -------------------------------------------------------------------------------
+
+template <int N>
+void expect_parity_projector(const ArrayGeometry<double, N>& g) {
+  const auto solver = ArraySolver<double, N>::create(g).value();
+  const auto mon = monitor_for<N>(solver, ParityConfig<double>{});
+  const auto& p = mon.projector();
+  const Eigen::Matrix<double, N, 6> h = design<N>(g);
+  // P H = 0 (a rigid-body motion leaves no residual), P = Pᵀ = P², trace = N − 6.
+  EXPECT_LT((p * h).cwiseAbs().maxCoeff(), 1e-12) << N;
+  EXPECT_LT((p - p.transpose()).cwiseAbs().maxCoeff(), 1e-14) << N;
+  EXPECT_LT((p * p - p).cwiseAbs().maxCoeff(), 1e-12) << N;
+  EXPECT_NEAR(p.trace(), N - 6, 1e-12) << N;
+  EXPECT_EQ(mon.dof(), N - 6);
+}
+
+TEST(ParityMonitorTest, ProjectorAnnihilatesRigidBodyMotionAndHasRankNMinusSix) {
+  expect_parity_projector<7>(table1_with_corners<double, 7>(kRho));
+  expect_parity_projector<8>(table1_with_corners<double, 8>(kRho));
+  expect_parity_projector<10>(table1_with_corners<double, 10>(kRho));
+  expect_parity_projector<12>(four_triads<double>(kRho));
+}
+
+TEST(ParityMonitorTest, SixSensorsHaveNoParitySpace) {
+  const auto solver = ArraySolver<double, 6>::create(table1_geometry(kRho)).value();
+  auto mon = monitor_for<6>(solver, ParityConfig<double>{});
+  EXPECT_EQ(mon.dof(), 0);
+  EXPECT_EQ(mon.add(Eigen::Matrix<double, 6, 1>::Constant(1.0), Vec3<double>::Zero()),
+            ParityVerdict::kUnavailable);
+  EXPECT_TRUE(std::isnan(mon.mean_statistic()));
+}
+
+// --- false alarms --------------------------------------------------------------------------------
+
+TEST(ParityMonitorTest, FalseAlarmRateIsTheConfiguredOneWhileTheArraySpins) {
+  // A spinning array (constant ω, so c(ω) ≠ 0 on every sensor; a monitor that forgot the
+  // centripetal term would alarm on every window) with noise only. Per-window probability
+  // α = 5e-3 (split α/2 between the tests): 20,000 windows expect 100 alarms, 50 per test.
+  // Poisson bounds [60, 145] for the total and [25, 85] per test: each side's probability below
+  // 1e-4 (total: P(X ≤ 60) = 2e-5, P(X ≥ 145) = 3e-5; per test: P(X ≤ 25) = 6e-5,
+  // P(X ≥ 85) = 2e-5), so a false failure below 2e-4. Using α for each test instead of α/2
+  // (200 expected), a wrong d (e.g. N − 5: about 20 expected at W = 10) or σ²/W confused with σ²
+  // fail. (The ten-hour run at the shipped rate is parity_evaluation_long.cpp.)
+  constexpr int kN = 8;
+  constexpr std::uint32_t kWindow = 10;
+  constexpr int kWindows = 20000;
+  constexpr double kAlpha = 5e-3;
+  const auto g = table1_with_corners<double, kN>(kRho);
+  const auto solver = ArraySolver<double, kN>::create(g).value();
+  ParityConfig<double> c;
+  c.white_sigma_mps2 = kSigma;
+  c.window = kWindow;
+  c.sample_rate_hz = kRateHz;
+  c.false_alarms_per_hour = kAlpha * 3600.0 * kRateHz / kWindow;
+  auto mon = monitor_for<kN>(solver, c);
+  EXPECT_NEAR(mon.window_false_alarm_probability(), kAlpha, 1e-12);
+  const Vec3<double> w(0.3, -0.2, 0.5);
+  const Vec3<double> f(0.4, -0.1, -kG);
+  const auto clean = forward<kN>(g, Vec3<double>::Zero(), f, w);
+  std::mt19937_64 rng(20261129);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  int mean_alarms = 0;
+  int scatter_alarms = 0;
+  int alarms = 0;
+  for (int k = 0; k < kWindows * static_cast<int>(kWindow); ++k) {
+    Eigen::Matrix<double, kN, 1> s = clean;
+    for (int j = 0; j < kN; ++j) s(j) += noise(rng);
+    const ParityVerdict v = mon.add(s, w);
+    if (v == ParityVerdict::kPending) continue;
+    if (v != ParityVerdict::kConsistent) ++alarms;
+    if (mon.mean_statistic() > mon.mean_threshold()) ++mean_alarms;
+    if (mon.scatter_statistic() > mon.scatter_threshold()) ++scatter_alarms;
+  }
+  EXPECT_EQ(mon.windows(), static_cast<std::uint32_t>(kWindows));
+  EXPECT_EQ(mon.alarms(), static_cast<std::uint32_t>(alarms));
+  EXPECT_GE(alarms, 60);
+  EXPECT_LE(alarms, 145);
+  EXPECT_GE(mean_alarms, 25);
+  EXPECT_LE(mean_alarms, 85);
+  EXPECT_GE(scatter_alarms, 25);
+  EXPECT_LE(scatter_alarms, 85);
+}
+
+// --- each kind of failure ------------------------------------------------------------------------
+
+enum class Failure { kBias, kRamp, kNoise, kStuck, kDead, kSaturation };
+
+struct FaultRun {
+  double first_alarm_s = -1.0;
+  double exclude_request_s = -1.0;
+  int excluded = -1;
+  double probability = 0.0;
+  double bias = 0.0;
+  int alarms_before_fault = 0;
+};
+
+// The motion: a 1 Hz angular oscillation of 0.2 rad amplitude about an inclined axis and a 1 m/s²
+// specific-force oscillation, so that a stuck or dead channel differs from a good one.
+struct Motion {
+  Vec3<double> axis = Vec3<double>(1.0, 2.0, 0.5).normalized();
+  double amp = 0.2;
+  double om = 2.0 * 3.14159265358979323846;
+  Vec3<double> w(double t) const { return axis * amp * om * std::cos(om * t); }
+  Vec3<double> wdot(double t) const { return -axis * amp * om * om * std::sin(om * t); }
+  Vec3<double> f(double t) const { return Vec3<double>(std::sin(om * t), 0.3, -kG); }
+};
+
+template <int N>
+FaultRun run_fault(const ArrayGeometry<double, N>& g, Failure kind, int channel, double t_fault_s,
+                   double duration_s, std::uint64_t seed) {
+  const auto solver = ArraySolver<double, N>::create(g).value();
+  ParityConfig<double> c;
+  c.white_sigma_mps2 = kSigma;
+  c.window = 100;
+  c.sample_rate_hz = kRateHz;
+  c.false_alarms_per_hour = 0.01;
+  auto mon = monitor_for<N>(solver, c);
+  const Motion motion;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  FaultRun out;
+  double stuck_value = 0.0;
+  // Saturation: the channel clips at 0.3 m/s² above its reading at the start, which the motion
+  // exceeds for part of each cycle.
+  const double clip = forward<N>(g, motion.wdot(0.0), motion.f(0.0), motion.w(0.0))(channel) + 0.3;
+  const int samples = static_cast<int>(duration_s * kRateHz);
+  for (int k = 0; k < samples; ++k) {
+    const double t = k * kDt;
+    Eigen::Matrix<double, N, 1> s = forward<N>(g, motion.wdot(t), motion.f(t), motion.w(t));
+    for (int j = 0; j < N; ++j) s(j) += noise(rng);
+    double& x = s(channel);
+    if (t < t_fault_s) {
+      stuck_value = x;
+    } else {
+      switch (kind) {
+        case Failure::kBias:
+          x += 3e-3;
+          break;  // 0.3 mg
+        case Failure::kRamp:
+          x += 0.02 * (t - t_fault_s);
+          break;  // 2 mg/s
+        case Failure::kNoise:
+          x += 9.0 * noise(rng);
+          break;  // σ × √82 ≈ ×9
+        case Failure::kStuck:
+          x = stuck_value;
+          break;
+        case Failure::kDead:
+          x = 0.0;
+          break;
+        case Failure::kSaturation:
+          x = std::min(x, clip);
+          break;
+      }
+    }
+    const ParityVerdict v = mon.add(s, motion.w(t));
+    if (v == ParityVerdict::kPending || v == ParityVerdict::kConsistent) continue;
+    if (t < t_fault_s) {
+      ++out.alarms_before_fault;
+      continue;
+    }
+    if (out.first_alarm_s < 0) out.first_alarm_s = t;
+    if (v == ParityVerdict::kExcludeRequest && out.exclude_request_s < 0) {
+      out.exclude_request_s = t;
+      out.excluded = mon.suspect_channel();
+      out.probability = mon.isolation_probability();
+      out.bias = mon.suspect_bias_mps2();
+    }
+  }
+  return out;
+}
+
+struct FailureCase {
+  Failure kind;
+  const char* name;
+  double max_delay_s;  // fault onset to exclusion request
+};
+
+// The delays: a fault present in a whole window alarms in that window, and exclusion needs three
+// consecutive isolating windows (confirm_windows), so 0.4 s at W = 100 for a fault that is
+// clear at once (bias, noise, dead, the clipped channel's first clipped window). The ramp needs
+// about 0.1 s to grow past the mean test's reach (≈ 0.6 mg·…: t_m = b² P_jj / σ_m²); the stuck
+// channel departs from the truth as the motion moves it (1 m/s² at 1 Hz: 3 mg within 1 ms).
+// The saturated channel clips only when its reading rises 0.3 m/s² above its start, which the
+// motion does from about 0.1 s of each cycle on.
+class ParityFailureTest : public ::testing::TestWithParam<FailureCase> {};
+
+TEST_P(ParityFailureTest, EightSensorsDetectIsolateAndRequestExclusionOfTheFailedChannel) {
+  constexpr int kN = 8;
+  constexpr int kChannel = 3;
+  constexpr double kFaultS = 2.0;
+  const FailureCase fc = GetParam();
+  const FaultRun r =
+      run_fault<kN>(table1_with_corners<double, kN>(kRho), fc.kind, kChannel, kFaultS, 4.0, 7);
+  // 0.01 false alarms per hour: over 2 s the chance of one is 6e-6.
+  EXPECT_EQ(r.alarms_before_fault, 0) << fc.name;
+  ASSERT_GE(r.exclude_request_s, 0.0) << fc.name << ": never excluded";
+  EXPECT_EQ(r.excluded, kChannel) << fc.name;
+  EXPECT_LE(r.exclude_request_s - kFaultS, fc.max_delay_s) << fc.name;
+  EXPECT_GE(r.probability, 0.99) << fc.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(EachFailure, ParityFailureTest,
+                         ::testing::Values(FailureCase{Failure::kBias, "bias", 0.41},
+                                           FailureCase{Failure::kRamp, "ramp", 0.6},
+                                           FailureCase{Failure::kNoise, "noise", 0.41},
+                                           FailureCase{Failure::kStuck, "stuck", 0.41},
+                                           FailureCase{Failure::kDead, "dead", 0.41},
+                                           FailureCase{Failure::kSaturation, "saturation", 1.2}),
+                         [](const ::testing::TestParamInfo<FailureCase>& i) {
+                           return std::string(i.param.name);
+                         });
+
+TEST(ParityMonitorTest, BiasEstimateOfTheSuspectIsTheInjectedFault) {
+  // b̂ = r̄_j / P_jj has σ = σ_m / √P_jj (σ_m = 5e-5 m/s² at W = 100; P_jj ≥ 0.2 here), about
+  // 1.1e-4 m/s² for a 3e-3 fault: 20 % is more than 5σ. A monitor returning r̄_j alone (no 1/P_jj)
+  // is off by a factor 1/P_jj ≥ 1.3.
+  const FaultRun r =
+      run_fault<8>(table1_with_corners<double, 8>(kRho), Failure::kBias, 5, 1.0, 2.0, 11);
+  ASSERT_EQ(r.excluded, 5);
+  EXPECT_NEAR(r.bias, 3e-3, 0.2 * 3e-3);
+}
+
+TEST(ParityMonitorTest, SevenSensorsDetectButCannotIsolate) {
+  // Rank-one parity space: every column of P is a multiple of the one parity vector, so every
+  // channel's normalised residual is the same and the posterior is equal across the channels the
+  // parity space sees: six here (sensor 2 of this layout has P_22 = 0: its fault is invisible,
+  // docs/redundancy.md), 1/6 each (analytic).
+  const auto g = table1_with_corners<double, 7>(kRho);
+  const auto solver = ArraySolver<double, 7>::create(g).value();
+  ParityConfig<double> c;
+  c.white_sigma_mps2 = kSigma;
+  auto mon = monitor_for<7>(solver, c);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  const Vec3<double> f(0.0, 0.0, -kG);
+  int unisolated = 0;
+  for (int k = 0; k < 1000; ++k) {
+    Eigen::Matrix<double, 7, 1> s = forward<7>(g, Vec3<double>::Zero(), f, Vec3<double>::Zero());
+    for (int j = 0; j < 7; ++j) s(j) += noise(rng);
+    s(3) += 3e-3;
+    const ParityVerdict v = mon.add(s, Vec3<double>::Zero());
+    if (v == ParityVerdict::kPending) continue;
+    EXPECT_EQ(v, ParityVerdict::kUnisolated);
+    EXPECT_NEAR(mon.isolation_probability(), 1.0 / 6.0, 1e-6);
+    ++unisolated;
+  }
+  EXPECT_EQ(unisolated, 10);
+  EXPECT_EQ(mon.suspect_channel(), -1);
+}
+
+// --- exclusion keeps the navigation going
+// ----------------------------------------------------------
+
+TEST(ParityMonitorTest, ExcludingTheFailedChannelStopsTheRateErrorGrowing) {
+  // At rest (truth ω = 0), a 0.02 m/s² bias on channel 1 from t = 1 s. Undetected, it enters ω̇
+  // through M (|M_ω̇,1| ≈ 1/(2ρ)·… here ≈ 4 /m, so ≈ 0.08 rad/s²) and the rate error grows by
+  // ≈ 0.4 rad/s between 5 s and 10 s. Excluded (within 0.4 s), what the fault left in ω stays
+  // constant and only noise moves it: the ω̇ noise per sample (σ·‖M_ω̇ row‖ ≈ 2e-3 rad/s²) random
+  // walks ω by σ_ω̇·dt·√5000 ≈ 1.5e-4 rad/s in 5 s; the bound 2e-3 rad/s is over 10σ of that
+  // and 200× below the undetected growth.
+  constexpr int kN = 8;
+  const auto g = table1_with_corners<double, kN>(kRho);
+  const auto solver = ArraySolver<double, kN>::create(g).value();
+  ParityConfig<double> c;
+  c.white_sigma_mps2 = kSigma;
+  c.false_alarms_per_hour = 0.01;
+  auto mon = monitor_for<kN>(solver, c);
+  const auto gravity = GravityModel<double>::constant(kG);
+  Strapdown<double, kN> monitored(solver, gravity);
+  Strapdown<double, kN> unmonitored(solver, gravity);
+  const Vec3<double> f(0.0, 0.0, -kG);
+  const auto clean = forward<kN>(g, Vec3<double>::Zero(), f, Vec3<double>::Zero());
+  monitored.initialize(NavState<double>{}, clean);
+  unmonitored.initialize(NavState<double>{}, clean);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  Vec3<double> w_monitored_5s = Vec3<double>::Zero();
+  Vec3<double> w_unmonitored_5s = Vec3<double>::Zero();
+  for (int k = 1; k <= 10000; ++k) {
+    const double t = k * kDt;
+    Eigen::Matrix<double, kN, 1> s = clean;
+    for (int j = 0; j < kN; ++j) s(j) += noise(rng);
+    if (t >= 1.0) s(1) += 0.02;
+    const auto t_ns = static_cast<std::int64_t>(k) * 1000000;
+    unmonitored.step(s, kDt, t_ns, static_cast<std::uint32_t>(k));
+    monitored.step(s, kDt, t_ns, static_cast<std::uint32_t>(k));
+    if (mon.add(s, monitored.state().w_b) == ParityVerdict::kExcludeRequest) {
+      const auto reduced = solver_without(monitored.solver(), mon.suspect_channel());
+      ASSERT_TRUE(reduced.is_ok());
+      monitored.set_solver(reduced.value());
+      ASSERT_TRUE(mon.set_solver(reduced.value()).is_ok());
+    }
+    if (k == 5000) {
+      w_monitored_5s = monitored.state().w_b;
+      w_unmonitored_5s = unmonitored.state().w_b;
+    }
+  }
+  EXPECT_EQ(mon.health(1), ChannelHealth::kExcluded);
+  EXPECT_EQ(mon.exclusions(), 1U);
+  EXPECT_EQ(mon.dof(), 1);
+  EXPECT_EQ(mon.active(), all_channels<kN>() & ~2U);
+  EXPECT_LT((monitored.state().w_b - w_monitored_5s).norm(), 2e-3);
+  EXPECT_GT((unmonitored.state().w_b - w_unmonitored_5s).norm(), 0.2);
+}
+
+TEST(ParityMonitorTest, ChannelsTheParitySpaceCannotTellApartAreNeverExcludedInFloat) {
+  // The board's float32 P s carries ~1e-5 m/s² of rounding at 1 g, which breaks the exact tie
+  // between parallel columns: without ambiguity groups a 1 mg fault on channel 6 was pinned on
+  // channel 4 with posterior 1 in every window.
+  constexpr int kN = 8;
+  const auto g = table1_with_corners<double, kN>(kRho);
+  ParityMonitor<float, kN> mon;
+  ASSERT_TRUE(
+      mon.configure(ArraySolver<float, kN>::create(g.cast<float>()).value(), ParityConfig<float>{})
+          .is_ok());
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  const Vec3<double> f(0.05, -0.03, -kG);
+  for (const int faulty : {2, 4, 6, 7}) {
+    for (int k = 0; k < 1000; ++k) {
+      Eigen::Matrix<double, kN, 1> s =
+          forward<kN>(g, Vec3<double>::Zero(), f, Vec3<double>::Zero());
+      for (int j = 0; j < kN; ++j) s(j) += noise(rng);
+      s(faulty) += 1e-3 * kG;
+      const ParityVerdict v = mon.add(s.cast<float>(), Vec3<float>::Zero());
+      if (v == ParityVerdict::kPending) continue;
+      EXPECT_EQ(v, ParityVerdict::kUnisolated) << faulty << " " << k;
+    }
+  }
+  EXPECT_EQ(mon.exclusions(), 0U);
+}
+
+TEST(ParityMonitorTest, ChannelsTheParitySpaceCannotTellApartAreNeverExcluded) {
+  // In table1_with_corners<8> the columns 4 and 6 of P are parallel (correlation 1, computed
+  // here from P itself): a fault on either gives the same residual, so the posterior splits
+  // evenly between them (≤ 1/2 each) and neither may be excluded, however large the fault.
+  constexpr int kN = 8;
+  const auto g = table1_with_corners<double, kN>(kRho);
+  const auto solver = ArraySolver<double, kN>::create(g).value();
+  auto mon = monitor_for<kN>(solver, ParityConfig<double>{});
+  const auto& p = mon.projector();
+  ASSERT_NEAR(std::abs(p(4, 6)) / std::sqrt(p(4, 4) * p(6, 6)), 1.0, 1e-9);
+  EXPECT_EQ(mon.ambiguity_group(4), (1U << 4U) | (1U << 6U));
+  EXPECT_EQ(mon.ambiguity_group(3), 1U << 3U);
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  const Vec3<double> f(0.0, 0.0, -kG);
+  int alarms = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::Matrix<double, kN, 1> s = forward<kN>(g, Vec3<double>::Zero(), f, Vec3<double>::Zero());
+    for (int j = 0; j < kN; ++j) s(j) += noise(rng);
+    s(6) += 0.05;
+    const ParityVerdict v = mon.add(s, Vec3<double>::Zero());
+    if (v == ParityVerdict::kPending) continue;
+    ++alarms;
+    EXPECT_EQ(v, ParityVerdict::kUnisolated) << k;
+    EXPECT_LE(mon.isolation_probability(), 0.5 + 1e-12) << k;
+  }
+  EXPECT_EQ(alarms, 20);
+  EXPECT_EQ(mon.health(4), ChannelHealth::kOk);
+  EXPECT_EQ(mon.health(6), ChannelHealth::kOk);
+}
+
+TEST(ParityMonitorTest, NonFiniteSamplesAreSkippedAndCounted) {
+  const auto solver = ArraySolver<double, 8>::create(table1_with_corners<double, 8>(kRho)).value();
+  auto mon = monitor_for<8>(solver, ParityConfig<double>{});
+  Eigen::Matrix<double, 8, 1> s = Eigen::Matrix<double, 8, 1>::Zero();
+  s(4) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(mon.add(s, Vec3<double>::Zero()), ParityVerdict::kPending);
+  EXPECT_EQ(mon.rejected_samples(), 1U);
+  EXPECT_EQ(mon.windows(), 0U);
+}
+
+TEST(ParityMonitorTest, BadConfigurationsAreRefused) {
+  const auto solver = ArraySolver<double, 8>::create(table1_with_corners<double, 8>(kRho)).value();
+  ParityMonitor<double, 8> mon;
+  ParityConfig<double> c;
+  c.window = 1;
+  EXPECT_FALSE(mon.configure(solver, c).is_ok());
+  c = ParityConfig<double>{};
+  c.white_sigma_mps2 = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(mon.configure(solver, c).is_ok());
+  c = ParityConfig<double>{};
+  c.false_alarms_per_hour = 1e9;  // more than one per window
+  EXPECT_FALSE(mon.configure(solver, c).is_ok());
+  c = ParityConfig<double>{};
+  c.isolation_probability = 1.0;
+  EXPECT_FALSE(mon.configure(solver, c).is_ok());
+}
+
+TEST(ParityMonitorTest, FloatMonitorMatchesDoubleOnTheSameSamples) {
+  // The board runs float32: the same bias run must raise the same verdicts window by window.
+  constexpr int kN = 8;
+  const auto g = table1_with_corners<double, kN>(kRho);
+  ParityMonitor<double, kN> md;
+  ParityMonitor<float, kN> mf;
+  ParityConfig<double> cd;
+  ParityConfig<float> cf;
+  ASSERT_TRUE(md.configure(ArraySolver<double, kN>::create(g).value(), cd).is_ok());
+  ASSERT_TRUE(mf.configure(ArraySolver<float, kN>::create(g.cast<float>()).value(), cf).is_ok());
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  const Vec3<double> f(0.2, 0.1, -kG);
+  int windows = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::Matrix<double, kN, 1> s = forward<kN>(g, Vec3<double>::Zero(), f, Vec3<double>::Zero());
+    for (int j = 0; j < kN; ++j) s(j) += noise(rng);
+    if (k >= 1000) s(3) += 2e-3;
+    const ParityVerdict vd = md.add(s, Vec3<double>::Zero());
+    const ParityVerdict vf = mf.add(s.cast<float>(), Vec3<float>::Zero());
+    EXPECT_EQ(vd, vf) << k;
+    if (vd == ParityVerdict::kPending) continue;
+    ++windows;
+    // float residuals of ~10 m/s² outputs carry ~1e-6 m/s² rounding: 2 % of σ_m at W = 100.
+    EXPECT_NEAR(mf.mean_statistic(), md.mean_statistic(), 0.05 * md.mean_statistic() + 0.5) << k;
+  }
+  EXPECT_EQ(windows, 20);
+  EXPECT_EQ(md.suspect_channel(), 3);
+  EXPECT_EQ(mf.suspect_channel(), 3);
+}
+
+}  // namespace
+}  // namespace gfins::nav
