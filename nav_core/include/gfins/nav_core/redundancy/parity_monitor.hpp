@@ -34,6 +34,14 @@
 // channel mask) and hands it to set_solver() here and to the integrator, which keep navigating
 // on the remaining N − 1 ≥ 6 sensors.
 //
+// What the fault did before its exclusion stays in the navigation state (a gyro-free INS
+// integrates ω̇ once for ω and twice for attitude). A fault f_j(t) on sensor j enters [ω̇; f] as
+// M e_j f_j, and E[r_kj] = P_jj f_j(t_k), so the monitor also sums the suspect's residuals from
+// the window before the streak's first alarm to the exclusion: ∫ f_j dt ≈ dt Σ r_kj / P_jj and
+// ∫ f_j (t_now − t) dt ≈ dt² Σ r_kj (k_now − k) / P_jj (FaultTransient), for any shape of fault
+// (step, ramp, stuck), without knowing its onset. correct_for_excluded_fault (exclusion.hpp)
+// removes their effect on ω, attitude, velocity and position.
+//
 // Static storage, float32 on the board, no heap: an N×N projector and 2N running sums.
 #pragma once
 
@@ -71,6 +79,16 @@ enum class ParityVerdict : std::uint8_t {
 /// the two channels differ by the 0.99 posterior, a size at which the geometry's own calibration
 /// error, not the noise, decides.
 inline constexpr double kIndistinguishable = 0.99;
+
+/// The fault of an excluded channel, integrated from the window before its first alarm to the
+/// exclusion (see above).
+template <typename T>
+struct FaultTransient {
+  int channel = -1;           // −1: none
+  T integral_mps = 0;         // ∫ f_j dt, m/s
+  T moment_m = 0;             // ∫ f_j (t_now − t) dt, m
+  std::uint32_t samples = 0;  // how many samples the sums cover
+};
 
 template <typename T>
 struct ParityConfig {
@@ -196,6 +214,8 @@ class ParityMonitor {
       return ParityVerdict::kPending;
     }
     if (n_ == 0) r_ref_ = r;
+    win_r_ += r;
+    win_kr_ += static_cast<T>(n_) * r;
     const Outputs dr = r - r_ref_;  // about the window's first residual: float sums keep digits
     sum_ += dr;
     sum2_ += dr.cwiseProduct(dr);
@@ -203,6 +223,21 @@ class ParityMonitor {
     const ParityVerdict v = decide();
     reset_window();
     return v;
+  }
+
+  /// The suspect's fault integrated over the streak (valid after kExcludeRequest; channel −1
+  /// otherwise).
+  FaultTransient<T> transient() const {
+    FaultTransient<T> t;
+    if (suspect_ < 0 || streak_ == 0) return t;
+    const T dt = T(1) / config_.sample_rate_hz;
+    const T pjj = p_(suspect_, suspect_);
+    const T k_now = static_cast<T>(trans_samples_);
+    t.channel = suspect_;
+    t.integral_mps = dt * trans_r_(suspect_) / pjj;
+    t.moment_m = dt * dt * (k_now * trans_r_(suspect_) - trans_kr_(suspect_)) / pjj;
+    t.samples = trans_samples_;
+    return t;
   }
 
   /// Health of channel j (0 ≤ j < N).
@@ -239,6 +274,11 @@ class ParityMonitor {
   }
 
   void reset_window() {
+    prev_r_ = win_r_;
+    prev_kr_ = win_kr_;
+    prev_samples_ = n_;
+    win_r_.setZero();
+    win_kr_.setZero();
     n_ = 0;
     sum_.setZero();
     sum2_.setZero();
@@ -324,6 +364,16 @@ class ParityMonitor {
       suspect_bias_ = std::numeric_limits<T>::quiet_NaN();
       return ParityVerdict::kUnisolated;
     }
+    if (best == suspect_ && streak_ > 0) {
+      // Sample m of the sums counts from the start of the window before the first alarm.
+      trans_r_ += win_r_;
+      trans_kr_ += win_kr_ + static_cast<T>(trans_samples_) * win_r_;
+      trans_samples_ += n_;
+    } else {
+      trans_r_ = prev_r_ + win_r_;
+      trans_kr_ = prev_kr_ + win_kr_ + static_cast<T>(prev_samples_) * win_r_;
+      trans_samples_ = prev_samples_ + n_;
+    }
     streak_ = best == suspect_ ? streak_ + 1 : 1U;
     suspect_ = best;
     suspect_bias_ = mean_r(best) / p_(best, best);
@@ -352,6 +402,15 @@ class ParityMonitor {
   T suspect_bias_ = std::numeric_limits<T>::quiet_NaN();
   int suspect_ = -1;
   std::uint32_t streak_ = 0;
+  // Σ r and Σ (sample index) r of this window and the last, and over the streak (transient()).
+  Outputs win_r_ = Outputs::Zero();
+  Outputs win_kr_ = Outputs::Zero();
+  Outputs prev_r_ = Outputs::Zero();
+  Outputs prev_kr_ = Outputs::Zero();
+  std::uint32_t prev_samples_ = 0;
+  Outputs trans_r_ = Outputs::Zero();
+  Outputs trans_kr_ = Outputs::Zero();
+  std::uint32_t trans_samples_ = 0;
   std::array<ChannelHealth, static_cast<std::size_t>(N)> health_{};
   std::array<ChannelMask, static_cast<std::size_t>(N)> group_{};
   std::uint32_t windows_ = 0;
