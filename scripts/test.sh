@@ -95,7 +95,7 @@ step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate \
   gfins_nav_bench gfins_pipeline_ir gfins_filter_bench gfins_filter_ir gfins_replay_bench \
-  nav_core_integrator_stability_long \
+  gfins_parity_bench nav_core_parity_evaluation_long nav_core_integrator_stability_long \
   nav_core_error_state_filter_long nav_core_filter_nees_long host_sim_aided_run_long \
   can_tool_fw_aided_e2e \
   nav_core_no_malloc_check calibration_no_malloc_check gfins-fw firmware_no_alloc_check \
@@ -110,6 +110,7 @@ step "host-release: main job and benchmarks, smoke run"
 ./build/host-release/tests/bench/gfins_nav_bench --benchmark_min_time=0.01 >/dev/null
 ./build/host-release/tests/bench/gfins_replay_bench --benchmark_min_time=0.01 >/dev/null
 ./build/host-release/tests/bench/gfins_filter_bench --benchmark_min_time=0.01 >/dev/null
+./build/host-release/tests/bench/gfins_parity_bench --benchmark_min_time=0.01 >/dev/null
 for op in propagate zupt zaru gnss-position gnss-velocity heading; do
   ./build/host-release/tests/bench/gfins_filter_ir float "$op" 50 >/dev/null
 done
