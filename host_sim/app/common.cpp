@@ -265,7 +265,38 @@ std::string describe(const Scenario& s) {
                   static_cast<unsigned long long>(sample_count(s)));
     text += buf;
   }
+  for (const ChannelFailure& f : s.failures) text += "\n  " + describe(f);
   return text;
+}
+
+std::string describe(const ChannelFailure& f) {
+  char buf[160];
+  const unsigned sensor = static_cast<unsigned>(f.sensor) + 1U;
+  switch (f.kind) {
+    case ChannelFailureKind::kBias:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u bias step %g mg from %g s", sensor,
+                    f.value * 1e3, f.start_s);
+      break;
+    case ChannelFailureKind::kRamp:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u bias ramp %g mg/s from %g s", sensor,
+                    f.value * 1e3, f.start_s);
+      break;
+    case ChannelFailureKind::kNoise:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u noise x%g from %g s", sensor, f.value,
+                    f.start_s);
+      break;
+    case ChannelFailureKind::kSaturation:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u saturates at %g g from %g s", sensor,
+                    f.value, f.start_s);
+      break;
+    case ChannelFailureKind::kStuck:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u stuck from %g s", sensor, f.start_s);
+      break;
+    case ChannelFailureKind::kDead:
+      std::snprintf(buf, sizeof buf, "failure: sensor %u dead (0 V) from %g s", sensor, f.start_s);
+      break;
+  }
+  return buf;
 }
 
 void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c) {

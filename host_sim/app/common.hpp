@@ -112,6 +112,8 @@ NavSummary nav_summary(const RunSeries& r);
 
 /// One paragraph: name, description, duration, rate, ρ, noise, compensator.
 std::string describe(const Scenario& s);
+/// One line naming a channel failure of the scenario (sensor 1-6, kind, magnitude, onset).
+std::string describe(const ChannelFailure& f);
 void print_calibration(std::FILE* f, const Scenario& s, const CalibrationOutcome& c);
 void print_run_table(std::FILE* f, const ScenarioOutcome& o);
 /// The same table from statistics accumulated while streaming (run_scenario_streamed).

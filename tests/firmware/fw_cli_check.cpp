@@ -230,6 +230,35 @@ TEST_F(FwCli, ASimulatedLogStartsAtTheDocumentedEpoch) {
   EXPECT_EQ(log.substr(last + 1, 20), "(1700000001.200000) ");
 }
 
+// A channel failure of the scenario reaches the board's own detectors: sensor 4 dead (0 V, the
+// converter reads a constant code) from sample 1050 is reported stuck by the sample loop when 50
+// samples after it have repeated its code (docs/faults.md), i.e. at sample 1100 (t = 1100 ms),
+// with the channel's bit (mask 8) in the log line and in the health summary.
+TEST_F(FwCli, AScenarioChannelFailureReachesTheBoardsDetectors) {
+  const std::string scenario = file("dead4.toml", R"([scenario]
+description = "at rest, sensor 4 dies at 1.05 s"
+duration_s = 2.0
+rate_hz = 1000.0
+
+[trajectory]
+kind = "rest"
+
+[sensors]
+noise_mg = 1.0
+
+[[sensors.failures]]
+kind = "dead"
+sensor = 4
+start_s = 1.05
+)");
+  const test::CliResult r = fw(sim_run({}, scenario));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("t=1100ms channel mask 8 stuck: code unchanged for 50 samples"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("stuck events 1 (mask 0x8)"), std::string::npos) << r.output;
+}
+
 TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {
   if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
   // /dev/full refuses every write with ENOSPC: every frame is lost.

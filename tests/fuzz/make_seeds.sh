@@ -15,6 +15,14 @@ rm -f "$corpus"/*/seed-*
 cp firmware/app/gfins-fw.toml "$corpus/firmware_config/seed-default.toml"
 cp scripts/vboard/gfins-fw-vboard.toml "$corpus/firmware_config/seed-vboard.toml"
 for f in host_sim/scenarios/*.toml; do cp "$f" "$corpus/scenario/seed-$(basename "$f")"; done
+# Channel failures ([[sensors.failures]], docs/simulation.md): one of each kind.
+{
+  cat host_sim/scenarios/rest.toml
+  for k in 'bias"\nbias_mg = 2.0' 'ramp"\nrate_mg_per_s = 5.0' 'noise"\nfactor = 8.0' \
+    'saturation"\nlimit_g = 0.5' 'stuck"' 'dead"'; do
+    printf '\n[[sensors.failures]]\nkind = "%b\nsensor = 3\nstart_s = 1.0\n' "$k"
+  done
+} >"$corpus/scenario/seed-failures.toml"
 "$build/host_sim/tools/gfins-calibrate" --means tests/golden/paper_tables_4_5.csv --latitude 24.8 \
   --adc-lsb 1.192e-6 --device-id board-001 --rho 0.1 -o "$tmp/cal.toml" >/dev/null
 cp "$tmp/cal.toml" "$corpus/calibration_file/seed-paper.toml"

@@ -100,6 +100,61 @@ TEST(ScenarioParse, MissingRequiredKeyIsNamed) {
                {"trajectory", "missing table"});
 }
 
+TEST(ScenarioParse, ChannelFailuresAreReadWithTheirUnits) {
+  const std::string text = replace(kGood, "noise_mps2 = 5e-4\n", R"(noise_mps2 = 5e-4
+[[sensors.failures]]
+kind = "bias"
+sensor = 3
+start_s = 1.5
+bias_mg = 2.0
+[[sensors.failures]]
+kind = "stuck"
+sensor = 6
+start_s = 0.25
+[[sensors.failures]]
+kind = "saturation"
+sensor = 1
+start_s = 0
+limit_g = 0.5
+)");
+  const HostResult<Scenario> p = parse_scenario(text, "failures.toml");
+  ASSERT_TRUE(p.is_ok()) << p.error().message;
+  const auto& f = p.value().failures;
+  ASSERT_EQ(f.size(), 3U);
+  EXPECT_EQ(f[0].kind, ChannelFailureKind::kBias);
+  EXPECT_EQ(f[0].sensor, 2U);  // sensor 3, 0-based
+  EXPECT_DOUBLE_EQ(f[0].start_s, 1.5);
+  EXPECT_DOUBLE_EQ(f[0].value, 2e-3);  // g
+  EXPECT_EQ(f[1].kind, ChannelFailureKind::kStuck);
+  EXPECT_EQ(f[1].sensor, 5U);
+  EXPECT_EQ(f[2].kind, ChannelFailureKind::kSaturation);
+  EXPECT_DOUBLE_EQ(f[2].value, 0.5);
+  // The sensor model the runs build gets them (array_errors, one path for gfins-sim and the
+  // simulated board).
+  EXPECT_EQ(array_errors(p.value()).failures.size(), 3U);
+}
+
+TEST(ScenarioParse, ABadChannelFailureIsNamedWithItsPlace) {
+  const auto with = [](const std::string& body) {
+    return replace(kGood, "noise_mps2 = 5e-4\n",
+                   "noise_mps2 = 5e-4\n[[sensors.failures]]\n" + body);
+  };
+  expect_error(with("kind = \"melted\"\nsensor = 1\nstart_s = 0\n"),
+               {"bad.toml", "sensors.failures[0].kind", "melted", "stuck"});
+  expect_error(with("kind = \"dead\"\nsensor = 7\nstart_s = 0\n"),
+               {"sensors.failures[0].sensor", "out of range"});
+  expect_error(with("kind = \"dead\"\nsensor = 2.5\nstart_s = 0\n"),
+               {"sensors.failures[0].sensor", "integer"});
+  expect_error(with("kind = \"dead\"\nsensor = 2\nstart_s = 3.0\n"),
+               {"sensors.failures[0].start_s", "out of range [0, 2]"});
+  expect_error(with("kind = \"bias\"\nsensor = 2\nstart_s = 1.0\n"),
+               {"sensors.failures[0].bias_mg", "missing"});
+  expect_error(with("kind = \"stuck\"\nsensor = 2\nstart_s = 1.0\nbias_mg = 1.0\n"),
+               {"sensors.failures[0].bias_mg", "unknown key"});
+  expect_error(replace(kGood, "noise_mps2 = 5e-4\n", "noise_mps2 = 5e-4\nfailures = 3\n"),
+               {"sensors.failures", "array of tables"});
+}
+
 TEST(ScenarioParse, WrongTypeIsNamedWithItsLine) {
   // rate_hz is on line 4 of kGood.
   expect_error(replace(kGood, "rate_hz = 100.0", "rate_hz = \"fast\""),

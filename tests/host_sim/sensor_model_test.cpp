@@ -291,5 +291,119 @@ TEST(SensorModelTest, MakeRefusesTheSameRatesWithAValue) {
   EXPECT_EQ(good.value().sample_rate_hz(), kRateHz);
 }
 
+// --- channel failures
+// ------------------------------------------------------------------------------ Each failure
+// against the same model without it, same seed: identical volts before the onset (and on the other
+// channels throughout), then the failure's own formula (sensor_model.hpp).
+
+namespace failures {
+
+constexpr double kSf = 1.33;      // V/g
+constexpr double kNoiseG = 1e-4;  // white noise, g
+constexpr double kOnsetS = 0.05;  // sample 50 at 1 kHz
+constexpr int kSamples = 100;
+
+struct Pair {
+  std::vector<SensorArrayModel::Volts> clean;
+  std::vector<SensorArrayModel::Volts> failed;
+};
+
+Pair run(const ChannelFailure& f) {
+  AccelErrors e;
+  e.scale_v_per_g = kSf;
+  e.noise_g = kNoiseG;
+  ArrayErrors clean = errors_with(e);
+  ArrayErrors failed = clean;
+  failed.failures.push_back(f);
+  SensorArrayModel a(kNominal, clean, kGravity, kRateHz, 9);
+  SensorArrayModel b(kNominal, failed, kGravity, kRateHz, 9);
+  Pair p;
+  for (int k = 0; k < kSamples; ++k) {
+    // A slow tilt so that a stuck channel differs from a good one.
+    TruthState x = rest(false);
+    x.t_s = k / kRateHz;
+    x.q_nb = Quatd(Eigen::AngleAxisd(0.5 * x.t_s, Vec3d::UnitX()));
+    p.clean.push_back(a.volts(x));
+    p.failed.push_back(b.volts(x));
+  }
+  return p;
+}
+
+// Sensor 3 (index 2) fails; the onset sample is 50.
+constexpr std::size_t kCh = 2;
+constexpr int kOnset = 50;
+
+void expect_untouched_before_and_elsewhere(const Pair& p) {
+  for (int k = 0; k < kSamples; ++k) {
+    for (std::size_t j = 0; j < 6; ++j) {
+      if (j == kCh && k >= kOnset) continue;
+      EXPECT_EQ(p.failed[static_cast<std::size_t>(k)](ix(j)),
+                p.clean[static_cast<std::size_t>(k)](ix(j)))
+          << k << " " << j;
+    }
+  }
+}
+
+}  // namespace failures
+
+TEST(SensorModelTest, BiasAndRampFailuresAddTheirBiasFromTheOnset) {
+  using namespace failures;
+  const Pair bias = run({ChannelFailureKind::kBias, kCh, kOnsetS, 2e-3});
+  const Pair ramp = run({ChannelFailureKind::kRamp, kCh, kOnsetS, 0.1});
+  expect_untouched_before_and_elsewhere(bias);
+  expect_untouched_before_and_elsewhere(ramp);
+  for (int k = kOnset; k < kSamples; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_NEAR(bias.failed[i](ix(kCh)) - bias.clean[i](ix(kCh)), kSf * 2e-3, kRounding) << k;
+    EXPECT_NEAR(ramp.failed[i](ix(kCh)) - ramp.clean[i](ix(kCh)),
+                kSf * 0.1 * (k / kRateHz - kOnsetS), kRounding)
+        << k;
+  }
+}
+
+TEST(SensorModelTest, NoiseFailureScalesTheSameDraws) {
+  using namespace failures;
+  const Pair noisy = run({ChannelFailureKind::kNoise, kCh, kOnsetS, 8.0});
+  expect_untouched_before_and_elsewhere(noisy);
+  // No other error: volts = SF (a + n), so (failed − SF a) = 8 (clean − SF a), with SF a the
+  // noise-free reading computed here from the truth.
+  SensorArrayModel ideal(kNominal, errors_with([] {
+                           AccelErrors e;
+                           e.scale_v_per_g = kSf;
+                           return e;
+                         }()),
+                         kGravity, kRateHz, 9);
+  for (int k = 0; k < kSamples; ++k) {
+    TruthState x = rest(false);
+    x.t_s = k / kRateHz;
+    x.q_nb = Quatd(Eigen::AngleAxisd(0.5 * x.t_s, Vec3d::UnitX()));
+    const double sa = ideal.volts(x)(ix(kCh));
+    if (k < kOnset) continue;
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_NEAR(noisy.failed[i](ix(kCh)) - sa, 8.0 * (noisy.clean[i](ix(kCh)) - sa), 1e-12) << k;
+  }
+}
+
+TEST(SensorModelTest, StuckHoldsTheLastReadingDeadReadsZeroSaturationClips) {
+  using namespace failures;
+  const Pair stuck = run({ChannelFailureKind::kStuck, kCh, kOnsetS, 0.0});
+  const Pair dead = run({ChannelFailureKind::kDead, kCh, kOnsetS, 0.0});
+  // Sensor 3 senses (0, k, k)·f with f = (0, 0, −g) level (NED, at rest): −0.707 g; clipped at
+  // −0.5 g from the onset.
+  const Pair clipped = run({ChannelFailureKind::kSaturation, kCh, kOnsetS, 0.5});
+  for (const Pair* p : {&stuck, &dead, &clipped}) expect_untouched_before_and_elsewhere(*p);
+  const double held = stuck.clean[kOnset - 1](ix(kCh));
+  for (int k = kOnset; k < kSamples; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_EQ(stuck.failed[i](ix(kCh)), held) << k;
+    EXPECT_EQ(dead.failed[i](ix(kCh)), 0.0) << k;
+    // SF (−0.5 g + n): within 6 noise σ of −SF·0.5 g, at least 0.19 g above the clean reading.
+    EXPECT_NEAR(clipped.failed[i](ix(kCh)), -kSf * 0.5, kSf * 6.0 * kNoiseG) << k;
+    EXPECT_GT(clipped.failed[i](ix(kCh)), clipped.clean[i](ix(kCh)) + kSf * 0.19) << k;
+  }
+  // The stuck channel really is stuck while the truth moves (the tilt changes it by ~1e-3 g).
+  EXPECT_GT(std::abs(stuck.clean[kSamples - 1](ix(kCh)) - held), kSf * 5e-4);
+}
+
 }  // namespace
 }  // namespace gfins::sim

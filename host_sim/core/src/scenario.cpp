@@ -319,6 +319,54 @@ void parse_aiding(const toml::table& root, const Reader& rd, AidingSpec& a) {
       rd.number(*t, p, "track_heading_sigma_deg", a.track_heading_sigma_deg, 0.0, 90.0);
 }
 
+/// [[sensors.failures]]: one table per failure, `kind`, `sensor` (1-6, the paper's numbering),
+/// `start_s` within the run and the kind's magnitude (sensor_model.hpp, ChannelFailure).
+std::vector<ChannelFailure> read_failures(const Reader& rd, const toml::table& sensors,
+                                          double duration_s) {
+  std::vector<ChannelFailure> out;
+  const toml::node* n = sensors.get("failures");
+  if (n == nullptr) return out;
+  const auto* a = n->as_array();
+  if (a == nullptr) {
+    rd.fail(n, "sensors.failures", "expected an array of tables ([[sensors.failures]])");
+  }
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const std::string p = "sensors.failures[" + std::to_string(i) + "].";
+    const auto* t = (*a)[i].as_table();
+    if (t == nullptr) rd.fail(&(*a)[i], p, "expected a table ([[sensors.failures]])");
+    const std::string kind = rd.string(*t, p, "kind", std::nullopt,
+                                       {"bias", "ramp", "noise", "saturation", "stuck", "dead"});
+    ChannelFailure f;
+    f.sensor = static_cast<std::size_t>(rd.number(*t, p, "sensor", std::nullopt, 1, 6)) - 1;
+    if (const toml::node* sn = t->get("sensor"); sn->as_integer() == nullptr) {
+      rd.fail(sn, p + "sensor", "expected an integer sensor number 1-6");
+    }
+    f.start_s = rd.number(*t, p, "start_s", std::nullopt, 0.0, duration_s);
+    if (kind == "bias") {
+      rd.only(*t, p, {"kind", "sensor", "start_s", "bias_mg"});
+      f.kind = ChannelFailureKind::kBias;
+      f.value = rd.number(*t, p, "bias_mg", std::nullopt, -6e4, 6e4) * 1e-3;
+    } else if (kind == "ramp") {
+      rd.only(*t, p, {"kind", "sensor", "start_s", "rate_mg_per_s"});
+      f.kind = ChannelFailureKind::kRamp;
+      f.value = rd.number(*t, p, "rate_mg_per_s", std::nullopt, -6e4, 6e4) * 1e-3;
+    } else if (kind == "noise") {
+      rd.only(*t, p, {"kind", "sensor", "start_s", "factor"});
+      f.kind = ChannelFailureKind::kNoise;
+      f.value = rd.number(*t, p, "factor", std::nullopt, 0.0, 1e4);
+    } else if (kind == "saturation") {
+      rd.only(*t, p, {"kind", "sensor", "start_s", "limit_g"});
+      f.kind = ChannelFailureKind::kSaturation;
+      f.value = rd.number(*t, p, "limit_g", std::nullopt, 0.0, 60.0);
+    } else {
+      rd.only(*t, p, {"kind", "sensor", "start_s"});
+      f.kind = kind == "stuck" ? ChannelFailureKind::kStuck : ChannelFailureKind::kDead;
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
   Scenario s;
   s.source = source;
@@ -431,7 +479,8 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     const std::string q = "sensors.";
     rd.only(*se, q,
             {"orientation", "beta_deg", "alpha_deg", "location_error_mm", "bias_mps2", "noise_mps2",
-             "noise_mg", "noise_distribution", "model", "temperature_c", "adc", "scale_v_per_g"});
+             "noise_mg", "noise_distribution", "model", "temperature_c", "adc", "scale_v_per_g",
+             "failures"});
     const std::string orient =
         rd.string(*se, q, "orientation", std::string("none"), {"none", "paper_table6", "custom"});
     if (orient == "paper_table6") {
@@ -474,6 +523,7 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
       std::copy(sf.begin(), sf.end(), s.scale_v_per_g.begin());
       if (!s.adc) rd.fail(se->get("scale_v_per_g"), q + "scale_v_per_g", "needs adc = true");
     }
+    s.failures = read_failures(rd, *se, s.duration_s);
     if (!s.adc && s.qa1100) {
       rd.fail(se->get("adc"), q + "adc",
               "false (the paper's §6.3 m/s² setting) needs model = \"paper\", not \"qa1100\"");

@@ -268,6 +268,7 @@ ArrayErrors array_errors(const Scenario& s) {
   ArrayErrors errors;
   errors.misalignment = s.misalignment;
   errors.temperature_c = s.temperature_c;
+  errors.failures = s.failures;
   const double g = nav::kStandardGravity;
   const double qa1100_sf = AccelErrors::qa1100_typical().scale_v_per_g;
   for (std::size_t j = 0; j < 6; ++j) {

@@ -86,20 +86,52 @@ SensorArrayModel::Volts SensorArrayModel::sensed_specific_force(const TruthState
 SensorArrayModel::Volts SensorArrayModel::volts(const TruthState& x) {
   const Volts s_mps2 = real_.outputs(x);
   const double dtemp_c = errors_.temperature_c - errors_.reference_temperature_c;
+  const double t_s = static_cast<double>(k_) / sample_rate_hz_;
   Volts p;
   for (std::size_t j = 0; j < 6; ++j) {
     const AccelErrors& e = errors_.sensors[j];
     // Both draws happen every sample, whatever the σ, so the streams stay aligned in time.
-    const double n_g = e.noise_g * noise_normal_[j](noise_rng_[j]);
+    double n_g = e.noise_g * noise_normal_[j](noise_rng_[j]);
     walk_g_[j] += e.bias_rw_g_per_sqrt_s * sqrt_dt_s_ * walk_normal_[j](walk_rng_[j]);
-    const double a_g = s_mps2(static_cast<Eigen::Index>(j)) / nav::kStandardGravity;
-    const double a_in_g = std::clamp(a_g, -e.saturation_g, e.saturation_g);
-    const double bias_g = e.bias_g + e.bias_tc_g_per_c * dtemp_c + walk_g_[j];
+    double saturation_g = e.saturation_g;
+    double failure_bias_g = 0.0;
+    bool stuck = false;
+    bool dead = false;
+    for (const ChannelFailure& f : errors_.failures) {
+      if (f.sensor != j || t_s < f.start_s) continue;
+      switch (f.kind) {
+        case ChannelFailureKind::kBias:
+          failure_bias_g += f.value;
+          break;
+        case ChannelFailureKind::kRamp:
+          failure_bias_g += f.value * (t_s - f.start_s);
+          break;
+        case ChannelFailureKind::kNoise:
+          n_g *= f.value;
+          break;
+        case ChannelFailureKind::kSaturation:
+          saturation_g = std::min(saturation_g, f.value);
+          break;
+        case ChannelFailureKind::kStuck:
+          stuck = true;
+          break;
+        case ChannelFailureKind::kDead:
+          dead = true;
+          break;
+      }
+    }
+    const auto jj = static_cast<Eigen::Index>(j);
+    const double a_g = s_mps2(jj) / nav::kStandardGravity;
+    const double a_in_g = std::clamp(a_g, -saturation_g, saturation_g);
+    const double bias_g = e.bias_g + e.bias_tc_g_per_c * dtemp_c + walk_g_[j] + failure_bias_g;
     const double sf_v_per_g = e.scale_v_per_g * (1.0 + e.scale_tc_ppm_per_c * 1e-6 * dtemp_c);
     // paper eq. (21), P = SF (f·θ + b), plus the second-order term and the noise.
-    p(static_cast<Eigen::Index>(j)) =
-        sf_v_per_g * (a_in_g + e.k2_g_per_g2 * a_in_g * a_in_g + bias_g + n_g);
+    p(jj) = sf_v_per_g * (a_in_g + e.k2_g_per_g2 * a_in_g * a_in_g + bias_g + n_g);
+    if (stuck && k_ > 0) p(jj) = last_(jj);
+    if (dead) p(jj) = 0.0;
   }
+  ++k_;
+  last_ = p;
   return p;
 }
 

@@ -109,7 +109,8 @@ struct Scenario {
   // Sensor errors (true values).
   nav::Misalignment<double> misalignment{};
   std::array<double, 6> bias_mps2{};
-  double noise_mps2 = 0.0;  // white noise per sensor and sample, 1σ
+  double noise_mps2 = 0.0;               // white noise per sensor and sample, 1σ
+  std::vector<ChannelFailure> failures;  // [[sensors.failures]], docs/simulation.md
   std::uint64_t seed = 1;
 
   // What the navigation core is told.

@@ -16,6 +16,12 @@
 // pendulous-axis (Kip) and higher-order terms are not modelled: the paper's calibration has no
 // place for them and orientation errors already cover the first-order cross-axis sensitivity.
 //
+// Channel failures (ChannelFailure, from a time on; docs/simulation.md, "Channel failures"):
+// a bias step or a ramp added to b(t), the white noise n_j multiplied by a factor (the same draws,
+// so the run is identical up to the onset), the rebalance range cut to a lower limit, the output
+// held at its last value before the onset (stuck), or 0 V (dead: zero counts through the
+// converter).
+//
 // The noise streams are per sensor (seeded from `seed` and the sensor index), so changing one
 // sensor's errors never changes the random numbers another sensor draws, and a given seed
 // reproduces the same volts on the same standard library.
@@ -25,6 +31,7 @@
 #include <array>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "gfins/host_sim/array_model.hpp"
 #include "gfins/host_sim/error.hpp"
@@ -53,8 +60,27 @@ struct AccelErrors {
   static AccelErrors qa1100_typical();
 };
 
+/// How a channel fails (ChannelFailure::value's unit in brackets).
+enum class ChannelFailureKind : std::uint8_t {
+  kBias,        // bias step [g]
+  kRamp,        // bias growing linearly from the onset [g/s]
+  kNoise,       // white noise multiplied by a factor [1]
+  kSaturation,  // rebalance range cut to ±value [g]
+  kStuck,       // output held at its last value before the onset
+  kDead,        // output 0 V
+};
+
+/// One channel's failure from start_s on (scenario time, s).
+struct ChannelFailure {
+  ChannelFailureKind kind = ChannelFailureKind::kBias;
+  std::size_t sensor = 0;  // 0..5
+  double start_s = 0.0;
+  double value = 0.0;
+};
+
 struct ArrayErrors {
   std::array<AccelErrors, 6> sensors{};
+  std::vector<ChannelFailure> failures{};
   nav::Misalignment<double> misalignment{};  // orientation (eqs. 14/15) and location (eq. 19)
   double temperature_c = 25.0, reference_temperature_c = 25.0;
 };
@@ -115,6 +141,8 @@ class SensorArrayModel {
   std::array<std::normal_distribution<double>, 6> noise_normal_{};  // N(0, 1)
   std::array<std::normal_distribution<double>, 6> walk_normal_{};   // N(0, 1)
   std::array<double, 6> walk_g_{};
+  std::uint64_t k_ = 0;         // samples produced so far (the time of the failures)
+  Volts last_ = Volts::Zero();  // the previous sample's volts (stuck channels hold them)
 };
 
 }  // namespace gfins::sim
