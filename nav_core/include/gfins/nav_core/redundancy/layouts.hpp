@@ -8,6 +8,11 @@
 //   four_triads<T>(ρ): twelve sensors, a triad (x, y, z axes) at each vertex of the regular
 //     tetrahedron inscribed in the sphere of radius ρ, the twelve-accelerometer configuration of
 //     the literature on angular rate from the centripetal terms.
+//   three_triads<T>(ρ): nine sensors, the first three triads of four_triads. The angular rate is
+//     observable from its centripetal terms except along the normal of the three vertices' plane,
+//     ±(1, 1, −1)/√3 (three points are always coplanar: every nine-sensor layout of three triads
+//     has such a direction). table1_with_corners carries no rate information: its Fisher
+//     information about ω is singular at N = 9 and 10 (docs/redundancy.md).
 #pragma once
 
 #include <array>
@@ -55,6 +60,17 @@ ArrayGeometry<T, 12> four_triads(T rho_m) {
       g.rho_b[3 * v + a] = vertices[v];
       g.theta_b[3 * v + a] = Vec3<T>::Unit(static_cast<Eigen::Index>(a));
     }
+  }
+  return g;
+}
+
+template <typename T>
+ArrayGeometry<T, 9> three_triads(T rho_m) {
+  const ArrayGeometry<T, 12> four = four_triads<T>(rho_m);
+  ArrayGeometry<T, 9> g;
+  for (std::size_t j = 0; j < 9; ++j) {
+    g.rho_b[j] = four.rho_b[j];
+    g.theta_b[j] = four.theta_b[j];
   }
   return g;
 }

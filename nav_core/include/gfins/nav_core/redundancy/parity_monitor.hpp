@@ -53,6 +53,7 @@
 #include "gfins/nav_core/filter/chi_square.hpp"
 #include "gfins/nav_core/geometry.hpp"
 #include "gfins/nav_core/geometry_impl.hpp"  // ArraySolver for any N
+#include "gfins/nav_core/redundancy/parity_projector.hpp"
 #include "gfins/status/status.hpp"
 
 namespace gfins::nav {
@@ -148,22 +149,7 @@ class ParityMonitor {
     if (d < 0) {
       return Status(ErrorCode::kInvalidArgument, "parity monitor: fewer than six active sensors");
     }
-    // Column j of H M is the fit of a unit output on sensor j: H (M e_j), evaluated with the
-    // solver's own forward model (ω = 0), so P = I − H M needs no second copy of the design.
-    Projector p = Projector::Zero();
-    for (int j = 0; j < N; ++j) {
-      if (!is_active(active, j)) continue;
-      Outputs e = Outputs::Zero();
-      e(j) = T(1);
-      Vec3<T> wdot;
-      Vec3<T> f;
-      solver.solve(e, Vec3<T>::Zero(), wdot, f);
-      p.col(j) = e - solver.predict(wdot, f, Vec3<T>::Zero());
-    }
-    for (int i = 0; i < N; ++i) {  // the sensors left out take no part in the residual
-      if (!is_active(active, i)) p.row(i).setZero();
-    }
-    p = (p + p.transpose()).eval() / T(2);  // symmetric to rounding
+    const Projector p = parity_projector(solver);
     for (int j = 0; j < N; ++j) {
       if (!is_active(active, j) &&
           health_[static_cast<std::size_t>(j)] != ChannelHealth::kExcluded) {
