@@ -7,12 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
-#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "gfins/nav_core/redundancy/layouts.hpp"
+#include "nav_core/array_forward.hpp"
 
 namespace gfins::nav {
 namespace {
@@ -20,16 +21,7 @@ namespace {
 constexpr double kRho = 0.1;
 constexpr double kSigma = 5e-4;  // m/s² per sensor and sample
 
-template <int N>
-Eigen::Matrix<double, N, 1> forward(const ArrayGeometry<double, N>& g, const Vec3<double>& wdot,
-                                    const Vec3<double>& f, const Vec3<double>& w) {
-  Eigen::Matrix<double, N, 1> s;
-  for (int j = 0; j < N; ++j) {
-    const auto& rho = g.rho_b[static_cast<std::size_t>(j)];
-    s(j) = g.theta_b[static_cast<std::size_t>(j)].dot(f + wdot.cross(rho) + w.cross(w.cross(rho)));
-  }
-  return s;
-}
+using test::forward;
 
 // ∂s/∂(ω̇, f, ω) at ω: row j = [(ρ×θ)ᵀ, θᵀ, ∂/∂ω θ·(ω×(ω×ρ))], the last from
 // θ·(ω×(ω×ρ)) = (θ·ω)(ρ·ω) − (θ·ρ)|ω|²: gradient (ρ·ω) θ + (θ·ω) ρ − 2 (θ·ρ) ω.
@@ -134,7 +126,8 @@ TEST(CentripetalRateTest, SlowRotationCarriesNoInformationAndIsRefused) {
   std::normal_distribution<double> noise(0.0, kSigma);
   for (const double scale : {0.0, 0.01, 1.0}) {
     const Vec3<double> w = Vec3<double>(1.5, -2.0, 1.0) * scale;
-    Eigen::Matrix<double, 9, 1> s = forward<9>(g, Vec3<double>::Zero(), Vec3<double>(0, 0, -9.8), w);
+    Eigen::Matrix<double, 9, 1> s =
+        forward<9>(g, Vec3<double>::Zero(), Vec3<double>(0, 0, -9.8), w);
     for (int j = 0; j < 9; ++j) s(j) += noise(rng);
     const auto r = est.estimate(s, w + Vec3<double>(0.01, 0.01, 0.01));
     const bool expected =

@@ -14,6 +14,7 @@
 #include "gfins/nav_core/integrator.hpp"
 #include "gfins/nav_core/redundancy/exclusion.hpp"
 #include "gfins/nav_core/redundancy/layouts.hpp"
+#include "nav_core/array_forward.hpp"
 
 namespace gfins::nav {
 namespace {
@@ -35,16 +36,7 @@ Eigen::Matrix<double, N, 6> design(const ArrayGeometry<double, N>& g) {
   return h;
 }
 
-template <int N>
-Eigen::Matrix<double, N, 1> forward(const ArrayGeometry<double, N>& g, const Vec3<double>& wdot,
-                                    const Vec3<double>& f, const Vec3<double>& w) {
-  Eigen::Matrix<double, N, 1> s;
-  for (int j = 0; j < N; ++j) {
-    const auto& rho = g.rho_b[static_cast<std::size_t>(j)];
-    s(j) = g.theta_b[static_cast<std::size_t>(j)].dot(f + wdot.cross(rho) + w.cross(w.cross(rho)));
-  }
-  return s;
-}
+using test::forward;
 
 template <int N>
 ParityMonitor<double, N> monitor_for(const ArraySolver<double, N>& solver, ParityConfig<double> c) {

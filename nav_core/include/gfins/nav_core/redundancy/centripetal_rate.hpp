@@ -36,8 +36,8 @@ namespace gfins::nav {
 
 template <typename T>
 struct CentripetalRate {
-  Vec3<T> w_b = Vec3<T>::Zero();        // rad/s, body
-  Mat3<T> covariance = Mat3<T>::Zero(); // rad²/s², the Cramér–Rao bound at w_b for the stated σ
+  Vec3<T> w_b = Vec3<T>::Zero();         // rad/s, body
+  Mat3<T> covariance = Mat3<T>::Zero();  // rad²/s², the Cramér–Rao bound at w_b for the stated σ
   int iterations = 0;
   bool converged = false;
   bool informative = false;  // the bound is small against |ω| (see above); w_b valid only then
@@ -88,7 +88,8 @@ class CentripetalRateEstimator {
   /// ω from one sample's outputs s (m/s²), Gauss–Newton from `seed` (rad/s; its sign decides
   /// between ω and −ω). At most `max_iterations`; converged when a step is below 1e-6 rad/s
   /// relative to |ω|.
-  CentripetalRate<T> estimate(const Outputs& s, const Vec3<T>& seed, int max_iterations = 10) const {
+  CentripetalRate<T> estimate(const Outputs& s, const Vec3<T>& seed,
+                              int max_iterations = 10) const {
     CentripetalRate<T> out;
     const Outputs ps = p_ * s;
     Vec3<T> w = seed;
