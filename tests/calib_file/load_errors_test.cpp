@@ -121,12 +121,12 @@ TEST_F(LoadErrors, BrokenSyntaxNamesTheLineAndColumn) {
 }
 
 TEST_F(LoadErrors, AnotherFormatVersionIsRefusedNamingBothVersions) {
-  const int line = line_of(good_, "format_version = 3");
-  const FileStatus s = load_text(replace_once(good_, "format_version = 3", "format_version = 4"));
+  const int line = line_of(good_, "format_version = 4");
+  const FileStatus s = load_text(replace_once(good_, "format_version = 4", "format_version = 5"));
   EXPECT_EQ(s.code(), ErrorCode::kUnimplemented);
   EXPECT_THAT(s.message(), HasSubstr("line " + std::to_string(line) +
-                                     ": format version 4 is "
-                                     "not supported (this build reads versions 1 to 3)"));
+                                     ": format version 5 is "
+                                     "not supported (this build reads versions 1 to 4)"));
 }
 
 // Removes every line of `text` that starts with `prefix` (canonical text: one key per line).
@@ -152,24 +152,30 @@ std::string drop_table(std::string text, const std::string& header) {
 }
 
 // A file as an older build wrote it (written here from docs/calibration-file.md, versioning):
-// version 2 without the sensor.N.correlation tables and orientation.correlations, version 1
-// also without [gravity]; the checksum over that version's key list.
+// version 3 without sensor.N.sigma_source, version 2 also without the sensor.N.correlation
+// tables and orientation.correlations, version 1 also without [gravity]; the checksum over that
+// version's key list.
 std::string older_version_text(const CalibrationData& d, int version) {
   std::string text = to_toml_text(d);
   std::string canon = canonical_serialisation(d);
-  for (int j = 1; j <= 6; ++j) {
-    text = drop_table(text, "[sensor." + std::to_string(j) + ".correlation]\n");
-    canon = drop_lines(canon, "sensor." + std::to_string(j) + ".correlation.");
+  text = drop_lines(text, "sigma_source = ");
+  for (int j = 1; j <= 6; ++j)
+    canon = drop_lines(canon, "sensor." + std::to_string(j) + ".sigma_source=");
+  if (version < 3) {
+    for (int j = 1; j <= 6; ++j) {
+      text = drop_table(text, "[sensor." + std::to_string(j) + ".correlation]\n");
+      canon = drop_lines(canon, "sensor." + std::to_string(j) + ".correlation.");
+    }
+    text = replace_once(text, "[orientation]\ncorrelations = 'stated'\n\n", "");
+    canon = drop_lines(canon, "orientation.correlations=");
   }
-  text = replace_once(text, "[orientation]\ncorrelations = 'stated'\n\n", "");
-  canon = drop_lines(canon, "orientation.correlations=");
   if (version < 2) {
     text = drop_table(text, "[gravity]\n");
     canon = drop_lines(canon, "gravity.");
   }
   const std::string v = std::to_string(version);
-  text = replace_once(text, "format_version = 3", "format_version = " + v);
-  canon = replace_once(canon, "format_version=3\n", "format_version=" + v + "\n");
+  text = replace_once(text, "format_version = 4", "format_version = " + v);
+  canon = replace_once(canon, "format_version=4\n", "format_version=" + v + "\n");
   char old_sum[40];
   char new_sum[40];
   std::snprintf(old_sum, sizeof old_sum, "fnv1a64:%016llx",
@@ -187,15 +193,49 @@ TEST(FormatVersion2, LoadsWithoutCorrelationsAndSaysSo) {
   // Then every value reads back, the correlations are 0 and marked as not known
   ASSERT_TRUE(r.is_ok()) << r.status().message();
   CalibrationData expected = d;
-  for (auto& s : expected.sensors) s.correlation = {};
+  for (auto& s : expected.sensors) {
+    s.correlation = {};
+    s.sigma_source = SigmaSource{SigmaBasis::kUnknown, 0};
+  }
   expected.correlations_known = false;
   EXPECT_EQ(r.value(), expected);
-  // And re-saved as version 3 the file says that they are not known
+  // And re-saved as version 4 the file says that they are not known
   const std::string text = to_toml_text(r.value());
   EXPECT_NE(text.find("correlations = 'unknown: taken as 0'"), std::string::npos) << text;
-  const auto again = parse_calibration_text(text, "v3.toml");
+  const auto again = parse_calibration_text(text, "v4.toml");
   ASSERT_TRUE(again.is_ok()) << again.status().message();
   EXPECT_EQ(again.value(), expected);
+}
+
+TEST(FormatVersion3, LoadsWithoutSigmaSourcesAndSaysSo) {
+  // Given a version-3 file (correlations, but not where the σ came from)
+  const CalibrationData d = table6_data();
+  const auto r = parse_calibration_text(older_version_text(d, 3), "v3.toml");
+  // Then every value reads back and each sensor's σ source is "unknown: older file"
+  ASSERT_TRUE(r.is_ok()) << r.status().message();
+  CalibrationData expected = d;
+  for (auto& s : expected.sensors) s.sigma_source = SigmaSource{SigmaBasis::kUnknown, 0};
+  EXPECT_EQ(r.value(), expected);
+  // And re-saved as version 4 the file says so, sensor by sensor
+  const std::string text = to_toml_text(r.value());
+  std::size_t n = 0;
+  for (auto at = text.find("sigma_source = 'unknown: older file'"); at != std::string::npos;
+       at = text.find("sigma_source = 'unknown: older file'", at + 1)) {
+    ++n;
+  }
+  EXPECT_EQ(n, 6U) << text;
+}
+
+TEST_F(LoadErrors, AVersion4FileWithoutASigmaSourceOrWithAnUnknownOneIsRefused) {
+  EXPECT_THAT(load_text(replace_once(good_, "sigma_source = 'stated'\n", "")).message(),
+              HasSubstr("missing key 'sensor.1.sigma_source'"));
+  for (const char* bad : {"'residuals'", "'residuals, 0 dof'", "'residuals, 04 dof'",
+                          "'residuals, -3 dof'", "'residuals, 10001 dof'", "'Stated'", "3"}) {
+    const FileStatus s = load_text(
+        replace_once(good_, "sigma_source = 'stated'", std::string("sigma_source = ") + bad));
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument) << bad;
+    EXPECT_THAT(s.message(), HasSubstr("sensor.1.sigma_source")) << bad;
+  }
 }
 
 TEST_F(LoadErrors, AVersion3FileWithoutCorrelationsIsRefused) {
@@ -221,11 +261,14 @@ TEST(FormatVersion1, LoadsWithStandardGravityAndSaysSo) {
   CalibrationData expected = d;
   expected.gravity_mps2 = nav::kStandardGravity;
   expected.gravity_source = kVersion1GravitySource;
-  for (auto& s : expected.sensors) s.correlation = {};  // not in version 1 either
+  for (auto& s : expected.sensors) {
+    s.correlation = {};  // not in version 1 either
+    s.sigma_source = SigmaSource{SigmaBasis::kUnknown, 0};
+  }
   expected.correlations_known = false;
   EXPECT_EQ(r.value(), expected);
-  // And re-saved it becomes a version-3 file that loads with the same values
-  const auto again = parse_calibration_text(to_toml_text(r.value()), "v3.toml");
+  // And re-saved it becomes a version-4 file that loads with the same values
+  const auto again = parse_calibration_text(to_toml_text(r.value()), "v4.toml");
   ASSERT_TRUE(again.is_ok()) << again.status().message();
   EXPECT_EQ(again.value(), expected);
 }
@@ -245,7 +288,7 @@ TEST_F(LoadErrors, AVersion2FileWithoutGravityIsRefused) {
 }
 
 TEST_F(LoadErrors, MissingVersionIsRefused) {
-  const FileStatus s = load_text(replace_once(good_, "format_version = 3", ""));
+  const FileStatus s = load_text(replace_once(good_, "format_version = 4", ""));
   EXPECT_THAT(s.message(), HasSubstr("missing key 'format_version'"));
 }
 

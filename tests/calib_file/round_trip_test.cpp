@@ -47,7 +47,7 @@ TEST(RoundTrip, TheFileIsReadableTomlWithUnitsAndTable6Digits) {
   EXPECT_NE(text.find("xy_deg = 1.117319\n"), std::string::npos);
   EXPECT_NE(text.find("angle = 'deg'"), std::string::npos);
   EXPECT_NE(text.find("scale_factor = 'V/g'"), std::string::npos);
-  EXPECT_NE(text.find("format_version = 3\n"), std::string::npos);
+  EXPECT_NE(text.find("format_version = 4\n"), std::string::npos);
   // Format version 3: each sensor's correlations, keyed by the Table 6 names of its two angles
   // (sensor 3 is row y of set β: Δβ_yx, Δβ_yz).
   EXPECT_NE(text.find("[sensor.3.correlation]\n    bias_yx = 0.0625\n"), std::string::npos) << text;
@@ -81,6 +81,13 @@ CalibrationData random_data(std::mt19937_64& rng) {
     for (double& r : s.correlation) r = any(0.3);
   }
   d.correlations_known = (rng() & 1u) != 0;
+  // Every sigma source, residuals with any dof of the domain.
+  for (auto& s : d.sensors) {
+    const auto basis = static_cast<SigmaBasis>(rng() % 4u);
+    s.sigma_source = SigmaSource{basis, basis == SigmaBasis::kResiduals
+                                            ? static_cast<std::int32_t>(1 + rng() % kMaxSigmaDof)
+                                            : 0};
+  }
   for (std::size_t i = 0; i < 6; ++i) {
     d.beta.angle_deg[i] = any(kMaxAngleDeg);
     d.alpha.angle_deg[i] = any(kMaxAngleDeg);
@@ -149,7 +156,7 @@ TEST(Checksum, CanonicalSerialisationIsKeyEqualsBitPatternLines) {
   const std::string c = canonical_serialisation(d);
   // Then it starts with the version and identity, doubles are their 16-hex-digit bit patterns,
   // and the file's checksum is FNV-1a 64 of exactly this text
-  EXPECT_TRUE(c.starts_with("format_version=3\ndevice_id=gfins-test-01\n")) << c;
+  EXPECT_TRUE(c.starts_with("format_version=4\ndevice_id=gfins-test-01\n")) << c;
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(std::bit_cast<std::uint64_t>(0.332572)));

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 #include <string>
+#include <string_view>
 
 #include <Eigen/Eigenvalues>
 
@@ -85,6 +86,12 @@ class Validator {
     }
   }
   void correlations(const std::string&, bool) {}
+  void sigma_source(const std::string& key, const SigmaSource& src) {
+    SigmaSource back;
+    if (!found() && !parse_sigma_source(to_string(src), back)) {
+      fail(key, "not a sigma source (residuals need 1.." + std::to_string(kMaxSigmaDof) + " dof)");
+    }
+  }
   void compensator(const std::string& key, nav::CompensatorKind k) {
     if (!found() && k != nav::CompensatorKind::kNone && k != nav::CompensatorKind::kPaper &&
         k != nav::CompensatorKind::kExact) {
@@ -169,6 +176,7 @@ class Canonical {
   void correlations(const std::string& key, bool known) {
     line(key, known ? kCorrelationsStated : kCorrelationsUnknown);
   }
+  void sigma_source(const std::string& key, const SigmaSource& src) { line(key, to_string(src)); }
   void number(const std::string& key, double x, Domain) { line(key, bits(x)); }
   void vec3(const std::string& key, const std::array<double, 3>& v, Domain) {
     line(key, bits(v[0]) + "," + bits(v[1]) + "," + bits(v[2]));
@@ -192,6 +200,45 @@ class Canonical {
 };
 
 }  // namespace
+
+std::string to_string(const SigmaSource& s) {
+  switch (s.basis) {
+    case SigmaBasis::kStated:
+      return "stated";
+    case SigmaBasis::kResiduals:
+      return "residuals, " + std::to_string(s.dof) + " dof";
+    case SigmaBasis::kNone:
+      return "none: not estimated";
+    case SigmaBasis::kUnknown:
+      return "unknown: older file";
+  }
+  return "invalid";
+}
+
+bool parse_sigma_source(const std::string& text, SigmaSource& out) {
+  for (const SigmaBasis b : {SigmaBasis::kStated, SigmaBasis::kNone, SigmaBasis::kUnknown}) {
+    if (text == to_string(SigmaSource{b, 0})) {
+      out = SigmaSource{b, 0};
+      return true;
+    }
+  }
+  // "residuals, K dof" with K a plain decimal 1..kMaxSigmaDof (no sign, no leading zero).
+  constexpr std::string_view kHead = "residuals, ";
+  constexpr std::string_view kTail = " dof";
+  const std::string_view t = text;
+  if (t.size() <= kHead.size() + kTail.size() || !t.starts_with(kHead) || !t.ends_with(kTail)) {
+    return false;
+  }
+  const std::string_view digits = t.substr(kHead.size(), t.size() - kHead.size() - kTail.size());
+  if (digits.empty() || digits.size() > 5 || digits.front() == '0') return false;
+  std::int32_t k = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), k);
+  if (ec != std::errc() || end != digits.data() + digits.size() || k < 1 || k > kMaxSigmaDof) {
+    return false;
+  }
+  out = SigmaSource{SigmaBasis::kResiduals, k};
+  return true;
+}
 
 const char* to_string(GeometryKind kind) {
   switch (kind) {

@@ -52,7 +52,7 @@ inline const char* to_string_compensator(nav::CompensatorKind k) { return nav::t
 /// D is CalibrationData or const CalibrationData. V has the methods
 ///   text(key, std::string&, Domain), unit(key, const char* unit),
 ///   geometry_kind(key, GeometryKind&), compensator(key, nav::CompensatorKind&),
-///   correlations(key, bool& known),
+///   correlations(key, bool& known), sigma_source(key, SigmaSource&),
 ///   number(key, double&, Domain), vec3(key, std::array<double, 3>&, Domain).
 /// Geometry's kind is visited before the keys that depend on it, so a reader sees it in time.
 /// `version` is the file's format version: the keys it defines (version 1 has no [gravity]).
@@ -100,6 +100,7 @@ void visit_fields(D& d, V& v, std::int64_t version = kFormatVersion) {
         v.number(p + "correlation." + names[c], s.correlation[c], Domain::kCorrelation);
       }
     }
+    if (version >= 4) v.sigma_source(p + "sigma_source", s.sigma_source);
   }
   const auto visit_set = [&v](const std::string& p, auto& set) {
     for (std::size_t i = 0; i < 6; ++i) {

@@ -67,6 +67,7 @@ class Writer {
   void correlations(const std::string& key, bool known) {
     put(key, std::string(known ? kCorrelationsStated : kCorrelationsUnknown));
   }
+  void sigma_source(const std::string& key, const SigmaSource& src) { put(key, to_string(src)); }
   void number(const std::string& key, double x, Domain) { put(key, x); }
   void vec3(const std::string& key, const std::array<double, 3>& v, Domain) {
     put(key, toml::array{v[0], v[1], v[2]});
@@ -133,6 +134,17 @@ class Reader {
       fail(ErrorCode::kInvalidArgument, line_of(key),
            key + " is \"" + s + "\": expected \"" + kCorrelationsStated + "\" or \"" +
                kCorrelationsUnknown + "\"");
+    }
+  }
+  void sigma_source(const std::string& key, SigmaSource& src) {
+    std::string s;
+    text(key, s, Domain::kSource);
+    if (!ok()) return;
+    if (!parse_sigma_source(s, src)) {
+      fail(ErrorCode::kInvalidArgument, line_of(key),
+           key + " is \"" + s + "\": expected \"stated\", \"residuals, K dof\" (K = 1.." +
+               std::to_string(kMaxSigmaDof) +
+               "), \"none: not estimated\" or \"unknown: older file\"");
     }
   }
   void compensator(const std::string& key, nav::CompensatorKind& k) {
@@ -272,6 +284,10 @@ FileResult<CalibrationData> parse_table(const toml::table& root, const std::stri
   // Versions 1 and 2 stated σ but not the correlations of SF, b and the angles: 0 by assumption,
   // and said so (docs/calibration-file.md, versioning).
   if (file_version < 3) d.correlations_known = false;
+  // Before version 4 a file did not say where its σ came from.
+  if (file_version < 4) {
+    for (auto& sensor : d.sensors) sensor.sigma_source = SigmaSource{SigmaBasis::kUnknown, 0};
+  }
   Reader reader(root);
   detail::visit_fields(d, reader, file_version);
   if (!reader.ok()) return FileStatus(reader.status().code(), prefix + reader.status().message());

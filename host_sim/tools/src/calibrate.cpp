@@ -419,6 +419,27 @@ HostResult<CalibrationRun> run_calibration(const CalibrationInputs& in,
   return in.poses ? run_with_poses(in, means_file) : run_paper_layout(in, means_file);
 }
 
+namespace {
+
+// What the file says about sensor j's σ (sensor.N.sigma_source): stated, from the residuals of
+// its fit (poses that used it, minus the 4 unknowns), or not estimated.
+calib_file::SigmaSource sigma_source_of(const CalibrationRun& run, std::size_t j) {
+  switch (run.result.covariance_source[j]) {
+    case calib::CovarianceSource::kStatedSigma:
+      return {calib_file::SigmaBasis::kStated, 0};
+    case calib::CovarianceSource::kResiduals: {
+      std::int32_t poses = 0;
+      for (const std::uint8_t mask : run.pose_used_mask) poses += (mask >> j) & 1u;
+      return {calib_file::SigmaBasis::kResiduals, std::max(1, poses - 4)};
+    }
+    case calib::CovarianceSource::kNone:
+      break;
+  }
+  return {calib_file::SigmaBasis::kNone, 0};
+}
+
+}  // namespace
+
 calib_file::CalibrationData make_calibration_data(const CalibrationRun& run,
                                                   const FileSettings& settings) {
   const auto& r = run.result;
@@ -449,6 +470,7 @@ calib_file::CalibrationData make_calibration_data(const CalibrationRun& run,
       s.correlation[k] =
           den > 0.0 ? std::clamp(cov(pairs[k][0], pairs[k][1]) / den, -1.0, 1.0) : 0.0;
     }
+    s.sigma_source = sigma_source_of(run, j);
   }
   d.gravity_mps2 = settings.gravity_mps2;
   d.gravity_source = settings.gravity_source;

@@ -28,8 +28,9 @@ namespace gfins::calib_file {
 
 /// The format version this build writes (docs/calibration-file.md, versioning). Version 2 added
 /// the local gravity of the calibration site ([gravity]); version 3 the correlations of each
-/// sensor's SF, bias and two orientation angles (sensor.N.correlation).
-inline constexpr std::int64_t kFormatVersion = 3;
+/// sensor's SF, bias and two orientation angles (sensor.N.correlation); version 4 where each
+/// sensor's σ came from (sensor.N.sigma_source).
+inline constexpr std::int64_t kFormatVersion = 4;
 /// The oldest version this build still reads (converted on load: see kVersion1GravitySource).
 inline constexpr std::int64_t kOldestFormatVersion = 1;
 inline constexpr std::size_t kNumSensors = 6;
@@ -81,6 +82,31 @@ struct GeometrySpec {
   bool operator==(const GeometrySpec&) const = default;
 };
 
+/// Where a sensor's σ of SF, bias and its two angles (and their correlations) came from
+/// (sensor.N.sigma_source, format version 4; docs/calibration-file.md).
+enum class SigmaBasis : std::uint8_t {
+  kStated = 0,  // propagated from the σ stated with every mean: Gaussian
+  kResiduals,   // from the fit residuals with `dof` degrees of freedom: a Student-t's width
+  kNone,        // not estimated (exactly determined, no σ stated): the zeros are not "exact"
+  kUnknown,     // read from a file older than version 4, which did not say
+};
+
+struct SigmaSource {
+  SigmaBasis basis = SigmaBasis::kStated;
+  std::int32_t dof = 0;  // kResiduals only: poses the sensor was fitted from, minus 4
+
+  bool operator==(const SigmaSource&) const = default;
+};
+
+/// Largest degrees of freedom accepted in a sigma_source (a calibration has tens of poses).
+inline constexpr std::int32_t kMaxSigmaDof = 10000;
+
+/// The file's text of a sigma_source: "stated", "residuals, K dof", "none: not estimated",
+/// "unknown: older file".
+std::string to_string(const SigmaSource& s);
+/// The inverse of to_string; false for any other text (or K outside 1..kMaxSigmaDof).
+bool parse_sigma_source(const std::string& text, SigmaSource& out);
+
 /// One accelerometer (index j = sensor j+1 of Table 1). Model: P = SF (f·θ + b), paper eq. (21).
 struct SensorCalibration {
   double adc_lsb_v_per_count = 0.0;                // V/count of its ADC channel
@@ -97,6 +123,9 @@ struct SensorCalibration {
   /// so with the σ above this is the whole covariance of the orientation calibration (format
   /// version 3; zero, i.e. unknown, when read from an older file: see correlations_known).
   std::array<double, 6> correlation{};
+  /// Where the σ above (and the correlations) came from (format version 4; kUnknown when read
+  /// from an older file).
+  SigmaSource sigma_source{};
 
   bool operator==(const SensorCalibration&) const = default;
 };
