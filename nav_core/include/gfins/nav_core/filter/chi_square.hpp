@@ -12,9 +12,10 @@
 //       for k ≥ 30 at p ≤ 0.999, and below 0.01 % for the detector's 6W − 3 ≥ 100
 //       (tests/nav_core/chi_square_test.cpp checks tabulated values).
 //   chi_square_upper_quantile(α, k): the x with P(χ²_k > x) = α, from the exact survival function
-//     (chi_square_survival, below) by bisection: for the tiny tail probabilities of a detector
-//     with a stated false-alarm rate per hour (α ~ 1e-7 per decision), where 1 − α is not
-//     representable in float and Wilson–Hilferty is several percent off at small k.
+//     (chi_square_survival, below) by bisection for k ≤ 200: for the tiny tail probabilities of a
+//     detector with a stated false-alarm rate per hour (α ~ 1e-7 per decision), where 1 − α is not
+//     representable in float and Wilson–Hilferty is several percent off at small k; above 200,
+//     Wilson–Hilferty written for the upper tail (no 1 − α).
 #pragma once
 
 #include <cmath>
@@ -97,12 +98,19 @@ T chi_square_survival(T x, int k) {
   return std::erfc(std::sqrt(y)) + sum;
 }
 
-/// The x with P(χ²_k > x) = alpha (0 < alpha < 1, 1 ≤ k ≤ 200; NaN otherwise), by bisection on
-/// chi_square_survival to the resolution of T. For start-up use (a hundred survival evaluations).
+/// The x with P(χ²_k > x) = alpha (0 < alpha < 1, k ≥ 1; NaN otherwise). For k ≤ 200, bisection
+/// on chi_square_survival to the resolution of T (a hundred survival evaluations: start-up use).
+/// Above, Wilson–Hilferty in its upper-tail form, z = −Φ⁻¹(α), so that 1 − α never has to be
+/// formed (it rounds to 1 in float for α < 3e-8); its x is slightly high there, the tail at x
+/// up to 5 % below α (k = 201, α = 1.4e-7; tests/nav_core/chi_square_test.cpp): conservative.
 template <typename T>
 T chi_square_upper_quantile(T alpha, int k) {
-  if (k < 1 || k > 200 || !(alpha > T(0) && alpha < T(1))) {
-    return std::numeric_limits<T>::quiet_NaN();
+  if (k < 1 || !(alpha > T(0) && alpha < T(1))) return std::numeric_limits<T>::quiet_NaN();
+  if (k > 200) {
+    const T kk = static_cast<T>(k);
+    const T v = T(2) / (T(9) * kk);
+    const T c = T(1) - v - normal_quantile(alpha) * std::sqrt(v);
+    return kk * c * c * c;
   }
   T lo = T(0);
   T hi = static_cast<T>(k) + T(10);

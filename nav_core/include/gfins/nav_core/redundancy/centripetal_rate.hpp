@@ -5,8 +5,9 @@
 // (geometry.hpp). u enters linearly, so for a given ω its least-squares value is M (s − Q m(ω))
 // and what is left is the parity residual r(ω) = P (s − Q m(ω)), P = I − H M (parity_monitor.hpp).
 // ω is the minimiser of ‖r(ω)‖² (variable projection, Golub & Pereyra 1973): three unknowns
-// against d = N − 6 parity equations, so N ≥ 9. Gauss–Newton from a seed ω₀ (the integrator's
-// rate):
+// against d = N − 6 parity equations, so N ≥ 9; at N = 9 (d = 3) other rates than ±ω can fit
+// exactly, so an estimate is only called informative from N = 10 on. Gauss–Newton from a seed ω₀
+// (the integrator's rate):
 //   J(ω) = −P Q D(ω),  D = ∂m/∂ω (6×3, linear in ω),   ω ← ω − (JᵀJ)⁻¹ Jᵀ r(ω).
 // m(−ω) = m(ω): −ω fits as well as ω, and the seed picks the sign (the solution is turned to the
 // seed's side when ω·ω₀ < 0).
@@ -62,24 +63,10 @@ class CentripetalRateEstimator {
       return Status(ErrorCode::kInvalidArgument,
                     "centripetal rate: positive finite sigma and relative limit required");
     }
-    // Q's columns from the solver's forward model: Q m(ω) = predict(0, 0, ω), so ω = e_i gives
-    // the squares and ω = e_i + e_k the cross term once the squares are taken off.
-    const auto c = [&solver](const Vec3<T>& w) {
-      return solver.predict(Vec3<T>::Zero(), Vec3<T>::Zero(), w);
-    };
-    const Vec3<T> ex = Vec3<T>::UnitX();
-    const Vec3<T> ey = Vec3<T>::UnitY();
-    const Vec3<T> ez = Vec3<T>::UnitZ();
-    Eigen::Matrix<T, N, 6> q;
-    q.col(0) = c(ex);
-    q.col(1) = c(ey);
-    q.col(2) = c(ez);
-    q.col(3) = c(ey + ez) - q.col(1) - q.col(2);
-    q.col(4) = c(ex + ez) - q.col(0) - q.col(2);
-    q.col(5) = c(ex + ey) - q.col(0) - q.col(1);
     const Eigen::Matrix<T, N, N> p = parity_projector(solver);
     p_ = p;
-    pq_ = p * q;
+    pq_ = p * centripetal_matrix(solver);
+    dof_ = channel_count(solver.active()) - 6;
     sigma2_ = white_sigma_mps2 * white_sigma_mps2;
     max_relative_sigma_ = max_relative_sigma;
     return Status::ok();
@@ -118,7 +105,11 @@ class CentripetalRateEstimator {
     if (out.converged && ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > T(0)) {
       out.covariance = ldlt.solve(Mat3<T>::Identity()) * sigma2_;
       // The trace bounds the largest eigenvalue from above (by at most 3×): conservative.
-      out.informative = std::sqrt(out.covariance.trace()) <= max_relative_sigma_ * w.norm();
+      // Nine sensors (d = 3) give as many equations as unknowns: besides ±ω, other rates fit
+      // the outputs exactly, and Gauss–Newton lands on one of them for a few per cent of seeds
+      // (a zero residual does not tell). From ten on, the extra equations reject them.
+      out.informative =
+          dof_ >= 4 && std::sqrt(out.covariance.trace()) <= max_relative_sigma_ * w.norm();
     }
     return out;
   }
@@ -136,22 +127,15 @@ class CentripetalRateEstimator {
   }
 
  private:
-  /// D(ω) = ∂m/∂ω for m = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy].
   static Eigen::Matrix<T, 6, 3> monomial_jacobian(const Vec3<T>& w) {
-    Eigen::Matrix<T, 6, 3> d;
-    d << T(2) * w.x(), T(0), T(0),  //
-        T(0), T(2) * w.y(), T(0),   //
-        T(0), T(0), T(2) * w.z(),   //
-        T(0), w.z(), w.y(),         //
-        w.z(), T(0), w.x(),         //
-        w.y(), w.x(), T(0);
-    return d;
+    return centripetal_monomial_jacobian(w);
   }
 
   Eigen::Matrix<T, N, N> p_ = Eigen::Matrix<T, N, N>::Zero();
   Eigen::Matrix<T, N, 6> pq_ = Eigen::Matrix<T, N, 6>::Zero();
   T sigma2_ = T(1);
   T max_relative_sigma_ = T(0.1);
+  int dof_ = 0;
 };
 
 }  // namespace gfins::nav

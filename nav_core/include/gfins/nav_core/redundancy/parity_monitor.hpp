@@ -100,6 +100,10 @@ struct ParityConfig {
   T false_alarms_per_hour = T(0.01);  // fault-free alarms per hour of operation, both tests
   T isolation_probability = T(0.99);  // posterior a channel needs to be suspected
   std::uint32_t confirm_windows = 3;  // consecutive windows isolating it before exclusion
+  // 1σ per axis of the error of the rate ω handed to add() (rad/s): the centripetal term removed
+  // with a wrong ω leaves P Q D(ω) δω in the residual, which grows with |ω| (see above). 0 only
+  // for a rate known exactly (tests, a rate table).
+  T rate_sigma_rps = T(0);
 };
 
 template <typename T, int N>
@@ -118,6 +122,7 @@ class ParityMonitor {
     if (!(config.white_sigma_mps2 > T(0)) || !std::isfinite(config.white_sigma_mps2) ||
         !(config.floor_sigma_mps2 >= T(0)) || !std::isfinite(config.floor_sigma_mps2) ||
         !(config.sample_rate_hz > T(0)) || !std::isfinite(config.sample_rate_hz) ||
+        !(config.rate_sigma_rps >= T(0)) || !std::isfinite(config.rate_sigma_rps) ||
         !(config.isolation_probability > T(0) && config.isolation_probability < T(1))) {
       return Status(ErrorCode::kInvalidArgument,
                     "parity monitor: positive finite sigma and rate, isolation probability in "
@@ -137,7 +142,10 @@ class ParityMonitor {
     alarms_ = 0;
     exclusions_ = 0;
     rejected_samples_ = 0;
-    return set_solver(solver);
+    nonfinite_run_.fill(0);
+    const Status st = set_solver(solver);
+    exclusions_ = 0;  // sensors the first solver leaves out were never excluded by the monitor
+    return st;
   }
 
   /// Takes a new solver (the same geometry with fewer active sensors after an exclusion, or a
@@ -151,13 +159,16 @@ class ParityMonitor {
     }
     const Projector p = parity_projector(solver);
     for (int j = 0; j < N; ++j) {
-      if (!is_active(active, j) &&
-          health_[static_cast<std::size_t>(j)] != ChannelHealth::kExcluded) {
-        health_[static_cast<std::size_t>(j)] = ChannelHealth::kExcluded;
+      auto& h = health_[static_cast<std::size_t>(j)];
+      if (!is_active(active, j) && h != ChannelHealth::kExcluded) {
+        h = ChannelHealth::kExcluded;
         ++exclusions_;
+      } else if (is_active(active, j) && h == ChannelHealth::kExcluded) {
+        h = ChannelHealth::kOk;  // back in use (a repaired channel, a new calibration)
       }
     }
     p_ = p;
+    pq_ = p * centripetal_matrix(solver);
     solver_ = solver;
     dof_ = d;
     for (int j = 0; j < N; ++j) {
@@ -173,12 +184,15 @@ class ParityMonitor {
     const auto w = static_cast<int>(config_.window);
     const T a = alpha_ / T(2);
     threshold_mean_ = d > 0 ? chi_square_upper_quantile(a, d) : std::numeric_limits<T>::quiet_NaN();
-    // (W − 1)·d degrees of freedom: above the exact survival's range (200) Wilson–Hilferty,
-    // whose relative error there is below 0.01 % (chi_square.hpp).
-    const int ds = (w - 1) * d;
-    threshold_scatter_ = d == 0      ? std::numeric_limits<T>::quiet_NaN()
-                         : ds <= 200 ? chi_square_upper_quantile(a, ds)
-                                     : chi_square_quantile(T(1) - a, ds);
+    // (W − 1)·d degrees of freedom: exact up to 200, Wilson–Hilferty's upper-tail form above
+    // (chi_square.hpp; below 0.1 % off).
+    threshold_scatter_ =
+        d > 0 ? chi_square_upper_quantile(a, (w - 1) * d) : std::numeric_limits<T>::quiet_NaN();
+    if (d > 0 && !(std::isfinite(threshold_mean_) && std::isfinite(threshold_scatter_))) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "parity monitor: no finite threshold for this false-alarm probability per "
+                    "window in this scalar type");
+    }
     sigma2_mean_ = config_.white_sigma_mps2 * config_.white_sigma_mps2 / static_cast<T>(w) +
                    config_.floor_sigma_mps2 * config_.floor_sigma_mps2;
     sigma2_ = config_.white_sigma_mps2 * config_.white_sigma_mps2;
@@ -197,8 +211,10 @@ class ParityMonitor {
     const Outputs r = p_ * (s - c);
     if (!std::isfinite(r.squaredNorm())) {
       ++rejected_samples_;
-      return ParityVerdict::kPending;
+      return nonfinite_sample(s);
     }
+    nonfinite_run_.fill(0);
+    sum_w_ += w_b;
     if (n_ == 0) r_ref_ = r;
     win_r_ += r;
     win_kr_ += static_cast<T>(n_) * r;
@@ -259,7 +275,35 @@ class ParityMonitor {
     return ((mask >> static_cast<unsigned>(j)) & 1U) != 0U;
   }
 
+  /// A sample with a non-finite residual: skipped; when exactly one active channel is not finite
+  /// for `window` · `confirm_windows` samples in a row, its exclusion is requested directly (a
+  /// channel stuck at inf or NaN would otherwise only ever be skipped).
+  ParityVerdict nonfinite_sample(const Outputs& s) {
+    int bad = -1;
+    int count = 0;
+    for (int j = 0; j < N; ++j) {
+      if (is_active(solver_.active(), j) && !std::isfinite(s(j))) {
+        bad = j;
+        ++count;
+      }
+    }
+    for (int j = 0; j < N; ++j) {
+      if (count != 1 || j != bad) nonfinite_run_[static_cast<std::size_t>(j)] = 0;
+    }
+    if (count != 1) return ParityVerdict::kPending;
+    auto& run = nonfinite_run_[static_cast<std::size_t>(bad)];
+    if (++run < config_.window * config_.confirm_windows) return ParityVerdict::kPending;
+    run = 0;
+    suspect_ = bad;
+    streak_ = 0;  // no residual sums: transient() has nothing to report
+    isolation_p_ = T(1);
+    suspect_bias_ = std::numeric_limits<T>::quiet_NaN();
+    health_[static_cast<std::size_t>(bad)] = ChannelHealth::kSuspected;
+    return ParityVerdict::kExcludeRequest;
+  }
+
   void reset_window() {
+    sum_w_.setZero();
     prev_r_ = win_r_;
     prev_kr_ = win_kr_;
     prev_samples_ = n_;
@@ -289,6 +333,14 @@ class ParityMonitor {
       p_best = T(0);
       return -1;
     }
+    if (!std::isfinite(llr(best))) {
+      // A fault so large that its likelihood overflows T: the channels sharing the infinite
+      // value (one, or an ambiguity group) share the posterior.
+      int tied = 0;
+      for (int j = 0; j < N; ++j) tied += usable(j) && llr(j) == llr(best) ? 1 : 0;
+      p_best = T(1) / static_cast<T>(tied);
+      return best;
+    }
     T z = T(0);
     for (int j = 0; j < N; ++j) {
       if (usable(j)) z += std::exp(llr(j) - llr(best));
@@ -313,7 +365,15 @@ class ParityMonitor {
     const Outputs mean_r = r_ref_ + mean_dr;
     // Σ_k (r_kj − r̄_j)² = Σ_k d_kj² − W d̄_j², per channel; clamp the rounding below zero.
     const Outputs scatter = (sum2_ - w * mean_dr.cwiseProduct(mean_dr)).cwiseMax(T(0));
-    t_mean_ = mean_r.squaredNorm() / sigma2_mean_;
+    // The rate's error leaves P Q D(ω̄) δω in the mean residual: its covariance is bounded by
+    // σ_ω² ‖P Q D(ω̄)‖²_F in every direction (the Frobenius norm bounds the largest singular
+    // value), added to the white part: conservative, the false-alarm rate stays at or below the
+    // stated one.
+    const Vec3<T> mean_w = sum_w_ / w;
+    const T rate_var = config_.rate_sigma_rps * config_.rate_sigma_rps *
+                       (pq_ * centripetal_monomial_jacobian(mean_w)).squaredNorm();
+    const T sigma2_mean = sigma2_mean_ + rate_var;
+    t_mean_ = mean_r.squaredNorm() / sigma2_mean;
     // The residual lies in the parity space, so its scatter per window is the sum over sensors.
     t_scatter_ = scatter.sum() / sigma2_;
     residual_rms_ = std::sqrt(mean_r.squaredNorm() / static_cast<T>(channel_count(active())));
@@ -332,14 +392,31 @@ class ParityMonitor {
     ++alarms_;
     Outputs llr = Outputs::Zero();
     const T n = w - T(1);
+    // The mean test's w_j² = r̄_j² / (σ_m² P_jj) is formed as (r̄_j / m)² / P_jj times (m/σ_m)²
+    // with m the largest |r̄_j|, so a huge fault (a channel at 1e16 m/s² in float) does not
+    // overflow every channel's likelihood to inf alike.
+    T m = T(0);
+    for (int j = 0; j < N; ++j) {
+      if (usable(j)) m = std::max(m, std::abs(mean_r(j)));
+    }
     for (int j = 0; j < N; ++j) {
       if (!usable(j)) continue;
       if (mean_alarm) {
-        llr(j) = mean_r(j) * mean_r(j) / (sigma2_mean_ * p_(j, j)) / T(2);
+        const T x = m > T(0) ? mean_r(j) / m : T(0);
+        llr(j) = x * x / p_(j, j);
       } else {
         const T z = scatter(j) / (sigma2_ * p_(j, j));
         llr(j) = z > n ? (z - n - n * std::log(z / n)) / T(2) : T(0);
+        if (!std::isfinite(llr(j))) llr(j) = std::numeric_limits<T>::max();
       }
+    }
+    if (mean_alarm) {
+      // Scale by (m/σ_m)²/2, capped so that the largest log-likelihood is at most 1e4: beyond
+      // that the evidence is overwhelming either way, and the order (and exact ties) are kept.
+      const T largest = llr.maxCoeff();
+      const T scale = (m / std::sqrt(sigma2_mean)) * (m / std::sqrt(sigma2_mean)) / T(2);
+      if (largest > T(0))
+        llr *= std::isfinite(scale) ? std::min(scale, T(1e4) / largest) : T(1e4) / largest;
     }
     T p_best = T(0);
     const int best = most_likely(llr, p_best);
@@ -371,6 +448,9 @@ class ParityMonitor {
   ParityConfig<T> config_{};
   Solver solver_{};
   Projector p_ = Projector::Zero();
+  Eigen::Matrix<T, N, 6> pq_ = Eigen::Matrix<T, N, 6>::Zero();  // P Q: the rate's leak
+  Vec3<T> sum_w_ = Vec3<T>::Zero();                             // Σ ω over the window
+  std::array<std::uint32_t, static_cast<std::size_t>(N)> nonfinite_run_{};
   int dof_ = 0;
   T alpha_ = T(0);
   T sigma2_ = T(1);
@@ -405,8 +485,9 @@ class ParityMonitor {
   std::uint32_t rejected_samples_ = 0;
 };
 
-/// The solver without sensor `channel` (the exclusion a monitor requested), same geometry and
-/// condition limit; kInvalidArgument/kSingular when the rest cannot determine [ω̇; f].
+/// The solver without sensor `channel` (the exclusion a monitor requested): same geometry, the
+/// condition limit given (a solver does not remember the one it was built with: pass it again if
+/// it was not the default); kInvalidArgument/kSingular when the rest cannot determine [ω̇; f].
 template <typename T, int N>
 Result<ArraySolver<T, N>> solver_without(const ArraySolver<T, N>& solver, int channel,
                                          T max_condition = T(kDefaultMaxCondition)) {

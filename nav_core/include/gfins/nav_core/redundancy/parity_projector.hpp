@@ -30,4 +30,38 @@ Eigen::Matrix<T, N, N> parity_projector(const ArraySolver<T, N>& solver) {
   return (p + p.transpose()) / T(2);
 }
 
+/// Q (N×6) of the centripetal term c(ω) = Q m(ω), m = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy]
+/// (geometry.hpp), from the solver's forward model: c(ω) = predict(0, 0, ω), so ω = e_i gives
+/// the squares and ω = e_i + e_k the cross term once the squares are taken off.
+template <typename T, int N>
+Eigen::Matrix<T, N, 6> centripetal_matrix(const ArraySolver<T, N>& solver) {
+  const auto c = [&solver](const Vec3<T>& w) {
+    return solver.predict(Vec3<T>::Zero(), Vec3<T>::Zero(), w);
+  };
+  const Vec3<T> ex = Vec3<T>::UnitX();
+  const Vec3<T> ey = Vec3<T>::UnitY();
+  const Vec3<T> ez = Vec3<T>::UnitZ();
+  Eigen::Matrix<T, N, 6> q;
+  q.col(0) = c(ex);
+  q.col(1) = c(ey);
+  q.col(2) = c(ez);
+  q.col(3) = c(ey + ez) - q.col(1) - q.col(2);
+  q.col(4) = c(ex + ez) - q.col(0) - q.col(2);
+  q.col(5) = c(ex + ey) - q.col(0) - q.col(1);
+  return q;
+}
+
+/// D(ω) = ∂m/∂ω (6×3) for m = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy].
+template <typename T>
+Eigen::Matrix<T, 6, 3> centripetal_monomial_jacobian(const Vec3<T>& w) {
+  Eigen::Matrix<T, 6, 3> d;
+  d << T(2) * w.x(), T(0), T(0),  //
+      T(0), T(2) * w.y(), T(0),   //
+      T(0), T(0), T(2) * w.z(),   //
+      T(0), w.z(), w.y(),         //
+      w.z(), T(0), w.x(),         //
+      w.y(), w.x(), T(0);
+  return d;
+}
+
 }  // namespace gfins::nav
