@@ -128,7 +128,7 @@ class CentripetalRateEstimator {
 
  private:
   static Eigen::Matrix<T, 6, 3> monomial_jacobian(const Vec3<T>& w) {
-    return centripetal_monomial_jacobian(w);
+    return centripetal_jacobian(w);
   }
 
   Eigen::Matrix<T, N, N> p_ = Eigen::Matrix<T, N, N>::Zero();

@@ -371,7 +371,7 @@ class ParityMonitor {
     // stated one.
     const Vec3<T> mean_w = sum_w_ / w;
     const T rate_var = config_.rate_sigma_rps * config_.rate_sigma_rps *
-                       (pq_ * centripetal_monomial_jacobian(mean_w)).squaredNorm();
+                       (pq_ * centripetal_jacobian(mean_w)).squaredNorm();
     const T sigma2_mean = sigma2_mean_ + rate_var;
     t_mean_ = mean_r.squaredNorm() / sigma2_mean;
     // The residual lies in the parity space, so its scatter per window is the sum over sensors.

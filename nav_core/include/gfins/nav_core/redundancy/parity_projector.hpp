@@ -3,6 +3,7 @@
 // leaves out are zero.
 #pragma once
 
+#include "gfins/nav_core/error_model.hpp"  // centripetal_jacobian, D(ω) = ∂m/∂ω
 #include "gfins/nav_core/geometry.hpp"
 
 namespace gfins::nav {
@@ -49,19 +50,6 @@ Eigen::Matrix<T, N, 6> centripetal_matrix(const ArraySolver<T, N>& solver) {
   q.col(4) = c(ex + ez) - q.col(0) - q.col(2);
   q.col(5) = c(ex + ey) - q.col(0) - q.col(1);
   return q;
-}
-
-/// D(ω) = ∂m/∂ω (6×3) for m = [ωx², ωy², ωz², ωyωz, ωxωz, ωxωy].
-template <typename T>
-Eigen::Matrix<T, 6, 3> centripetal_monomial_jacobian(const Vec3<T>& w) {
-  Eigen::Matrix<T, 6, 3> d;
-  d << T(2) * w.x(), T(0), T(0),  //
-      T(0), T(2) * w.y(), T(0),   //
-      T(0), T(0), T(2) * w.z(),   //
-      T(0), w.z(), w.y(),         //
-      w.z(), T(0), w.x(),         //
-      w.y(), w.x(), T(0);
-  return d;
 }
 
 }  // namespace gfins::nav
