@@ -210,7 +210,7 @@ TEST(CentripetalRateTest, FewerThanNineSensorsAreRefused) {
   CentripetalRateEstimator<double, 9> e9;
   const auto g9 = three_triads<double>(kRho);
   using Solver9 = ArraySolver<double, 9>;
-  EXPECT_FALSE(e9.configure(Solver9::create(g9, 100.0, 0x1FEU).value(), kSigma).is_ok());
+  EXPECT_FALSE(e9.configure(Solver9::create_subset(g9, 100.0, 0x1FEU).value(), kSigma).is_ok());
   EXPECT_FALSE(e9.configure(Solver9::create(g9).value(), -1.0).is_ok());
 }
 

@@ -52,7 +52,7 @@ TEST(ChannelMaskTest, ASevenSensorArrayWithoutItsCornerIsTheTable1Solver) {
   // Paper eq. (4): for Table 1, M = [S/(2ρ); T/2]; the seven-sensor solver with the corner left
   // out must give the six-sensor solution whatever the corner reads.
   const auto g7 = table1_with_corners<double, 7>(kRho);
-  const auto s7 = ArraySolver<double, 7>::create(g7, 100.0, all_channels<7>() & ~(1U << 6U));
+  const auto s7 = ArraySolver<double, 7>::create_subset(g7, 100.0, all_channels<7>() & ~(1U << 6U));
   ASSERT_TRUE(s7.is_ok());
   const auto s6 = ArraySolver<double, 6>::create(table1_geometry(kRho)).value();
   EXPECT_LT((s7.value().m().leftCols<6>() - s6.m()).cwiseAbs().maxCoeff(), 1e-12);
@@ -61,14 +61,14 @@ TEST(ChannelMaskTest, ASevenSensorArrayWithoutItsCornerIsTheTable1Solver) {
 }
 
 TEST(ChannelMaskTest, FewerThanSixActiveSensorsAreRefused) {
-  const auto r = ArraySolver<double, 6>::create(table1_geometry(kRho), 100.0, 0x1FU);
+  const auto r = ArraySolver<double, 6>::create_subset(table1_geometry(kRho), 100.0, 0x1FU);
   ASSERT_FALSE(r.is_ok());
   EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
   // Eight sensors, two excluded: six left, fine; three excluded: refused.
   const auto g8 = table1_with_corners<double, 8>(kRho);
   using Solver8 = ArraySolver<double, 8>;
-  EXPECT_TRUE(Solver8::create(g8, 100.0, 0xFCU).is_ok());
-  EXPECT_FALSE(Solver8::create(g8, 100.0, 0xF8U).is_ok());
+  EXPECT_TRUE(Solver8::create_subset(g8, 100.0, 0xFCU).is_ok());
+  EXPECT_FALSE(Solver8::create_subset(g8, 100.0, 0xF8U).is_ok());
 }
 
 // --- the projector -------------------------------------------------------------------------------
@@ -695,7 +695,8 @@ TEST(ParityMonitorTest, ExcludedChannelsBackInUseAreOkAndTheFirstSolversMaskIsNo
   using Solver9 = ArraySolver<double, 9>;
   ParityMonitor<double, 9> mon;
   ASSERT_TRUE(
-      mon.configure(Solver9::create(g, 100.0, 0x1F7U).value(), ParityConfig<double>{}).is_ok());
+      mon.configure(Solver9::create_subset(g, 100.0, 0x1F7U).value(), ParityConfig<double>{})
+          .is_ok());
   EXPECT_EQ(mon.health(3), ChannelHealth::kExcluded);  // left out by the first solver
   EXPECT_EQ(mon.exclusions(), 0U);                     // but not excluded by the monitor
   ASSERT_TRUE(mon.set_solver(Solver9::create(g).value()).is_ok());

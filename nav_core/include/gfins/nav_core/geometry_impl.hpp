@@ -84,17 +84,9 @@ void zero_rounding_noise(Eigen::Matrix<T, R, C>& m, const Eigen::Matrix<T, R, C>
 }  // namespace detail
 
 template <typename T, int N>
-Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g, T max_condition,
-                                                    ChannelMask active) {
+Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g, T max_condition) {
   using HMatrix = Eigen::Matrix<T, N, 6>;
 
-  active &= all_channels<N>();
-  if (channel_count(active) < 6) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "array geometry: fewer than six active sensors cannot determine [angular accel; "
-                  "specific force]");
-  }
-  const auto used = [active](int j) { return ((active >> static_cast<unsigned>(j)) & 1U) != 0U; };
   T lever_sum = T(0);
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
@@ -103,17 +95,17 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
       return Status(ErrorCode::kInvalidArgument,
                     "array geometry: a sensor position is not a finite number");
     }
-    if (used(j)) lever_sum += rho.norm();
+    lever_sum += rho.norm();
   }
-  const T lever = lever_sum / static_cast<T>(channel_count(active));
+  const T lever = lever_sum / T(N);
   if (!(lever > T(0)) || !std::isfinite(lever)) {
     return Status(ErrorCode::kInvalidArgument,
                   "array geometry: sensors have no lever arm (all positions at the centre), so "
                   "angular acceleration is unobservable");
   }
 
-  HMatrix a = HMatrix::Zero();  // H with its ω̇ columns divided by the mean lever arm; rows of
-  HMatrix q = HMatrix::Zero();  // the sensors left out stay zero (zero columns of M = pinv(H))
+  HMatrix a;  // H with its ω̇ columns divided by the mean lever arm (dimensionless)
+  HMatrix q;
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
     const Vec3<T>& th = g.theta_b[static_cast<std::size_t>(j)];
@@ -121,7 +113,6 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
       return Status(ErrorCode::kInvalidArgument,
                     "array geometry: a sensitive axis is not near unit length or not finite");
     }
-    if (!used(j)) continue;
     a.row(j) << rho.cross(th).transpose() / lever, th.transpose();
     const T tr = th.dot(rho);
     q.row(j) << th.x() * rho.x() - tr, th.y() * rho.y() - tr, th.z() * rho.z() - tr,
@@ -160,7 +151,107 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create(const ArrayGeometry<T, N>& g
   solver.k_force_.template topRows<3>() = k.template bottomRows<3>();
   solver.condition_ = cond;
   solver.geometry_ = g;
-  solver.active_ = active;
+  return solver;
+}
+
+// The masked set-up of create_subset(): create()'s steps with the rows of the sensors left out
+// set to zero. Kept apart from create() (see geometry.hpp).
+template <typename T, int N>
+template <typename Mask>
+Result<ArraySolver<T, N>> ArraySolver<T, N>::create_subset(const ArrayGeometry<T, N>& g,
+                                                           T max_condition, Mask active_in) {
+  constexpr bool kMasked = true;
+  ChannelMask active = static_cast<ChannelMask>(active_in);
+  using HMatrix = Eigen::Matrix<T, N, 6>;
+
+  if constexpr (kMasked) {
+    active &= all_channels<N>();
+    if (channel_count(active) < 6) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "array geometry: fewer than six active sensors cannot determine [angular "
+                    "accel; specific force]");
+    }
+  }
+  const auto used = [active](int j) {
+    if constexpr (kMasked) {
+      return ((active >> static_cast<unsigned>(j)) & 1U) != 0U;
+    } else {
+      (void)active;
+      (void)j;
+      return true;
+    }
+  };
+  T lever_sum = T(0);
+  for (int j = 0; j < N; ++j) {
+    const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
+    if (!std::isfinite(rho.squaredNorm())) {
+      // Checked first: a NaN position made the mean lever arm NaN, reported as "no lever arm".
+      return Status(ErrorCode::kInvalidArgument,
+                    "array geometry: a sensor position is not a finite number");
+    }
+    if (used(j)) lever_sum += rho.norm();
+  }
+  const T lever = lever_sum / static_cast<T>(kMasked ? channel_count(active) : N);
+  if (!(lever > T(0)) || !std::isfinite(lever)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "array geometry: sensors have no lever arm (all positions at the centre), so "
+                  "angular acceleration is unobservable");
+  }
+
+  HMatrix a;  // H with its ω̇ columns divided by the mean lever arm; rows of the sensors left
+  HMatrix q;  // out are zero (zero columns of M = pinv(H))
+  for (int j = 0; j < N; ++j) {
+    const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
+    const Vec3<T>& th = g.theta_b[static_cast<std::size_t>(j)];
+    if (!(std::abs(th.norm() - T(1)) <= T(0.1))) {  // NaN fails the comparison too
+      return Status(ErrorCode::kInvalidArgument,
+                    "array geometry: a sensitive axis is not near unit length or not finite");
+    }
+    if (!used(j)) {
+      // Row by row, not HMatrix::Zero() up front: Eigen unrolls a whole-matrix fill into one
+      // store per element at -Os on the Cortex-M4F (docs/performance.md).
+      a.row(j).setZero();
+      q.row(j).setZero();
+      continue;
+    }
+    a.row(j) << rho.cross(th).transpose() / lever, th.transpose();
+    const T tr = th.dot(rho);
+    q.row(j) << th.x() * rho.x() - tr, th.y() * rho.y() - tr, th.z() * rho.z() - tr,
+        th.y() * rho.z() + th.z() * rho.y(), th.x() * rho.z() + th.z() * rho.x(),
+        th.x() * rho.y() + th.y() * rho.x();
+  }
+
+  Mat6<T> v = Mat6<T>::Identity();
+  const bool converged = detail::jacobi_orthogonalize(a, v);
+  const Vec6<T> sigma_sq = a.colwise().squaredNorm().transpose();
+  const T smax = std::sqrt(sigma_sq.maxCoeff());
+  const T smin = std::sqrt(sigma_sq.minCoeff());
+  const T cond = smin > T(0) ? smax / smin : std::numeric_limits<T>::infinity();
+  if (!converged || !(cond <= max_condition)) {
+    return Status(ErrorCode::kSingular,
+                  "array geometry: the map from outputs to [angular accel; specific force] is "
+                  "singular or ill-conditioned (condition number above the limit); check that "
+                  "positions and axes are not coplanar or repeated");
+  }
+
+  // pinv(H_s) = V Σ⁻² (H_s V)ᵀ. H_s = H D with D = diag(I₃/lever, I₃), so pinv(H) = D pinv(H_s):
+  // the ω̇ rows of pinv(H_s) divided by the lever arm.
+  const Vec6<T> inv_sigma_sq = sigma_sq.cwiseInverse();
+  Eigen::Matrix<T, 6, N> m = v * inv_sigma_sq.asDiagonal() * a.transpose();
+  detail::zero_rounding_noise<T, 6, N>(
+      m, v.cwiseAbs() * inv_sigma_sq.asDiagonal() * a.cwiseAbs().transpose(), 6);
+  m.template topRows<3>() /= lever;  // exact zeros stay zero
+  Mat6<T> k = m * q;
+  detail::zero_rounding_noise<T, 6, 6>(k, m.cwiseAbs() * q.cwiseAbs(), N);
+
+  ArraySolver solver;
+  solver.m_.template topRows<3>() = m.template topRows<3>();
+  solver.m_.template middleRows<3>(kHalfRows) = m.template bottomRows<3>();
+  solver.k_.template topRows<3>() = k.template topRows<3>();
+  solver.k_.template middleRows<3>(kHalfRows) = k.template bottomRows<3>();
+  solver.k_force_.template topRows<3>() = k.template bottomRows<3>();
+  solver.condition_ = cond;
+  solver.geometry_ = g;
   return solver;
 }
 

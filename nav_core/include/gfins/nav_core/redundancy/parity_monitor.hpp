@@ -494,7 +494,7 @@ Result<ArraySolver<T, N>> solver_without(const ArraySolver<T, N>& solver, int ch
   if (channel < 0 || channel >= N) {
     return Status(ErrorCode::kInvalidArgument, "exclusion: no such channel");
   }
-  return ArraySolver<T, N>::create(
+  return ArraySolver<T, N>::create_subset(
       solver.geometry(), max_condition,
       solver.active() & ~(ChannelMask{1} << static_cast<unsigned>(channel)));
 }
