@@ -160,27 +160,15 @@ template <typename T, int N>
 template <typename Mask>
 Result<ArraySolver<T, N>> ArraySolver<T, N>::create_subset(const ArrayGeometry<T, N>& g,
                                                            T max_condition, Mask active_in) {
-  constexpr bool kMasked = true;
-  ChannelMask active = static_cast<ChannelMask>(active_in);
+  const ChannelMask active = static_cast<ChannelMask>(active_in) & all_channels<N>();
   using HMatrix = Eigen::Matrix<T, N, 6>;
 
-  if constexpr (kMasked) {
-    active &= all_channels<N>();
-    if (channel_count(active) < 6) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "array geometry: fewer than six active sensors cannot determine [angular "
-                    "accel; specific force]");
-    }
+  if (channel_count(active) < 6) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "array geometry: fewer than six active sensors cannot determine [angular "
+                  "accel; specific force]");
   }
-  const auto used = [active](int j) {
-    if constexpr (kMasked) {
-      return ((active >> static_cast<unsigned>(j)) & 1U) != 0U;
-    } else {
-      (void)active;
-      (void)j;
-      return true;
-    }
-  };
+  const auto used = [active](int j) { return ((active >> static_cast<unsigned>(j)) & 1U) != 0U; };
   T lever_sum = T(0);
   for (int j = 0; j < N; ++j) {
     const Vec3<T>& rho = g.rho_b[static_cast<std::size_t>(j)];
@@ -191,7 +179,7 @@ Result<ArraySolver<T, N>> ArraySolver<T, N>::create_subset(const ArrayGeometry<T
     }
     if (used(j)) lever_sum += rho.norm();
   }
-  const T lever = lever_sum / static_cast<T>(kMasked ? channel_count(active) : N);
+  const T lever = lever_sum / static_cast<T>(channel_count(active));
   if (!(lever > T(0)) || !std::isfinite(lever)) {
     return Status(ErrorCode::kInvalidArgument,
                   "array geometry: sensors have no lever arm (all positions at the centre), so "

@@ -30,7 +30,7 @@
 // ~1e-5 m/s² at 1 g) or a calibration error would pick one of them with certainty. A channel
 // whose posterior reaches the
 // configured probability is suspected; suspected in `confirm_windows` consecutive alarm windows,
-// its exclusion is requested: the owner builds the solver without it (ArraySolver::create with a
+// its exclusion is requested: the owner builds the solver without it (ArraySolver::create_subset, a
 // channel mask) and hands it to set_solver() here and to the integrator, which keep navigating
 // on the remaining N − 1 ≥ 6 sensors.
 //
