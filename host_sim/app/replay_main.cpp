@@ -5,6 +5,7 @@
 //                                                     (NavLoop, float32 core by default), CSV,
 //                                                     summary with the gap and hash report, PNG
 //   gfins-replay dump FILE.gfr                        header and samples as CSV on stdout
+//   gfins-replay dump FILE.gfr --frames               the CAN frames recorded, as a candump log
 //
 // The recording is what a board (or `gfins-sim run --record`) delivered: counts, sequence
 // counter, data-ready time and flags. Navigation starts as on the board: static alignment over
@@ -25,6 +26,7 @@
 #include "finite_range.hpp"
 #include "gfins/calib_file/calibration_data.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
+#include "gfins/drivers/lnx/candump.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/replay.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
@@ -88,7 +90,7 @@ class ReplayUsage final : public CLI::Formatter {
  public:
   std::string make_usage(const CLI::App* app, std::string name) const override {
     return CLI::Formatter::make_usage(app, std::move(name)) +
-           "       gfins-replay dump RECORDING.gfr\n"
+           "       gfins-replay dump RECORDING.gfr [--frames]\n"
            "       gfins-replay means RECORDING.gfr --mounting K --up X Y Z --rate-rad-s W "
            "[--header]\n";
   }
@@ -96,33 +98,70 @@ class ReplayUsage final : public CLI::Formatter {
 
 // ---- dump -------------------------------------------------------------------------------------
 
-int dump(const std::string& path) {
+// Each sample of a block as a CSV row.
+void print_samples(const std::vector<RawSample>& block, const sim::RecordingHeader& h) {
+  for (const RawSample& s : block) {
+    std::printf("%" PRIu32 ",%" PRId64, s.seq, s.t_ns);
+    for (const auto c : s.counts) std::printf(",%" PRId32, c);
+    for (std::size_t j = 0; j < 6; ++j) {
+      std::printf(",%.9g", static_cast<double>(s.counts[j]) * h.volts_per_count[j]);
+    }
+    std::printf(",%" PRIu32 "\n", s.flags);
+  }
+}
+
+// `dump --frames`: a block's frame records (version 2) as candump lines, "(sec.usec) rec ID#DATA",
+// stamped with the time of the cycle that handled each (gfins-can decode reads them).
+bool print_frames(const std::vector<sim::RecordedFrame>& frames) {
+  std::array<char, 64> line{};
+  for (const sim::RecordedFrame& r : frames) {
+    gfins::hal::CanFrame f;
+    f.id = r.frame.id;
+    f.extended = r.frame.extended;
+    f.len = r.frame.len;
+    f.data = r.frame.data;
+    // Floor division: a negative time still gives micros in 0..999999.
+    std::int64_t sec = r.frame.t_ns / 1000000000;
+    std::int64_t rem = r.frame.t_ns % 1000000000;
+    if (rem < 0) rem += 1000000000, --sec;
+    const std::size_t n = gfins::drivers::lnx::format_candump_line(
+        line, sec, static_cast<std::uint32_t>(rem / 1000), "rec", f);
+    if (n == 0) return false;
+    std::printf("%.*s\n", static_cast<int>(n), line.data());
+  }
+  return true;
+}
+
+int dump(const std::string& path, bool frames) {
   auto reader = sim::RecordingReader::open(path);
   if (!reader.is_ok()) return fail(reader.error().message, app::kExitBadInput);
   const sim::RecordingHeader& h = reader.value().header();
-  std::printf("# gfins raw-sample recording %s (docs/recording-format.md)\n",
-              printable(path).c_str());
-  std::printf("# version %u, %u channels, %u records per block, record_count %s\n",
-              static_cast<unsigned>(h.version), static_cast<unsigned>(h.channel_count),
-              static_cast<unsigned>(h.records_per_block),
-              h.record_count == sim::kRecordCountUnknown ? "unknown (writer not closed)"
-                                                         : std::to_string(h.record_count).c_str());
-  std::printf("# sample_rate_hz %.9g\n", h.sample_rate_hz);
-  for (std::size_t j = 0; j < 6; ++j) {
-    const auto& r = h.geometry.rho_b[j];
-    const auto& t = h.geometry.theta_b[j];
+  if (!frames) {
+    std::printf("# gfins raw-sample recording %s (docs/recording-format.md)\n",
+                printable(path).c_str());
+    std::printf("# version %u, %u channels, %u records per block, record_count %s\n",
+                static_cast<unsigned>(h.version), static_cast<unsigned>(h.channel_count),
+                static_cast<unsigned>(h.records_per_block),
+                h.record_count == sim::kRecordCountUnknown
+                    ? "unknown (writer not closed)"
+                    : std::to_string(h.record_count).c_str());
+    std::printf("# sample_rate_hz %.9g\n", h.sample_rate_hz);
+    for (std::size_t j = 0; j < 6; ++j) {
+      const auto& r = h.geometry.rho_b[j];
+      const auto& t = h.geometry.theta_b[j];
+      std::printf(
+          "# sensor a%zu: volts_per_count %.9g V, rho_b [%.6g %.6g %.6g] m, theta_b [%.6g %.6g "
+          "%.6g] (body FRD)\n",
+          j + 1, h.volts_per_count[j], r.x(), r.y(), r.z(), t.x(), t.y(), t.z());
+    }
     std::printf(
-        "# sensor a%zu: volts_per_count %.9g V, rho_b [%.6g %.6g %.6g] m, theta_b [%.6g %.6g "
-        "%.6g] (body FRD)\n",
-        j + 1, h.volts_per_count[j], r.x(), r.y(), r.z(), t.x(), t.y(), t.z());
+        "# columns: seq (ADC counter), t_ns (data-ready time, ns), count_1..count_6 (24-bit ADC "
+        "codes), v_1_V..v_6_V (volts at the sensor output = count x volts_per_count), flags (bit 0 "
+        "CRC error, 1 saturated, 2 late read, 3 synthetic)\n");
+    std::printf(
+        "seq,t_ns,count_1,count_2,count_3,count_4,count_5,count_6,v_1_V,v_2_V,v_3_V,v_4_V,v_5_V,"
+        "v_6_V,flags\n");
   }
-  std::printf(
-      "# columns: seq (ADC counter), t_ns (data-ready time, ns), count_1..count_6 (24-bit ADC "
-      "codes), v_1_V..v_6_V (volts at the sensor output = count x volts_per_count), flags (bit 0 "
-      "CRC error, 1 saturated, 2 late read, 3 synthetic)\n");
-  std::printf(
-      "seq,t_ns,count_1,count_2,count_3,count_4,count_5,count_6,v_1_V,v_2_V,v_3_V,v_4_V,v_5_V,"
-      "v_6_V,flags\n");
   std::vector<RawSample> block;
   for (;;) {
     auto more = reader.value().next_block(block);
@@ -131,13 +170,10 @@ int dump(const std::string& path) {
       return fail(more.error().message, app::kExitBadInput);
     }
     if (!more.value()) break;
-    for (const RawSample& s : block) {
-      std::printf("%" PRIu32 ",%" PRId64, s.seq, s.t_ns);
-      for (const auto c : s.counts) std::printf(",%" PRId32, c);
-      for (std::size_t j = 0; j < 6; ++j) {
-        std::printf(",%.9g", static_cast<double>(s.counts[j]) * h.volts_per_count[j]);
-      }
-      std::printf(",%" PRIu32 "\n", s.flags);
+    if (!frames) {
+      print_samples(block, h);
+    } else if (!print_frames(reader.value().frames())) {
+      return fail("frame record not printable as a candump line", app::kExitBadInput);
     }
   }
   if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
@@ -325,6 +361,14 @@ void print_report(std::FILE* f, const sim::NavReport& r, double rate_hz) {
                  g.index, static_cast<double>(g.index) / rate_hz, g.expected_seq, g.seq, g.missing);
   }
   if (r.gaps.size() > kListed) std::fprintf(f, "  ... %zu more\n", r.gaps.size() - kListed);
+  if (r.frames_not_applied > 0) {
+    std::fprintf(f,
+                 "CAN frames in the recording (what the recording board received: aiding inputs, "
+                 "commands): %" PRIu64
+                 ", not applied by gfins-replay (unaided navigation); gfins-fw --replay applies "
+                 "them in their cycles\n",
+                 r.frames_not_applied);
+  }
   std::fprintf(f, "output hash (FNV-1a-64 of every navigation state): %016" PRIx64 "\n",
                r.output_hash);
 }
@@ -558,13 +602,17 @@ int replay_main(int argc, char** argv) {
                  "gfins-replay dump"};
     cli.footer(stdout_footer);
     std::string path;
+    bool frames = false;
     cli.add_option("recording", path, "raw-sample recording (.gfr)")->required();
+    cli.add_flag("--frames", frames,
+                 "print the CAN frames the recording board received (version 2) as a candump "
+                 "log instead of the samples");
     try {
       cli.parse(argc - 1, argv + 1);
     } catch (const CLI::ParseError& e) {
       return cli.exit(e) == 0 ? app::kExitOk : app::kExitBadInput;
     }
-    return dump(path);
+    return dump(path, frames);
   }
   if (argc >= 2 && std::string(argv[1]) == "means") {
     CLI::App cli{

@@ -276,5 +276,45 @@ TEST_F(FwCli, ACanLogThatLosesFramesFailsTheRun) {
   EXPECT_GT(std::filesystem::file_size(path("out.log")), 0u);
 }
 
+// Record and replay as a user sets them up (docs/replay.md): what cannot work is refused before
+// the run, by --check-config and the run alike, naming the key and why; a recorder whose file
+// cannot be written fails the run, its loop unharmed.
+TEST_F(FwCli, AReplayThatCannotWorkIsRefusedBeforeTheRun) {
+  const std::string rec = path("short.gfr");
+  ASSERT_EQ(fw(sim_run({"--record", rec})).exit_code, 0);
+  const struct {
+    std::vector<std::string> args;
+    const char* says;
+  } bad[] = {
+      {{"--replay", rec, "--pacing", "realtime"},
+       "a recording is replayed by sample index: sim.pacing must be \"fast\""},
+      {{"--replay", rec, "--sample-rate", "2000"}, "recorded at 1000"},
+      {{"--replay", path("missing.gfr")}, "cannot open"},
+      {{"--replay", path("out.log")}, "wrong magic"},
+      {{"--replay", rec, "--record", rec}, "name the same file"},
+  };
+  for (const auto& b : bad) {
+    for (const bool check : {true, false}) {
+      std::vector<std::string> a = b.args;
+      a.insert(a.end(), {"--calibration", "", "--can-log", path("replay.log")});
+      if (check) a.push_back("--check-config");
+      const test::CliResult r = fw(a);
+      EXPECT_EQ(r.exit_code, 2) << b.says << "\n" << r.output;
+      EXPECT_NE(r.output.find(b.says), std::string::npos) << r.output;
+      EXPECT_EQ(r.output.find(kStarted), std::string::npos) << r.output;
+    }
+  }
+  // The same recording replays; a recorder on /dev/full fails the run at start-up (exit 1).
+  EXPECT_EQ(fw({"--replay", rec, "--calibration", "", "--can-log", path("replay.log")}).exit_code,
+            0);
+  if (std::filesystem::exists("/dev/full")) {
+    const test::CliResult full = fw(sim_run({"--record", "/dev/full"}));
+    EXPECT_EQ(full.exit_code, 1) << full.output;
+    EXPECT_NE(full.output.find("record.file \"/dev/full\": cannot write the header of /dev/full"),
+              std::string::npos)
+        << full.output;
+  }
+}
+
 }  // namespace
 }  // namespace gfins

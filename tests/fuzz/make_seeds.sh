@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Writes the seed corpora of tests/fuzz/corpus/ (docs/reliability.md) from the project's own
 # files and programs: usage `tests/fuzz/make_seeds.sh BUILD_DIR` (a release tree with gfins-sim,
-# gfins-calibrate and gfins-can-gen built). Findings kept as regression inputs are not touched:
+# gfins-calibrate, gfins-fw and gfins-can-gen built). Findings kept as regression inputs are not touched:
 # only files named seed-* are rewritten.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -42,6 +42,12 @@ sed 's/^duration_s = .*/duration_s = 0.02/' host_sim/scenarios/rest.toml >"$tmp/
 "$build/host_sim/app/gfins-sim" run "$tmp/short.toml" --record "$tmp/rest.gfr" --no-plot \
   -o "$tmp/rest" >/dev/null
 prefixed 001 "$tmp/rest.gfr" "$corpus/recording/seed-rest.gfr"
+# Version 2 with frame records: the firmware recording an aided drive (its receiver's frames).
+printf '[aiding]\nenabled = true\ntrack_heading_sigma_deg = 0.5\n' >"$tmp/vehicle.toml"
+"$build/firmware/app/gfins-fw" --config "$tmp/vehicle.toml" --sim drive-gnss \
+  --scenario-dir host_sim/scenarios --calibration "" --can-log "$tmp/drive.log" \
+  --record "$tmp/drive.gfr" --duration 0.1 --watchdog none --log-level off
+prefixed 001 "$tmp/drive.gfr" "$corpus/recording/seed-drive-frames.gfr"
 for f in clean restart bad_crc sample_back time_jump out_of_range malformed_lines; do
   prefixed 001 "tests/golden/can/$f.log" "$corpus/can_log/seed-$f.log"
 done

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -306,18 +307,21 @@ TEST(RecordingTest, WrongMagicAndVersionAreRejected) {
   ASSERT_FALSE(m.is_ok());
   EXPECT_EQ(m.error().byte_offset, 0u);
   EXPECT_NE(m.error().message.find("magic"), std::string::npos);
-  // and one of version 2 (with a consistent header CRC, as a newer writer would make),
-  RecordingHeader h2 = test_header();
-  h2.version = 2;
-  const auto head = encode_header(h2);
-  auto v2 = good_image();
-  std::copy(head.begin(), head.end(), v2.begin());
-  const auto v = decode_recording(v2);
-  // then both are refused, the version naming offset 8 and the version found.
-  ASSERT_FALSE(v.is_ok());
-  EXPECT_EQ(v.error().code, ErrorCode::kUnimplemented);
-  EXPECT_EQ(v.error().byte_offset, 8u);
-  EXPECT_NE(v.error().message.find("version 2"), std::string::npos) << v.error().message;
+  // and ones of versions 0 and 3 (with a consistent header CRC, as a newer writer would make),
+  for (const std::uint16_t version : {std::uint16_t{0}, std::uint16_t{3}}) {
+    RecordingHeader h = test_header();
+    h.version = version;
+    const auto head = encode_header(h);
+    auto image = good_image();
+    std::copy(head.begin(), head.end(), image.begin());
+    const auto v = decode_recording(image);
+    // then all are refused, the version naming offset 8 and the version found.
+    ASSERT_FALSE(v.is_ok());
+    EXPECT_EQ(v.error().code, ErrorCode::kUnimplemented);
+    EXPECT_EQ(v.error().byte_offset, 8u);
+    EXPECT_NE(v.error().message.find("version " + std::to_string(version)), std::string::npos)
+        << v.error().message;
+  }
 }
 
 TEST(RecordingTest, TrailingBytesAfterTheAnnouncedRecordsAreAnError) {
@@ -336,7 +340,7 @@ TEST(RecordingTest, SamplesThatDoNotFitTheRecordAreRefused) {
   RawSample big;
   big.counts[2] = 1 << 23;
   RawSample flag;
-  flag.flags = 1u << 16;
+  flag.flags = 1u << 15;  // the frame-record mark (version 2)
   // then neither encodes (so no sample is ever silently changed).
   EXPECT_FALSE(encode_record(big).is_ok());
   EXPECT_EQ(encode_record(big).error().code, ErrorCode::kOutOfRange);
@@ -354,15 +358,15 @@ TEST(RecordingTest, SamplesThatDoNotFitTheRecordAreRefused) {
 }
 
 TEST(RecordingTest, HeadersTheReaderWouldRefuseAreNotWritten) {
-  // Given headers with 0 records per block, 5 channels or version 2,
+  // Given headers with 0 records per block, 5 channels or version 1 (read, no longer written),
   RecordingHeader zero = test_header();
   zero.records_per_block = 0;
   RecordingHeader five = test_header();
   five.channel_count = 5;
-  RecordingHeader v2 = test_header();
-  v2.version = 2;
+  RecordingHeader v1 = test_header();
+  v1.version = 1;
   // then neither the encoder nor the writer produces a file from them.
-  for (const RecordingHeader& h : {zero, five, v2}) {
+  for (const RecordingHeader& h : {zero, five, v1}) {
     const auto e = encode_recording(h, test_samples());
     ASSERT_FALSE(e.is_ok());
     EXPECT_EQ(e.error().code, ErrorCode::kInvalidArgument);
@@ -374,6 +378,177 @@ TEST(RecordingTest, MissingFileIsAnIoError) {
   const auto rec = read_recording(temp_path("does_not_exist.gfr"));
   ASSERT_FALSE(rec.is_ok());
   EXPECT_EQ(rec.error().code, ErrorCode::kIoError);
+}
+
+// ---- Version 2: frame records ------------------------------------------------------------
+
+// The bytes of a version-1 file, written here field by field from docs/recording-format.md
+// (not through the encoder under test): the header of test_header() and `samples`, one block.
+std::vector<std::uint8_t> version1_image(const std::vector<RawSample>& samples) {
+  std::vector<std::uint8_t> b(kRecordingHeaderBytes, 0);
+  const auto put = [&b](std::size_t at, std::uint64_t v, int n) {
+    for (int i = 0; i < n; ++i)
+      b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+  };
+  const RecordingHeader h = test_header();
+  const char* magic = "GFINSRAW";
+  for (std::size_t i = 0; i < 8; ++i) b[i] = static_cast<std::uint8_t>(magic[i]);
+  put(8, 1, 2);
+  put(10, 384, 2);
+  put(12, 6, 2);
+  put(14, 32, 2);
+  put(16, samples.size(), 4);
+  put(24, samples.size(), 8);
+  put(32, std::bit_cast<std::uint64_t>(h.sample_rate_hz), 8);
+  for (std::size_t j = 0; j < 6; ++j) {
+    put(40 + 8 * j, std::bit_cast<std::uint64_t>(h.volts_per_count[j]), 8);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto r = static_cast<Eigen::Index>(k);
+      put(88 + 8 * (3 * j + k), std::bit_cast<std::uint64_t>(h.geometry.rho_b[j](r)), 8);
+      put(232 + 8 * (3 * j + k), std::bit_cast<std::uint64_t>(h.geometry.theta_b[j](r)), 8);
+    }
+  }
+  put(380, crc32(std::span(b.data(), 380)), 4);
+  const std::size_t start = b.size();
+  for (const RawSample& s : samples) {
+    const std::size_t at = b.size();
+    b.resize(at + 32, 0);
+    put(at, s.seq, 4);
+    put(at + 4, static_cast<std::uint64_t>(s.t_ns), 8);
+    for (std::size_t j = 0; j < 6; ++j)
+      put(at + 12 + 3 * j, static_cast<std::uint32_t>(s.counts[j]), 3);
+    put(at + 30, s.flags, 2);
+  }
+  const std::uint32_t crc = crc32(std::span(b).subspan(start));
+  b.resize(b.size() + 4);
+  put(b.size() - 4, crc, 4);
+  return b;
+}
+
+TEST(RecordingV2Test, AVersion1FileStillReadsAndItsBit15IsASampleFlag) {
+  // Given a version-1 file written byte by byte, one of whose samples has flag bit 15 set (a
+  // version-1 writer allowed it),
+  const std::vector<RawSample> all = test_samples();
+  std::vector<RawSample> samples(all.begin(), all.begin() + 5);
+  samples[2].flags = 0x8001u;
+  const auto rec = decode_recording(version1_image(samples));
+  // then it reads as five samples and no frame, bit 15 kept as a sample flag.
+  ASSERT_TRUE(rec.is_ok()) << rec.error().message;
+  EXPECT_EQ(rec.value().header.version, 1u);
+  expect_same(rec.value().samples, samples);
+  EXPECT_TRUE(rec.value().frames.empty());
+}
+
+TEST(RecordingV2Test, FrameRecordsHaveTheDocumentedLayout) {
+  // Given a 29-bit frame of 5 bytes at t = -3 ns,
+  recording::FrameRecord f;
+  f.t_ns = -3;
+  f.id = 0x18FEF100u;
+  f.extended = true;
+  f.len = 5;
+  f.data = {1, 2, 3, 4, 5, 0xAA, 0xBB, 0xCC};
+  std::array<std::uint8_t, kRecordingRecordBytes> b{};
+  ASSERT_TRUE(recording::encode_frame_record(f, b).ok());
+  // then the bytes are those of docs/recording-format.md, "Frame records": identifier with bit
+  // 31 for a 29-bit one, time, length, a zero byte, all eight data bytes, zeros, flags 0x8000.
+  const std::array<std::uint8_t, 32> want = {
+      0x00, 0xF1, 0xFE, 0x98,                          // id | 0x80000000, little-endian
+      0xFD, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,  // t_ns = -3
+      5,    0,                                         // len, reserved
+      1,    2,    3,    4,    5,    0xAA, 0xBB, 0xCC,  // data[8], as given
+      0,    0,    0,    0,    0,    0,    0,    0,     // reserved
+      0x00, 0x80};                                     // the frame mark
+  EXPECT_EQ(b, want);
+  recording::FrameRecord back;
+  ASSERT_TRUE(recording::decode_frame_record(b, back).ok());
+  EXPECT_EQ(back.t_ns, f.t_ns);
+  EXPECT_EQ(back.id, f.id);
+  EXPECT_TRUE(back.extended);
+  EXPECT_EQ(back.len, f.len);
+  EXPECT_EQ(back.data, f.data);
+}
+
+TEST(RecordingV2Test, FramesComeBackBetweenTheSamplesTheyFollowed) {
+  // Given samples with frames after samples 0, 15 (the end of a block of 16), 16 and 99,
+  const std::string path = temp_path("frames.gfr");
+  const auto samples = test_samples();
+  auto w = RecordingWriter::open(path, test_header());
+  ASSERT_TRUE(w.is_ok()) << w.error().message;
+  const std::vector<std::size_t> after = {0, 15, 15, 16, 99};
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    ASSERT_TRUE(w.value().append(samples[i]).is_ok());
+    for (; next < after.size() && after[next] == i; ++next) {
+      recording::FrameRecord f;
+      f.t_ns = samples[i].t_ns;
+      f.id = 0x300u + static_cast<std::uint32_t>(next);
+      f.len = static_cast<std::uint8_t>(next + 1);
+      f.data[0] = static_cast<std::uint8_t>(next);
+      ASSERT_TRUE(w.value().append_frame(f).is_ok());
+    }
+  }
+  ASSERT_TRUE(w.value().close().is_ok());
+  // when read whole and streamed,
+  const auto rec = read_recording(path);
+  ASSERT_TRUE(rec.is_ok()) << rec.error().message;
+  // then the samples are unchanged, the header counts every record, and each frame comes back
+  // with the number of samples before it and its own fields.
+  expect_same(rec.value().samples, samples);
+  EXPECT_EQ(rec.value().header.record_count, samples.size() + after.size());
+  ASSERT_EQ(rec.value().frames.size(), after.size());
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    const RecordedFrame& f = rec.value().frames[k];
+    EXPECT_EQ(f.samples_before, after[k] + 1) << k;
+    EXPECT_EQ(f.frame.id, 0x300u + k);
+    EXPECT_EQ(f.frame.len, k + 1);
+    EXPECT_EQ(f.frame.data[0], k);
+    EXPECT_EQ(f.frame.t_ns, samples[after[k]].t_ns);
+  }
+  auto reader = RecordingReader::open(path);
+  ASSERT_TRUE(reader.is_ok());
+  std::vector<RawSample> block;
+  std::size_t frames = 0;
+  while (reader.value().next_block(block).value()) frames += reader.value().frames().size();
+  EXPECT_EQ(frames, after.size());
+  EXPECT_EQ(reader.value().samples_read(), samples.size());
+  EXPECT_EQ(reader.value().frames_read(), after.size());
+  std::filesystem::remove(path);
+}
+
+TEST(RecordingV2Test, AMalformedFrameRecordIsAnErrorNamingItsByte) {
+  // Given a file whose only record is a frame with length 9 (CRC made consistent, as a hostile
+  // file would be),
+  const std::string path = temp_path("bad_frame.gfr");
+  RecordingHeader h = test_header();
+  auto w = RecordingWriter::open(path, h);
+  ASSERT_TRUE(w.is_ok());
+  recording::FrameRecord f;
+  f.id = 0x123;
+  f.len = 8;
+  ASSERT_TRUE(w.value().append_frame(f).is_ok());
+  ASSERT_TRUE(w.value().close().is_ok());
+  ASSERT_TRUE(read_recording(path).is_ok());
+  std::FILE* fp = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(fp, nullptr);
+  std::vector<std::uint8_t> image(kRecordingHeaderBytes + 32 + 4);
+  ASSERT_EQ(std::fread(image.data(), 1, image.size(), fp), image.size());
+  std::fclose(fp);
+  image[kRecordingHeaderBytes + 12] = 9;
+  const std::uint32_t crc = crc32(std::span(image).subspan(kRecordingHeaderBytes, 32));
+  for (int i = 0; i < 4; ++i)
+    image[kRecordingHeaderBytes + 32 + static_cast<std::size_t>(i)] =
+        static_cast<std::uint8_t>(crc >> (8 * i));
+  // then the reader refuses it at the length byte, and an identifier too large for 11 bits too.
+  const auto r = decode_recording(image);
+  ASSERT_FALSE(r.is_ok());
+  EXPECT_EQ(r.error().code, ErrorCode::kDataLoss);
+  EXPECT_EQ(r.error().byte_offset, kRecordingHeaderBytes + 12);
+  EXPECT_NE(r.error().message.find("length above 8"), std::string::npos) << r.error().message;
+  recording::FrameRecord wide;
+  wide.id = 0x800;
+  std::array<std::uint8_t, kRecordingRecordBytes> b{};
+  EXPECT_EQ(recording::encode_frame_record(wide, b).code, ErrorCode::kOutOfRange);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -191,7 +191,7 @@ TEST_F(ReplayChecksCli, UsageNamesNavigationDumpAndMeans) {
   EXPECT_EQ(r.exit_code, kExitOk) << r.output;
   EXPECT_NE(r.output.find("Usage: gfins-replay [OPTIONS] recording"), std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("       gfins-replay dump RECORDING.gfr\n"), std::string::npos)
+  EXPECT_NE(r.output.find("       gfins-replay dump RECORDING.gfr [--frames]\n"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("       gfins-replay means RECORDING.gfr --mounting K --up X Y Z "
                           "--rate-rad-s W [--header]\n"),

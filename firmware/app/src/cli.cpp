@@ -29,7 +29,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       "publishes on CAN; --sim runs the same program on the simulated board.",
       "gfins-fw"};
   std::string config_file, board, spi, chip, line, can_if, can_log, compensator, calib, gravity,
-      watchdog, wd_device, level, scenario, scenario_dir, pacing, hil_address, hil_port_file;
+      watchdog, wd_device, level, scenario, scenario_dir, pacing, hil_address, hil_port_file,
+      record, replay;
   int hil_port = 0;
   double rate = 0, g = 0, lat = 0, height = 0, heading = 0, align = 0, duration = 0;
   std::vector<double> position;
@@ -43,6 +44,13 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   auto* o_sim = app.add_option("--sim", scenario,
                                "run on the simulated board with this scenario (name or .toml; "
                                "sets board.kind = \"sim\" and sim.scenario)");
+  auto* o_replay =
+      app.add_option("--replay", replay,
+                     "replay a raw-sample recording (.gfr, e.g. one of --record) through the same "
+                     "loop on the simulated board (sets board.kind = \"sim\" and sim.recording)")
+          ->excludes(o_sim);
+  auto* o_record = app.add_option("--record", record,
+                                  "record.file: every sample and received CAN frame, for --replay");
   auto* o_board =
       app.add_option("--board", board, "board.kind")->check(CLI::IsMember({"linux", "sim", "hil"}));
   auto* o_hil_addr = app.add_option("--hil-address", hil_address, "hil.address");
@@ -137,7 +145,13 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_sim->count()) {
     c.board = BoardKind::kSim;
     c.sim_scenario = scenario;
+    c.sim_recording.clear();
   }
+  if (o_replay->count()) {
+    c.board = BoardKind::kSim;
+    c.sim_recording = replay;
+  }
+  if (o_record->count()) c.record_file = record;
   if (o_spi->count()) c.spi_device = spi;
   if (o_chip->count()) c.gpio_chip = chip;
   if (o_line->count()) c.drdy_line = line;
@@ -226,6 +240,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       {"can.log_file (--can-log)", c.can_log},
       {"--latency-csv", out.latency_csv},
       {"hil.port_file (--hil-port-file)", c.hil_port_file},
+      {"record.file (--record)", c.record_file},
+      {"sim.recording (--replay, read while the run writes)", c.sim_recording},
       {"calibration.file (--calibration, written by the calibrate command)", c.calibration_file},
   };
   if (auto clash = drivers::lnx::output_clash(outputs)) {

@@ -177,7 +177,7 @@ class Reader {
 
 void read_all(Reader& r, FwConfig& c) {
   for (const char* t : {"board", "adc", "can", "output", "navigation", "aiding", "calibration",
-                        "realtime", "watchdog", "log", "sim", "hil"}) {
+                        "realtime", "watchdog", "log", "sim", "hil", "record"}) {
     r.table(t);
   }
   r.choice("board.kind", c.board, std::array<const char*, 3>{"linux", "sim", "hil"},
@@ -236,6 +236,8 @@ void read_all(Reader& r, FwConfig& c) {
   r.choice("sim.pacing", c.pacing, std::array<const char*, 3>{"fast", "realtime", "gpio"},
            std::array<Pacing, 3>{Pacing::kFast, Pacing::kRealTime, Pacing::kGpio});
   r.number("sim.duration_s", c.sim_duration_s);
+  r.text("sim.recording", c.sim_recording);
+  r.text("record.file", c.record_file);
   r.text("hil.address", c.hil_address);
   r.integer("hil.port", c.hil_port, 0, 65535);
   r.text("hil.port_file", c.hil_port_file);

@@ -228,6 +228,14 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
   if (!(c.sim_duration_s >= 0.0 && c.sim_duration_s <= 86400.0)) {
     return P{"sim.duration_s", num(c.sim_duration_s), "must be 0 (the scenario's) .. 86400 s"};
   }
+  if (!c.sim_recording.empty() && !valid_path(c.sim_recording)) {
+    return P{"sim.recording", quote_text(c.sim_recording),
+             std::string(kPathRule) + " (or empty for a scenario)"};
+  }
+  if (!c.record_file.empty() && !valid_path(c.record_file)) {
+    return P{"record.file", quote_text(c.record_file),
+             std::string(kPathRule) + " (or empty for none)"};
+  }
   if (!valid_ipv4(c.hil_address)) {
     return P{"hil.address", quote_text(c.hil_address),
              "must be an IPv4 address a.b.c.d (each 0..255), e.g. \"127.0.0.1\""};

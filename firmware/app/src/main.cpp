@@ -16,6 +16,7 @@
 #include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
+#include "gfins/app/recorder.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/service_status.hpp"
 #include "gfins/app/startup.hpp"
@@ -79,8 +80,27 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   drain.start();
   ReloadWorker reload(calibration_reloader(cfg, converter_lsb(board.defaults), cal.device_id));
 
+  // The recorder (record.file): its header says how the samples were made (rate, the chain's
+  // LSB, the configured nominal geometry); opened before the loop, as every output is.
+  std::unique_ptr<Recorder> recorder;
+  if (!cfg.record_file.empty()) {
+    gfins::recording::Header h;
+    h.sample_rate_hz = cfg.sample_rate_hz;
+    h.volts_per_count.fill(board.source->volts_per_count());
+    h.geometry = cal.set.config.nominal.cast<double>();
+    Recorder::Opened opened = Recorder::open(cfg.record_file, h);
+    if (!opened.recorder) {
+      spdlog::critical("record.file {}: {}", quote_text(cfg.record_file),
+                       printable_text(opened.error));
+      return 1;
+    }
+    recorder = std::move(opened.recorder);
+    recorder->start();
+  }
+
   auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
                                            *log_queue);
+  if (recorder) loop->set_recorder(&recorder->queue());
   loop->set_commands(board.commands);
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);
@@ -171,6 +191,15 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
       spdlog::error("--latency-csv {}: write error: {}", quote_text(latency_csv),
                     std::strerror(errno));
       status = 1;
+    }
+  }
+  if (recorder) {
+    if (const std::string e = recorder->stop(); !e.empty()) {
+      spdlog::error("record.file {}: {}", quote_text(cfg.record_file), printable_text(e));
+      status = 1;
+    } else {
+      spdlog::info("recorded {} records ({} samples and the frames received) to {}",
+                   recorder->records_written(), h.samples, quote_text(cfg.record_file));
     }
   }
   board.close();

@@ -48,6 +48,11 @@ std::string preflight(const FwConfig& c, const BoardTable& boards, const std::st
       return bad("can.log_file", c.can_log, why);
     }
   }
+  if (!c.record_file.empty()) {
+    if (std::string why = output_path_problem(c.record_file); !why.empty()) {
+      return bad("record.file", c.record_file, why);
+    }
+  }
   if (c.board == BoardKind::kHil && !c.hil_port_file.empty()) {
     if (std::string why = output_path_problem(c.hil_port_file); !why.empty()) {
       return bad("hil.port_file", c.hil_port_file, why);

@@ -56,6 +56,7 @@ SampleLoop::Cycle SampleLoop::step() {
   Cycle cycle = Cycle::kSample;
   if (r.is_ok()) {
     t_cycle_ = r.value().t_ns;
+    if (recorder_ != nullptr && !record_sample(*recorder_, r.value())) note_record_dropped();
     on_sample(r.value());
   } else {
     t_cycle_ = clock_.now_ns();
@@ -382,11 +383,20 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
 
 // ---- Commands -------------------------------------------------------------------------------
 
+void SampleLoop::note_record_dropped() {
+  ++health_.record_dropped;
+  limited_log(LogKind::kRecordDropped, LogLevel::kError, t_cycle_,
+              "recorder queue full: record lost, the recording has a hole (lost: {}; {} more "
+              "since the last line)",
+              health_.record_dropped);
+}
+
 void SampleLoop::handle_commands(std::int64_t t_ns) {
   if (!commands_ && !options_.aiding_inputs) return;
   for (int i = 0; i < kMaxCommandsPerCycle; ++i) {
     const Result<hal::CanFrame> f = bus_.receive(0);
     if (!f.is_ok()) return;  // kTimeout: nothing waiting
+    if (recorder_ != nullptr && !record_frame(*recorder_, f.value(), t_ns)) note_record_dropped();
     if (options_.aiding_inputs && handle_input(f.value(), t_ns)) continue;
     if (!commands_) continue;
     const can::DecodedCommand d = can::decode_command(f.value(), options_.node_id);

@@ -23,6 +23,7 @@ struct SimParts {
 }  // namespace
 
 app::BoardResult make_board(const app::FwConfig& c) {
+  if (!c.sim_recording.empty()) return make_replay_board(c);
   app::BoardResult out;
   // Named scenarios: sim.scenario_dir when set, else found relative to this program
   // ($GFINS_SCENARIO_DIR, PREFIX/share/gfins/scenarios, PREFIX/share/gfins-fw/scenarios: the
@@ -138,6 +139,7 @@ app::BoardResult make_board(const app::FwConfig& c) {
 }
 
 std::string check_config(const app::FwConfig& c, const std::string& origin) {
+  if (!c.sim_recording.empty()) return check_recording(c, origin);
   const auto bad = [&](const std::string& why) {
     return origin + ": sim.scenario = " + app::quote_text(c.sim_scenario) + ": " + why;
   };

@@ -75,7 +75,8 @@ HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const 
   if (c.ok()) return b;
   if (std::string(c.what).find("flags") != std::string::npos) {
     return error_at(c.code, 0,
-                    "sample " + std::to_string(s.seq) + ": flags above bit 15 do not fit");
+                    "sample " + std::to_string(s.seq) +
+                        ": flags at or above bit 15 do not fit (bit 15 marks a frame record)");
   }
   return error_at(c.code, 0,
                   "sample " + std::to_string(s.seq) + ": count " +
@@ -84,19 +85,42 @@ HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const 
 }
 
 HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
-                                                       std::span<const RawSample> samples) {
+                                                       std::span<const RawSample> samples,
+                                                       std::span<const RecordedFrame> frames) {
   if (auto bad = writable_error(header)) return *bad;
-  header.record_count = samples.size();
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (frames[k].samples_before > samples.size() ||
+        (k > 0 && frames[k].samples_before < frames[k - 1].samples_before)) {
+      return HostError{
+          ErrorCode::kInvalidArgument,
+          "recording: frame " + std::to_string(k) + " is out of order or after the last sample", 0};
+    }
+  }
+  const std::size_t total = samples.size() + frames.size();
+  header.record_count = total;
   const auto head = encode_header(header);
   std::vector<std::uint8_t> out(head.begin(), head.end());
   const std::size_t rpb = header.records_per_block;
-  const std::size_t blocks = (samples.size() + rpb - 1) / rpb;
-  out.reserve(out.size() + samples.size() * kRecordingRecordBytes + blocks * kRecordingCrcBytes);
-  for (std::size_t first = 0; first < samples.size(); first += rpb) {
+  const std::size_t blocks = (total + rpb - 1) / rpb;
+  out.reserve(out.size() + total * kRecordingRecordBytes + blocks * kRecordingCrcBytes);
+  std::size_t next_sample = 0, next_frame = 0;
+  for (std::size_t first = 0; first < total; first += rpb) {
     const std::size_t block_start = out.size();
-    const std::size_t n = std::min(rpb, samples.size() - first);
-    for (std::size_t i = first; i < first + n; ++i) {
-      const auto rec = encode_record(samples[i]);
+    const std::size_t n = std::min(rpb, total - first);
+    for (std::size_t i = 0; i < n; ++i) {
+      // Frames due after the samples written so far come first, then the next sample.
+      if (next_frame < frames.size() && frames[next_frame].samples_before <= next_sample) {
+        std::array<std::uint8_t, kRecordingRecordBytes> rec{};
+        const CodecStatus c = recording::encode_frame_record(frames[next_frame].frame, rec);
+        if (!c.ok()) {
+          return error_at(c.code, out.size(),
+                          "frame " + std::to_string(next_frame) + ": " + c.what);
+        }
+        out.insert(out.end(), rec.begin(), rec.end());
+        ++next_frame;
+        continue;
+      }
+      const auto rec = encode_record(samples[next_sample++]);
       if (!rec.is_ok()) {
         HostError e = rec.error();
         e.byte_offset = out.size();
@@ -122,6 +146,7 @@ HostResult<Recording> read_remaining_blocks(RecordingReader& reader, Recording r
     if (!more.is_ok()) return more.error();
     if (!more.value()) break;
     rec.samples.insert(rec.samples.end(), block.begin(), block.end());
+    rec.frames.insert(rec.frames.end(), reader.frames().begin(), reader.frames().end());
   }
   return rec;
 }
@@ -159,7 +184,9 @@ RecordingReader::RecordingReader(RecordingReader&& other) noexcept
       header_(std::move(other.header_)),
       pos_(other.pos_),
       index_(other.index_),
+      samples_(other.samples_),
       block_(other.block_),
+      frames_(std::move(other.frames_)),
       file_pos_(other.file_pos_),
       stdio_buffer_(std::move(other.stdio_buffer_)),
       buffer_(std::move(other.buffer_)) {}
@@ -176,7 +203,9 @@ RecordingReader& RecordingReader::operator=(RecordingReader&& other) noexcept {
     header_ = std::move(other.header_);
     pos_ = other.pos_;
     index_ = other.index_;
+    samples_ = other.samples_;
     block_ = other.block_;
+    frames_ = std::move(other.frames_);
     file_pos_ = other.file_pos_;
     stdio_buffer_ = std::move(other.stdio_buffer_);  // after fclose of the stream that used ours
     buffer_ = std::move(other.buffer_);
@@ -328,9 +357,26 @@ HostResult<bool> RecordingReader::next_block(std::vector<RawSample>& out) {
                         ", computed " + hex32(c.expected) + ")");
   }
   out.resize(static_cast<std::size_t>(n));  // keeps its capacity from block to block
+  frames_.clear();
+  std::size_t samples = 0;
   for (std::size_t i = 0; i < out.size(); ++i) {
-    out[i] = decode_record(data.subspan(i * kRecordingRecordBytes).first<kRecordingRecordBytes>());
+    const auto rec = data.subspan(i * kRecordingRecordBytes).first<kRecordingRecordBytes>();
+    if (!recording::is_frame_record(rec, header_.version)) {
+      out[samples++] = decode_record(rec);
+      continue;
+    }
+    RecordedFrame f;
+    f.samples_before = samples_ + samples;
+    if (const CodecStatus c = recording::decode_frame_record(rec, f.frame); !c.ok()) {
+      const std::uint64_t at = pos_ + i * kRecordingRecordBytes;
+      return error_at(c.code, at + c.offset,
+                      "record " + std::to_string(index_ + i) + " at byte offset " +
+                          std::to_string(at) + ": " + c.what);
+    }
+    frames_.push_back(f);
   }
+  out.resize(samples);
+  samples_ += samples;
   index_ += n;
   pos_ += need;
   ++block_;
@@ -407,16 +453,29 @@ HostResult<RecordingWriter> RecordingWriter::open(const std::string& path,
 }
 
 HostStatus RecordingWriter::append(const RawSample& s) {
-  if (file_ == nullptr) {
-    return HostError{ErrorCode::kFailedPrecondition, "recording: append after close", offset_};
-  }
   const auto rec = encode_record(s);
   if (!rec.is_ok()) {
     HostError e = rec.error();
     e.byte_offset = offset_ + block_.size();
     return e;
   }
-  block_.insert(block_.end(), rec.value().begin(), rec.value().end());
+  return append_bytes(rec.value());
+}
+
+HostStatus RecordingWriter::append_frame(const recording::FrameRecord& f) {
+  std::array<std::uint8_t, kRecordingRecordBytes> rec{};
+  if (const CodecStatus c = recording::encode_frame_record(f, rec); !c.ok()) {
+    return error_at(c.code, offset_ + block_.size(),
+                    std::string("frame id ") + hex32(f.id) + ": " + c.what);
+  }
+  return append_bytes(rec);
+}
+
+HostStatus RecordingWriter::append_bytes(std::span<const std::uint8_t, kRecordingRecordBytes> rec) {
+  if (file_ == nullptr) {
+    return HostError{ErrorCode::kFailedPrecondition, "recording: append after close", offset_};
+  }
+  block_.insert(block_.end(), rec.begin(), rec.end());
   ++records_;
   if (block_.size() == header_.records_per_block * kRecordingRecordBytes) return flush_block();
   return Done{};

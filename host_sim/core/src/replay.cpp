@@ -17,11 +17,14 @@ HostResult<NavReport> replay_recording(const std::string& path, nav::NavPipeline
     if (!more.is_ok()) return more.error();
     if (!more.value()) break;
     for (const RawSample& x : block) {
-      if (stop != nullptr && *stop != 0) return loop.report();
+      if (stop != nullptr && *stop != 0) break;
       loop.step(x);
     }
+    if (stop != nullptr && *stop != 0) break;
   }
-  return loop.report();
+  NavReport r = loop.report();
+  r.frames_not_applied = reader.value().frames_read();
+  return r;
 }
 
 template HostResult<NavReport> replay_recording<float>(const std::string&, nav::NavPipeline<float>&,

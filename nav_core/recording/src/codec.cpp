@@ -12,6 +12,14 @@ constexpr std::size_t kRecSeq = 0;
 constexpr std::size_t kRecTime = 4;
 constexpr std::size_t kRecCounts = 12;
 constexpr std::size_t kRecFlags = 30;
+// Frame records (version 2, docs/recording-format.md, "Frame records"): the identifier with bit
+// 31 marking a 29-bit one, the time at kRecTime, the length, the eight data bytes.
+constexpr std::size_t kRecFrameId = 0;
+constexpr std::size_t kRecFrameLen = 12;
+constexpr std::size_t kRecFrameData = 14;
+constexpr std::uint32_t kExtendedBit = 0x80000000u;
+constexpr std::uint32_t kMaxStandardId = 0x7FFu;
+constexpr std::uint32_t kMaxExtendedId = 0x1FFFFFFFu;
 
 // CRC-32 "slicing by 8" (the method of Intel's Kounavis and Berry, 2005): t[0] is the classic
 // byte table; t[k][i] is the CRC of byte i followed by k zero bytes, so eight table look-ups
@@ -85,7 +93,7 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc) {
 
 CodecStatus check_writable(const Header& h) {
   if (h.version != kVersion) {
-    return fail(ErrorCode::kInvalidArgument, "header version is not 1", kOffVersion, h.version,
+    return fail(ErrorCode::kInvalidArgument, "header version is not 2", kOffVersion, h.version,
                 kVersion);
   }
   if (h.channel_count != kAdcChannels) {
@@ -131,7 +139,7 @@ CodecStatus decode_header(std::span<const std::uint8_t> bytes, Header& out) {
   }
   Header h;
   h.version = get_u16(p + kOffVersion);
-  if (h.version != kVersion) {
+  if (h.version < kMinVersion || h.version > kVersion) {
     return fail(ErrorCode::kUnimplemented, "unsupported version", kOffVersion, h.version, kVersion);
   }
   const std::uint32_t stored = get_u32(p + kOffHeaderCrc);
@@ -170,8 +178,9 @@ CodecStatus decode_header(std::span<const std::uint8_t> bytes, Header& out) {
 
 CodecStatus encode_record(const RawSample& s, std::span<std::uint8_t, kRecordBytes> out) {
   std::uint8_t* b = out.data();
-  if (s.flags > 0xFFFFu) {
-    return fail(ErrorCode::kOutOfRange, "flags above bit 15 do not fit", 0, s.flags, 0xFFFFu);
+  if (s.flags >= kFrameRecordFlag) {
+    return fail(ErrorCode::kOutOfRange, "flags at or above bit 15 do not fit", 0, s.flags,
+                kFrameRecordFlag - 1u);
   }
   std::memset(b, 0, kRecordBytes);
   put_u32(b + kRecSeq, s.seq);
@@ -205,6 +214,61 @@ RawSample decode_record(std::span<const std::uint8_t, kRecordBytes> bytes) {
   }
   s.flags = get_u16(p + kRecFlags);
   return s;
+}
+
+bool is_frame_record(std::span<const std::uint8_t, kRecordBytes> bytes, std::uint16_t version) {
+  return version >= 2 && (get_u16(bytes.data() + kRecFlags) & kFrameRecordFlag) != 0;
+}
+
+CodecStatus encode_frame_record(const FrameRecord& f, std::span<std::uint8_t, kRecordBytes> out) {
+  std::uint8_t* b = out.data();
+  const std::uint32_t max_id = f.extended ? kMaxExtendedId : kMaxStandardId;
+  if (f.id > max_id) {
+    return fail(ErrorCode::kOutOfRange, "frame identifier beyond its range", 0, f.id, max_id);
+  }
+  if (f.len > f.data.size()) {
+    return fail(ErrorCode::kOutOfRange, "frame length above 8", 0, f.len, f.data.size());
+  }
+  std::memset(b, 0, kRecordBytes);
+  put_u32(b + kRecFrameId, f.id | (f.extended ? kExtendedBit : 0u));
+  put_u64(b + kRecTime, static_cast<std::uint64_t>(f.t_ns));
+  b[kRecFrameLen] = f.len;
+  std::memcpy(b + kRecFrameData, f.data.data(), f.data.size());
+  put_u16(b + kRecFlags, kFrameRecordFlag);
+  return {};
+}
+
+CodecStatus decode_frame_record(std::span<const std::uint8_t, kRecordBytes> bytes,
+                                FrameRecord& out) {
+  const std::uint8_t* p = bytes.data();
+  FrameRecord f;
+  const std::uint32_t raw_id = get_u32(p + kRecFrameId);
+  f.extended = (raw_id & kExtendedBit) != 0;
+  f.id = raw_id & ~kExtendedBit;
+  const std::uint32_t max_id = f.extended ? kMaxExtendedId : kMaxStandardId;
+  if (f.id > max_id) {
+    return fail(ErrorCode::kDataLoss, "frame record: identifier beyond its range", kRecFrameId,
+                f.id, max_id);
+  }
+  f.t_ns = static_cast<std::int64_t>(get_u64(p + kRecTime));
+  f.len = p[kRecFrameLen];
+  if (f.len > f.data.size()) {
+    return fail(ErrorCode::kDataLoss, "frame record: length above 8", kRecFrameLen, f.len,
+                f.data.size());
+  }
+  std::memcpy(f.data.data(), p + kRecFrameData, f.data.size());
+  for (std::size_t i = kRecFrameLen + 1; i < kRecFrameData; ++i) {
+    if (p[i] != 0) return fail(ErrorCode::kDataLoss, "frame record: reserved byte not zero", i);
+  }
+  for (std::size_t i = kRecFrameData + f.data.size(); i < kRecFlags; ++i) {
+    if (p[i] != 0) return fail(ErrorCode::kDataLoss, "frame record: reserved byte not zero", i);
+  }
+  if (get_u16(p + kRecFlags) != kFrameRecordFlag) {
+    return fail(ErrorCode::kDataLoss, "frame record: flags other than the frame mark", kRecFlags,
+                get_u16(p + kRecFlags), kFrameRecordFlag);
+  }
+  out = f;
+  return {};
 }
 
 CodecStatus check_block(std::span<const std::uint8_t> block, std::uint64_t offset) {

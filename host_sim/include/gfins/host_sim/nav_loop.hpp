@@ -59,6 +59,10 @@ struct NavReport {
   bool aided = false;  // the aiding filter ran (filter is its counters)
   nav::FilterCounters filter{};
   std::uint32_t motion_vetoes = 0;  // standstill decisions refused by the ZUPT's gate
+  /// Frame records of a version-2 recording (the CAN frames the recording board's loop
+  /// received: aiding inputs, commands): the host loop does not apply them (gfins-fw --replay
+  /// does), so a replay here counts them and says so.
+  std::uint64_t frames_not_applied = 0;
 };
 
 template <typename T>

@@ -51,14 +51,25 @@ HostResult<RecordingHeader> decode_header(std::span<const std::uint8_t> bytes);
 /// encode_record of the codec with a message naming the sample.
 HostResult<std::array<std::uint8_t, kRecordingRecordBytes>> encode_record(const RawSample& s);
 
+/// A frame record (version 2) with its place in the stream: it came after `samples_before`
+/// samples (the loop handled it in the cycle of sample samples_before − 1).
+struct RecordedFrame {
+  std::uint64_t samples_before = 0;
+  recording::FrameRecord frame;
+};
+
 struct Recording {
   RecordingHeader header;
   std::vector<RawSample> samples;
+  std::vector<RecordedFrame> frames;  // version 2: the CAN frames the loop received, in order
 };
 
-/// The whole file in memory (header with record_count set, every block and its CRC).
+/// The whole file in memory (header with record_count set, every block and its CRC): the
+/// samples, and each frame after the first `samples_before` of them (frames in stream order;
+/// kInvalidArgument when their samples_before decrease or exceed the samples).
 HostResult<std::vector<std::uint8_t>> encode_recording(RecordingHeader header,
-                                                       std::span<const RawSample> samples);
+                                                       std::span<const RawSample> samples,
+                                                       std::span<const RecordedFrame> frames = {});
 /// Parses a whole file image; errors name the byte offset (docs/recording-format.md).
 HostResult<Recording> decode_recording(std::span<const std::uint8_t> bytes);
 
@@ -84,12 +95,17 @@ class RecordingReader {
 
   const RecordingHeader& header() const { return header_; }
 
-  /// Replaces `out` with the samples of the next block. Returns false (and an empty `out`) at the
-  /// clean end of the recording, an error when the file is truncated or corrupt there.
+  /// Replaces `out` with the samples of the next block, and frames() with its frame records.
+  /// Returns false (and an empty `out`) at the clean end of the recording, an error when the
+  /// file is truncated or corrupt there (a malformed frame record included).
   HostResult<bool> next_block(std::vector<RawSample>& out);
+  /// The frame records of the block next_block() returned last, in file order.
+  const std::vector<RecordedFrame>& frames() const { return frames_; }
 
-  /// Records returned so far.
+  /// Records (samples and frames) read so far.
   std::uint64_t records_read() const { return index_; }
+  std::uint64_t samples_read() const { return samples_; }
+  std::uint64_t frames_read() const { return index_ - samples_; }
 
  private:
   RecordingReader() = default;
@@ -103,7 +119,9 @@ class RecordingReader {
   RecordingHeader header_{};
   std::uint64_t pos_ = kRecordingHeaderBytes;
   std::uint64_t index_ = 0;
+  std::uint64_t samples_ = 0;
   std::uint64_t block_ = 0;
+  std::vector<RecordedFrame> frames_;
   static constexpr std::uint64_t kUnknownPos = ~std::uint64_t{0};
   static constexpr std::size_t kReadBufferBytes = std::size_t{256} * 1024;
   std::uint64_t file_pos_ = kUnknownPos;  // where the next fread starts, when known
@@ -127,12 +145,15 @@ class RecordingWriter {
   ~RecordingWriter();
 
   HostStatus append(const RawSample& s);
+  /// A CAN frame the loop received, after the sample of the cycle that handled it.
+  HostStatus append_frame(const recording::FrameRecord& f);
   HostStatus close();
   std::uint64_t records_written() const { return records_; }
 
  private:
   RecordingWriter(std::FILE* file, const RecordingHeader& header);
   HostStatus flush_block();
+  HostStatus append_bytes(std::span<const std::uint8_t, kRecordingRecordBytes> rec);
   HostError io_error(const char* what) const;
 
   std::FILE* file_ = nullptr;

@@ -23,7 +23,13 @@
 namespace gfins::recording {
 
 inline constexpr std::array<char, 8> kMagic = {'G', 'F', 'I', 'N', 'S', 'R', 'A', 'W'};
-inline constexpr std::uint16_t kVersion = 1;
+/// The version a writer writes. Version 2 adds frame records (the CAN frames the loop received,
+/// between the samples they followed); a reader takes versions kMinVersion..kVersion.
+inline constexpr std::uint16_t kVersion = 2;
+inline constexpr std::uint16_t kMinVersion = 1;
+/// Bit 15 of a record's last u16 (the sample flags of a sample record): set in a frame record
+/// (version 2 on; sample_flags never use it).
+inline constexpr std::uint16_t kFrameRecordFlag = 0x8000u;
 inline constexpr std::size_t kHeaderBytes = 384;
 inline constexpr std::size_t kRecordBytes = 32;
 inline constexpr std::size_t kCrcBytes = 4;
@@ -79,10 +85,31 @@ CodecStatus decode_header(std::span<const std::uint8_t> bytes, Header& out);
 /// What a writer must refuse to write because a reader would refuse to read it.
 CodecStatus check_writable(const Header& h);
 
-/// One 32-byte record. kOutOfRange when a count is outside 24-bit two's complement (found = the
-/// channel) or flags has bits above 15: the record could not hold them exactly.
+/// One 32-byte sample record. kOutOfRange when a count is outside 24-bit two's complement (found =
+/// the channel) or flags has bit 15 (the frame-record mark) or above: the record could not hold
+/// them exactly.
 CodecStatus encode_record(const RawSample& s, std::span<std::uint8_t, kRecordBytes> out);
 RawSample decode_record(std::span<const std::uint8_t, kRecordBytes> bytes);
+
+/// A CAN frame the navigation loop received (an aiding input, a command), recorded after the
+/// sample of the cycle that handled it, with that cycle's time: what a replay hands to the same
+/// loop at the same point to reproduce its output (docs/recording-format.md, "Frame records").
+struct FrameRecord {
+  std::int64_t t_ns = 0;  // the handling cycle's time (its sample's data-ready time)
+  std::uint32_t id = 0;   // 11-bit or 29-bit identifier
+  bool extended = false;  // 29-bit identifier
+  std::uint8_t len = 0;   // 0..8
+  std::array<std::uint8_t, 8> data{};
+};
+
+/// Whether the 32 bytes of a record of a file of `version` are a frame record.
+bool is_frame_record(std::span<const std::uint8_t, kRecordBytes> bytes, std::uint16_t version);
+/// One 32-byte frame record. kOutOfRange when the identifier or the length does not fit.
+CodecStatus encode_frame_record(const FrameRecord& f, std::span<std::uint8_t, kRecordBytes> out);
+/// kDataLoss (offset within the record) when the bytes are not a well-formed frame record: an
+/// identifier beyond its range, a length above 8, reserved bytes that are not zero.
+CodecStatus decode_frame_record(std::span<const std::uint8_t, kRecordBytes> bytes,
+                                FrameRecord& out);
 
 /// The CRC-32 stored after a block's records (`block` = records then 4 CRC bytes) against the
 /// one computed; kDataLoss with found = stored, expected = computed when they differ.

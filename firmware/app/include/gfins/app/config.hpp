@@ -114,6 +114,10 @@ struct FwConfig {
   std::string sim_scenario_dir;  // empty: the installed scenarios next to the binary
   Pacing pacing = Pacing::kFast;
   double sim_duration_s = 0.0;  // 0 = the scenario's duration
+  std::string sim_recording;    // non-empty: replay this raw-sample recording instead of a scenario
+
+  // [record] the raw-sample recorder (docs/replay.md, "Recording on the board")
+  std::string record_file;  // non-empty: every sample and received frame is recorded here
 
   // [hil] hardware-in-the-loop replay (docs/hil.md): samples arrive over TCP from gfins-can hil
   std::string hil_address = "127.0.0.1";  // IPv4 address to listen on

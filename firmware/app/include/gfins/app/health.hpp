@@ -33,6 +33,7 @@ struct HealthCounters {
   std::uint32_t aiding_inputs = 0;      // GNSS fixes and headings decoded from input frames
   std::uint32_t aiding_input_errors = 0;  // input frames refused (CRC, length, range, stale id)
   std::uint32_t gravity_mismatches = 0;   // alignments whose |f| disagreed with the gravity model
+  std::uint32_t record_dropped = 0;       // recorder records lost (full queue; record.file set)
   std::uint8_t stuck_mask = 0;            // channels stuck now (bit j = channel j)
   std::uint8_t saturated_mask = 0;        // channels saturated in the last sample
 };

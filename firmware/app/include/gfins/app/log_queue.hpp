@@ -5,9 +5,10 @@
 #pragma once
 
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
+
+#include "gfins/app/spsc_ring.hpp"
 
 namespace gfins::app {
 
@@ -21,24 +22,12 @@ struct LogRecord {
   LogLevel level = LogLevel::kInfo;
 };
 
-/// Single producer (the sample loop), single consumer (the logger thread). Lock-free: one
-/// acquire/release pair per push and per pop.
+/// The sample loop's log: an SpscRing of records (spsc_ring.hpp) that can also be filled from
+/// a level, a format and its arguments.
 template <std::size_t kCapacity>
-class LogQueue {
-  static_assert((kCapacity & (kCapacity - 1)) == 0, "capacity must be a power of two");
-
+class LogQueue : public SpscRing<LogRecord, kCapacity> {
  public:
-  /// Copies the record in; false (and counted) when the ring is full.
-  bool push(const LogRecord& r) {
-    const std::size_t head = head_.load(std::memory_order_relaxed);
-    if (head - tail_.load(std::memory_order_acquire) >= kCapacity) {
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-      return false;
-    }
-    ring_[head & (kCapacity - 1)] = r;
-    head_.store(head + 1, std::memory_order_release);
-    return true;
-  }
+  using SpscRing<LogRecord, kCapacity>::push;
 
   bool push(LogLevel level, std::int64_t t_ns, const char* format, std::int64_t a0 = 0,
             std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0) {
@@ -49,24 +38,6 @@ class LogQueue {
     r.level = level;
     return push(r);
   }
-
-  /// Consumer side: the oldest record, false when empty.
-  bool pop(LogRecord& out) {
-    const std::size_t tail = tail_.load(std::memory_order_relaxed);
-    if (tail == head_.load(std::memory_order_acquire)) return false;
-    out = ring_[tail & (kCapacity - 1)];
-    tail_.store(tail + 1, std::memory_order_release);
-    return true;
-  }
-
-  std::uint32_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
-  static constexpr std::size_t capacity() { return kCapacity; }
-
- private:
-  std::array<LogRecord, kCapacity> ring_{};
-  alignas(64) std::atomic<std::size_t> head_{0};
-  alignas(64) std::atomic<std::size_t> tail_{0};
-  std::atomic<std::uint32_t> dropped_{0};
 };
 
 /// The firmware's queue: 1024 records absorb a burst of one event per sample for a second at

@@ -21,6 +21,7 @@
 #include "gfins/app/health.hpp"
 #include "gfins/app/log_queue.hpp"
 #include "gfins/app/ports.hpp"
+#include "gfins/app/record_queue.hpp"
 #include "gfins/app/reload_worker.hpp"
 #include "gfins/app/status_board.hpp"
 #include "gfins/can/aiding_input.hpp"
@@ -102,6 +103,7 @@ enum class LogKind : std::uint8_t {
   kInputRejected,    // a GNSS / heading input frame refused by its decoder
   kAidingRejected,   // a decoded fix refused by the filter (χ² gate, before alignment)
   kGravityMismatch,  // the aligned |f| and the navigation gravity disagree
+  kRecordDropped,    // a record lost to the recorder's full queue
   kCount,
 };
 
@@ -154,6 +156,9 @@ class SampleLoop {
   /// Where each cycle leaves the mode and health for the service status line (read by another
   /// thread: service_status.hpp).
   void set_status_board(StatusBoard* b) { status_board_ = b; }
+  /// The raw-sample recorder's queue (record_queue.hpp): every sample read and every CAN frame
+  /// received go into it, in the order the loop handles them. Null: no recording.
+  void set_recorder(RecordQueue* q) { recorder_ = q; }
 
   /// Start-up: configures the pipeline (alignment starts with the first sample).
   [[nodiscard]] Status configure(const CalibrationSet& cal, const LoopOptions& options);
@@ -230,6 +235,8 @@ class SampleLoop {
   /// A received frame that is a GNSS or heading input of this node: decoded, offered to the
   /// filter, counted. False when it is not one (a command frame, another node's input).
   bool handle_input(const hal::CanFrame& f, std::int64_t t_ns);
+  /// A record the recorder's queue refused: counted and logged (rate-limited).
+  void note_record_dropped();
   /// Once per alignment: the mean |f| at rest against the navigation gravity.
   void check_gravity(std::int64_t t_ns);
   void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
@@ -246,6 +253,7 @@ class SampleLoop {
   hal::Watchdog* watchdog_ = nullptr;
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;
+  RecordQueue* recorder_ = nullptr;
 
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};

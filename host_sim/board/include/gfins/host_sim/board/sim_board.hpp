@@ -234,6 +234,11 @@ app::BoardResult make_board(const app::FwConfig& c);
 /// preflight()'s checks for this board: the scenario loads and runs at adc.sample_rate_hz.
 std::string check_config(const app::FwConfig& c, const std::string& origin);
 
+/// gfins-fw --replay (sim.recording set): the recording's samples and received frames through the
+/// loop (replay_board.cpp; docs/replay.md, "Replay through the firmware").
+app::BoardResult make_replay_board(const app::FwConfig& c);
+/// preflight()'s checks for a replay: the recording opens, its rate and LSB fit the configuration.
+std::string check_recording(const app::FwConfig& c, const std::string& origin);
 /// Registers the simulated board (board.kind = "sim") in the firmware's board table.
 void add_to(app::BoardTable& t);
 
