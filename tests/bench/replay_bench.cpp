@@ -19,6 +19,8 @@
 //                          to NavPipeline<T>::process() directly: what replay_recording() does
 //                          without NavLoop's report and FNV-1a output hash (which is byte-serial
 //                          and costs about as much as the navigation itself in double).
+//   BM_RecordInLoop        the board recorder's loop side per sample: encode + queue push;
+//   BM_RecorderWrites      its writer side: queue → blocks with CRC → file (page cache).
 // The file is read from the page cache after the first iteration, as when a recording is
 // replayed again; the first read from the disk itself is not what is measured.
 //
@@ -33,6 +35,8 @@
 #include <string>
 #include <vector>
 
+#include "gfins/app/record_queue.hpp"
+#include "gfins/app/recorder.hpp"
 #include "gfins/host_sim/adc_model.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/replay.hpp"
@@ -239,6 +243,46 @@ void BM_ReadFileAndNavigate(benchmark::State& state) {
   set_rates(state, navigating);
 }
 
+// The board's recorder (gfins-fw --record, firmware/app/recorder.hpp), per sample: what the loop
+// pays (encode the 32-byte record, push it into the queue; the pop stands for the writer thread)
+// and what the writer thread does (pop, assemble blocks with their CRC, write them to a file in the
+// temporary folder).
+void BM_RecordInLoop(benchmark::State& state) {
+  const Data& d = data();
+  auto q = std::make_unique<app::RecordQueue>();
+  app::RecordSlot slot;
+  for (auto _ : state) {
+    for (const RawSample& s : d.samples) {
+      benchmark::DoNotOptimize(app::record_sample(*q, s));
+      benchmark::DoNotOptimize(q->pop(slot));
+    }
+  }
+  set_rates(state, 0);
+}
+
+void BM_RecorderWrites(benchmark::State& state) {
+  const Data& d = data();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "gfins_bench_recorder.gfr").string();
+  recording::Header h;
+  h.volts_per_count.fill(1e-6);
+  h.geometry = nav::table1_geometry(kRhoM);
+  for (auto _ : state) {
+    app::Recorder::Opened opened = app::Recorder::open(path, h);
+    if (!opened.recorder) {
+      state.SkipWithError(opened.error.c_str());
+      break;
+    }
+    for (std::size_t i = 0; i < d.samples.size(); ++i) {
+      (void)app::record_sample(opened.recorder->queue(), d.samples[i]);
+      if ((i & 1023u) == 1023u) opened.recorder->drain();
+    }
+    if (!opened.recorder->stop().empty()) state.SkipWithError("recorder write failed");
+  }
+  std::filesystem::remove(path);
+  set_rates(state, 0);
+}
+
 BENCHMARK(BM_Replay<float>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Replay<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DecodeAndReplay<float>)->Unit(benchmark::kMillisecond);
@@ -249,6 +293,8 @@ BENCHMARK(BM_ReplayFile<double>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadFile)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadFileAndNavigate<float>)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ReadFileAndNavigate<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RecordInLoop)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RecorderWrites)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace gfins::sim

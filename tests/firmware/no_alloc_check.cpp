@@ -2,10 +2,15 @@
 // simulated board (reading frames, navigating, publishing, servicing the CAN bus, polling for
 // commands, logging events, detecting faults) with every malloc-family call of the process
 // counted. The loop's logger thread is not running during the window (it allocates by design:
-// formatting happens there); the queue it drains is what the loop writes to.
+// formatting happens there); the queue it drains is what the loop writes to. The raw-sample
+// recorder's writer is counted too: it writes what the loop queues without allocating.
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "gfins/app/recorder.hpp"
 
 #include "heap_counter.hpp"
 #include "sim_rig.hpp"
@@ -94,6 +99,39 @@ TEST(NoAlloc, SampleLoopAllocatesNothingAfterStartUp) {
   EXPECT_EQ(rig.loop->health().adc_read_errors, 3u + kDeadCycles);
   EXPECT_GE(rig.loop->health().samples, kCountedCycles - kDeadCycles);
   EXPECT_EQ(after - before, 0) << "heap calls inside the sample loop";
+}
+
+TEST(NoAlloc, RecordingAllocatesNothingInTheLoopOrItsWriter) {
+  if (!HeapCounter::available()) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  // Given a started board recording to a file (record.file), the writer's block buffer and the
+  // file's stdio buffer in place (the header is written at open),
+  SimRig rig("rest", (kWarmUpCycles + kCountedCycles + 100) / 1000.0);
+  rig.configure();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "gfins_no_alloc_recording.gfr").string();
+  recording::Header h;
+  h.sample_rate_hz = rig.s.rate_hz;
+  h.volts_per_count.fill(rig.adc->volts_per_count());
+  h.geometry = rig.cal.config.nominal.cast<double>();
+  Recorder::Opened opened = Recorder::open(path, h);
+  ASSERT_TRUE(opened.recorder) << opened.error;
+  rig.loop->set_recorder(&opened.recorder->queue());
+  rig.run_cycles(kWarmUpCycles);
+  opened.recorder->drain();
+  // when the loop records many thousand cycles and the writer's work (drain: blocks, CRCs,
+  // writes) runs between them, as its thread would,
+  const long before = HeapCounter::calls();
+  for (std::uint32_t done = 0; done < kCountedCycles; done += 1000) {
+    rig.run_cycles(1000);
+    opened.recorder->drain();
+  }
+  const long after = HeapCounter::calls();
+  // then every sample was recorded and nothing was allocated on either side.
+  EXPECT_EQ(rig.loop->health().record_dropped, 0u);
+  EXPECT_EQ(after - before, 0) << "heap calls while recording";
+  EXPECT_EQ(opened.recorder->stop(), "");
+  EXPECT_EQ(opened.recorder->records_written(), rig.loop->health().samples);
+  std::filesystem::remove(path);
 }
 
 }  // namespace
