@@ -3,6 +3,8 @@
 // checked against the byte layout written here and the CRC-32 check value of its standard.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -260,12 +262,25 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
   sim::RecordingHeader h;
   h.sample_rate_hz = kRate;
   const fs::path rec = dir() / "stream.gfr";
-  ASSERT_TRUE(sim::write_recording(rec.string(), h, samples).is_ok());
+  // Two frame records among them (a recording the firmware made holds what its loop received):
+  // the link carries samples only, and the tool says it leaves the frames out.
+  const std::vector<sim::RecordedFrame> frames = {{100, {99000000, 0x0C1, false, 8, {}}},
+                                                  {1500, {1499000000, 0x0D1, false, 8, {}}}};
+  const auto image = sim::encode_recording(h, samples, frames);
+  ASSERT_TRUE(image.is_ok()) << image.error().message;
+  {
+    std::FILE* f = std::fopen(rec.string().c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(image.value().data(), 1, image.value().size(), f), image.value().size());
+    ASSERT_EQ(std::fclose(f), 0);
+  }
   const int port = start_firmware();
   ASSERT_GT(port, 0) << fw_result().output;
   const auto host = run_host(port, {"--recording", rec.string()}, "rec");
   const std::string& out = host.output;
   EXPECT_EQ(host.exit_code, 0) << out;
+  EXPECT_NE(out.find("2 CAN frames recorded with the samples are not replayed"), std::string::npos)
+      << out;
   const std::string e = std::to_string((kRecSamples - 1) / kEpochDivider + 1);
   EXPECT_NE(out.find("epochs: expected " + e + ", decoded " + e), std::string::npos) << out;
   EXPECT_NE(out.find("outside quantisation 0"), std::string::npos) << out;

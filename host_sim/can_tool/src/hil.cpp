@@ -181,6 +181,13 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
     in.samples = rec.value().samples;
     in.rate_hz = rec.value().header.sample_rate_hz;
     in.what = "recording " + o.recording;
+    // The link carries samples only: a version-2 recording's frames (aiding inputs, commands)
+    // stay here, on both sides of the comparison. Said, not silently dropped.
+    if (!rec.value().frames.empty()) {
+      out << "gfins-can hil: " << rec.value().frames.size()
+          << " CAN frames recorded with the samples are not replayed (the link carries samples; "
+             "gfins-fw --replay applies them)\n";
+    }
   }
   if (in.samples.empty()) {
     err << "gfins-can hil: " << in.what << " holds no sample\n";
