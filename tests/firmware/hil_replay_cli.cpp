@@ -3,10 +3,9 @@
 // checked against the byte layout written here and the CRC-32 check value of its standard.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
