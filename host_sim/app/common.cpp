@@ -266,6 +266,14 @@ std::string describe(const Scenario& s) {
     text += buf;
   }
   for (const ChannelFailure& f : s.failures) text += "\n  " + describe(f);
+  if (!s.board_faults.empty()) {
+    std::snprintf(
+        buf, sizeof buf,
+        "\n  board faults: %zu ([[board.faults]]: made by gfins-fw --sim on its simulated "
+        "board; this program has no board and does not make them)",
+        s.board_faults.size());
+    text += buf;
+  }
   return text;
 }
 

@@ -28,6 +28,7 @@
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/math.hpp"
 #include "support/cli_fixture.hpp"
+#include "support/csv.hpp"
 
 namespace gfins {
 namespace {
@@ -39,35 +40,7 @@ constexpr double kUnaidedVelMinMps = 1.0;
 constexpr double kSigmaHorizonMps = 0.5;  // the filter's default validity horizon for velocity
 constexpr double kSigmaVelStep = 0.01;    // SigmaVelH's factor (docs/can/gfins.dbc)
 
-struct Table {
-  std::vector<std::string> names;
-  std::vector<std::vector<std::string>> rows;
-  int col(const std::string& n) const {
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      if (names[i] == n) return static_cast<int>(i);
-    }
-    return -1;
-  }
-};
-
-Table read_csv(const std::string& text) {
-  Table t;
-  std::istringstream in(text);
-  std::string line;
-  const auto split = [](const std::string& s) {
-    std::vector<std::string> out;
-    std::string cell;
-    std::istringstream ls(s);
-    while (std::getline(ls, cell, ',')) out.push_back(cell);
-    if (!s.empty() && s.back() == ',') out.emplace_back();
-    return out;
-  };
-  if (std::getline(in, line)) {
-    for (const std::string& h : split(line)) t.names.push_back(h.substr(0, h.find('[')));
-  }
-  while (std::getline(in, line)) t.rows.push_back(split(line));
-  return t;
-}
+using Table = test::DecodedTable;
 
 struct Outcome {
   double worst_vel = 0;        // largest |v| component after the settling time, m/s
@@ -94,7 +67,7 @@ class FwAided : public test::CliTest {
     EXPECT_EQ(fw.exit_code, 0) << fw.output;
     const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--view", "csv", "-o", csv});
     EXPECT_EQ(dec.exit_code, 0) << dec.output;
-    const Table t = read_csv(test::slurp(csv));
+    const Table t = test::read_decoded_csv(test::slurp(csv));
     const int ct = t.col("TimeUs"), vn = t.col("VelN"), ve = t.col("VelE"), vd = t.col("VelD"),
               sh = t.col("SigmaVelH");
     EXPECT_TRUE(ct >= 0 && vn >= 0 && ve >= 0 && vd >= 0 && sh >= 0) << "columns";
@@ -195,7 +168,7 @@ class FwAidedDrive : public FwAided {
     const auto traj = sim::make_trajectory(sc.value().trajectory);
     EXPECT_TRUE(traj.is_ok());
     if (!traj.is_ok()) return o;
-    const Table t = read_csv(test::slurp(csv));
+    const Table t = test::read_decoded_csv(test::slurp(csv));
     const char* pos_names[3] = {"PosN", "PosE", "PosD"};
     const char* vel_names[3] = {"VelN", "VelE", "VelD"};
     int cp[3], cv[3];
@@ -303,7 +276,7 @@ TEST_F(FwAided, APowerUpWhileDrivingAlignsFromTheGnssFrames) {
   ASSERT_TRUE(sc.is_ok());
   const auto traj = sim::make_trajectory(sc.value().trajectory);
   ASSERT_TRUE(traj.is_ok());
-  const Table t = read_csv(test::slurp(csv));
+  const Table t = test::read_decoded_csv(test::slurp(csv));
   const int ct = t.col("TimeUs"), cn = t.col("PosN"), ce = t.col("PosE"), cs = t.col("SigmaPosH"),
             cr = t.col("Roll"), csr = t.col("SigmaRoll"), cva = t.col("GnssVelAccepted"),
             cvr = t.col("GnssVelRejected"), cha = t.col("HeadingAccepted"),

@@ -31,6 +31,7 @@
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/nav_core/pipeline.hpp"
 #include "support/cli_fixture.hpp"
+#include "support/csv.hpp"
 
 namespace gfins {
 namespace {
@@ -86,34 +87,7 @@ std::map<std::string, Step> dbc_steps(const std::string& path) {
 
 // ---- The decoded CSV --------------------------------------------------------------------------
 
-struct Table {
-  std::vector<std::string> names;  // "Roll" of "Roll[rad]"
-  std::vector<std::vector<std::string>> rows;
-  int col(const std::string& n) const {
-    const auto it = std::find(names.begin(), names.end(), n);
-    return it == names.end() ? -1 : static_cast<int>(it - names.begin());
-  }
-};
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(s);
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!s.empty() && s.back() == ',') out.emplace_back();
-  return out;
-}
-
-Table read_csv(const std::string& text) {
-  Table t;
-  std::istringstream in(text);
-  std::string line;
-  if (std::getline(in, line)) {
-    for (const std::string& h : split(line)) t.names.push_back(h.substr(0, h.find('[')));
-  }
-  while (std::getline(in, line)) t.rows.push_back(split(line));
-  return t;
-}
+using Table = test::DecodedTable;
 
 // ---- The host-only core run -------------------------------------------------------------------
 
@@ -284,7 +258,7 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
   ASSERT_EQ(fw.exit_code, 0) << fw.output;
   const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--view", "csv", "-o", csv});
   ASSERT_EQ(dec.exit_code, 0) << dec.output;
-  const Table t = read_csv(test::slurp(csv));
+  const Table t = test::read_decoded_csv(test::slurp(csv));
 
   // Then gfins-can's summary: every epoch, every frame ok, no problem at all (no bad CRC, no
   // counter jump, no drop, duplicate or reorder). Frame counts from the default dividers:

@@ -40,67 +40,8 @@ class TapSource final : public app::SampleSource {
   std::vector<RawSample> samples_;
 };
 
-/// ADC read failures the chip model cannot make (tests/firmware/faults_test.cpp):
-///  - fail_reads(n): the next n reads take their conversion and then fail as an SPI transfer
-///    error does (kIoError): that conversion is lost;
-///  - set_dead(true): every read fails at once without waiting for an edge, as the ADS131M06
-///    driver does in its kFailed state (kFailedPrecondition). When the ADC comes back, the
-///    conversions made meanwhile are lost (read and dropped until one is not older than the
-///    clock), so the sample clock never runs backwards;
-///  - add_flags(n, flags): the next n samples carry `flags` besides their own (a producer that
-///    flags a frame the chip model would not: a recording's saturated frames, counts off the
-///    rails).
-class FaultySource final : public app::SampleSource {
- public:
-  FaultySource(app::SampleSource& inner, hal::Clock& clock) : inner_(inner), clock_(clock) {}
-  void fail_reads(std::uint32_t n) { fail_ = n; }
-  void add_flags(std::uint32_t n, std::uint32_t flags) {
-    flag_n_ = n;
-    flags_ = flags;
-  }
-  void set_dead(bool dead) {
-    if (dead_ && !dead) revive_ = true;
-    dead_ = dead;
-  }
-
- private:
-  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override {
-    if (dead_) {
-      return Status(ErrorCode::kFailedPrecondition,
-                    "adc: not running (start() failed or not called)");
-    }
-    if (revive_) {
-      revive_ = false;
-      const std::int64_t t = clock_.now_ns();
-      for (;;) {
-        Result<RawSample> r = inner_.read_sample(timeout_ns);
-        if (!r.is_ok() || r.value().t_ns >= t) return r;
-      }
-    }
-    Result<RawSample> r = inner_.read_sample(timeout_ns);
-    if (fail_ > 0 && r.is_ok()) {
-      --fail_;
-      return Status(ErrorCode::kIoError, "spidev: SPI_IOC_MESSAGE failed");
-    }
-    if (flag_n_ > 0 && r.is_ok()) {
-      --flag_n_;
-      RawSample s = r.value();
-      s.flags |= flags_;
-      return s;
-    }
-    return r;
-  }
-  app::AdcCounters do_counters() const override { return inner_.counters(); }
-  double do_volts_per_count() const override { return inner_.volts_per_count(); }
-
-  app::SampleSource& inner_;
-  hal::Clock& clock_;
-  std::uint32_t fail_ = 0;
-  std::uint32_t flag_n_ = 0;
-  std::uint32_t flags_ = 0;
-  bool dead_ = false;
-  bool revive_ = false;
-};
+/// ADC read failures on the simulated board: the board's own (sim_board.hpp).
+using FaultySource = sim_board::FaultySource;
 
 /// A publisher that takes too long: while stalls are pending, each epoch handed over moves the
 /// (sample) clock to `stall_ns` after the epoch's edge, as a cycle that overran would.

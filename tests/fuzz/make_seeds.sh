@@ -23,6 +23,18 @@ for f in host_sim/scenarios/*.toml; do cp "$f" "$corpus/scenario/seed-$(basename
     printf '\n[[sensors.failures]]\nkind = "%b\nsensor = 3\nstart_s = 1.0\n' "$k"
   done
 } >"$corpus/scenario/seed-failures.toml"
+# Board faults ([[board.faults]], docs/simulation.md): one of each kind.
+{
+  cat host_sim/scenarios/rest.toml
+  t=1
+  for k in 'crc_error"' 'missed_edges"\ncount = 3' 'extra_edge"' 'silent_line"\ncount = 6' \
+    'adc_reset"' 'saturated"\nsensor = 4\nduration_s = 0.05' 'stuck"\nsensor = 2\nduration_s = 0.2' \
+    'can_refuse"\nduration_s = 0.5' 'bus_off"\nduration_s = 0.5' 'read_error"\ncount = 3' \
+    'adc_dead"\nduration_s = 0.5'; do
+    printf '\n[[board.faults]]\nkind = "%b\nat_s = %d.%d\n' "$k" $((t / 2)) $((t % 2 * 5))
+    t=$((t + 1))
+  done
+} >"$corpus/scenario/seed-board-faults.toml"
 "$build/host_sim/tools/gfins-calibrate" --means tests/golden/paper_tables_4_5.csv --latitude 24.8 \
   --adc-lsb 1.192e-6 --device-id board-001 --rho 0.1 -o "$tmp/cal.toml" >/dev/null
 cp "$tmp/cal.toml" "$corpus/calibration_file/seed-paper.toml"

@@ -155,6 +155,64 @@ TEST(ScenarioParse, ABadChannelFailureIsNamedWithItsPlace) {
                {"sensors.failures", "array of tables"});
 }
 
+TEST(ScenarioParse, BoardFaultsAreReadInTimeOrder) {
+  // Written out of order; kGood runs 2 s at 100 Hz.
+  const HostResult<Scenario> p = parse_scenario(std::string(kGood) + R"(
+[[board.faults]]
+kind = "stuck"
+at_s = 1.5
+sensor = 6
+duration_s = 0.25
+[[board.faults]]
+kind = "missed_edges"
+at_s = 0.5
+count = 4
+[[board.faults]]
+kind = "bus_off"
+at_s = 1.0
+duration_s = 0.5
+[[board.faults]]
+kind = "crc_error"
+at_s = 1.25
+)",
+                                                "faults.toml");
+  ASSERT_TRUE(p.is_ok()) << p.error().message;
+  const auto& f = p.value().board_faults;
+  ASSERT_EQ(f.size(), 4U);
+  EXPECT_EQ(f[0].kind, BoardFaultKind::kMissedEdges);
+  EXPECT_EQ(f[0].count, 4U);
+  EXPECT_EQ(f[1].kind, BoardFaultKind::kBusOff);
+  EXPECT_DOUBLE_EQ(f[1].duration_s, 0.5);
+  EXPECT_EQ(f[2].kind, BoardFaultKind::kCrcError);
+  EXPECT_EQ(f[3].kind, BoardFaultKind::kStuck);
+  EXPECT_EQ(f[3].channel, 5U);  // sensor 6, 0-based
+  EXPECT_DOUBLE_EQ(f[3].at_s, 1.5);
+  EXPECT_STREQ(to_string(f[3].kind), "stuck");
+}
+
+TEST(ScenarioParse, ABadBoardFaultIsNamedWithItsPlace) {
+  const auto with = [](const std::string& body) {
+    return std::string(kGood) + "\n[[board.faults]]\n" + body;
+  };
+  expect_error(with("kind = \"melted\"\nat_s = 1.0\n"),
+               {"bad.toml", "board.faults[0].kind", "melted", "adc_dead"});
+  expect_error(with("kind = \"crc_error\"\nat_s = 3.0\n"),
+               {"board.faults[0].at_s", "out of range"});
+  expect_error(with("kind = \"bus_off\"\nat_s = 1.8\nduration_s = 0.5\n"),
+               {"board.faults[0].duration_s", "out of range"});
+  expect_error(with("kind = \"stuck\"\nat_s = 1.0\nduration_s = 0.5\n"),
+               {"board.faults[0].sensor", "missing"});
+  expect_error(with("kind = \"read_error\"\nat_s = 1.0\ncount = 2.5\n"),
+               {"board.faults[0].count", "integer"});
+  expect_error(with("kind = \"crc_error\"\nat_s = 1.0\ncount = 2\n"),
+               {"board.faults[0].count", "unknown key"});
+  expect_error(with("kind = \"can_refuse\"\nat_s = 1.0\nduration_s = 0.5\n"
+                    "[[board.faults]]\nkind = \"can_refuse\"\nat_s = 1.25\nduration_s = 0.1\n"),
+               {"board.faults[1].at_s", "overlaps an earlier can_refuse fault"});
+  expect_error(std::string(kGood) + "\n[board]\nfaults = 3\n", {"board.faults", "array of tables"});
+  expect_error(std::string(kGood) + "\n[board]\nfault = []\n", {"board.fault", "unknown key"});
+}
+
 TEST(ScenarioParse, WrongTypeIsNamedWithItsLine) {
   // rate_hz is on line 4 of kGood.
   expect_error(replace(kGood, "rate_hz = 100.0", "rate_hz = \"fast\""),

@@ -73,4 +73,42 @@ inline Csv parse_csv(const std::string& text) {
   return c;
 }
 
+/// `gfins-can decode --view csv` output: the header's names without their units ("Roll" of
+/// "Roll[rad]") and every row's cells as text, an empty cell being a value not available (or a
+/// message not in that epoch). Trailing empty cells are kept, so each row has the header's width.
+struct DecodedTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<std::string>> rows;
+  /// Index of a column, -1 when there is none.
+  int col(const std::string& n) const {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i] == n) return static_cast<int>(i);
+    }
+    return -1;
+  }
+};
+
+/// The cells of a line of the decoder's CSV, empty ones (and a trailing one) included.
+inline std::vector<std::string> decoded_cells(const std::string& line) {
+  std::vector<std::string> out = cells_of(line);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+/// The header of the decoder's CSV: its names without units.
+inline std::vector<std::string> decoded_names(const std::string& header) {
+  std::vector<std::string> out;
+  for (const std::string& h : decoded_cells(header)) out.push_back(h.substr(0, h.find('[')));
+  return out;
+}
+
+inline DecodedTable read_decoded_csv(const std::string& text) {
+  DecodedTable t;
+  std::istringstream in(text);
+  std::string line;
+  if (std::getline(in, line)) t.names = decoded_names(line);
+  while (std::getline(in, line)) t.rows.push_back(decoded_cells(line));
+  return t;
+}
+
 }  // namespace gfins::test

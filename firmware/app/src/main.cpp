@@ -7,11 +7,14 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <string>
 
 #include "gfins/app/board.hpp"
 #include "gfins/app/config.hpp"
@@ -38,6 +41,16 @@ void print(std::FILE* to, const std::string& text) {
 struct FileCloser {
   void operator()(std::FILE* f) const { (void)std::fclose(f); }
 };
+
+/// Resident memory of this process in KiB (VmRSS of /proc/self/status), -1 where there is none.
+long resident_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
+  }
+  return -1;
+}
 
 int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
         const std::string& latency_csv) {
@@ -127,6 +140,9 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  // Resident memory at the loop's start and end: a loop that allocates nothing keeps it flat
+  // (the soak test bounds the difference over a simulated hour).
+  const long rss0_kib = resident_kib();
   const std::clock_t cpu0 = std::clock();
   const auto wall0 = std::chrono::steady_clock::now();
   // A board with a known end (the simulated board, fast) reports how far it got: a line every
@@ -143,6 +159,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
                  p.fraction * p.duration_s, p.duration_s);
   }
   const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  const long rss1_kib = resident_kib();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
@@ -163,6 +180,8 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
       h.missed_edges, h.extra_edges, h.drdy_timeouts, h.crc_errors, h.adc_resets,
       h.saturated_samples, h.stuck_events, h.stuck_mask, h.can_tx_dropped, h.bus_off_events,
       h.loop_overruns, h.log_dropped);
+  spdlog::info("memory: resident {} KiB at the loop's start, {} KiB at its end", rss0_kib,
+               rss1_kib);
   spdlog::info(
       "final state t {:.3f} s: v_n [{:.4f} {:.4f} {:.4f}] m/s, r_n [{:.4f} {:.4f} {:.4f}] m",
       static_cast<double>(st.t_ns) * 1e-9, st.v_n.x(), st.v_n.y(), st.v_n.z(), st.r_n.x(),

@@ -17,7 +17,8 @@ namespace {
 struct SimParts {
   std::unique_ptr<SensorStream> stream;
   std::unique_ptr<ChipAdc> adc;
-  std::unique_ptr<hal::DataReadyLine> drdy;  // pacing "gpio" only
+  std::unique_ptr<SimSampleSource> sim_source;  // behind a ScheduledFaultSource ([[board.faults]])
+  std::unique_ptr<hal::DataReadyLine> drdy;     // pacing "gpio" only
 };
 
 }  // namespace
@@ -83,6 +84,11 @@ app::BoardResult make_board(const app::FwConfig& c) {
   }
   const SimSampleSource* src = source.get();
   b->finished = [src] { return src->finished(); };
+  const double rate = s.rate_hz;
+  // The scenario's time of the last sample read (-1 before the first).
+  const auto now_s = [src, rate] {
+    return src->next_seq() == 0 ? -1.0 : static_cast<double>(src->next_seq() - 1) / rate;
+  };
   if (fast) {
     // Faster than real time, a long scenario runs for minutes: gfins-fw reports how far it got.
     b->progress = [src, samples, duration] {
@@ -90,10 +96,27 @@ app::BoardResult make_board(const app::FwConfig& c) {
     };
     b->progress_interval_s = paths::progress_interval_s();
   }
-  b->source = std::move(source);
+  if (!s.board_faults.empty() && c.pacing == app::Pacing::kGpio) {
+    out.error = "scenario " + s.name +
+                ": [[board.faults]] are made by the simulated ADC and need sim.pacing \"fast\" or "
+                "\"realtime\" (with \"gpio\" the faults are made on the line and the bus)";
+    return out;
+  }
+  if (!s.board_faults.empty()) {
+    // The scenario's board faults ([[board.faults]]): the sample source's before the loop reads,
+    // the CAN output's below.
+    parts->sim_source = std::move(source);
+    b->source = std::make_unique<ScheduledFaultSource>(*parts->sim_source, *b->clock,
+                                                       s.board_faults, s.rate_hz);
+  } else {
+    b->source = std::move(source);
+  }
   if (std::string e = app::open_can_output(c, *b->clock, *b); !e.empty()) {
     out.error = e;
     return out;
+  }
+  if (!s.board_faults.empty()) {
+    b->bus = std::make_unique<FaultyCanBus>(std::move(b->bus), s.board_faults, now_s);
   }
   app::add_can_protocol(c, *b);
   // The scenario's GNSS receiver ([gnss]) sends its fixes on the board's bus, as a receiver
@@ -105,12 +128,8 @@ app::BoardResult make_board(const app::FwConfig& c) {
       return out;
     }
     std::vector<sim::GnssSample> fixes = sim::GnssModel(*s.gnss, *traj.value()).fixes(duration);
-    const double rate = s.rate_hz;
-    b->bus = std::make_unique<GnssReceiverBus>(
-        std::move(b->bus), std::move(fixes), *s.gnss, static_cast<std::uint8_t>(c.node_id),
-        [src, rate] {
-          return src->next_seq() == 0 ? -1.0 : static_cast<double>(src->next_seq() - 1) / rate;
-        });
+    b->bus = std::make_unique<GnssReceiverBus>(std::move(b->bus), std::move(fixes), *s.gnss,
+                                               static_cast<std::uint8_t>(c.node_id), now_s);
   }
   // Uncalibrated defaults: the nominal chain (no misalignment, nominal scale factors, no bias).
   // The factory calibration: the scenario's true parameters.

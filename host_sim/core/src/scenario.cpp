@@ -3,6 +3,7 @@
 #include "gfins/host_sim/scenario.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,6 +19,16 @@
 #include "gfins/toml/safe_parse.hpp"
 
 namespace gfins::sim {
+
+namespace {
+// [[board.faults]] kind names, in BoardFaultKind order.
+constexpr std::array<const char*, 11> kBoardFaultNames = {
+    "crc_error", "missed_edges", "extra_edge", "silent_line", "adc_reset", "saturated",
+    "stuck",     "can_refuse",   "bus_off",    "read_error",  "adc_dead"};
+}  // namespace
+
+const char* to_string(BoardFaultKind k) { return kBoardFaultNames[static_cast<std::size_t>(k)]; }
+
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
@@ -367,13 +378,87 @@ std::vector<ChannelFailure> read_failures(const Reader& rd, const toml::table& s
   return out;
 }
 
+/// [[board.faults]]: one table per fault, `kind` and `at_s` within the run, then the kind's own
+/// keys (scenario.hpp, BoardFault). Two faults of one kind may not overlap, and a fault with a
+/// duration must end within the run.
+std::vector<BoardFault> read_board_faults(const Reader& rd, const toml::table& board,
+                                          double duration_s) {
+  std::vector<BoardFault> out;
+  const toml::node* n = board.get("faults");
+  const auto* a = n == nullptr ? nullptr : n->as_array();
+  if (n != nullptr && a == nullptr) {
+    rd.fail(n, "board.faults", "expected an array of tables ([[board.faults]])");
+  }
+  if (a == nullptr) return out;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const std::string p = "board.faults[" + std::to_string(i) + "].";
+    const auto* t = (*a)[i].as_table();
+    if (t == nullptr) rd.fail(&(*a)[i], p, "expected a table ([[board.faults]])");
+    const std::string kind = rd.string(*t, p, "kind", std::nullopt);
+    BoardFault f;
+    const auto named = std::find(kBoardFaultNames.begin(), kBoardFaultNames.end(), kind);
+    if (named == kBoardFaultNames.end()) {
+      std::string list;
+      for (const char* c : kBoardFaultNames) list += std::string(list.empty() ? "" : ", ") + c;
+      rd.fail(t->get("kind"), p + "kind",
+              "unknown value '" + kind + "' (expected one of: " + list + ")");
+    }
+    f.kind = static_cast<BoardFaultKind>(named - kBoardFaultNames.begin());
+    // After the first sample (the loop's reference) and before the last.
+    f.at_s = rd.number(*t, p, "at_s", std::nullopt, 0.001, duration_s);
+    switch (f.kind) {
+      case BoardFaultKind::kMissedEdges:
+      case BoardFaultKind::kSilentLine:
+      case BoardFaultKind::kReadError:
+        rd.only(*t, p, {"kind", "at_s", "count"});
+        f.count = static_cast<std::uint32_t>(rd.number(*t, p, "count", std::nullopt, 1, 1000));
+        if (t->get("count")->as_integer() == nullptr) {
+          rd.fail(t->get("count"), p + "count", "expected an integer 1-1000");
+        }
+        break;
+      case BoardFaultKind::kSaturated:
+      case BoardFaultKind::kStuck:
+        rd.only(*t, p, {"kind", "at_s", "sensor", "duration_s"});
+        f.channel = static_cast<std::size_t>(rd.number(*t, p, "sensor", std::nullopt, 1, 6)) - 1;
+        if (t->get("sensor")->as_integer() == nullptr) {
+          rd.fail(t->get("sensor"), p + "sensor", "expected an integer sensor number 1-6");
+        }
+        [[fallthrough]];
+      case BoardFaultKind::kCanRefuse:
+      case BoardFaultKind::kBusOff:
+      case BoardFaultKind::kAdcDead:
+        if (f.kind != BoardFaultKind::kSaturated && f.kind != BoardFaultKind::kStuck) {
+          rd.only(*t, p, {"kind", "at_s", "duration_s"});
+        }
+        f.duration_s = rd.number(*t, p, "duration_s", std::nullopt, 0.001, duration_s - f.at_s);
+        break;
+      default:
+        rd.only(*t, p, {"kind", "at_s"});
+        break;
+    }
+    for (const BoardFault& e : out) {
+      const double end = e.at_s + std::max(e.duration_s, 1e-3 * e.count);
+      if (e.kind == f.kind && f.at_s < end &&
+          e.at_s < f.at_s + std::max(f.duration_s, 1e-3 * f.count)) {
+        rd.fail(t->get("at_s"), p + "at_s",
+                "overlaps an earlier " + kind + " fault (at " + std::to_string(e.at_s) +
+                    " s): faults of one kind follow each other");
+      }
+    }
+    out.push_back(f);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const BoardFault& x, const BoardFault& y) { return x.at_s < y.at_s; });
+  return out;
+}
+
 Scenario parse_root(const toml::table& root, const Reader& rd, const std::string& source) {
   Scenario s;
   s.source = source;
   s.name = std::filesystem::path(source).stem().string();
   rd.only(root, "",
           {"scenario", "gravity", "trajectory", "sensors", "compensator", "calibration", "gnss",
-           "aiding"});
+           "aiding", "board"});
 
   // [scenario]
   const toml::table& sc = *rd.table(root, "scenario", true);
@@ -565,6 +650,10 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
 
   if (const toml::table* g = rd.table(root, "gnss", false)) s.gnss = parse_gnss(*g, rd);
   parse_aiding(root, rd, s.aiding);
+  if (const toml::table* b = rd.table(root, "board", false)) {
+    rd.only(*b, "board.", {"faults"});
+    s.board_faults = read_board_faults(rd, *b, s.duration_s);
+  }
   return s;
 }
 

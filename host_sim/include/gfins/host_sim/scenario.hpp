@@ -91,6 +91,32 @@ struct AidingSpec {
   double track_heading_sigma_deg = 0.0;
 };
 
+/// A fault of the simulated board ([[board.faults]]): each kind is a row of docs/faults.md.
+enum class BoardFaultKind : std::uint8_t {
+  kCrcError,     // one ADC output frame with a bad CRC
+  kMissedEdges,  // `count` data-ready edges lost in a row
+  kExtraEdge,    // a spurious data-ready edge without a conversion
+  kSilentLine,   // no data-ready edge for `count` periods
+  kAdcReset,     // the ADC resets (power-on reset) mid-run
+  kSaturated,    // `channel` at full scale for `duration_s`
+  kStuck,        // `channel`'s code frozen for `duration_s`
+  kCanRefuse,    // the CAN output refuses every frame (queue full) for `duration_s`
+  kBusOff,       // the CAN controller is bus-off for `duration_s`
+  kReadError,    // `count` ADC reads fail (SPI transfer error), their conversions lost
+  kAdcDead,      // every ADC read fails at once for `duration_s` (the driver gave up)
+};
+
+struct BoardFault {
+  BoardFaultKind kind = BoardFaultKind::kCrcError;
+  double at_s = 0.0;        // scenario time of the fault's start
+  std::uint32_t count = 1;  // kMissedEdges, kSilentLine (periods), kReadError
+  std::size_t channel = 0;  // kSaturated, kStuck: ADC channel 0..5 (sensor 1..6)
+  double duration_s = 0.0;  // kSaturated, kStuck, kCanRefuse, kBusOff, kAdcDead
+};
+
+/// The name of a kind as [[board.faults]] writes it ("crc_error", "bus_off", ...).
+const char* to_string(BoardFaultKind k);
+
 struct Scenario {
   std::string name;         // file stem or [scenario] name
   std::string description;  // one line
@@ -143,6 +169,12 @@ struct Scenario {
   // `gfins-can gnss`). Absent: no GNSS.
   std::optional<GnssSpec> gnss;
   AidingSpec aiding{};
+
+  // [[board.faults]] (optional): faults of the simulated board itself (its ADC, data-ready line
+  // and CAN bus), each a row of docs/faults.md, injected by `gfins-fw --sim` at their times
+  // (docs/simulation.md, "Board faults"). The host simulator's own runs (gfins-sim) have no board
+  // and do not use them.
+  std::vector<BoardFault> board_faults;
 };
 
 /// Parses TOML text; `source` names it in messages. Errors name the file, the key and the line.

@@ -149,6 +149,110 @@ class SimSampleSource final : public app::SampleSource {
   std::uint32_t first_edge_seq_ = 0;
 };
 
+/// ADC read failures the chip model cannot make (docs/faults.md, "ADC read error", "ADC dead"),
+/// in front of a sample source (tests/firmware/faults_test.cpp; [[board.faults]] read_error and
+/// adc_dead through ScheduledFaultSource):
+///  - fail_reads(n): the next n reads take their conversion and then fail as an SPI transfer
+///    error does (kIoError): that conversion is lost;
+///  - set_dead(true): every read fails at once without waiting for an edge, as the ADS131M06
+///    driver does in its kFailed state (kFailedPrecondition). When the ADC comes back, the
+///    conversions made meanwhile are lost (read and dropped until one is not older than the
+///    clock), so the sample clock never runs backwards;
+///  - add_flags(n, flags): the next n samples carry `flags` besides their own (a producer that
+///    flags a frame the chip model would not: a recording's saturated frames, counts off the
+///    rails).
+class FaultySource final : public app::SampleSource {
+ public:
+  FaultySource(app::SampleSource& inner, hal::Clock& clock) : inner_(inner), clock_(clock) {}
+  void fail_reads(std::uint32_t n) { fail_ = n; }
+  void add_flags(std::uint32_t n, std::uint32_t flags) {
+    flag_n_ = n;
+    flags_ = flags;
+  }
+  void set_dead(bool dead) {
+    if (dead_ && !dead) revive_ = true;
+    dead_ = dead;
+  }
+  bool dead() const { return dead_; }
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override;
+  app::AdcCounters do_counters() const override { return inner_.counters(); }
+  double do_volts_per_count() const override { return inner_.volts_per_count(); }
+
+  app::SampleSource& inner_;
+  hal::Clock& clock_;
+  std::uint32_t fail_ = 0;
+  std::uint32_t flag_n_ = 0;
+  std::uint32_t flags_ = 0;
+  bool dead_ = false;
+  bool revive_ = false;
+};
+
+/// The scenario's [[board.faults]] on the simulated board (docs/simulation.md, "Board faults"):
+/// the ADC and data-ready faults through the sample source's FaultPlan (each set before its
+/// conversion comes), read errors and a dead ADC through a FaultySource in front of it, both by
+/// the conversion's index (sample k of the run at k / rate).
+class ScheduledFaultSource final : public app::SampleSource {
+ public:
+  ScheduledFaultSource(SimSampleSource& source, hal::Clock& clock,
+                       const std::vector<sim::BoardFault>& faults, double rate_hz);
+
+ private:
+  Result<RawSample> do_read_sample(std::int64_t timeout_ns) override;
+  app::AdcCounters do_counters() const override { return faulty_.counters(); }
+  double do_volts_per_count() const override { return faulty_.volts_per_count(); }
+  /// The FaultPlan's single-valued faults (reset, silence, stuck, saturated): each kind's first
+  /// fault that has not ended by conversion `seq`.
+  void refresh(std::uint32_t seq);
+
+  struct Timed {
+    sim::BoardFault fault;
+    std::uint32_t from = 0;   // first conversion
+    std::uint32_t until = 0;  // first conversion after it (from + 1 for an instant)
+    bool applied = false;     // read_error: handed to the FaultySource
+  };
+  SimSampleSource& source_;
+  hal::Clock& clock_;
+  FaultySource faulty_;
+  std::vector<Timed> faults_;
+  FaultPlan plan_{};
+  std::int64_t period_ns_;
+  std::int64_t t0_ns_ = 0;
+  bool have_t0_ = false;
+};
+
+/// The scenario's CAN faults (can_refuse, bus_off) on the board's output, by scenario time
+/// (`now_s`: the time of the last sample read, as GnssReceiverBus takes it): a refusing sink drops
+/// and counts every frame (kResourceExhausted), a bus-off controller drops and counts them too
+/// (kUnavailable) and reports kBusOff; leaving bus-off counts a restart, as SocketCAN's automatic
+/// restart does.
+class FaultyCanBus final : public hal::CanBus {
+ public:
+  FaultyCanBus(std::unique_ptr<hal::CanBus> inner, const std::vector<sim::BoardFault>& faults,
+               std::function<double()> now_s);
+
+ private:
+  Status do_send(const hal::CanFrame& f) override;
+  Result<hal::CanFrame> do_receive(std::int64_t timeout_ns) override {
+    return inner_->receive(timeout_ns);
+  }
+  void do_service() override {
+    update();
+    inner_->service();
+  }
+  hal::CanBusState do_state() const override;
+  hal::CanCounters do_counters() const override;
+  void update();
+  bool within(sim::BoardFaultKind kind) const;
+
+  std::unique_ptr<hal::CanBus> inner_;
+  std::function<double()> now_s_;
+  std::vector<sim::BoardFault> faults_;  // can_refuse and bus_off only
+  hal::CanCounters own_{};               // what this layer dropped and its state changes
+  bool bus_off_ = false;
+};
+
 /// An in-memory CAN bus: frames sent are kept (fixed capacity, the oldest overwritten), frames
 /// queued with inject_rx() are received. Faults: refuse(true) makes every send fail as a full
 /// queue does (kResourceExhausted, counted as dropped); bus_off(true) enters bus-off (sends fail
