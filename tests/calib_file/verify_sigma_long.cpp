@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <random>
 #include <string>
@@ -261,6 +262,101 @@ TEST(VerifySigma, PredictedResidualSigmaMatchesAMonteCarloOverTheStatedCovarianc
               uncorrelated_outside, kPoses.size() * 6);
 }
 
+// The tail of Student's t against closed forms written here (not the tool's continued fraction):
+// ν = 1 (Cauchy) P(|T| ≥ t) = 1 − 2 atan(t)/π; ν = 2: 1 − t/√(2 + t²); ν = 3:
+// 1 − (2/π)(atan(t/√3) + (t/√3)/(1 + t²/3)); ν = ∞: erfc(t/√2). Each to 1e-12 relative (the
+// fraction converges to 1e-15 per step; a wrong term makes it fail by far more).
+TEST(VerifySigma, StudentTTailMatchesTheClosedForms) {
+  const double pi = 3.14159265358979323846;
+  for (const double t : {0.0, 0.3, 1.0, 2.5, 5.0, 19.2, 300.0}) {
+    const double u = t / std::sqrt(3.0);
+    const double want[] = {1.0 - 2.0 * std::atan(t) / pi, 1.0 - t / std::sqrt(2.0 + t * t),
+                           1.0 - 2.0 / pi * (std::atan(u) + u / (1.0 + u * u))};
+    for (int k = 0; k < 3; ++k) {
+      const double got = student_t_two_sided_p(t, k + 1.0);
+      EXPECT_NEAR(got, want[k], 1e-12 * std::max(want[k], 1e-300) + 1e-15)
+          << "t " << t << " dof " << k + 1;
+      EXPECT_NEAR(student_t_two_sided_p(-t, k + 1.0), got, 1e-15);
+    }
+    EXPECT_NEAR(student_t_two_sided_p(t, std::numeric_limits<double>::infinity()),
+                std::erfc(t / std::sqrt(2.0)), 1e-15);
+    // Many degrees of freedom approach the Gaussian: the tail's relative difference is about
+    // (t⁴ + 2t² − 1)/(4ν) (the expansion of the t density in 1/ν); bound: four times its size.
+    const double gauss = std::erfc(t / std::sqrt(2.0));
+    EXPECT_NEAR(student_t_two_sided_p(t, 1e7), gauss,
+                (t * t * t * t + 2 * t * t + 1) / 1e7 * gauss + 1e-300);
+  }
+}
+
+// The paper's route writes σ from the fit residuals with 2 degrees of freedom per sensor: the
+// file's σ is then an estimate, s = σ √(χ²₂/2), and a residual of a verification pose divided by
+// its predicted σ is a Student-t with 2 dof (|t| > 3 with probability 9.5 %, not 0.27 %). The
+// tool maps it to the Gaussian z of the same tail probability.
+//
+// Monte-Carlo, oracle written here: the true covariance is the paper file's; each draw makes a
+// file off the truth by an error drawn from it, whose stated σ (the whole 4×4 covariance: a
+// residual-based covariance is s² times a fixed matrix) are scaled per sensor by √(χ²₂/2), as a
+// fit with 2 residual dof would have stated them; the true board is captured in the 30° tilt
+// (pose 13), one row per sensor, and verified. Sensors are independent, so each draw gives 6
+// independent rows: 2000 draws, 12,000 rows. Criteria (Poisson counts, expected from the
+// Gaussian tails):
+//  - |z_gauss| > 3: 0.27 %, 32.4 expected; accepted 12..60 (P(outside) < 3e-5 each way);
+//  - |z_gauss| > 2: 4.55 %, 546 expected; accepted 546 ± 5·√546 (±117);
+//  - the naive |z| > 3 (the verdict before): more than 500 (9.5 %: 1,140 expected), which is why
+//    the paper's file failed a correct verification that often.
+TEST(VerifySigma, AResidualBasedSigmaIsJudgedAsTheStudentTItIs) {
+  const calib_file::CalibrationData truth = paper_file();
+  for (const auto& s : truth.sensors) {
+    ASSERT_EQ(s.sigma_source.basis, calib_file::SigmaBasis::kResiduals);
+    ASSERT_EQ(s.sigma_source.dof, 2);
+  }
+  std::array<Eigen::Matrix4d, 6> chol{};
+  for (std::size_t j = 0; j < 6; ++j) {
+    const Eigen::LLT<Eigen::Matrix4d> llt(stated_covariance(truth, j));
+    ASSERT_EQ(llt.info(), Eigen::Success);
+    chol[j] = llt.matrixL();
+  }
+  const auto theta_true = axes_of(truth);
+  const std::vector<Pose> poses = verify_poses();
+  std::mt19937_64 rng(20261129);
+  std::chi_squared_distribution<double> chi2(2.0);
+  constexpr int kT3Draws = 2000;
+  int over3 = 0, over2 = 0, naive_over3 = 0, rows_seen = 0;
+  for (int draw = 0; draw < kT3Draws; ++draw) {
+    calib_file::CalibrationData file = draw_file(rng, truth, chol);
+    for (std::size_t j = 0; j < 6; ++j) {
+      const double scale = std::sqrt(chi2(rng) / 2.0);
+      auto& s = file.sensors[j];
+      s.scale_sigma_v_per_g *= scale;
+      s.bias_sigma_g *= scale;
+      const Place p = place_of(j);
+      auto& sig = p.alpha ? file.alpha.angle_sigma_deg : file.beta.angle_sigma_deg;
+      sig[2 * p.row] *= scale;
+      sig[2 * p.row + 1] *= scale;
+    }
+    std::vector<MeanRow> rows = capture(rng, truth, theta_true);
+    rows.resize(6);  // pose 13, sensors 1..6
+    const auto rep = verify_calibration(rows, poses, file, "t.csv");
+    ASSERT_TRUE(rep.is_ok()) << rep.error().message;
+    for (const VerifyRow& r : rep.value().rows) {
+      ++rows_seen;
+      over3 += std::abs(r.z_gauss) > 3.0 ? 1 : 0;
+      over2 += std::abs(r.z_gauss) > 2.0 ? 1 : 0;
+      naive_over3 += std::abs(r.z) > 3.0 ? 1 : 0;
+      // The capture's stated part adds dof (Welch–Satterthwaite): never fewer than the file's 2.
+      EXPECT_GE(r.dof, 2.0);
+    }
+  }
+  std::printf("%d rows: |z_gauss| > 3: %d, > 2: %d; naive |z| > 3: %d\n", rows_seen, over3, over2,
+              naive_over3);
+  ASSERT_EQ(rows_seen, 6 * kT3Draws);
+  EXPECT_GE(over3, 12);
+  EXPECT_LE(over3, 60);
+  EXPECT_GE(over2, 546 - 117);
+  EXPECT_LE(over2, 546 + 117);
+  EXPECT_GT(naive_over3, 500);
+}
+
 TEST(VerifySigma, TheReportSaysWhichSigmaAndAnOldFileTakesCorrelationsAsZero) {
   const calib_file::CalibrationData truth = paper_file();
   const auto theta_true = axes_of(truth);
@@ -280,6 +376,18 @@ TEST(VerifySigma, TheReportSaysWhichSigmaAndAnOldFileTakesCorrelationsAsZero) {
   for (auto& s : old.sensors) s.correlation = {};
   const std::string unknown = text_of(old);
   EXPECT_NE(unknown.find("correlations unknown: taken as 0"), std::string::npos) << unknown;
+  // The paper's file has σ from residuals: said, and each row says its dof and Gaussian z; a file
+  // older than format 4 does not say where its σ came from, and the note says what is assumed.
+  EXPECT_NE(stated.find("sigma of a1 a2 a3 a4 a5 a6 from fit residuals"), std::string::npos)
+      << stated;
+  EXPECT_NE(stated.find("(Student-t, "), std::string::npos) << stated;
+  calib_file::CalibrationData v3 = truth;
+  for (auto& s : v3.sensors) s.sigma_source = {calib_file::SigmaBasis::kUnknown, 0};
+  const std::string older = text_of(v3);
+  EXPECT_NE(older.find("does not say where the sigma of a1 a2 a3 a4 a5 a6 came from"),
+            std::string::npos)
+      << older;
+  EXPECT_EQ(older.find("(Student-t, "), std::string::npos) << older;
 }
 
 }  // namespace

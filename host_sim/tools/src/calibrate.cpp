@@ -7,6 +7,8 @@
 #include <numbers>
 #include <span>
 
+#include "gfins/nav_core/filter/chi_square.hpp"
+
 namespace gfins::tools {
 namespace {
 
@@ -755,6 +757,46 @@ HostResult<LocationReport> run_location_calibration(const std::vector<LocationRu
   return rep;
 }
 
+namespace {
+
+/// I_x(a, b), the regularized incomplete beta function (0 ≤ x ≤ 1, a, b > 0): the continued
+/// fraction of Abramowitz & Stegun 26.5.8 by the modified Lentz method, on the side where it
+/// converges fast (x < (a + 1) / (a + b + 2)), the symmetry I_x(a, b) = 1 − I_{1−x}(b, a) on the
+/// other.
+double incomplete_beta(double x, double a, double b) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  if (x > (a + 1.0) / (a + b + 2.0)) return 1.0 - incomplete_beta(1.0 - x, b, a);
+  const double log_front =
+      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
+  constexpr double kTiny = 1e-300;
+  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::abs(d) < kTiny) d = kTiny;
+  d = 1.0 / d;
+  double f = d;
+  for (int m = 1; m <= 1000; ++m) {
+    const double md = m;
+    for (const double num : {md * (b - md) * x / ((a + 2 * md - 1) * (a + 2 * md)),
+                             -(a + md) * (a + b + md) * x / ((a + 2 * md) * (a + 2 * md + 1))}) {
+      d = 1.0 + num * d;
+      if (std::abs(d) < kTiny) d = kTiny;
+      c = 1.0 + num / c;
+      if (std::abs(c) < kTiny) c = kTiny;
+      d = 1.0 / d;
+      f *= c * d;
+    }
+    if (std::abs(c * d - 1.0) < 1e-15) break;
+  }
+  return std::exp(log_front) * f / a;
+}
+
+}  // namespace
+
+double student_t_two_sided_p(double t, double dof) {
+  if (!std::isfinite(dof)) return std::erfc(std::abs(t) / std::sqrt(2.0));
+  return incomplete_beta(dof / (dof + t * t), dof / 2.0, 0.5);
+}
+
 HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
                                             const std::optional<std::vector<Pose>>& poses,
                                             const calib_file::CalibrationData& cal,
@@ -777,6 +819,25 @@ HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
            ? " and correlations"
            : "; correlations unknown: taken as 0, the file predates format version 3") +
       "), propagated to first order through eq. (16)");
+  std::string residual_based, unknown;
+  for (std::size_t j = 0; j < 6; ++j) {
+    const calib_file::SigmaBasis b = cal.sensors[j].sigma_source.basis;
+    if (b == calib_file::SigmaBasis::kResiduals) residual_based += " a" + std::to_string(j + 1);
+    if (b == calib_file::SigmaBasis::kUnknown) unknown += " a" + std::to_string(j + 1);
+  }
+  if (!residual_based.empty()) {
+    rep.lines.push_back("  sigma of" + residual_based +
+                        " from fit residuals (sensor.N.sigma_source): their z is a Student-t, "
+                        "judged by the Gaussian z of the same tail probability");
+  }
+  if (!unknown.empty()) {
+    rep.lines.push_back(
+        "  note: the file predates format version 4 and does not say where the "
+        "sigma of" +
+        unknown +
+        " came from: taken as stated (Gaussian); if they came from residuals, "
+        "the verdict is too strict");
+  }
   std::array<Eigen::Matrix4d, 6> cov{};
   std::array<std::array<nav::Vec3<double>, 2>, 6> d_theta{};
   for (std::size_t j = 0; j < 6; ++j) {
@@ -816,18 +877,35 @@ HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
                               s.scale_v_per_g * d_theta[j][1].dot(av));
     const double var_mean = m.count > 0 ? m.std_v * m.std_v / static_cast<double>(m.count) : 0.0;
     // A valid file's Σ_j is positive semidefinite (checked on load); max() guards rounding.
-    const double var = var_mean + std::max(0.0, jac.dot(cov[j] * jac));
+    const double var_par = std::max(0.0, jac.dot(cov[j] * jac));
+    const double var = var_mean + var_par;
     const double sigma = std::sqrt(var);
-    const double z = sigma > 0.0 ? res / sigma : 0.0;
-    rep.rows.push_back(VerifyRow{m.attitude, m.sensor, res, sigma, std::sqrt(var_mean)});
-    if (std::abs(z) > rep.max_abs_z) {
-      rep.max_abs_z = std::abs(z);
+    VerifyRow row{m.attitude, m.sensor, res, sigma, std::sqrt(var_mean)};
+    row.z = sigma > 0.0 ? res / sigma : 0.0;
+    row.z_gauss = row.z;
+    std::string how;
+    // σ from fit residuals with K degrees of freedom are an estimate: z is then a Student-t, whose
+    // tails are far wider (|t| > 5 has probability 3.8 % with 2 dof, 5.7e-7 for a Gaussian). Its
+    // dof, with the capture's stated part added: Welch–Satterthwaite, ν = var² / (var_par² / K).
+    // The verdict takes the Gaussian z of the same tail probability.
+    if (s.sigma_source.basis == calib_file::SigmaBasis::kResiduals && var_par > 0.0) {
+      row.dof = static_cast<double>(s.sigma_source.dof) * (var * var) / (var_par * var_par);
+      const double p = student_t_two_sided_p(row.z, row.dof);
+      row.z_gauss = p > 1e-300 ? -nav::normal_quantile(p / 2.0) : 40.0;
+      row.z_gauss = std::copysign(row.z_gauss, row.z);
+      how = " (Student-t, " + fmt("%.1f", row.dof) + " dof: " + fmt("%.2f", row.z_gauss) +
+            " as a Gaussian)";
+    }
+    rep.rows.push_back(row);
+    if (std::abs(row.z_gauss) > rep.max_abs_z) {
+      rep.max_abs_z = std::abs(row.z_gauss);
       rep.worst_sensor = m.sensor;
       rep.worst_pose = m.attitude;
     }
     rep.lines.push_back("  pose " + std::to_string(m.attitude) + " sensor a" +
                         std::to_string(m.sensor) + ": residual " + fmt("%9.4f", res * 1e3) +
-                        " mV, sigma " + fmt("%.3g", sigma * 1e3) + " mV, z " + fmt("%6.2f", z));
+                        " mV, sigma " + fmt("%.3g", sigma * 1e3) + " mV, z " + fmt("%6.2f", row.z) +
+                        how);
   }
   return rep;
 }

@@ -3,6 +3,7 @@
 // solver of gfins::nav_calib, the CalibrationData it yields and a printed report.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -108,18 +109,29 @@ std::vector<std::string> verdict_warnings(const calib::MultiAttitudeResult<doubl
 /// b and two angles (its σ and correlations; correlations taken as 0 when
 /// cal.correlations_known is false), propagated to first order (docs/calibration.md §7). Poses
 /// without a poses file are numbered as in Tables 2/3.
+/// Two-sided tail probability of Student's t with `dof` > 0 degrees of freedom (non-integer
+/// allowed): P(|T| ≥ |t|) = I_{ν/(ν+t²)}(ν/2, 1/2), the regularized incomplete beta function by
+/// its continued fraction (modified Lentz). 2 Φ(−|t|) for an infinite dof.
+double student_t_two_sided_p(double t, double dof);
+
 struct VerifyRow {
   int attitude = 0;
   int sensor = 0;             // 1-based
   double residual_v = 0.0;    // P − SF (b + θ*·a), V
   double sigma_v = 0.0;       // predicted 1σ of the residual, V
   double sigma_mean_v = 0.0;  // the capture's part of it (std_v/√count), V
+  double z = 0.0;             // residual / sigma
+  /// Degrees of freedom of z: infinite (Gaussian) when every part of sigma is stated; finite
+  /// when the file's σ of the sensor came from fit residuals (Welch–Satterthwaite of its part and
+  /// the capture's stated noise).
+  double dof = std::numeric_limits<double>::infinity();
+  double z_gauss = 0.0;  // the Gaussian z with the same two-sided tail probability as z
 };
 struct VerifyReport {
   std::vector<std::string> lines;
   std::vector<VerifyRow> rows;  // one per row of the means, in their order
-  double max_abs_z = 0.0;
-  int worst_sensor = 0;  // 1-based
+  double max_abs_z = 0.0;       // of z_gauss: the verdict's statistic
+  int worst_sensor = 0;         // 1-based
   int worst_pose = 0;
 };
 HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,

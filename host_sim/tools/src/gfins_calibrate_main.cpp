@@ -269,7 +269,9 @@ int calibrate(const Options& o, const std::optional<Recording>& rec, Calibration
 }
 
 // Verification poses against an installed file: residuals and z, exit 3 beyond kVerifyMaxZ.
-// 5σ: a correct calibration exceeds it on one of 36 residuals with probability 2e-5 (Gaussian).
+// 5σ: a correct calibration exceeds it on one of 36 residuals with probability 2e-5 (Gaussian; a
+// z from residual-based σ, a Student-t, is first mapped to the Gaussian z of its tail
+// probability, so the same holds for it).
 constexpr double kVerifyMaxZ = 5.0;
 int verify(const Options& o) {
   const auto cal = calib_file::load_calibration_file(o.verify);
@@ -290,10 +292,12 @@ int verify(const Options& o) {
                                   std::to_string(rep.value().worst_sensor) + " in pose " +
                                   std::to_string(rep.value().worst_pose) + " is " +
                                   num(rep.value().max_abs_z) +
-                                  " sigma from the calibration (limit 5): the pose, the jig or "
+                                  " sigma (Gaussian-equivalent) from the calibration (limit 5): "
+                                  "the pose, the jig or "
                                   "the file is not what it should be");
   }
-  std::cout << "verification passed: largest |z| " << num(rep.value().max_abs_z) << " (limit 5)\n";
+  std::cout << "verification passed: largest |z| " << num(rep.value().max_abs_z)
+            << " (Gaussian-equivalent; limit 5)\n";
   return kExitOk;
 }
 
