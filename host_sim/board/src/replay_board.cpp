@@ -56,7 +56,9 @@ class Player {
     return true;
   }
 
-  bool finished() const { return done_ || !error_.empty(); }
+  /// After the last sample (the read ahead has then met the end): the loop stops there, as on the
+  /// simulated board, instead of running one more cycle into a failed read.
+  bool finished() const { return done_ || !error_.empty() || (eof_ && samples_.empty()); }
   std::uint64_t delivered() const { return delivered_; }
   std::uint64_t frames_delivered() const { return frames_delivered_; }
   const sim::RecordingHeader& header() const { return reader_.header(); }
