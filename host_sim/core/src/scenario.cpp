@@ -398,10 +398,13 @@ std::vector<BoardFault> read_board_faults(const Reader& rd, const toml::table& b
     BoardFault f;
     const auto named = std::find(kBoardFaultNames.begin(), kBoardFaultNames.end(), kind);
     if (named == kBoardFaultNames.end()) {
-      std::string list;
-      for (const char* c : kBoardFaultNames) list += std::string(list.empty() ? "" : ", ") + c;
-      rd.fail(t->get("kind"), p + "kind",
-              "unknown value '" + kind + "' (expected one of: " + list + ")");
+      std::string what = "unknown value '" + kind + "' (expected one of: ";
+      for (std::size_t k = 0; k < kBoardFaultNames.size(); ++k) {
+        what += k == 0 ? "" : ", ";
+        what += kBoardFaultNames[k];
+      }
+      what += ")";
+      rd.fail(t->get("kind"), p + "kind", what);
     }
     f.kind = static_cast<BoardFaultKind>(named - kBoardFaultNames.begin());
     // After the first sample (the loop's reference) and before the last.
