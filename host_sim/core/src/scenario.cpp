@@ -27,7 +27,12 @@ constexpr std::array<const char*, 11> kBoardFaultNames = {
     "stuck",     "can_refuse",   "bus_off",    "read_error",  "adc_dead"};
 }  // namespace
 
-const char* to_string(BoardFaultKind k) { return kBoardFaultNames[static_cast<std::size_t>(k)]; }
+const char* to_string(BoardFaultKind k) {
+  const auto i = static_cast<std::size_t>(k);
+  if (i >= kBoardFaultNames.size()) return "unknown";
+  const char* name = kBoardFaultNames.at(i);
+  return name;
+}
 
 namespace {
 
