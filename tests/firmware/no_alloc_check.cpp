@@ -109,11 +109,7 @@ TEST(NoAlloc, RecordingAllocatesNothingInTheLoopOrItsWriter) {
   rig.configure();
   const std::string path =
       (std::filesystem::temp_directory_path() / "gfins_no_alloc_recording.gfr").string();
-  recording::Header h;
-  h.sample_rate_hz = rig.s.rate_hz;
-  h.volts_per_count.fill(rig.adc->volts_per_count());
-  h.geometry = rig.cal.config.nominal.cast<double>();
-  Recorder::Opened opened = Recorder::open(path, h);
+  Recorder::Opened opened = Recorder::open(path, testing::recording_header(rig));
   ASSERT_TRUE(opened.recorder) << opened.error;
   rig.loop->set_recorder(&opened.recorder->queue());
   rig.run_cycles(kWarmUpCycles);

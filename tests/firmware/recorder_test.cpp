@@ -27,11 +27,7 @@ std::string temp_path(const char* name) {
 // A recorder on `path` attached to the rig's loop (header as gfins-fw writes it); null (and a
 // test failure) when it cannot be opened.
 std::unique_ptr<Recorder> attach(SimRig& rig, const std::string& path) {
-  recording::Header h;
-  h.sample_rate_hz = rig.s.rate_hz;
-  h.volts_per_count.fill(rig.adc->volts_per_count());
-  h.geometry = rig.cal.config.nominal.cast<double>();
-  Recorder::Opened opened = Recorder::open(path, h);
+  Recorder::Opened opened = Recorder::open(path, testing::recording_header(rig));
   EXPECT_TRUE(opened.recorder) << opened.error;
   if (opened.recorder) rig.loop->set_recorder(&opened.recorder->queue());
   return std::move(opened.recorder);

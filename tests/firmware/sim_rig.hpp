@@ -15,6 +15,7 @@
 #include "gfins/app/startup.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
+#include "gfins/recording/codec.hpp"
 #include "support/sim_chain.hpp"
 
 namespace gfins::testing {
@@ -138,5 +139,15 @@ struct SimRig {
   app::CalibrationSet cal;
   std::unique_ptr<app::SampleLoop> loop;
 };
+
+/// The recording header gfins-fw writes for this rig's board (rate, the chain's LSB, the
+/// configured nominal geometry): for tests that attach a recorder to the loop.
+inline recording::Header recording_header(const SimRig& rig) {
+  recording::Header h;
+  h.sample_rate_hz = rig.s.rate_hz;
+  h.volts_per_count.fill(rig.adc->volts_per_count());
+  h.geometry = rig.cal.config.nominal.cast<double>();
+  return h;
+}
 
 }  // namespace gfins::testing

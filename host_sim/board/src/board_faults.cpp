@@ -74,8 +74,8 @@ ScheduledFaultSource::ScheduledFaultSource(SimSampleSource& source, hal::Clock& 
         break;
     }
   }
-  refresh(0);
   source_.set_faults(plan_);
+  refresh(0);
 }
 
 void ScheduledFaultSource::refresh(std::uint32_t seq) {
@@ -87,26 +87,33 @@ void ScheduledFaultSource::refresh(std::uint32_t seq) {
     }
     return nullptr;
   };
-  FaultPlan p = plan_;
+  // Called before every read: only the single-valued fields are compared and set (no copy of
+  // the plan's lists), and the source gets the plan again only when one of them changed.
   const Timed* reset = current(BoardFaultKind::kAdcReset);
-  p.reset_at = reset != nullptr ? reset->from : 0;
   const Timed* silent = current(BoardFaultKind::kSilentLine);
-  p.silent_from = silent != nullptr ? silent->from : 0;
-  p.silent_edges = silent != nullptr ? silent->fault.count : 0;
   const Timed* stuck = current(BoardFaultKind::kStuck);
-  p.stuck_channel = stuck != nullptr ? static_cast<int>(stuck->fault.channel) : -1;
-  p.stuck_from = stuck != nullptr ? stuck->from : 0;
-  p.stuck_until = stuck != nullptr ? stuck->until : 0;
   const Timed* sat = current(BoardFaultKind::kSaturated);
-  p.saturated_channel = sat != nullptr ? static_cast<int>(sat->fault.channel) : -1;
-  p.saturated_from = sat != nullptr ? sat->from : 0;
-  p.saturated_until = sat != nullptr ? sat->until : 0;
-  if (p.reset_at != plan_.reset_at || p.silent_from != plan_.silent_from ||
-      p.stuck_channel != plan_.stuck_channel || p.stuck_from != plan_.stuck_from ||
-      p.saturated_channel != plan_.saturated_channel || p.saturated_from != plan_.saturated_from) {
-    plan_ = std::move(p);
-    source_.set_faults(plan_);
+  const std::uint32_t reset_at = reset != nullptr ? reset->from : 0;
+  const std::uint32_t silent_from = silent != nullptr ? silent->from : 0;
+  const int stuck_channel = stuck != nullptr ? static_cast<int>(stuck->fault.channel) : -1;
+  const std::uint32_t stuck_from = stuck != nullptr ? stuck->from : 0;
+  const int sat_channel = sat != nullptr ? static_cast<int>(sat->fault.channel) : -1;
+  const std::uint32_t sat_from = sat != nullptr ? sat->from : 0;
+  if (reset_at == plan_.reset_at && silent_from == plan_.silent_from &&
+      stuck_channel == plan_.stuck_channel && stuck_from == plan_.stuck_from &&
+      sat_channel == plan_.saturated_channel && sat_from == plan_.saturated_from) {
+    return;
   }
+  plan_.reset_at = reset_at;
+  plan_.silent_from = silent_from;
+  plan_.silent_edges = silent != nullptr ? silent->fault.count : 0;
+  plan_.stuck_channel = stuck_channel;
+  plan_.stuck_from = stuck_from;
+  plan_.stuck_until = stuck != nullptr ? stuck->until : 0;
+  plan_.saturated_channel = sat_channel;
+  plan_.saturated_from = sat_from;
+  plan_.saturated_until = sat != nullptr ? sat->until : 0;
+  source_.set_faults(plan_);
 }
 
 Result<RawSample> ScheduledFaultSource::do_read_sample(std::int64_t timeout_ns) {
