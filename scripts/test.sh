@@ -39,7 +39,25 @@ step() {
   printf '\n=== %s (%s, +%ds)\n' "$*" "$(date +%T)" "$((step_t - start))"
 }
 
+# The free space of the file system the trees are on, in MiB, with a label.
+free_space() {
+  printf 'test.sh: %s: %s MiB free on the file system of %s\n' "$1" \
+    "$(df -Pm . | awk 'NR == 2 { print $4 }')" "$PWD"
+}
+# Deletes the ELF executables a build tree linked (not its objects, libraries or scripts).
+prune_programs() {
+  local n=0 bytes=0 f size
+  while IFS= read -r -d '' f; do
+    [ "$(head -c 4 "$f" | od -An -c | tr -d ' ')" = '177ELF' ] || continue
+    size=$(stat -c %s "$f")
+    rm -f -- "$f"
+    n=$((n + 1)) bytes=$((bytes + size))
+  done < <(find "$1" -path "$1/CMakeFiles" -prune -o -type f -perm -u+x -print0)
+  printf 'test.sh: removed %d programs of %s (%d MiB)\n' "$n" "$1" $((bytes / 1048576))
+}
+
 step "install packages"
+free_space "at the start"
 ./scripts/install-deps.sh
 
 step "clang-format check"
@@ -76,6 +94,17 @@ ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 # build/host-debug/fuzz-findings/ (docs/reliability.md). Not the preset: it excludes the label.
 step "host-debug: fuzzing (libFuzzer, every parser of outside input)"
 ctest --test-dir build/host-debug -L fuzz -j "$jobs" --output-on-failure | tee "$log_dir/ctest-fuzz.log"
+
+# The sanitizer tree's linked programs (about 120 test and fuzz executables of 30-50 MB each: ASan
+# at -O0, every library linked in) are 5-6 GB, most of what the run writes; nothing after this
+# step uses them, and a machine with 10 GB free ran out of space in the virtual board's kernel
+# download with them kept (docs/ci.md, "Disk"). The objects and libraries stay, so
+# `cmake --build --preset host-debug` relinks them in about a minute. On a failure above the
+# script has ended already and the tree is left whole, with any fuzz finding.
+step "host-debug: remove its linked programs (disk)"
+free_space "before"
+prune_programs build/host-debug
+free_space "after"
 
 # The threaded parts (the Monte-Carlo pool, the candump log writer, the reload worker, the
 # status reporter, and gfins-fw as a process: logger thread, HIL link) under ThreadSanitizer:
@@ -136,27 +165,17 @@ cmake --build --preset cortex-m4f -j "$jobs"
 # The limits (flash, RAM, no soft-float double) are a test of that tree: GFINS_M4F_*_LIMIT.
 ctest --preset cortex-m4f | tail -n 40
 
-# The tests of the code that runs on the board (label `board`, tests/CMakeLists.txt: core,
-# calibration, calib_file, CAN codec, drivers, Linux backends, firmware, heap checks) are
-# cross-built for 32-bit armhf (target gfins_board_tests) and run under qemu-arm-static (test
-# preset armhf-linux): ARM code generation, 32-bit size_t and long, the hard-float ABI. The same
-# tests for aarch64 (preset aarch64-linux) and the whole suite under qemu-aarch64-static (preset
-# aarch64-linux-all) are one command each, run before a release (docs/deploy.md); per commit
-# they would build the same sources a third time for a 64-bit target that x86-64 and armhf
-# already bracket (docs/ci.md, "The 40-minute budget"). The host-only tests run natively in both
-# host presets.
-step "cross build armhf (multiarch), the board tests under qemu-arm-static"
+# The board's program cross-built for 32-bit armhf (ARM code generation, 32-bit size_t and long,
+# the hard-float ABI, every warning an error) and packaged with the amd64 packages from the
+# host-release tree above (CPack, lintian). The tests of the code that runs on the board (label
+# `board`) cross-built and run under qemu-arm-static (preset armhf-linux) or qemu-aarch64-static
+# (preset aarch64-linux; the whole suite: aarch64-linux-all) are one command each, run before a
+# release (docs/deploy.md): per commit they compiled the same sources a third time, about 430 s of
+# the run, for targets whose code x86-64 and the bare-metal ARM build bracket (docs/ci.md, "The
+# 40-minute budget"). The armhf tools and both arm64 packages are made on request
+# (scripts/package.sh armhf-linux, scripts/package.sh aarch64-linux).
+step "armhf cross build of gfins-fw, Debian packages (amd64; armhf gfins-fw) and lintian"
 ./scripts/install-cross-deps.sh
-cmake --preset armhf-linux >/dev/null
-cmake --build --preset armhf-linux -j "$jobs"
-ctest --preset armhf-linux -j "$jobs" | tee "$log_dir/ctest-armhf-linux.log"
-
-# amd64 from the host-release tree built above (CPack and lintian only); for armhf the board's
-# package, gfins-fw cross-built in the armhf tree the step before built (its libraries are the
-# board tests', so only the program's own files are new); the tools for armhf and both arm64
-# packages are made on request (scripts/package.sh armhf-linux, scripts/package.sh
-# aarch64-linux).
-step "Debian packages (amd64; armhf gfins-fw, cross-built) and lintian"
 ./scripts/package.sh host-release armhf-linux:board
 
 # One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
@@ -171,6 +190,7 @@ fw_debs=(out/deb/gfins-fw_*_amd64.deb)
 [ ${#fw_debs[@]} -eq 1 ] && [ -e "${fw_debs[0]}" ] ||
   { echo "test.sh: expected one out/deb/gfins-fw_*_amd64.deb, found: ${fw_debs[*]}" >&2; exit 1; }
 fw_deb=${fw_debs[0]}
+free_space "before the virtual board"
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,service}" \
   --deb "$fw_deb"
 
