@@ -3,7 +3,8 @@
 // board mounted on the vehicle with a tilt (roll 2°, pitch −3°), the array's forward physics with
 // white noise and a constant bias per sensor, the counts a converter would deliver, and a GNSS
 // receiver of stated accuracy (0.05 m/s, 1 m per axis, 5 Hz) whose fixes arrive 100 ms after
-// their time of validity, with the antenna at the array (no lever arm).
+// their time of validity, with the antenna at the array or at a lever arm l from it (the fixes
+// then the antenna's: position r + C l, velocity v + C (ω × l)).
 #pragma once
 
 #include <algorithm>
@@ -56,9 +57,11 @@ class InMotionDrive {
  public:
   /// in_motion: PipelineConfig::align_in_motion; track_sigma_deg: the filter's
   /// track_heading_sigma_rad in degrees (0: not a vehicle, no heading from the track).
-  /// t0: the power-up's place on the figure eight (board_truth).
-  InMotionDrive(bool in_motion, unsigned seed, double t0, double track_sigma_deg = 0.5)
-      : rng_(seed), t0_(t0) {
+  /// t0: the power-up's place on the figure eight (board_truth). lever_b: the antenna from the
+  /// array, body axes (m); the filter is told it.
+  InMotionDrive(bool in_motion, unsigned seed, double t0, double track_sigma_deg = 0.5,
+                const Vec3<double>& lever_b = Vec3<double>::Zero())
+      : rng_(seed), t0_(t0), lever_b_(lever_b) {
     config_.front_end.volts_per_count.fill(10.0 / 8388608.0);
     config_.front_end.scale_v_per_g.fill(1.33);
     config_.gravity = GravityModel<double>::constant(kG);
@@ -69,6 +72,7 @@ class InMotionDrive {
     a.filter.noise.bias_sigma_mps2.fill(kArrayBiasMps2);
     a.filter.heading_known = false;
     a.filter.track_heading_sigma_rad = track_sigma_deg * kDeg;
+    a.filter.gnss_lever_arm_b = lever_b;
     a.standstill.white_sigma_mps2 = kArrayNoiseMps2;
     a.standstill.gravity_mps2 = kG;
     configured_ = pipeline_.configure(config_).is_ok();
@@ -113,9 +117,12 @@ class InMotionDrive {
     pos.sigma.setConstant(kGnssSigmaPos);
     GnssFix<double> vel = pos;
     vel.sigma.setConstant(kGnssSigmaVel);
+    // The antenna's position and velocity: a point of the rigid body at l.
+    const Vec3<double> r_antenna = x.r_n + x.q_nb * lever_b_;
+    const Vec3<double> v_antenna = x.v_n + x.q_nb * x.w_b.cross(lever_b_);
     for (int i = 0; i < 3; ++i) {
-      pos.value_n(i) = x.r_n(i) + kGnssSigmaPos * unit_(rng_);
-      vel.value_n(i) = x.v_n(i) + kGnssSigmaVel * unit_(rng_);
+      pos.value_n(i) = r_antenna(i) + kGnssSigmaPos * unit_(rng_);
+      vel.value_n(i) = v_antenna(i) + kGnssSigmaVel * unit_(rng_);
     }
     (void)pipeline_.offer_gnss_position(pos);
     (void)pipeline_.offer_gnss_velocity(vel);
@@ -142,6 +149,7 @@ class InMotionDrive {
   std::normal_distribution<double> unit_{0.0, 1.0};
   Vec6<double> bias_;
   double t0_;
+  Vec3<double> lever_b_;
   bool configured_ = false;
 };
 

@@ -583,7 +583,11 @@ class ErrorStateFilter {
     const Vec3<T> v = array_velocity(fix, at);
     const T speed = v.template head<2>().norm();
     if (!(speed >= config_.track_min_speed_mps)) return UpdateOutcome{};
-    const T sv = fix.sigma.template head<2>().maxCoeff() / speed;
+    // The array's velocity is the antenna's minus Ĉ(ω̂ × l): ω̂'s error moves the course too
+    // (|l|² tr P_ωω, as in array_velocity_variance), and the heading update has no rate column to
+    // take it: after an in-motion start in a turn ω̂'s error is the vehicle's rate.
+    const T sv =
+        std::sqrt(array_velocity_variance(fix, at, false).template head<2>().maxCoeff()) / speed;
     const T sigma =
         std::sqrt(sv * sv + config_.track_heading_sigma_rad * config_.track_heading_sigma_rad);
     return apply(heading_measurement(at.q_nb, std::atan2(v.y(), v.x()), sigma),
