@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "nav_core/filter_run.hpp"
@@ -569,6 +570,44 @@ TEST(ErrorStateFilterTest, EulerJacobianMatchesFiniteDifferences) {
         euler_from_quat(Quat<double>(quat_from_rotation_vector<double>(phi) * q));
     const Vec3<double> col = (ep - em) / (2 * kStep);
     EXPECT_NEAR((col - j.col(i)).norm(), 0.0, kTol) << i;
+  }
+}
+
+// Why the Joseph form (docs/math.md): in float32 a measurement far more precise than the state
+// makes the gain 1 to the last bit, and the short form (I − KH) P then leaves a variance of 0
+// (floored to 1e-14: a σ of 1e-7 m/s claimed after a 1e-4 m/s measurement), where (I − KH) P
+// (I − KH)ᵀ + K R Kᵀ keeps K R Kᵀ = R. Oracle: a velocity uncorrelated with every other state
+// (the initial covariance is diagonal in it) takes a ZUPT of variance R to P R / (P + R) per
+// axis, in double here. Bound 1 %: float rounding of the Joseph terms is about 1e-7 relative;
+// the short form computed in float below is off by 4.6 % (R = 1e-6) and 100 % (R = 1e-8).
+TEST(ErrorStateFilterTest, APreciseUpdateInFloatLeavesTheVarianceTheFormulaGives) {
+  static ErrorStateFilter<float> filter;
+  const auto solver = ArraySolver<float>::create(table1_geometry(0.1F)).value();
+  const auto solver_d = ArraySolver<double>::create(table1_geometry(0.1)).value();
+  const testing::Truth truth = testing::rest(Quat<double>::Identity());
+  for (const double r : {1e-6, 1e-8}) {
+    Strapdown<float> nav(solver, GravityModel<float>::constant(static_cast<float>(testing::kG)));
+    nav.initialize(testing::nav_state_of<float>(truth),
+                   testing::ideal_outputs(solver_d.geometry(), truth).cast<float>());
+    FilterConfig<float> c;
+    c.init_sigma_vel_mps = 1.0F;
+    c.zupt_sigma_mps = static_cast<float>(std::sqrt(r));
+    ASSERT_TRUE(filter.configure(c).is_ok());
+    filter.start(nav);
+    const double p = 1.0;
+    const double exact = p * r / (p + r);
+    ASSERT_EQ(filter.update_zupt(nav).status, UpdateStatus::kAccepted) << "R " << r;
+    for (int i = 0; i < 3; ++i) {
+      const double got = filter.covariance()(filt_idx::kVel + i, filt_idx::kVel + i);
+      EXPECT_NEAR(got / exact, 1.0, 0.01) << "R " << r << ", axis " << i;
+    }
+    EXPECT_EQ(filter.counters().covariance_resets, 0U);
+    // The short form in float on the same numbers is outside the bound: the bound can fail.
+    const float pf = 1.0F;
+    const auto rf = static_cast<float>(r);
+    const float k = pf / (pf + rf);
+    const float short_form = (1.0F - k) * pf;
+    EXPECT_GT(std::abs(static_cast<double>(short_form) / exact - 1.0), 0.01) << "R " << r;
   }
 }
 
