@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -137,11 +138,18 @@ struct ReplayParts {
   std::unique_ptr<Player> player;
 };
 
-}  // namespace
+// The recording opened once and checked against the configuration: the reader, or what is wrong
+// with it, named with the key and where it came from.
+struct CheckedRecording {
+  std::optional<sim::RecordingReader> reader;
+  std::string error;
+};
 
-std::string check_recording(const app::FwConfig& c, const std::string& origin) {
+CheckedRecording open_checked(const app::FwConfig& c, const std::string& origin) {
+  CheckedRecording out;
   const auto bad = [&](const std::string& why) {
-    return origin + ": sim.recording = " + app::quote_text(c.sim_recording) + ": " + why;
+    out.error = origin + ": sim.recording = " + app::quote_text(c.sim_recording) + ": " + why;
+    return std::move(out);
   };
   auto reader = sim::RecordingReader::open(c.sim_recording);
   if (!reader.is_ok()) return bad(reader.error().message);
@@ -158,23 +166,27 @@ std::string check_recording(const app::FwConfig& c, const std::string& origin) {
   if (c.pacing != app::Pacing::kFast) {
     return bad("a recording is replayed by sample index: sim.pacing must be \"fast\"");
   }
-  return "";
+  out.reader.emplace(std::move(reader).value());
+  return out;
+}
+
+}  // namespace
+
+std::string check_recording(const app::FwConfig& c, const std::string& origin) {
+  return open_checked(c, origin).error;
 }
 
 app::BoardResult make_replay_board(const app::FwConfig& c) {
   app::BoardResult out;
-  if (std::string e = check_recording(c, "sim.recording"); !e.empty()) {
-    out.error = e;
+  CheckedRecording checked = open_checked(c, "sim.recording");
+  if (!checked.reader) {
+    out.error = checked.error;
     return out;
   }
-  auto reader = sim::RecordingReader::open(c.sim_recording);
-  if (!reader.is_ok()) {
-    out.error = reader.error().message;
-    return out;
-  }
-  const sim::RecordingHeader header = reader.value().header();
+  sim::RecordingReader& reader = *checked.reader;
+  const sim::RecordingHeader header = reader.header();
   auto parts = std::make_shared<ReplayParts>();
-  parts->player = std::make_unique<Player>(std::move(reader).value());
+  parts->player = std::make_unique<Player>(std::move(reader));
   Player* player = parts->player.get();
   auto b = std::make_unique<app::Board>();
   auto clock = std::make_unique<app::SampleClock>();
