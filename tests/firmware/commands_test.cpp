@@ -218,5 +218,49 @@ TEST_F(Commands, ReloadWithoutAWorkerFailsAndKeepsTheCalibration) {
   EXPECT_EQ(rig_->loop->cal_id(), id);
 }
 
+// A new alignment while the vehicle moves would navigate from a wrong attitude: with aiding on,
+// Realign and ResetNavigation are refused (kMoving, counted as a command error, navigation
+// untouched) unless forced. The scenario says when the board moves: urban-stop-and-go stands
+// 10 s and then 15 s (its first stop), then accelerates to 12 m/s in 5 s along a smooth profile,
+// 4.5 m/s² at 27.5 s (|f| 1 m/s² above gravity: the standstill detector's gravity test; at a
+// cruise's constant speed a straight stretch can look at rest to accelerometers, docs/math.md,
+// "Standstill updates in motion").
+TEST(CommandsWhileMoving, RealignAndResetAreRefusedWhileMovingUnlessForced) {
+  SimRig rig("urban-stop-and-go", 29.0);
+  rig.config.aiding = true;
+  rig.cal = load_calibration(rig.config, rig.factory, &rig.factory).set;
+  rig.configure();
+  const auto exec = [&](can::Opcode op, bool forced) {
+    can::Command c;
+    c.opcode = op;
+    c.forced = forced;
+    SampleLoop::CommandReply r;
+    rig.loop->execute(c, r);
+    return r.response.result;
+  };
+  // At rest (5 s): a reset is carried out, and the board aligns again before it moves.
+  rig.run_cycles(5000);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  ASSERT_TRUE(rig.loop->pipeline().aiding().at_rest());
+  EXPECT_EQ(exec(can::Opcode::kResetNavigation, false), can::ResultCode::kOk);
+  rig.run_cycles(4000);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  // Accelerating (27.5 s).
+  rig.run_cycles(18500);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  ASSERT_FALSE(rig.loop->pipeline().aiding().at_rest());
+  const std::uint32_t errors = rig.loop->health().command_errors;
+  EXPECT_EQ(exec(can::Opcode::kRealign, false), can::ResultCode::kMoving);
+  EXPECT_EQ(exec(can::Opcode::kResetNavigation, false), can::ResultCode::kMoving);
+  EXPECT_EQ(rig.loop->health().command_errors, errors + 2);
+  rig.run_cycles(1);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  // Forced, it is carried out.
+  EXPECT_EQ(exec(can::Opcode::kRealign, true), can::ResultCode::kOk);
+  rig.run_cycles(1);
+  EXPECT_EQ(rig.loop->mode(), can::Mode::kAligning);
+  EXPECT_EQ(rig.loop->health().command_errors, errors + 2);
+}
+
 }  // namespace
 }  // namespace gfins::app
