@@ -321,6 +321,7 @@ void SampleLoop::on_sample(const RawSample& s) {
   if (!measured) ++health_.rejected_samples;
   if (measured) last_good_ = s;
   pipeline_.process(s);
+  note_alignment_refusal(s.t_ns);
   if (pipeline_.phase() == nav::PipelinePhase::kAligning) {
     gravity_checked_ = false;
   } else if (!gravity_checked_) {
@@ -415,6 +416,49 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
           static_cast<std::int64_t>(r.response.result));
     }
     if (!r.deferred) send_response(r.response);
+  }
+}
+
+void SampleLoop::note_alignment_refusal(std::int64_t t_ns) {
+  const nav::PipelineCounters& c = pipeline_.counters();
+  if (c.alignment_restarts == alignment_refusals_seen_) return;
+  // configure() (a re-align, a reload) starts the core's counters again from 0.
+  const bool refused = c.alignment_restarts > alignment_refusals_seen_;
+  alignment_refusals_seen_ = c.alignment_restarts;
+  if (!refused) return;
+  // One literal per reason: a log record carries numbers only (log_queue.hpp).
+  constexpr LogKind kKind = LogKind::kAlignmentRefused;
+  constexpr LogLevel kLevel = LogLevel::kInfo;
+  const auto n = static_cast<std::int64_t>(c.alignment_restarts);
+  switch (c.last_refusal) {
+    case nav::AlignmentRefusal::kNotGravity:
+      return limited_log(kKind, kLevel, t_ns,
+                         "alignment window refused: |f| is no gravity vector (board not at rest "
+                         "or no sensor signal); {} refused, {} more since the last line",
+                         n);
+    case nav::AlignmentRefusal::kSpecificForce:
+      return limited_log(kKind, kLevel, t_ns,
+                         "alignment window refused: the specific force scattered beyond the "
+                         "limit (the board moved); {} refused, {} more since the last line",
+                         n);
+    case nav::AlignmentRefusal::kAngularAccel:
+      return limited_log(kKind, kLevel, t_ns,
+                         "alignment window refused: angular acceleration beyond the limit (the "
+                         "board turned); {} refused, {} more since the last line",
+                         n);
+    case nav::AlignmentRefusal::kGravityMagnitude:
+      return limited_log(kKind, kLevel, t_ns,
+                         "alignment window refused: |f| differs from the navigation gravity (the "
+                         "board accelerates, or a wrong calibration); {} refused, {} more since "
+                         "the last line",
+                         n);
+    case nav::AlignmentRefusal::kGnssMotion:
+      return limited_log(kKind, kLevel, t_ns,
+                         "alignment window refused: a GNSS velocity fix says the board moves; {} "
+                         "refused, {} more since the last line",
+                         n);
+    case nav::AlignmentRefusal::kNone:
+      return;
   }
 }
 

@@ -100,10 +100,11 @@ enum class LogKind : std::uint8_t {
   kCanStateBetter,  // back to error-active or warning
   kOverrun,
   kCommandRejected,
-  kInputRejected,    // a GNSS / heading input frame refused by its decoder
-  kAidingRejected,   // a decoded fix refused by the filter (χ² gate, before alignment)
-  kGravityMismatch,  // the aligned |f| and the navigation gravity disagree
-  kRecordDropped,    // a record lost to the recorder's full queue
+  kInputRejected,     // a GNSS / heading input frame refused by its decoder
+  kAidingRejected,    // a decoded fix refused by the filter (χ² gate, before alignment)
+  kGravityMismatch,   // the aligned |f| and the navigation gravity disagree
+  kRecordDropped,     // a record lost to the recorder's full queue
+  kAlignmentRefused,  // an alignment window refused: the board was not at rest (says why)
   kCount,
 };
 
@@ -239,6 +240,9 @@ class SampleLoop {
   void note_record_dropped();
   /// Once per alignment: the mean |f| at rest against the navigation gravity.
   void check_gravity(std::int64_t t_ns);
+  /// Logs why the core refused an alignment window (PipelineCounters::last_refusal), once per
+  /// refusal the counter shows, rate-limited.
+  void note_alignment_refusal(std::int64_t t_ns);
   void log(LogLevel level, std::int64_t t_ns, const char* fmt, std::int64_t a0 = 0,
            std::int64_t a1 = 0, std::int64_t a2 = 0, std::int64_t a3 = 0);
 
@@ -248,8 +252,9 @@ class SampleLoop {
   hal::Clock& clock_;
   FwLogQueue& log_;
   bool commands_ = false;
-  can::InputDecoder inputs_{1};   // GNSS / heading frames of options_.node_id
-  bool gravity_checked_ = false;  // check_gravity() done for the current alignment
+  can::InputDecoder inputs_{1};                // GNSS / heading frames of options_.node_id
+  bool gravity_checked_ = false;               // check_gravity() done for the current alignment
+  std::uint32_t alignment_refusals_seen_ = 0;  // PipelineCounters::alignment_restarts logged
   hal::Watchdog* watchdog_ = nullptr;
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;
