@@ -39,8 +39,8 @@ class Board {
     testing::SensorErrors errors(0.0, noise_mps2, 20261129);
     for (std::uint32_t k = k0; k < k1; ++k) {
       const double t = k / kRateHz;
-      const Vec6<double> s = errors.apply(
-          testing::ideal_outputs(pipeline_.solver().geometry(), x(t)));
+      const Vec6<double> s =
+          errors.apply(testing::ideal_outputs(pipeline_.solver().geometry(), x(t)));
       RawSample r;
       for (int j = 0; j < 6; ++j) {
         r.counts[static_cast<std::size_t>(j)] =
@@ -60,6 +60,16 @@ class Board {
 
 testing::Truth at_rest(double) { return testing::rest(Quat<double>::Identity()); }
 
+// Three 1 s windows of the disturbance x: each refused, for `why`; the board still aligning.
+void expect_three_refusals(Board& b, const std::function<testing::Truth(double)>& x, double noise,
+                           AlignmentRefusal why) {
+  ASSERT_TRUE(b.configured());
+  b.run(0, 3001, x, noise);
+  EXPECT_EQ(b.pipeline().phase(), PipelinePhase::kAligning);
+  EXPECT_EQ(b.pipeline().counters().alignment_restarts, 3u);
+  EXPECT_EQ(b.pipeline().counters().last_refusal, why);
+}
+
 TEST(AlignmentRefusal, ABoardAtRestAlignsAtTheEndOfItsFirstWindow) {
   Board b;
   ASSERT_TRUE(b.configured());
@@ -73,11 +83,7 @@ TEST(AlignmentRefusal, ABoardAtRestAlignsAtTheEndOfItsFirstWindow) {
 // angular acceleration too; the scatter is checked first).
 TEST(AlignmentRefusal, AShakenBoardIsRefusedForItsSpecificForce) {
   Board b;
-  ASSERT_TRUE(b.configured());
-  b.run(0, 3001, at_rest, 0.5);
-  EXPECT_EQ(b.pipeline().phase(), PipelinePhase::kAligning);
-  EXPECT_EQ(b.pipeline().counters().alignment_restarts, 3u);
-  EXPECT_EQ(b.pipeline().counters().last_refusal, AlignmentRefusal::kSpecificForce);
+  expect_three_refusals(b, at_rest, 0.5, AlignmentRefusal::kSpecificForce);
 }
 
 // Turning back and forth about the vertical: ω̇ = 3 sin(2π·2 t) rad/s² (RMS 2.1 rad/s²); a turn
@@ -85,7 +91,6 @@ TEST(AlignmentRefusal, AShakenBoardIsRefusedForItsSpecificForce) {
 // (|ω| ≤ 0.24 rad/s over 0.1 m: 6 mm/s²) stay below the scatter limit.
 TEST(AlignmentRefusal, ABoardTurningToAndFroIsRefusedForItsAngularAcceleration) {
   Board b;
-  ASSERT_TRUE(b.configured());
   const auto turning = [](double t) {
     constexpr double kAmp = 3.0;
     constexpr double kW = 2 * kPi * 2.0;
@@ -96,27 +101,20 @@ TEST(AlignmentRefusal, ABoardTurningToAndFroIsRefusedForItsAngularAcceleration) 
     x.wdot_b = Vec3<double>(0, 0, kAmp * std::sin(kW * t));
     return x;
   };
-  b.run(0, 3001, turning, 1e-3);
-  EXPECT_EQ(b.pipeline().phase(), PipelinePhase::kAligning);
-  EXPECT_EQ(b.pipeline().counters().alignment_restarts, 3u);
-  EXPECT_EQ(b.pipeline().counters().last_refusal, AlignmentRefusal::kAngularAccel);
+  expect_three_refusals(b, turning, 1e-3, AlignmentRefusal::kAngularAccel);
 }
 
 // Accelerating north at a steady 2 m/s²: nothing scatters, the window reads like a tilt of 11.5°,
 // and only |f̄| = √(g² + 2²) = 10.008 m/s², 0.20 above g, gives it away.
 TEST(AlignmentRefusal, ASmoothlyAcceleratingBoardIsRefusedForTheGravityMagnitude) {
   Board b;
-  ASSERT_TRUE(b.configured());
   const auto accelerating = [](double t) {
     testing::Truth x = testing::rest(Quat<double>::Identity());
     x.a_n = Vec3<double>(2.0, 0, 0);
     x.v_n = x.a_n * t;
     return x;
   };
-  b.run(0, 3001, accelerating, 1e-3);
-  EXPECT_EQ(b.pipeline().phase(), PipelinePhase::kAligning);
-  EXPECT_EQ(b.pipeline().counters().alignment_restarts, 3u);
-  EXPECT_EQ(b.pipeline().counters().last_refusal, AlignmentRefusal::kGravityMagnitude);
+  expect_three_refusals(b, accelerating, 1e-3, AlignmentRefusal::kGravityMagnitude);
   // Once it stands still, a window at rest is accepted (the one in progress holds a sample of the
   // acceleration, which scatters it beyond the limit: 2 m/s² / √1000 = 0.063 m/s²).
   b.run(3001, 5001, at_rest, 1e-3);

@@ -1,5 +1,6 @@
 #include "gfins/app/sample_loop.hpp"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -426,40 +427,25 @@ void SampleLoop::note_alignment_refusal(std::int64_t t_ns) {
   const bool refused = c.alignment_restarts > alignment_refusals_seen_;
   alignment_refusals_seen_ = c.alignment_restarts;
   if (!refused) return;
-  // One literal per reason: a log record carries numbers only (log_queue.hpp).
-  constexpr LogKind kKind = LogKind::kAlignmentRefused;
-  constexpr LogLevel kLevel = LogLevel::kInfo;
-  const auto n = static_cast<std::int64_t>(c.alignment_restarts);
-  switch (c.last_refusal) {
-    case nav::AlignmentRefusal::kNotGravity:
-      return limited_log(kKind, kLevel, t_ns,
-                         "alignment window refused: |f| is no gravity vector (board not at rest "
-                         "or no sensor signal); {} refused, {} more since the last line",
-                         n);
-    case nav::AlignmentRefusal::kSpecificForce:
-      return limited_log(kKind, kLevel, t_ns,
-                         "alignment window refused: the specific force scattered beyond the "
-                         "limit (the board moved); {} refused, {} more since the last line",
-                         n);
-    case nav::AlignmentRefusal::kAngularAccel:
-      return limited_log(kKind, kLevel, t_ns,
-                         "alignment window refused: angular acceleration beyond the limit (the "
-                         "board turned); {} refused, {} more since the last line",
-                         n);
-    case nav::AlignmentRefusal::kGravityMagnitude:
-      return limited_log(kKind, kLevel, t_ns,
-                         "alignment window refused: |f| differs from the navigation gravity (the "
-                         "board accelerates, or a wrong calibration); {} refused, {} more since "
-                         "the last line",
-                         n);
-    case nav::AlignmentRefusal::kGnssMotion:
-      return limited_log(kKind, kLevel, t_ns,
-                         "alignment window refused: a GNSS velocity fix says the board moves; {} "
-                         "refused, {} more since the last line",
-                         n);
-    case nav::AlignmentRefusal::kNone:
-      return;
-  }
+  // One literal per reason (AlignmentRefusal order): a log record carries numbers only.
+  static constexpr std::array<const char*, 6> kWhy = {
+      "",
+      "alignment window refused: |f| is no gravity vector (board not at rest or no sensor "
+      "signal); {} refused, {} more since the last line",
+      "alignment window refused: the specific force scattered beyond the limit (the board "
+      "moved); {} refused, {} more since the last line",
+      "alignment window refused: angular acceleration beyond the limit (the board turned); {} "
+      "refused, {} more since the last line",
+      "alignment window refused: |f| differs from the navigation gravity (the board "
+      "accelerates, or a wrong calibration); {} refused, {} more since the last line",
+      "alignment window refused: a GNSS velocity fix says the board moves; {} refused, {} more "
+      "since the last line",
+  };
+  static_assert(static_cast<std::size_t>(nav::AlignmentRefusal::kGnssMotion) + 1 == kWhy.size());
+  const auto why = static_cast<std::size_t>(c.last_refusal);
+  if (why == 0 || why >= kWhy.size()) return;
+  limited_log(LogKind::kAlignmentRefused, LogLevel::kInfo, t_ns, kWhy[why],
+              static_cast<std::int64_t>(c.alignment_restarts));
 }
 
 void SampleLoop::check_gravity(std::int64_t t_ns) {
