@@ -130,5 +130,51 @@ TEST(NoAlloc, RecordingAllocatesNothingInTheLoopOrItsWriter) {
   std::filesystem::remove(path);
 }
 
+TEST(NoAlloc, TheLoopWithAidingAllocatesNothingWithFixesArriving) {
+  if (!HeapCounter::available()) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  // Given a started board with aiding on (the filter's propagation, standstill updates at rest:
+  // the QA-1100 model, whose noise the aiding's detector is configured for),
+  SimRig rig("rest-qa1100", (kWarmUpCycles + kCountedCycles + 100) / 1000.0);
+  rig.config.aiding = true;
+  rig.cal = load_calibration(rig.config, rig.factory, &rig.factory).set;
+  rig.configure();
+  rig.run_cycles(kWarmUpCycles);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  // when GNSS fixes (5 Hz: the board's true position and velocity at rest, zero) and an external
+  // heading (1 Hz, the one it was given) arrive as input frames over many thousand cycles,
+  can::GnssFix fix;
+  fix.has_position = true;
+  fix.has_velocity = true;
+  fix.sigma_pos_h_m = 1.5;
+  fix.sigma_pos_v_m = 3.0;
+  fix.sigma_vel_mps = 0.1;
+  fix.age_s = 0.05;
+  can::HeadingFix heading;
+  heading.sigma_rad = 0.01;
+  heading.age_s = 0.01;
+  const long before = HeapCounter::calls();
+  for (std::uint32_t done = 0; done < kCountedCycles; done += 200) {
+    fix.fix_id = static_cast<std::uint8_t>(fix.fix_id + 1);
+    for (const hal::CanFrame& f : can::encode_gnss_fix(fix, SimRig::kNode)) {
+      ASSERT_TRUE(rig.bus->inject_rx(f));
+    }
+    if (done % 1000 == 0) {
+      heading.sequence = static_cast<std::uint8_t>(heading.sequence + 1);
+      ASSERT_TRUE(rig.bus->inject_rx(can::encode_heading_fix(heading, SimRig::kNode)));
+    }
+    rig.run_cycles(200);
+  }
+  const long after = HeapCounter::calls();
+  // then every kind of update ran and nothing was allocated.
+  const auto& c = rig.loop->pipeline().aiding().filter().counters();
+  const auto accepted = [&c](nav::AidingKind k) { return c.accepted[static_cast<std::size_t>(k)]; };
+  EXPECT_GT(accepted(nav::AidingKind::kZupt), 0u);
+  EXPECT_GT(accepted(nav::AidingKind::kZaru), 0u);
+  EXPECT_EQ(accepted(nav::AidingKind::kGnssPosition), kCountedCycles / 200);
+  EXPECT_EQ(accepted(nav::AidingKind::kGnssVelocity), kCountedCycles / 200);
+  EXPECT_EQ(accepted(nav::AidingKind::kHeading), kCountedCycles / 1000);
+  EXPECT_EQ(after - before, 0) << "heap calls in the aided loop";
+}
+
 }  // namespace
 }  // namespace gfins::app
