@@ -598,7 +598,8 @@ TEST(ErrorStateFilterTest, APreciseUpdateInFloatLeavesTheVarianceTheFormulaGives
     const double exact = p * r / (p + r);
     ASSERT_EQ(filter.update_zupt(nav).status, UpdateStatus::kAccepted) << "R " << r;
     for (int i = 0; i < 3; ++i) {
-      const double got = filter.covariance()(filt_idx::kVel + i, filt_idx::kVel + i);
+      const auto got =
+          static_cast<double>(filter.covariance()(filt_idx::kVel + i, filt_idx::kVel + i));
       EXPECT_NEAR(got / exact, 1.0, 0.01) << "R " << r << ", axis " << i;
     }
     EXPECT_EQ(filter.counters().covariance_resets, 0U);
