@@ -790,15 +790,7 @@ TEST_F(Faults, GnssInputFramesReachTheFilterAndACorruptedOneIsCountedAndLogged) 
   rig.cal = app::load_calibration(rig.config, rig.factory, &rig.factory).set;
   rig.configure();
   rig.run_cycles(2000);  // aligned after 1 s
-  can::GnssFix fix;
-  fix.fix_id = 3;
-  fix.has_position = true;
-  fix.has_velocity = true;
-  fix.sigma_pos_h_m = 1.5;
-  fix.sigma_pos_v_m = 3.0;
-  fix.sigma_vel_mps = 0.1;
-  fix.age_s = 0.05;
-  const auto frames = can::encode_gnss_fix(fix, SimRig::kNode);
+  const auto frames = can::encode_gnss_fix(testing::gnss_fix_at_rest(3), SimRig::kNode);
   hal::CanFrame bad = frames[0];
   bad.data[7] ^= 0x5A;  // CRC byte
   ASSERT_TRUE(rig.bus->inject_rx(bad));

@@ -142,13 +142,7 @@ TEST(NoAlloc, TheLoopWithAidingAllocatesNothingWithFixesArriving) {
   ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
   // when GNSS fixes (5 Hz: the board's true position and velocity at rest, zero) and an external
   // heading (1 Hz, the one it was given) arrive as input frames over many thousand cycles,
-  can::GnssFix fix;
-  fix.has_position = true;
-  fix.has_velocity = true;
-  fix.sigma_pos_h_m = 1.5;
-  fix.sigma_pos_v_m = 3.0;
-  fix.sigma_vel_mps = 0.1;
-  fix.age_s = 0.05;
+  can::GnssFix fix = testing::gnss_fix_at_rest(0);
   can::HeadingFix heading;
   heading.sigma_rad = 0.01;
   heading.age_s = 0.01;

@@ -13,6 +13,7 @@
 #include "gfins/app/publisher_sink.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
+#include "gfins/can/aiding_input.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/recording/codec.hpp"
@@ -148,6 +149,20 @@ inline recording::Header recording_header(const SimRig& rig) {
   h.volts_per_count.fill(rig.adc->volts_per_count());
   h.geometry = rig.cal.config.nominal.cast<double>();
   return h;
+}
+
+/// The fix a receiver (1.5 m horizontal, 3 m vertical, 0.1 m/s) sends 50 ms after its time of
+/// validity for a board at rest at the origin: position and velocity zero.
+inline can::GnssFix gnss_fix_at_rest(std::uint8_t fix_id) {
+  can::GnssFix fix;
+  fix.fix_id = fix_id;
+  fix.has_position = true;
+  fix.has_velocity = true;
+  fix.sigma_pos_h_m = 1.5;
+  fix.sigma_pos_v_m = 3.0;
+  fix.sigma_vel_mps = 0.1;
+  fix.age_s = 0.05;
+  return fix;
 }
 
 }  // namespace gfins::testing
