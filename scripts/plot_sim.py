@@ -7,6 +7,8 @@
     plot_sim.py replay DIR [TITLE]      DIR/navigation.csv (gfins-replay) → DIR/replay.png
     plot_sim.py aided DIR [TITLE]       DIR/{unaided,aided}.csv → DIR/accuracy.png, the errors
                                         with the filter's ±3σ (gfins-sim aided)
+    plot_sim.py consistency DIR [TITLE] DIR/{nees,nis}.csv → DIR/consistency.png, NEES and NIS
+                                        with their χ² bounds (gfins-sim consistency)
 
 TITLE names the scenario (or recording), the compensator and the core; every figure carries it.
 Column names carry units and frames (docs/simulation.md, "Output files"): err_v_n_x_mps is the
@@ -34,6 +36,7 @@ import numpy as np  # noqa: E402
 
 AXES = "xyz"
 COLORS = ["tab:red", "tab:green", "tab:blue"]
+GROUP_COLORS = COLORS + ["tab:purple"]  # gfins-sim consistency: tilt, heading, velocity, position
 
 
 # Rows of one CSV file kept for a figure: more points than a PNG has pixels across (every
@@ -307,9 +310,46 @@ def cmd_aided(d, title):
     save(fig, d + "/accuracy.png")
 
 
+def cmd_consistency(d, title):
+    """Run-averaged NEES per epoch and NIS per GNSS fix, each divided by its degrees of freedom
+    (1 expected), with the χ² 95 % bounds of the runs' total (gfins-sim consistency)."""
+    nees = np.genfromtxt(d + "/nees.csv", delimiter=",", names=True)
+    nis = np.genfromtxt(d + "/nis.csv", delimiter=",", names=True)
+    panels = [(nees, "t_s", "", "NEES / dof (published states)"),
+              (nis, "t_valid_s", "", "NIS / 3, GNSS position fixes"),
+              (nis, "t_valid_s", "_b", "NIS / 3, GNSS velocity fixes")]
+    fig, axs = plt.subplots(len(panels) + 1, 1, figsize=(11, 10), sharex=True)
+    for ax, (data, tcol, sfx, label) in zip(axs, panels):
+        if data.size == 0 or data.ndim == 0:
+            ax.text(0.5, 0.5, "none", transform=ax.transAxes, ha="center")
+            continue
+        t = data[tcol]
+        v, lo, hi = data["value" + sfx], data["lo" + sfx], data["hi" + sfx]
+        ax.plot(t, v, color=COLORS[0], lw=0.8, marker=".", ms=2, label="run-averaged")
+        ax.plot(t, lo, color="k", lw=0.8, ls="--", label="χ² 95 % bounds")
+        ax.plot(t, hi, color="k", lw=0.8, ls="--")
+        out = np.isfinite(v) & ((v < lo) | (v > hi))
+        ax.plot(t[out], v[out], "x", color=COLORS[1], ms=4, label="outside")
+        ax.set_yscale("log")
+        ax.grid(True, alpha=0.3, which="both")
+        ax.set_ylabel(label, fontsize=8)
+        ax.legend(loc="best", fontsize=7)
+    ax = axs[-1]
+    for i, g in enumerate(["tilt", "heading", "velocity", "position"]):
+        ax.plot(nees["t_s"], nees[g], color=GROUP_COLORS[i], lw=0.8, label=g)
+    ax.axhline(1.0, color="k", lw=0.8, ls=":", label="1 (consistent)")
+    ax.set_yscale("log")
+    ax.grid(True, alpha=0.3, which="both")
+    ax.set_ylabel("NEES / dof by group", fontsize=8)
+    ax.legend(loc="best", fontsize=7, ncol=5)
+    axs[-1].set_xlabel("t (s)")
+    fig.suptitle(f"filter consistency: {title}", fontsize=10)
+    save(fig, d + "/consistency.png")
+
+
 def main():
     cmds = {"run": cmd_run, "paper63": cmd_paper63, "montecarlo": cmd_montecarlo,
-            "replay": cmd_replay, "aided": cmd_aided}
+            "replay": cmd_replay, "aided": cmd_aided, "consistency": cmd_consistency}
     if len(sys.argv) not in (3, 4) or sys.argv[1] not in cmds:
         sys.exit(__doc__)
     default = "float32" if sys.argv[1] == "paper63" else sys.argv[2]

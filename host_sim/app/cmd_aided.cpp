@@ -145,27 +145,15 @@ void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& 
 }  // namespace
 
 int cmd_aided(const std::string& name, const OutputOptions& out) {
-  auto loaded = load(name);
-  if (!loaded.is_ok()) return fail(loaded.error(), kExitBadInput);
-  const Scenario& s = loaded.value();
-  if (s.trajectory.kind == "calibration_poses") {
-    return fail({ErrorCode::kInvalidArgument,
-                 "scenario " + s.name + " is a calibration (calibration_poses): nothing navigates"},
-                kExitBadInput);
+  StreamedCommand cmd;
+  if (const int rc = prepare_streamed(name, out, "sim-out/aided-",
+                                      {"summary.txt", "aided.csv", "unaided.csv"}, cmd);
+      rc != kExitOk) {
+    return rc;
   }
-  const auto dir = output_dir(out, "sim-out/aided-" + s.name);
-  if (!dir.is_ok()) return fail(dir.error(), kExitBadInput);
-  const auto scalar = nav_scalar(out.scalar);
-  if (!scalar.is_ok()) return fail(scalar.error(), kExitBadInput);
-  if (auto c = check_run_size(s, false, /*in_memory=*/false); !c.is_ok()) {
-    return fail(c.error(), kExitBadInput);
-  }
-  if (auto d = make_dir(dir.value(), "gfins-sim", {"summary.txt", "aided.csv", "unaided.csv"});
-      !d.is_ok()) {
-    return fail(d.error(), kExitError);
-  }
+  const Scenario& s = cmd.scenario;
   std::printf("gfins-sim aided %s\n  navigation: %s\n", describe(s).c_str(),
-              scalar_text(scalar.value()));
+              scalar_text(cmd.scalar));
   AccuracyTracker trackers[2] = {make_tracker(s), make_tracker(s)};
   StreamedOutcome outcomes[2];
   const char* names[2] = {"aided", "unaided"};
@@ -176,13 +164,12 @@ int cmd_aided(const std::string& name, const OutputOptions& out) {
     StreamTargets targets;
     targets.uncompensated_run = false;
     targets.accuracy = &trackers[i];
-    targets.compensated_csv = dir.value() + "/" + names[i] + ".csv";
+    targets.compensated_csv = cmd.dir + "/" + names[i] + ".csv";
     targets.decimate = out.decimate;
     targets.stop = &g_stop_signal;
     HostResult<StreamedOutcome> o = [&] {
       const StopSignals handlers;
-      return run_scenario_streamed(sx, targets, run_progress(sx.name, sx.duration_s),
-                                   scalar.value());
+      return run_scenario_streamed(sx, targets, run_progress(sx.name, sx.duration_s), cmd.scalar);
     }();
     if (!o.is_ok()) return fail(o.error(), kExitError);
     outcomes[i] = o.value();
@@ -192,28 +179,28 @@ int cmd_aided(const std::string& name, const OutputOptions& out) {
       return kExitInterrupted;
     }
   }
-  const std::string summary_path = dir.value() + "/summary.txt";
+  const std::string summary_path = cmd.dir + "/summary.txt";
   std::FILE* summary = std::fopen(summary_path.c_str(), "w");
   if (summary == nullptr) return fail({ErrorCode::kIoError, "cannot write " + summary_path}, 1);
   for (std::FILE* f : {stdout, summary}) {
     if (f == summary) {
-      std::fprintf(f, "%s\n  navigation: %s\n", describe(s).c_str(), scalar_text(scalar.value()));
+      std::fprintf(f, "%s\n  navigation: %s\n", describe(s).c_str(), scalar_text(cmd.scalar));
     }
     print_table(f, trackers[0], trackers[1]);
     print_run_table(f, SeriesStats{}, outcomes[0].compensated);
   }
   if (auto c = close_output(summary, summary_path); !c.is_ok()) return fail(c.error(), kExitError);
   std::printf(
-      "written: %s/{aided,unaided}.csv, summary.txt%s\n", dir.value().c_str(),
+      "written: %s/{aided,unaided}.csv, summary.txt%s\n", cmd.dir.c_str(),
       out.decimate > 1 ? (" (every " + std::to_string(out.decimate) + "th sample)").c_str() : "");
   if (!out.plot) return kExitOk;
   const std::string title = s.name + ", " + nav::to_string(s.compensator) + " compensator, " +
-                            (scalar.value() == NavScalar::kFloat ? "float32" : "double") + " core";
-  if (const int rc = plot_step("gfins-sim", "plot_sim.py", {"aided", dir.value(), title});
+                            (cmd.scalar == NavScalar::kFloat ? "float32" : "double") + " core";
+  if (const int rc = plot_step("gfins-sim", "plot_sim.py", {"aided", cmd.dir, title});
       rc != kExitOk) {
     return rc;
   }
-  std::printf("figures: %s/accuracy.png\n", dir.value().c_str());
+  std::printf("figures: %s/accuracy.png\n", cmd.dir.c_str());
   return kExitOk;
 }
 

@@ -45,6 +45,16 @@ int cmd_paper63(const OutputOptions& out);
 int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed0, std::size_t jobs,
                    const OutputOptions& out);
 
+/// gfins-sim consistency [NAME]: the aided filter's NEES and NIS by Monte-Carlo.
+struct ConsistencyOptions {
+  std::size_t runs = 100;
+  std::uint64_t seed0 = 1;
+  double from_s = 10.0;             // epochs and fixes before this are not judged (the alignment)
+  std::size_t jobs = 0;             // threads, 0: the hardware's (the output does not depend on it)
+  double stated_sigma_scale = 1.0;  // the receiver states σ × this (StreamTargets)
+};
+int cmd_consistency(const std::string& name, const ConsistencyOptions& c, const OutputOptions& out);
+
 /// gfins-sim covariance [NAME]: predicted 1σ envelopes and error budget (docs/error-model.md).
 struct CovarianceOptions {
   double bias_ug = 0, bias_rw_ug_sqrt_s = 0, scale_ppm = 0, orientation_urad = 0, location_mm = 0;

@@ -19,6 +19,8 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;       // an output could not be written, a run failed
 inline constexpr int kExitBadInput = 2;    // command line or scenario file rejected
 inline constexpr int kExitPlotFailed = 3;  // CSV written, but the PNG figures asked for are not
+// `consistency`: every file written, and the filter failed its NEES or NIS check.
+inline constexpr int kExitCheckFailed = 4;
 // `run` stopped by SIGINT/SIGTERM (Ctrl-C): files closed and valid up to the last sample done
 // (128 + SIGINT, the shells' convention for a program ended by Ctrl-C).
 inline constexpr int kExitInterrupted = 130;

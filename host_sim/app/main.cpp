@@ -5,6 +5,7 @@
 //   gfins-sim run FILE|NAME        cmd_run.cpp: without and with compensation, CSV, summary, PNG
 //   gfins-sim paper63              cmd_paper63.cpp: the paper's §6.3 (Figs. 7-10), four configs
 //   gfins-sim montecarlo [NAME]    cmd_montecarlo.cpp: N seeds, statistics and growth slopes
+//   gfins-sim consistency [NAME]   cmd_consistency.cpp: the aided filter's NEES and NIS, N seeds
 //   gfins-sim covariance [NAME]    cmd_covariance.cpp: predicted 1σ envelopes, error budget
 //   gfins-sim list                 cmd_list.cpp: the built-in scenarios
 //
@@ -34,7 +35,8 @@ int sim_main(int argc, char** argv) {
   const std::string footer =
       "Exit codes: 0 ok; 1 an output could not be written or a run failed; 2 command line or "
       "scenario rejected (also: a run whose files would not fit on the disk); 3 CSV written but "
-      "plotting failed (PNG asked for); 130 stopped by Ctrl-C/SIGINT or SIGTERM: every file "
+      "plotting failed (PNG asked for); 4 consistency: files written, the NEES or NIS check "
+      "failed; 130 stopped by Ctrl-C/SIGINT or SIGTERM: every file "
       "written is whole (run: up to the time in summary.txt; montecarlo: the runs finished; "
       "covariance: the files it names; while plotting: everything but the PNG).\n"
       "A scenario argument with a '/' or ending in .toml is a file (./drive), otherwise a "
@@ -98,6 +100,23 @@ int sim_main(int argc, char** argv) {
       ->check(CLI::Range(2, 100000))
       ->capture_default_str();
   mc->add_option("--seed0", mc_seed, "seed of the first run")->capture_default_str();
+  app::ConsistencyOptions nees_opts;
+  auto* nees = cli.add_subcommand(
+      "consistency", "the aided filter's NEES and NIS by Monte-Carlo against chi-square bounds");
+  nees->add_option("scenario", scenario_name, "file, or built-in name")
+      ->default_val("urban-stop-and-go");
+  nees->add_option("-n,--runs", nees_opts.runs, "number of runs")
+      ->check(CLI::Range(2, 100000))
+      ->capture_default_str();
+  nees->add_option("--seed0", nees_opts.seed0, "seed of the first run")->capture_default_str();
+  nees->add_option("--from", nees_opts.from_s, "judge epochs and fixes from this time on, s")
+      ->check(app::finite_range(0.0, 1e6))
+      ->capture_default_str();
+  nees->add_option("--stated-sigma-scale", nees_opts.stated_sigma_scale,
+                   "offer the GNSS fixes with the receiver's sigma times this (below 1: a "
+                   "receiver that claims a better accuracy than it has)")
+      ->check(app::finite_range(0.01, 100.0))
+      ->capture_default_str();
   app::CovarianceOptions cov_opts;
   auto* cov = cli.add_subcommand("covariance", "predicted 1-sigma envelopes and error budget");
   cov->add_option("scenario", scenario_name, "file, or built-in name")
@@ -126,7 +145,7 @@ int sim_main(int argc, char** argv) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
       ->capture_default_str();
   std::vector<CLI::Option*> out_opts;
-  for (auto* c : {run_cmd, aided_cmd, p63, mc, cov}) {
+  for (auto* c : {run_cmd, aided_cmd, p63, mc, nees, cov}) {
     out_opts.push_back(
         c->add_option("-o,--out", out.dir, "output folder (default sim-out/<name>)"));
     c->add_flag("--no-plot", no_plot, "write CSV only, no PNG");
@@ -137,13 +156,13 @@ int sim_main(int argc, char** argv) {
         ->capture_default_str();
   }
   std::size_t jobs = 0;  // 0: one thread per hardware thread (host_sim/parallel.hpp)
-  for (auto* c : {mc, cov}) {
+  for (auto* c : {mc, nees, cov}) {
     c->add_option("-j,--jobs", jobs,
                   "threads (default: the hardware's); the output does not depend on it")
         ->check(CLI::Range(1, 1024));
   }
   auto* list_cmd = cli.add_subcommand("list", "list the built-in scenarios");
-  for (auto* c : {run_cmd, aided_cmd, p63, mc, cov, list_cmd}) c->footer(footer);
+  for (auto* c : {run_cmd, aided_cmd, p63, mc, nees, cov, list_cmd}) c->footer(footer);
   cli.require_subcommand(0, 1);
   try {
     cli.parse(argc, argv);
@@ -170,6 +189,8 @@ int sim_main(int argc, char** argv) {
   }
   if (*p63) return app::cmd_paper63(out);
   if (*mc) return app::cmd_montecarlo(scenario_name, mc_runs, mc_seed, jobs, out);
+  nees_opts.jobs = jobs;
+  if (*nees) return app::cmd_consistency(scenario_name, nees_opts, out);
   cov_opts.jobs = jobs;
   if (*cov) return app::cmd_covariance(scenario_name, cov_opts, out);
   if (*list_cmd) return app::cmd_list();

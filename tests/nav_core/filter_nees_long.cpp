@@ -7,7 +7,7 @@
 // Bounds: χ²_0.025(900) = 818.75 and χ²_0.975(900) = 985.03 (Wilson–Hilferty, exact to < 0.01 % at
 // 900 degrees of freedom; computed here, not with the code under test), so 8.1875 ≤ NEES ≤ 9.8503.
 // The test asks for ≥ 90 % of the 60 epochs inside: with independent epochs the number outside is
-// Binomial(60, 0.05) and P(> 6 outside) = 2.9 %; this is the false-failure probability of a fresh
+// Binomial(60, 0.05) and P(> 6 outside) = 3.0 %; this is the false-failure probability of a fresh
 // seed (the seeds are fixed, so the test is deterministic).
 //
 // NIS: the same runs' GNSS position updates (300 per run), run-averaged per fix: a consistent

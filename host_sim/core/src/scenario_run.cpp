@@ -17,6 +17,7 @@
 
 #include "gfins/host_sim/accuracy.hpp"
 #include "gfins/host_sim/adc_model.hpp"
+#include "gfins/host_sim/consistency.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "gfins/host_sim/sample_source.hpp"
@@ -50,8 +51,9 @@ std::vector<GnssSample> aiding_fixes(const Scenario& s, const Trajectory& traj) 
 /// and the receiver's stated σ: what the board does with the frames of `gfins-can gnss`.
 class GnssFeeder {
  public:
-  GnssFeeder(const std::vector<GnssSample>& fixes, const std::optional<GnssSpec>& spec)
-      : fixes_(fixes), spec_(spec) {}
+  GnssFeeder(const std::vector<GnssSample>& fixes, const std::optional<GnssSpec>& spec,
+             ConsistencyRecorder* consistency = nullptr, double stated_sigma_scale = 1.0)
+      : fixes_(fixes), spec_(spec), consistency_(consistency), scale_(stated_sigma_scale) {}
 
   template <typename T>
   void offer_due(nav::NavPipeline<T>& p, double t_s) {
@@ -60,20 +62,23 @@ class GnssFeeder {
       nav::GnssFix<T> pos;
       pos.t_valid_ns = static_cast<std::int64_t>(std::llround(g.t_valid_s * 1e9));
       pos.value_n = g.r_n_m.template cast<T>();
-      pos.sigma =
-          nav::Vec3<T>(static_cast<T>(spec_->sigma_pos_h_m), static_cast<T>(spec_->sigma_pos_h_m),
-                       static_cast<T>(spec_->sigma_pos_v_m));
+      pos.sigma = nav::Vec3<T>(static_cast<T>(scale_ * spec_->sigma_pos_h_m),
+                               static_cast<T>(scale_ * spec_->sigma_pos_h_m),
+                               static_cast<T>(scale_ * spec_->sigma_pos_v_m));
       nav::GnssFix<T> vel = pos;
       vel.value_n = g.v_n_mps.template cast<T>();
-      vel.sigma.setConstant(static_cast<T>(spec_->sigma_vel_mps));
-      (void)p.offer_gnss_position(pos);
-      (void)p.offer_gnss_velocity(vel);
+      vel.sigma.setConstant(static_cast<T>(scale_ * spec_->sigma_vel_mps));
+      const nav::UpdateOutcome op = p.offer_gnss_position(pos);
+      const nav::UpdateOutcome ov = p.offer_gnss_velocity(vel);
+      if (consistency_ != nullptr) consistency_->add_fix(next_, op, ov);
     }
   }
 
  private:
   const std::vector<GnssSample>& fixes_;
   const std::optional<GnssSpec>& spec_;
+  ConsistencyRecorder* consistency_;
+  double scale_;
   std::size_t next_ = 0;
 };
 
@@ -147,6 +152,26 @@ SampleRecord record_of(const TruthState& truth, const nav::NavPipeline<T>& p) {
     rec.r_sigma_n = a.pos_sigma_m.template cast<double>();
   }
   return rec;
+}
+
+/// Epoch k of a consistency run (consistency.hpp): the filter's first nine error states against
+/// the truth, in its own convention (error_model.hpp: φ from attitude_error_n, then δr, δv,
+/// estimate − truth), with their covariance and what the board publishes of them now.
+template <typename T>
+void record_epoch(ConsistencyRecorder& c, long k, const TruthState& truth,
+                  const nav::NavPipeline<T>& p) {
+  if (!p.aiding().started()) {
+    c.add_epoch(k, Eigen::Matrix<double, 9, 1>::Zero(), Eigen::Matrix<double, 9, 9>::Identity(), 0);
+    return;
+  }
+  const nav::NavState<double> e = p.state().template cast<double>();
+  Eigen::Matrix<double, 9, 1> x;
+  x.segment<3>(nav::filt_idx::kPhi) = nav::attitude_error_n<double>(e.q_nb, truth.q_nb);
+  x.segment<3>(nav::filt_idx::kPos) = e.r_n - truth.r_n;
+  x.segment<3>(nav::filt_idx::kVel) = e.v_n - truth.v_n;
+  const Eigen::Matrix<double, 9, 9> cov =
+      p.aiding().filter().covariance().template topLeftCorner<9, 9>().template cast<double>();
+  c.add_epoch(k, x, cov, p.accuracy().valid);
 }
 
 /// The filter and standstill detector of [aiding], with the noise the scenario's sensors have
@@ -668,6 +693,7 @@ struct StreamedSeries {
   const std::string* csv_path = nullptr;
   SeriesStats* stats = nullptr;
   AccuracyTracker* accuracy = nullptr;
+  ConsistencyRecorder* consistency = nullptr;
   std::array<double, 6> bias_mps2{};
   HostStatus sink_status = Done{};
   std::unique_ptr<GnssFeeder> gnss;
@@ -708,12 +734,16 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
     for (const Spec& sp : specs) {
       if (sp.stats == &out.uncompensated && !targets.uncompensated_run) continue;
       auto r = std::make_unique<StreamedSeries<T>>();
-      if (sp.stats == &out.compensated) r->accuracy = targets.accuracy;
+      if (sp.stats == &out.compensated) {
+        r->accuracy = targets.accuracy;
+        r->consistency = targets.consistency;
+      }
       GFINS_TRY(auto p, make_pipeline<T>(s, vpc, sf, sp.kind, sp.m, sp.bias));
       r->pipeline = std::move(p);
       r->stats = sp.stats;
       r->bias_mps2 = sp.bias;
-      r->gnss = std::make_unique<GnssFeeder>(gnss_fixes, s.gnss);
+      r->gnss = std::make_unique<GnssFeeder>(gnss_fixes, s.gnss, r->consistency,
+                                             targets.gnss_stated_sigma_scale);
       r->csv_path = sp.csv;
       StreamedSeries<T>* self = r.get();
       r->loop = std::make_unique<NavLoop<T>>(
@@ -721,6 +751,10 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
             // The sink runs inside step(), for the sample just offered: its truth is `current`.
             if (!self->sink_status.is_ok()) return;
             self->sink_status = self->take(record_of(*current, *self->pipeline));
+            if (self->consistency == nullptr) return;
+            if (const long k = self->consistency->due(current->t_s); k >= 0) {
+              record_epoch(*self->consistency, k, *current, *self->pipeline);
+            }
           });
       runs.push_back(std::move(r));
     }
@@ -813,7 +847,10 @@ HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const Strea
                           source_name(s.misalignment_source) + ")";
   GFINS_TRY(const auto traj, make_trajectory(s.trajectory));
   // The same source as make_stream: the same samples, the same noise.
-  const ArrayErrors errors = array_errors(s);
+  ArrayErrors errors = array_errors(s);
+  for (std::size_t j = 0; j < 6; ++j) {
+    errors.sensors[j].bias_g += targets.unknown_bias_mps2[j] / nav::kStandardGravity;
+  }
   SensorArrayModel model(nav::table1_geometry<double>(s.rho_m), errors, gravity_model(s), s.rate_hz,
                          s.seed);
   AdcConfig adc_config;

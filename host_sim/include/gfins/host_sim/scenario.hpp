@@ -438,13 +438,23 @@ SeriesStats series_stats(const RunSeries& r);
 /// Where a streamed run writes while it navigates, and how it can be stopped.
 class AccuracyTracker;  // accuracy.hpp
 
+class ConsistencyRecorder;
+
 struct StreamTargets {
   bool uncompensated_run = true;        // false: only the compensated run navigates
   AccuracyTracker* accuracy = nullptr;  // fed every record of the compensated run (if not null)
-  std::string uncompensated_csv;        // empty: not written
-  std::string compensated_csv;          // empty: not written
-  std::size_t decimate = 1;             // of both CSV files (write_series_csv)
-  std::string recording;                // empty: none; else the .gfr of every sample offered
+  /// Fed the compensated run's NEES once a second and its GNSS updates' NIS (consistency.hpp).
+  ConsistencyRecorder* consistency = nullptr;
+  /// Added to each sensor's bias and not told to the compensator: the bias the filter is to
+  /// find (a consistency run draws it from the filter's prior), m/s².
+  std::array<double, 6> unknown_bias_mps2{};
+  /// The GNSS fixes are offered with the receiver's σ times this (below 1: a receiver that
+  /// states a better accuracy than it has; the noise stays [gnss]'s).
+  double gnss_stated_sigma_scale = 1.0;
+  std::string uncompensated_csv;  // empty: not written
+  std::string compensated_csv;    // empty: not written
+  std::size_t decimate = 1;       // of both CSV files (write_series_csv)
+  std::string recording;          // empty: none; else the .gfr of every sample offered
   /// Polled before each sample: when it reads non-zero the run stops there, closes its files
   /// (the recording's last block and record_count written: a valid file) and reports it.
   /// Set by a signal handler (SIGINT/SIGTERM), hence volatile sig_atomic_t.
