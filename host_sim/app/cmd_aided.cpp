@@ -88,7 +88,34 @@ void print_coverage(std::FILE* f, const Coverage& c) {
   std::fprintf(f, "\n");
 }
 
-void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& u) {
+double percent(std::uint64_t part, std::uint64_t whole) {
+  return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+}
+
+/// The standstill detector's decisions against the truth (DetectorTally).
+void print_detector(std::FILE* f, const DetectorTally& d, const AidingSpec& spec) {
+  std::fprintf(
+      f,
+      "standstill detector (windows of %u samples): false alarms %llu of %llu rest "
+      "windows (%.2f %%; configured %.2f %%); missed detections %llu of %llu moving "
+      "windows (%.2f %%), %llu of them in the %llu that move like rest (every sensor's "
+      "output constant within its noise: straight, or a steady turn, at constant speed); %llu "
+      "windows straddle a stop's start or end (%llu "
+      "declared at rest); stops reached %llu of %llu\n",
+      spec.window, static_cast<unsigned long long>(d.false_alarms()),
+      static_cast<unsigned long long>(d.rest_windows()),
+      percent(d.false_alarms(), d.rest_windows()), 100.0 * spec.false_alarm,
+      static_cast<unsigned long long>(d.missed()),
+      static_cast<unsigned long long>(d.moving_windows()), percent(d.missed(), d.moving_windows()),
+      static_cast<unsigned long long>(d.missed_like_rest()),
+      static_cast<unsigned long long>(d.moving_like_rest()),
+      static_cast<unsigned long long>(d.mixed_windows()),
+      static_cast<unsigned long long>(d.mixed_declared_rest()),
+      static_cast<unsigned long long>(d.stops_seen()), static_cast<unsigned long long>(d.stops()));
+}
+
+void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& u,
+                 const AidingSpec& spec) {
   std::fprintf(f, "%-26s | %-38s | %-38s\n", "", "aided", "unaided");
   std::fprintf(f, "%-26s", "error");
   for (int i = 0; i < 2; ++i) {
@@ -140,6 +167,7 @@ void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& 
                "%.3g / %.3g deg (what its covariance predicts for them)\n",
                rp.roll_rms_deg, rp.pitch_rms_deg, a.windows().empty() ? "" : " outside outages",
                rp.roll_sigma_rms_deg, rp.pitch_sigma_rms_deg);
+  if (spec.standstill) print_detector(f, a.detector(), spec);
 }
 
 }  // namespace
@@ -186,7 +214,7 @@ int cmd_aided(const std::string& name, const OutputOptions& out) {
     if (f == summary) {
       std::fprintf(f, "%s\n  navigation: %s\n", describe(s).c_str(), scalar_text(cmd.scalar));
     }
-    print_table(f, trackers[0], trackers[1]);
+    print_table(f, trackers[0], trackers[1], s.aiding);
     print_run_table(f, SeriesStats{}, outcomes[0].compensated);
   }
   if (auto c = close_output(summary, summary_path); !c.is_ok()) return fail(c.error(), kExitError);

@@ -99,5 +99,43 @@ TEST(AccuracyTracker, NonFiniteErrorIsTheWorst) {
   EXPECT_TRUE(std::isnan(a.worst().pos_h_m));
 }
 
+/// A sample of the detector tally: the truth at rest, or moving at `v` m/s with body
+/// acceleration `a` m/s² along x; `windows` decisions so far, the last `at_rest`.
+SampleRecord detector_sample(double v, double a, std::uint32_t windows, bool at_rest) {
+  SampleRecord r;
+  r.truth.v_n = Vec3d(v, 0, 0);
+  r.truth.a_n = Vec3d(a, 0, 0);
+  r.detector_windows = windows;
+  r.detector_at_rest = at_rest;
+  return r;
+}
+
+// Windows of 2 samples, each decided at its second sample: the truth and the decisions are
+// written here, so every count is known by hand.
+TEST(AccuracyTracker, DetectorFalseAlarmsAndMissedDetectionsPerWindow) {
+  DetectorTally d;
+  const auto window = [&d](double v0, double a0, double v1, double a1, std::uint32_t n, bool rest) {
+    d.add(detector_sample(v0, a0, n - 1, !rest));  // the previous decision still shown
+    d.add(detector_sample(v1, a1, n, rest));
+  };
+  window(0, 0, 0, 0, 1, true);    // rest, declared rest (stop 1 reached)
+  window(0, 0, 0, 0, 2, false);   // rest, declared moving: a false alarm
+  window(0, 0, 1, 1, 3, false);   // rest then moving: straddles the stop's end
+  window(1, 1, 2, 2, 4, false);   // accelerating, declared moving
+  window(2, 0, 2, 0, 5, true);    // constant velocity, declared rest: missed, like rest
+  window(2, 0, 2, 0.5, 6, true);  // the acceleration changes, declared rest: missed
+  window(0, 0, 0, 0, 7, false);   // stop 2 (its first sample ends the motion), declared moving
+  EXPECT_EQ(d.rest_windows(), 3u);
+  EXPECT_EQ(d.false_alarms(), 2u);
+  EXPECT_EQ(d.moving_windows(), 3u);
+  EXPECT_EQ(d.missed(), 2u);
+  EXPECT_EQ(d.moving_like_rest(), 1u);
+  EXPECT_EQ(d.missed_like_rest(), 1u);
+  EXPECT_EQ(d.mixed_windows(), 1u);
+  EXPECT_EQ(d.mixed_declared_rest(), 0u);
+  EXPECT_EQ(d.stops(), 2u);
+  EXPECT_EQ(d.stops_seen(), 1u);
+}
+
 }  // namespace
 }  // namespace gfins::sim

@@ -85,7 +85,7 @@ TEST_F(AidedCli, WritesBothRunsWithTheFiltersSigmaAndTheTable) {
   EXPECT_NE(unaided.find(",nan,nan,nan"), std::string::npos);
   const std::string summary = read(dir() / "out/summary.txt");
   for (const char* row : {"at 10 s", "RMS over t >= 10 s", "worst over t >= 10 s",
-                          "within the filter's 3 sigma", "aiding updates"}) {
+                          "within the filter's 3 sigma", "aiding updates", "standstill detector"}) {
     EXPECT_NE(summary.find(row), std::string::npos) << row << "\n" << summary;
   }
   EXPECT_NE(r.output.find("RMS over t >= 10 s"), std::string::npos);

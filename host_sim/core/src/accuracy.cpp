@@ -59,7 +59,56 @@ void AccuracyTracker::keep_worst(ErrorSnapshot& w, const ErrorSnapshot& e) {
   w.seen = true;
 }
 
+void DetectorTally::add(const SampleRecord& x) {
+  const TruthState& t = x.truth;
+  const bool rest = t.v_n.isZero(0.0) && t.w_b.isZero(0.0);
+  // The body's kinematic acceleration and rate against the window's first sample: a steady turn
+  // at constant speed keeps both (and so every sensor's output) constant.
+  const Vec3d a_b = t.q_nb.conjugate() * t.a_n;
+  if (window_first_) {
+    a_b0_ = a_b;
+    window_first_ = false;
+  }
+  const bool dynamic = (a_b - a_b0_).norm() > kLikeRestAccel || t.wdot_b.norm() > kLikeRestWdot;
+  window_moves_ = window_moves_ || !rest;
+  window_rests_ = window_rests_ || rest;
+  window_dynamic_ = window_dynamic_ || dynamic;
+  if (rest && !in_stop_) {
+    in_stop_ = true;
+    stop_seen_ = false;
+    ++stops_;
+  } else if (!rest) {
+    in_stop_ = false;
+  }
+  if (x.detector_windows == last_windows_) return;
+  // A decision: about the samples since the previous one, this one included.
+  last_windows_ = x.detector_windows;
+  if (window_moves_ && window_rests_) {
+    ++mixed_;
+    if (x.detector_at_rest) ++mixed_rest_;
+  } else if (!window_moves_) {
+    ++rest_;
+    if (!x.detector_at_rest) ++false_alarms_;
+    if (x.detector_at_rest && in_stop_ && !stop_seen_) {
+      stop_seen_ = true;
+      ++stops_seen_;
+    }
+  } else {
+    ++moving_;
+    if (!window_dynamic_) ++like_rest_;
+    if (x.detector_at_rest) {
+      ++missed_;
+      if (!window_dynamic_) ++missed_like_rest_;
+    }
+  }
+  window_moves_ = false;
+  window_rests_ = false;
+  window_dynamic_ = false;
+  window_first_ = true;
+}
+
 void AccuracyTracker::add(const SampleRecord& x) {
+  detector_.add(x);
   const ErrorSnapshot e = snapshot(x);
   for (std::size_t i = 0; i < checkpoints_s_.size(); ++i) {
     if (!at_[i].seen && x.t_s >= checkpoints_s_[i]) at_[i] = e;

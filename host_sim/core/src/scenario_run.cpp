@@ -150,6 +150,8 @@ SampleRecord record_of(const TruthState& truth, const nav::NavPipeline<T>& p) {
     rec.euler_sigma_rad = a.euler_sigma_rad.template cast<double>();
     rec.v_sigma_n = a.vel_sigma_mps.template cast<double>();
     rec.r_sigma_n = a.pos_sigma_m.template cast<double>();
+    rec.detector_windows = p.aiding().detector().windows();
+    rec.detector_at_rest = p.aiding().at_rest();
   }
   return rec;
 }

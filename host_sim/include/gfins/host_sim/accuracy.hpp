@@ -53,6 +53,49 @@ class Coverage {
   std::array<std::uint64_t, kConsistencyComponents> within_{};
 };
 
+/// The standstill detector's decisions against the truth, per window (docs/math.md,
+/// "Standstill detection"): a window is at rest when the truth has zero velocity and zero rate
+/// at every one of its samples, else it moves; it moves "like rest" when the body's kinematic
+/// acceleration stays within kLikeRestAccel of the window's first sample and its angular
+/// acceleration below kLikeRestWdot (a straight drive or a steady or slowly changing turn at
+/// constant speed: every sensor's output constant, as at rest, which no accelerometer statistic
+/// can tell apart; the ZUPT's gate and the GNSS veto handle it). A false alarm is a rest window
+/// declared moving (the configured false_alarm is its probability); a missed detection is a moving
+/// window declared at rest.
+class DetectorTally {
+ public:
+  /// One sample's noise of the QA-1100 model (70 µg) and the per-sample σ of the array's ω̇ at
+  /// ρ = 0.1 m (docs/math.md, "Standstill detection"): below these a change is not visible.
+  static constexpr double kLikeRestAccel = 70e-6 * 9.80665;  // m/s²
+  static constexpr double kLikeRestWdot = 5e-3;              // rad/s²
+
+  void add(const SampleRecord& x);
+  std::uint64_t rest_windows() const { return rest_; }
+  std::uint64_t false_alarms() const { return false_alarms_; }
+  std::uint64_t moving_windows() const { return moving_; }
+  std::uint64_t missed() const { return missed_; }
+  std::uint64_t moving_like_rest() const { return like_rest_; }
+  std::uint64_t missed_like_rest() const { return missed_like_rest_; }
+  /// Rest stretches of the truth and those with at least one rest window declared at rest (the
+  /// standstill updates reached that stop; the stretch before the filter starts counts too).
+  std::uint64_t stops() const { return stops_; }
+  std::uint64_t stops_seen() const { return stops_seen_; }
+  /// Windows that hold both rest and motion (a stop's first or last window), judged neither way,
+  /// and of them those declared at rest.
+  std::uint64_t mixed_windows() const { return mixed_; }
+  std::uint64_t mixed_declared_rest() const { return mixed_rest_; }
+
+ private:
+  std::uint32_t last_windows_ = 0;
+  bool window_moves_ = false, window_rests_ = false, window_dynamic_ = false;
+  bool window_first_ = true;
+  Vec3d a_b0_ = Vec3d::Zero();
+  std::uint64_t mixed_ = 0, mixed_rest_ = 0;
+  bool in_stop_ = false, stop_seen_ = false;
+  std::uint64_t rest_ = 0, false_alarms_ = 0, moving_ = 0, missed_ = 0;
+  std::uint64_t like_rest_ = 0, missed_like_rest_ = 0, stops_ = 0, stops_seen_ = 0;
+};
+
 class AccuracyTracker {
  public:
   /// checkpoints_s: instants whose errors are kept (the first sample at or after each);
@@ -101,6 +144,8 @@ class AccuracyTracker {
   double within_3sigma(std::size_t component) const { return coverage_.fraction(component); }
   const Coverage& coverage() const { return coverage_; }
 
+  const DetectorTally& detector() const { return detector_; }
+
   /// One-line summaries for a terminal (what `gfins-sim aided` prints).
   std::string describe_rms() const;
 
@@ -119,6 +164,7 @@ class AccuracyTracker {
   double tilt2_out_ = 0, heading2_out_ = 0, vel2_out_ = 0, pos2_out_ = 0;
   ErrorSnapshot worst_{};
   Coverage coverage_;
+  DetectorTally detector_;
   std::uint64_t rp_n_ = 0, rp_sigma_n_ = 0;
   double roll2_ = 0, pitch2_ = 0, roll_sigma2_ = 0, pitch_sigma2_ = 0;
 };

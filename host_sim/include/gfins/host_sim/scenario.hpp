@@ -270,6 +270,10 @@ struct SampleRecord {
   Vec3d euler_sigma_rad = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
   Vec3d v_sigma_n = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
   Vec3d r_sigma_n = Vec3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  // The standstill detector's windows decided so far and its last decision (0 / false when no
+  // filter runs): a new decision is a change of the count.
+  std::uint32_t detector_windows = 0;
+  bool detector_at_rest = false;
 };
 
 struct RunSeries {
