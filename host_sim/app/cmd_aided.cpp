@@ -150,7 +150,14 @@ void print_table(std::FILE* f, const AccuracyTracker& a, const AccuracyTracker& 
                "(tilt: the larger of |roll| and |pitch| error; pos_h: horizontal position error; "
                "velocity 3-D)\n");
   if (a.sigma_samples() == 0) {
-    std::fprintf(f, "aided: the filter never ran (no [aiding] updates possible)\n");
+    // Either the filter never started, or it restarted after diverging and never got a σ
+    // back: the board marks every value of this stretch not available.
+    std::fprintf(f,
+                 "aided: no sample from t = %g s on had its sigma published (the filter never "
+                 "started, or diverged with nothing to aid it and restarted): the board marks "
+                 "these values not available, and the aided errors above are of values it does "
+                 "not vouch for\n",
+                 a.rms_from_s());
     return;
   }
   std::fprintf(f, "aided errors within the filter's 3 sigma (%llu samples, t >= %g s):",
