@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <system_error>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -78,6 +80,25 @@ int cmd_consistency(const std::string& name, const ConsistencyOptions& c,
     return rc;
   }
   const Scenario& s = cmd.scenario;
+  if (c.from_s >= s.duration_s) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "--from %g s: scenario %s lasts %g s, so nothing would be judged; give a time "
+                  "before its end",
+                  c.from_s, s.name.c_str(), s.duration_s);
+    return fail({ErrorCode::kInvalidArgument, buf}, kExitBadInput);
+  }
+  // An earlier run's files go now: a run stopped before two runs finish writes none, and must
+  // not leave the old ones looking like its own.
+  for (const char* f : {"summary.txt", "nees.csv", "nis.csv", "consistency.png"}) {
+    std::error_code ec;
+    std::filesystem::remove(cmd.dir + "/" + f, ec);
+    if (ec) {
+      return fail({ErrorCode::kIoError,
+                   "cannot remove the earlier " + cmd.dir + "/" + f + ": " + ec.message()},
+                  kExitError);
+    }
+  }
   std::printf("gfins-sim consistency: %zu runs of %s\n  navigation: %s, aided\n", c.runs,
               describe(s).c_str(), scalar_text(cmd.scalar));
   if (c.stated_sigma_scale != 1.0) {
@@ -110,7 +131,9 @@ int cmd_consistency(const std::string& name, const ConsistencyOptions& c,
   }
   const std::string summary_path = cmd.dir + "/summary.txt";
   std::FILE* summary = std::fopen(summary_path.c_str(), "w");
-  if (summary == nullptr) return fail({ErrorCode::kIoError, "cannot write " + summary_path}, 1);
+  if (summary == nullptr) {
+    return fail({ErrorCode::kIoError, "cannot write " + summary_path}, kExitError);
+  }
   for (std::FILE* f : {stdout, summary}) {
     if (f == summary) {
       std::fprintf(f, "%zu runs of %s\n  navigation: %s, aided\n", r.runs, describe(s).c_str(),
@@ -148,6 +171,15 @@ int cmd_consistency(const std::string& name, const ConsistencyOptions& c,
       return rc;
     }
     std::printf("figure: %s/consistency.png\n", cmd.dir.c_str());
+  }
+  if (r.nees.offered == 0) {
+    // Not a failed check: nothing was published to check (the filter's σ past its horizon all
+    // along, as in a scenario with nothing to aid it).
+    std::fprintf(stderr,
+                 "gfins-sim: nothing to judge: no run published a sigma from t = %g s on (see "
+                 "`gfins-sim aided %s`)\n",
+                 c.from_s, s.name.c_str());
+    return kExitError;
   }
   const bool pass = r.nees.pass() && (r.nis_pos.offered == 0 || r.nis_pos.pass()) &&
                     (r.nis_vel.offered == 0 || r.nis_vel.pass());

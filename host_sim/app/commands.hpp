@@ -49,7 +49,7 @@ int cmd_montecarlo(const std::string& name, std::size_t runs, std::uint64_t seed
 struct ConsistencyOptions {
   std::size_t runs = 100;
   std::uint64_t seed0 = 1;
-  double from_s = 10.0;             // epochs and fixes before this are not judged (the alignment)
+  double from_s = 10.0;             // epochs and fixes before this are not judged (the start)
   std::size_t jobs = 0;             // threads, 0: the hardware's (the output does not depend on it)
   double stated_sigma_scale = 1.0;  // the receiver states σ × this (StreamTargets)
 };

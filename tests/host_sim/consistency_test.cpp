@@ -30,6 +30,27 @@ TEST(ConsistencyTest, ChiSquareQuantilesMatchPrintedTables) {
     EXPECT_NEAR(chi_square_quantile(r.p, r.dof) / r.table, 1.0, tol)
         << "dof " << r.dof << " p " << r.p;
   }
+  // 1 and 2 degrees of freedom (a group one or two runs published) are exact: the table's
+  // 0.000982, 5.024, 0.0506, 7.378 (4 significant figures, so 1e-3 relative).
+  for (const Row& r : {Row{1, 0.025, 0.000982}, Row{1, 0.975, 5.024}, Row{2, 0.025, 0.0506},
+                       Row{2, 0.975, 7.378}}) {
+    EXPECT_NEAR(chi_square_quantile(r.p, r.dof) / r.table, 1.0, 1e-3)
+        << "dof " << r.dof << " p " << r.p;
+  }
+}
+
+// The verdict: at most 10 % of the judged epochs outside, the event whose complement the
+// printed false-failure probability measures.
+TEST(ConsistencyTest, TheVerdictAllowsTenPercentOutside) {
+  ConsistencySeries c;
+  c.offered = 10;
+  c.inside = 9;
+  EXPECT_TRUE(c.pass());
+  c.inside = 8;
+  EXPECT_FALSE(c.pass());
+  c.offered = 0;
+  c.inside = 0;
+  EXPECT_FALSE(c.pass());  // nothing judged is no pass
 }
 
 // P(X > k) summed from the probability mass written out here, and for Binomial(60, 0.05) the sum

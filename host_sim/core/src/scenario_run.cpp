@@ -156,6 +156,17 @@ SampleRecord record_of(const TruthState& truth, const nav::NavPipeline<T>& p) {
   return rec;
 }
 
+/// The truth moved by a start error (StreamTargets::start_error): attitude_error_n(q, q_true) = φ
+/// for q = exp(−φ) ⊗ q_true (error_model.hpp).
+TruthState with_start_error(TruthState x, const StreamTargets::StartError& e) {
+  const double angle = e.phi_n.norm();
+  if (angle > 0) x.q_nb = Quatd(Eigen::AngleAxisd(-angle, e.phi_n / angle)) * x.q_nb;
+  x.r_n += e.dr_n;
+  x.v_n += e.dv_n;
+  x.w_b += e.dw_b;
+  return x;
+}
+
 /// Epoch k of a consistency run (consistency.hpp): the filter's first nine error states against
 /// the truth, in its own convention (error_model.hpp: φ from attitude_error_n, then δr, δv,
 /// estimate − truth), with their covariance and what the board publishes of them now.
@@ -790,8 +801,12 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
     if (rec) GFINS_TRY_STATUS(rec->append(x->raw));
     for (auto& r : runs) {
       if (k == 0) {
-        // The truth is given at the first sample (no alignment), as run_scenario does.
-        const nav::NavState<T> init = to_nav_state<T>(x->truth, 0);
+        // The truth is given at the first sample (no alignment), as run_scenario does; the
+        // compensated run may start off it by targets.start_error.
+        const nav::NavState<T> init =
+            r->stats == &out.compensated
+                ? to_nav_state<T>(with_start_error(x->truth, targets.start_error), 0)
+                : to_nav_state<T>(x->truth, 0);
         if (s.adc) {
           r->pipeline->start_at(init, x->raw);
         } else {

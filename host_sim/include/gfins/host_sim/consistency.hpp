@@ -2,9 +2,10 @@
 // docs/navigation-accuracy.md, "Filter consistency").
 //
 // Each run is the scenario's aided navigation (the board's pipeline and filter, float32 unless
-// asked otherwise) with its own sensor noise (seed), GNSS noise (gnss.seed) and an unknown
+// asked otherwise) with its own sensor noise (seed), GNSS noise (gnss.seed), an unknown
 // per-sensor bias drawn from the filter's own prior ([aiding] bias_sigma_ug), which the sensors
-// have and the compensator is not told: what the filter claims to estimate.
+// have and the compensator is not told, and a start off the truth drawn from the filter's P0
+// (FilterConfig's initial σ): what the filter claims at its start and claims to estimate.
 //
 // NEES. Once per epoch (every second of scenario time) a run contributes x̂ᵀ P⁻¹ x̂ over the
 // states whose σ the board publishes at that moment (NavAccuracy::valid): the tilt φ_N, φ_E

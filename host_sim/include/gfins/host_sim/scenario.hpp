@@ -455,6 +455,12 @@ struct StreamTargets {
   /// The GNSS fixes are offered with the receiver's σ times this (below 1: a receiver that
   /// states a better accuracy than it has; the noise stays [gnss]'s).
   double gnss_stated_sigma_scale = 1.0;
+  /// The compensated run starts from the truth plus this error (estimate − truth, the filter's
+  /// convention: φ in the n frame, then δr, δv, δω_b): a consistency run draws it from the
+  /// filter's P0, which the filter claims at its start.
+  struct StartError {
+    Vec3d phi_n = Vec3d::Zero(), dr_n = Vec3d::Zero(), dv_n = Vec3d::Zero(), dw_b = Vec3d::Zero();
+  } start_error;
   std::string uncompensated_csv;  // empty: not written
   std::string compensated_csv;    // empty: not written
   std::size_t decimate = 1;       // of both CSV files (write_series_csv)

@@ -175,6 +175,10 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
   }
   pending_dt_s_ += dt_s;
   if (++pending_ < config_.decimation) return;
+  // A decision is used at this propagation or dropped (a failed propagation, a restart): never
+  // applied later, about samples it did not see.
+  const bool fresh = fresh_;
+  fresh_ = false;
   const Status s = filter_.propagate(nav, pending_dt_s_);
   pending_ = 0;
   pending_dt_s_ = T(0);
@@ -190,8 +194,6 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
     const T speed = nav.state().v_n.template head<2>().norm();
     if (speed + T(2) * sigma_h <= config_.gnss_moving_speed_mps) moving_ = false;
   }
-  const bool fresh = fresh_;
-  fresh_ = false;
   if (!fresh) return;
   if (still_ && config_.standstill_updates && moving_) {
     ++motion_vetoes_;
