@@ -159,8 +159,7 @@ SampleRecord record_of(const TruthState& truth, const nav::NavPipeline<T>& p) {
 /// The truth moved by a start error (StreamTargets::start_error): attitude_error_n(q, q_true) = φ
 /// for q = exp(−φ) ⊗ q_true (error_model.hpp).
 TruthState with_start_error(TruthState x, const StreamTargets::StartError& e) {
-  const double angle = e.phi_n.norm();
-  if (angle > 0) x.q_nb = Quatd(Eigen::AngleAxisd(-angle, e.phi_n / angle)) * x.q_nb;
+  x.q_nb = nav::quat_from_rotation_vector<double>(-e.phi_n) * x.q_nb;
   x.r_n += e.dr_n;
   x.v_n += e.dv_n;
   x.w_b += e.dw_b;
@@ -173,10 +172,7 @@ TruthState with_start_error(TruthState x, const StreamTargets::StartError& e) {
 template <typename T>
 void record_epoch(ConsistencyRecorder& c, long k, const TruthState& truth,
                   const nav::NavPipeline<T>& p) {
-  if (!p.aiding().started()) {
-    c.add_epoch(k, Eigen::Matrix<double, 9, 1>::Zero(), Eigen::Matrix<double, 9, 9>::Identity(), 0);
-    return;
-  }
+  if (!p.aiding().started()) return;  // nothing published: the epoch stays empty
   const nav::NavState<double> e = p.state().template cast<double>();
   Eigen::Matrix<double, 9, 1> x;
   x.segment<3>(nav::filt_idx::kPhi) = nav::attitude_error_n<double>(e.q_nb, truth.q_nb);
