@@ -30,11 +30,14 @@ except ImportError as e:
     sys.exit(f"{sys.argv[0]}: cannot plot: {e} (Debian: apt install python3-matplotlib; "
              f"this interpreter is {sys.executable})")
 
+# Angles in deg and angular rates in deg/s, as in every figure of gfins-sim (the CSV holds rad,
+# rad/s).
+RAD2DEG = 180.0 / math.pi
 BLOCKS = [
-    ("attitude error phi (n frame)", "phi_n", "deg", 180.0 / math.pi),
+    ("attitude error phi (n frame)", "phi_n", "deg", RAD2DEG),
     ("position error dr (NED)", "dr_n", "m", 1.0),
     ("velocity error dv (NED)", "dv_n", "m/s", 1.0),
-    ("rate error dw (body)", "dw_b", "rad/s", 1.0),
+    ("rate error dw (body)", "dw_b", "deg/s", RAD2DEG),
 ]
 
 
@@ -46,8 +49,45 @@ def read_csv(path):
     return rows
 
 
-def column(rows, name):
-    return [float(r[name]) for r in rows]
+def number(text):
+    """A CSV field as a float; an empty or unreadable field is NaN (reported by column)."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+REPORTED = set()
+
+
+def column(rows, name, path=None):
+    """The column's values. With path (a column drawn on a figure): a column with no finite
+    value, or with some, is reported once on stderr naming the file and the column."""
+    values = [number(r[name]) for r in rows]
+    if path is not None and (path, name) not in REPORTED:
+        bad = sum(1 for v in values if not math.isfinite(v))
+        if bad:
+            REPORTED.add((path, name))
+            what = (f" has no finite value (NaN, inf or empty in all {len(values)} rows): its "
+                    "panel says so and draws nothing for it" if bad == len(values) else
+                    f": {bad} of {len(values)} values are not finite (NaN, inf or empty): left "
+                    "out of its panel")
+            print(f"plot_covariance: warning: {path}: column {name}{what}", file=sys.stderr)
+    return values
+
+
+def note_nonfinite(ax, series):
+    """Say on the panel which of its series, (name, values) pairs, hold no finite value (in the
+    middle) or some non-finite ones (a corner note). The warning on stderr names the file."""
+    empty = [n for n, v in series if not any(math.isfinite(x) for x in v)]
+    gaps = [n for n, v in series if n not in empty and not all(math.isfinite(x) for x in v)]
+    if empty:
+        ax.text(0.5, 0.5, "no finite values:\n" + "\n".join(empty), transform=ax.transAxes,
+                ha="center", va="center", fontsize=9, color="tab:red",
+                bbox={"facecolor": "white", "edgecolor": "tab:red", "alpha": 0.9})
+    if gaps:
+        ax.text(0.99, 0.02, "non-finite values left out: " + ", ".join(gaps),
+                transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="tab:red")
 
 
 def state_columns(header, prefix):
@@ -60,41 +100,48 @@ RUN_COLUMNS = {"dr_n": ("err_r_n", "m"), "dv_n": ("err_v_n", "mps"), "dw_b": ("e
 
 
 def plot_envelopes(out_dir, fig_title):
-    rows = read_csv(os.path.join(out_dir, "covariance.csv"))
-    t = column(rows, "t_s")
+    path = os.path.join(out_dir, "covariance.csv")
+    rows = read_csv(path)
+    t = column(rows, "t_s", path)
     header = list(rows[0].keys())
     run_path = os.path.join(out_dir, "reference_run.csv")
     run = read_csv(run_path) if os.path.exists(run_path) else None
-    fig, axes = plt.subplots(4, 2, figsize=(12, 13))
+    # One row per block: predicted 1σ on linear axes (left, with the reference run's |error|)
+    # and log-log (right). Each column shares its time axis, named on the bottom row; the
+    # constrained layout keeps every title, label and tick label clear of its neighbours.
+    fig, axes = plt.subplots(4, 2, figsize=(12, 13), sharex="col", layout="constrained")
     colors = ["tab:red", "tab:green", "tab:blue"]
     for i, (title, prefix, unit, scale) in enumerate(BLOCKS):
+        lin, log = axes[i]
+        series = []
         for k, name in enumerate(state_columns(header, prefix)):
-            y = [v * scale for v in column(rows, name)]
+            y = [v * scale for v in column(rows, name, path)]
+            series.append((name, y))
             # The column names carry the CSV's unit (rad, m, ...); the axis states the plotted one.
             label = name.replace("sigma_", "").rsplit("_", 1)[0]
-            axes[i][0].plot(t, y, color=colors[k], label="1σ " + label)
-            pos = [(a, b) for a, b in zip(t, y) if a > 0 and b > 0]
+            lin.plot(t, y, color=colors[k], label="1σ " + label)
+            pos = [(a, b) for a, b in zip(t, y)
+                   if math.isfinite(a) and math.isfinite(b) and a > 0 and b > 0]
             if pos:
-                axes[i][1].loglog([p[0] for p in pos], [p[1] for p in pos], color=colors[k],
-                                  label="1σ " + label)
+                log.loglog([p[0] for p in pos], [p[1] for p in pos], color=colors[k],
+                           label="1σ " + label)
             if run is not None and prefix in RUN_COLUMNS:
                 pre, u = RUN_COLUMNS[prefix]
                 axis = "xyz"[k]
-                tr = column(run, "t_s")
-                er = [abs(v) * scale for v in column(run, f"{pre}_{axis}_{u}")]
-                axes[i][0].plot(tr, er, color=colors[k], ls=":", lw=1, label=f"|one run| {axis}")
-        axes[i][0].set_title(f"{title}: predicted 1 sigma", fontsize=9)
-        axes[i][0].set_ylabel(unit)
-        axes[i][1].set_ylabel(unit)
-        axes[i][1].set_title("log-log (slope = growth exponent)")
-        for ax in axes[i]:
+                tr = column(run, "t_s", run_path)
+                er = [abs(v) * scale for v in column(run, f"{pre}_{axis}_{u}", run_path)]
+                lin.plot(tr, er, color=colors[k], ls=":", lw=1, label=f"|one run| {axis}")
+        note_nonfinite(lin, series)
+        note_nonfinite(log, series)
+        lin.set_title(f"{title}: predicted 1σ, linear", fontsize=10)
+        log.set_title(f"{title}: predicted 1σ, log-log (slope = growth exponent)", fontsize=10)
+        for ax in (lin, log):
+            ax.set_ylabel(f"1σ ({unit})")
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
     for ax in axes[-1]:
-        ax.set_xlabel("t, s")
-    fig.suptitle(f"predicted error envelopes: {fig_title}", fontsize=11)
-    # The title gets its own band above the first row (tight_layout alone lets the two meet).
-    fig.tight_layout(rect=(0, 0, 1, 0.965))
+        ax.set_xlabel("t (s)")
+    fig.suptitle(f"predicted error envelopes: {fig_title}", fontsize=12)
     fig.savefig(os.path.join(out_dir, "covariance.png"), dpi=110)
     plt.close(fig)
 
@@ -104,21 +151,35 @@ def plot_budget(out_dir, fig_title):
     if not os.path.exists(path):
         return
     all_rows = read_csv(path)
-    times = sorted({float(r["t_s"]) for r in all_rows})
     header = [h for h in all_rows[0].keys() if h.startswith("sigma_")]
+    for name in ["t_s"] + header:
+        column(all_rows, name, path)  # reports non-finite values
+    times = sorted({number(r["t_s"]) for r in all_rows if math.isfinite(number(r["t_s"]))})
+    if not times:
+        fig, ax = plt.subplots(figsize=(8, 3))
+        note_nonfinite(ax, [("t_s", [math.nan])])
+        fig.suptitle(f"error budget by source: {fig_title}", fontsize=11)
+        fig.savefig(os.path.join(out_dir, "budget.png"), dpi=90)
+        plt.close(fig)
+        return
+
+    def value(r, h):  # a σ drawn as a bar: finite and positive (log axis), else 0 (no bar)
+        v = number(r[h])
+        return v if math.isfinite(v) and v > 0 else 0.0
+
     # Sources that contribute nothing (σ = 0 everywhere) are left out: they would be empty bars
     # on a log axis.
     sources = [src for src in dict.fromkeys(r["source"] for r in all_rows)
-               if any(float(r[h]) > 0 for r in all_rows if r["source"] == src for h in header)]
+               if any(value(r, h) > 0 for r in all_rows if r["source"] == src for h in header)]
     fig, axes = plt.subplots(len(times), 4, figsize=(18, 3.6 * len(times)), squeeze=False)
     for row, t_b in enumerate(times):
-        rows = [r for r in all_rows if float(r["t_s"]) == t_b and r["source"] in sources]
+        rows = [r for r in all_rows if number(r["t_s"]) == t_b and r["source"] in sources]
         for ax, (title, prefix, unit, scale) in zip(axes[row], BLOCKS):
             names = [h for h in header if h.startswith("sigma_" + prefix)]
             width = 0.8 / max(1, len(rows))
             for k, r in enumerate(rows):
                 xs = [i + k * width for i in range(len(names))]
-                ys = [float(r[n]) * scale for n in names]
+                ys = [value(r, n) * scale for n in names]
                 ax.bar(xs, ys, width, label=r["source"])
             ax.set_xticks([i + 0.4 - width / 2 for i in range(len(names))])
             # Tick labels name the state and axis; the unit is the axis label's (the plotted one).
@@ -130,10 +191,11 @@ def plot_budget(out_dir, fig_title):
             ax.grid(True, axis="y", which="both", alpha=0.3)
             # Headroom above the tallest bar (a third of the log span) holds the legend in one
             # row, so it covers no bar (it sat on the z bars before).
-            ys = [float(r[n]) * scale for r in rows for n in names if float(r[n]) > 0]
+            ys = [value(r, n) * scale for r in rows for n in names if value(r, n) > 0]
             if ys:
                 lo, hi = min(ys) / 3, max(ys) * 3
                 ax.set_ylim(lo, hi * (hi / lo) ** 0.45)
+            note_nonfinite(ax, [(n, [number(r[n]) for r in rows]) for n in names])
             ax.legend(fontsize=6, loc="upper center", ncol=max(1, len(rows)), frameon=False)
     fig.suptitle(f"error budget by source: {fig_title}", fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.975))
