@@ -26,6 +26,10 @@ cmd_ok() {
   rc=$?
   check "cmd-$name" "gfins-can cmd $* exit $rc ($(tr '\n' ' ' </tmp/cmd-$name.out | head -c 160))" [ $rc -eq 0 ]
 }
+# Every command frame the host sends from here to the malformed ones, for the replay below.
+candump -L vcan0,601:7FF >/tmp/cmd-sent.log 2>/dev/null &
+sent_pid=$!
+sleep 0.3
 cmd_ok realign realign --heading-deg 30
 cmd_ok reset reset
 cmd_ok compensator-exact compensator exact
@@ -57,6 +61,24 @@ gfins-can cmd --iface vcan0 --node 9 --timeout-ms 300 reset >/tmp/cmd-none.out 2
 rc=$?
 check cmd-no-such-node "gfins-can cmd --node 9 exit $rc, expected 5 (no response)" [ $rc -eq 5 ]
 
+kill $sent_pid 2>/dev/null
+wait $sent_pid 2>/dev/null
+
+# Replay (docs/can-interface.md, "Sequence numbers"): Debian's canplayer sends the captured command
+# frames again, 20 ms apart; every configuration-changing one (opcode 1-4, 7-9) carries a number
+# the board has taken and must be answered Result 11 (Replayed, 0x0B) without being carried out.
+n_cfg=$(grep -cE ' vcan0 601#0[1234789][0-9A-F]{14}$' /tmp/cmd-sent.log)
+candump -L vcan0,681:7FF >/tmp/cmd-replay-rsp.log 2>/dev/null &
+rsp_pid=$!
+sleep 0.3
+canplayer -t -g 20 -I /tmp/cmd-sent.log
+sleep 1
+kill $rsp_pid 2>/dev/null
+wait $rsp_pid 2>/dev/null
+n_rep=$(grep -cE ' vcan0 681#0[1234789][0-9A-F]{2}000B' /tmp/cmd-replay-rsp.log)
+check cmd-replayed "canplayer replayed $(grep -c . /tmp/cmd-sent.log) command frames, $n_cfg of them configuration-changing: $n_rep answered Replayed (11)" \
+  [ "$n_cfg" -gt 0 -a "$n_rep" -eq "$n_cfg" ]
+
 # raw_cmd NAME FRAME EXPECTED_RESULT: cansend a frame on 601, the response on 681 must be a status
 # part (byte 2 = 0) with byte 3 = EXPECTED_RESULT.
 raw_cmd() {
@@ -76,6 +98,37 @@ raw_cmd() {
 }
 raw_cmd short-frame 0142 02         # 2 bytes: length not 8
 raw_cmd bad-crc 0242000000000000 03  # ResetNavigation with a wrong CRC byte
+
+# Stored settings (docs/can-interface.md, "Stored settings"): the divider set above is in the
+# settings file; a node id set by command is taken at the next start of gfins-fw, and
+# RestoreDefaults gives the configuration's node id back at the start after that.
+settings=/tmp/gfins-can-settings.toml
+check cmd-settings-divider "settings file after the divider command: $(grep -c '^euler = 20$' $settings 2>/dev/null) line 'euler = 20'" \
+  grep -q '^euler = 20$' $settings
+cmd_ok node-id node-id 2
+check cmd-settings-node "settings file node_id: $(sed -n 's/^node_id = //p' $settings 2>/dev/null)" \
+  grep -q '^node_id = 2$' $settings
+# epochs_of ID LOG: GfinsEpoch frames of one node id (0x100 + node) in 1 s of candump.
+epochs_of() {
+  timeout 1 candump -L vcan0 >"$2" 2>/dev/null
+  grep -c " vcan0 $1#" "$2"
+}
+fw_stop
+fw_start /tmp/cmd-fw-restart.log
+check cmd-settings-restart "gfins-fw started again on the stored settings" [ $? -eq 0 ]
+n2=$(epochs_of 102 /tmp/cmd-restart.log)
+n1=$(grep -c ' vcan0 101#' /tmp/cmd-restart.log)
+check cmd-settings-node-after-restart "after the restart, 1 s: $n2 epochs of node 2, $n1 of node 1" \
+  [ "$n2" -gt 0 -a "$n1" -eq 0 ]
+gfins-can cmd --iface vcan0 --node 2 --timeout-ms 2000 restore-defaults >/tmp/cmd-restore.out 2>&1
+rc=$?
+left=$([ -e $settings ] && echo present || echo removed)
+check cmd-settings-restore "restore-defaults exit $rc, settings file $left" [ $rc -eq 0 -a "$left" = removed ]
+fw_stop
+fw_start /tmp/cmd-fw-defaults.log
+check cmd-settings-defaults-start "gfins-fw started again on the configuration" [ $? -eq 0 ]
+n1=$(epochs_of 101 /tmp/cmd-defaults.log)
+check cmd-settings-defaults "after RestoreDefaults and a restart, 1 s: $n1 epochs of node 1" [ "$n1" -gt 0 ]
 
 fw_stop
 kill -TERM $toggle_pid 2>/dev/null

@@ -188,7 +188,7 @@ struct Board {
     // waits for the load to finish: a reload requested in step k always applies in step k + 1,
     // so every capture after it starts at the same epoch on every run.
     reload = std::make_unique<app::ReloadWorker>(
-        [this, load = app::calibration_reloader(config)](const nav::PipelineConfig<float>& c) {
+        [this, load = app::calibration_reloader(config)](const app::ReloadRequest& c) {
           {
             std::unique_lock<std::mutex> lock(gate_mutex);
             gate_cv.wait(lock, [this] { return !in_step; });
@@ -486,6 +486,7 @@ TEST(FirmwareCalibration, ABoardWithKnownErrorsIsCalibratedThroughTheCanCommands
   can::Command reload;
   reload.opcode = can::Opcode::kReloadCalibration;
   reload.token = 0xA5;
+  reload.sequence = 1;  // the board's first configuration-changing command of this session
   const can_tool::CommandOutcome r =
       can_tool::run_command(*b.host_bus, reload, kNode, can_tool::CommandTimeouts{});
   ASSERT_EQ(r.kind, can_tool::CommandOutcome::Kind::kOk) << r.text;

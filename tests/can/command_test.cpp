@@ -26,6 +26,7 @@ TEST(Command, EveryCommandRoundTrips) {
   std::vector<Command> cmds;
   Command c;
   c.token = 77;
+  c.sequence = 4242;
   c.opcode = Opcode::kRealign;
   c.heading_rad = -1.2345f;
   cmds.push_back(c);
@@ -45,6 +46,13 @@ TEST(Command, EveryCommandRoundTrips) {
   c.samples = 5000;
   cmds.push_back(c);
   c.opcode = Opcode::kReloadCalibration;
+  c.forced = true;
+  cmds.push_back(c);
+  c.opcode = Opcode::kSetNodeId;
+  c.node_id = 15;
+  c.forced = false;
+  cmds.push_back(c);
+  c.opcode = Opcode::kRestoreDefaults;
   cmds.push_back(c);
   for (const Command& in : cmds) {
     SCOPED_TRACE(to_string(in.opcode));
@@ -54,6 +62,7 @@ TEST(Command, EveryCommandRoundTrips) {
     ASSERT_TRUE(d.ok()) << d.error.message;
     EXPECT_EQ(d.command.opcode, in.opcode);
     EXPECT_EQ(d.command.token, 77);
+    EXPECT_EQ(d.command.sequence, carries_sequence(in.opcode) ? 4242 : 0);
     switch (in.opcode) {
       case Opcode::kRealign:
         EXPECT_NEAR(d.command.heading_rad, -1.2345f, 0.5e-4 + 1e-6);  // half a 1e-4 rad step
@@ -68,6 +77,12 @@ TEST(Command, EveryCommandRoundTrips) {
       case Opcode::kStartCapture:
         EXPECT_EQ(d.command.pose, 17);
         EXPECT_EQ(d.command.samples, 5000);
+        break;
+      case Opcode::kReloadCalibration:
+        EXPECT_TRUE(d.command.forced);
+        break;
+      case Opcode::kSetNodeId:
+        EXPECT_EQ(d.command.node_id, 15);
         break;
       default:
         break;
@@ -84,6 +99,7 @@ TEST(Command, ForcedFlagOfRealignAndResetRoundTripsAtTheIcdBits) {
     c.opcode = Opcode::kRealign;
     c.heading_rad = 0.5f;
     c.forced = forced;
+    c.sequence = 1;
     hal::CanFrame f = encode_command(c, kNode);
     EXPECT_EQ(f.data[4], forced ? 1 : 0);
     DecodedCommand d = decode_command(f, kNode);
@@ -97,11 +113,50 @@ TEST(Command, ForcedFlagOfRealignAndResetRoundTripsAtTheIcdBits) {
     EXPECT_EQ(d.command.forced, forced);
   }
   // A forced bit on a command that has none is a bit the opcode does not use.
-  EXPECT_EQ(decode_command(raw_command({3, 1, 2, 0, 1, 0, 0}), kNode).error.code,
+  EXPECT_EQ(decode_command(raw_command({3, 1, 2, 0, 1, 1, 0}), kNode).error.code,
             ResultCode::kMalformed);  // SetCompensator with bit 32 set
   // Bits next to the flag stay reserved.
-  EXPECT_EQ(decode_command(raw_command({2, 1, 2, 0, 0, 0, 0}), kNode).error.code,
+  EXPECT_EQ(decode_command(raw_command({2, 1, 2, 0, 0, 1, 0}), kNode).error.code,
             ResultCode::kMalformed);  // ResetNavigation with bit 17 set
+}
+
+// ICD: the sequence number of a configuration-changing command is a uint16 in bytes 5-6 (bits
+// 40..55, little-endian), 1..65535; ReloadCalibration's ReloadForced is bit 16; SetNodeId's
+// NodeId byte 2 (0..15). Frames written byte by byte here.
+TEST(Command, SequenceNodeIdAndReloadForcedAtTheIcdBits) {
+  DecodedCommand d = decode_command(raw_command({3, 9, 2, 0, 0, 0x34, 0x12}), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_EQ(d.command.sequence, 0x1234);
+  d = decode_command(raw_command({3, 9, 2, 0, 0, 0xFF, 0xFF}), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_EQ(d.command.sequence, 65535);
+  // 0 is below the range: no command can carry it (the board's last number starts at 0).
+  EXPECT_EQ(decode_command(raw_command({3, 9, 2, 0, 0, 0, 0}), kNode).error.code,
+            ResultCode::kOutOfRange);
+  EXPECT_EQ(decode_command(raw_command({9, 9, 0, 0, 0, 0, 0}), kNode).error.code,
+            ResultCode::kOutOfRange);  // RestoreDefaults without a number
+  // The two commands that change nothing carry none: bytes 5-6 are reserved for them.
+  EXPECT_EQ(decode_command(raw_command({5, 9, 0, 0, 0, 1, 0}), kNode).error.code,
+            ResultCode::kMalformed);
+  d = decode_command(raw_command({7, 9, 1, 0, 0, 2, 0}), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_TRUE(d.command.forced);
+  EXPECT_EQ(d.command.sequence, 2);
+  d = decode_command(raw_command({8, 9, 15, 0, 0, 3, 0}), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_EQ(d.command.opcode, Opcode::kSetNodeId);
+  EXPECT_EQ(d.command.node_id, 15);
+  EXPECT_EQ(decode_command(raw_command({8, 9, 16, 0, 0, 3, 0}), kNode).error.code,
+            ResultCode::kOutOfRange);  // node id 16
+  // The encoder puts them where the ICD says.
+  Command c;
+  c.opcode = Opcode::kSetNodeId;
+  c.node_id = 7;
+  c.sequence = 0xBEEF;
+  const hal::CanFrame f = encode_command(c, kNode);
+  EXPECT_EQ(f.data[2], 7);
+  EXPECT_EQ(f.data[5], 0xEF);
+  EXPECT_EQ(f.data[6], 0xBE);
 }
 
 TEST(Command, SetDividerReachesTheAccuracyMessages) {
@@ -109,6 +164,7 @@ TEST(Command, SetDividerReachesTheAccuracyMessages) {
   c.opcode = Opcode::kSetDivider;
   c.message = MessageId::kAidingCounters;
   c.divider = 100;
+  c.sequence = 1;
   const DecodedCommand d = decode_command(encode_command(c, kNode), kNode);
   ASSERT_TRUE(d.ok()) << d.error.message;
   EXPECT_EQ(d.command.message, MessageId::kAidingCounters);
@@ -121,8 +177,8 @@ TEST(Command, ByteLayoutAsTheIcdSays) {
   EXPECT_EQ(d.command.opcode, Opcode::kStartCapture);
   EXPECT_EQ(d.command.pose, 3);
   EXPECT_EQ(d.command.samples, 1000);
-  // Realign to heading 1.0 rad = 10000 = 0x2710.
-  const DecodedCommand r = decode_command(raw_command({1, 0, 0x10, 0x27, 0, 0, 0}), kNode);
+  // Realign to heading 1.0 rad = 10000 = 0x2710, sequence 1.
+  const DecodedCommand r = decode_command(raw_command({1, 0, 0x10, 0x27, 0, 1, 0}), kNode);
   ASSERT_TRUE(r.ok());
   EXPECT_NEAR(r.command.heading_rad, 1.0f, 1e-6f);
 }
@@ -138,6 +194,7 @@ TEST(Command, MalformedFramesDecodeToTypedErrors) {
   short_frame.len = 5;
   hal::CanFrame bad_crc = raw_command({2, 9, 0, 0, 0, 0, 0});
   bad_crc.data[7] ^= 0x01;
+  // The arguments' cases carry sequence number 1 (byte 5): only the argument is wrong.
   const std::vector<Bad> cases{
       {"short", short_frame, ResultCode::kBadLength},
       {"crc", bad_crc, ResultCode::kBadCrc},
@@ -146,10 +203,10 @@ TEST(Command, MalformedFramesDecodeToTypedErrors) {
       {"reset with argument", raw_command({2, 9, 2, 0, 0, 0, 0}), ResultCode::kMalformed},
       {"byte 6 set", raw_command({5, 9, 0, 0, 0, 0, 0x10}), ResultCode::kMalformed},
       // heading 3.2 rad = 32000 > 31416
-      {"heading > pi", raw_command({1, 9, 0x00, 0x7D, 0, 0, 0}), ResultCode::kOutOfRange},
-      {"heading N/A", raw_command({1, 9, 0x00, 0x80, 0, 0, 0}), ResultCode::kOutOfRange},
-      {"compensator 3", raw_command({3, 9, 3, 0, 0, 0, 0}), ResultCode::kOutOfRange},
-      {"divider of message 14", raw_command({4, 9, 14, 10, 0, 0, 0}), ResultCode::kOutOfRange},
+      {"heading > pi", raw_command({1, 9, 0x00, 0x7D, 0, 1, 0}), ResultCode::kOutOfRange},
+      {"heading N/A", raw_command({1, 9, 0x00, 0x80, 0, 1, 0}), ResultCode::kOutOfRange},
+      {"compensator 3", raw_command({3, 9, 3, 0, 0, 1, 0}), ResultCode::kOutOfRange},
+      {"divider of message 14", raw_command({4, 9, 14, 10, 0, 1, 0}), ResultCode::kOutOfRange},
       {"capture pose 64", raw_command({6, 9, 64, 10, 0, 0, 0}), ResultCode::kOutOfRange},
       {"capture 0 samples", raw_command({6, 9, 1, 0, 0, 0, 0}), ResultCode::kOutOfRange},
   };

@@ -27,9 +27,10 @@ TEST(Publisher, DefaultsSendTheDocumentedFramesPerSecond) {
   Publisher pub(bus, PublisherConfig{});
   ASSERT_TRUE(pub.init_status().is_ok());
   for (std::uint32_t seq = 0; seq < 1000; ++seq) pub.publish(epoch_at(seq));  // one second
-  // 8 messages at 100 Hz, Euler and angular acceleration at 50 Hz, two health frames at 1 Hz,
-  // accuracy at 5 Hz, aiding counters every 400 samples (seq 0, 400, 800).
-  EXPECT_EQ(bus.count, 8u * 100 + 2 * 50 + 2 + 5 + 3);
+  // 8 messages at 100 Hz, Euler and angular acceleration at 50 Hz, two health frames and the
+  // command counters at 1 Hz, accuracy at 5 Hz, aiding counters every 400 samples (seq 0, 400,
+  // 800).
+  EXPECT_EQ(bus.count, 8u * 100 + 2 * 50 + 3 + 5 + 3);
   EXPECT_EQ(pub.counters().epochs, 100u);
   EXPECT_EQ(pub.counters().frames_sent, bus.count);
 }
@@ -97,10 +98,10 @@ TEST(Publisher, NavStatusBitsReachTheStatusFrame) {
   EXPECT_EQ(extract_bits(p, status.signals[1]), 0xDEADBEEFu);
 }
 
-// The budget: the table's defaults at 1 kHz (aiding messages included: 909.5 frames/s x 135
-// worst-case bits = 122,782.5 bit/s, docs/can-interface.md) on a 250 kbit/s bus are 49.1 %;
-// with a 50 % budget one more message at 100 Hz (+13,500 bit/s, 54.5 %) is refused and changes
-// nothing, one at 10 Hz (+1,350 bit/s, 49.65 %) is accepted. A construction over budget falls
+// The budget: the table's defaults at 1 kHz (aiding messages included: 910.5 frames/s x 135
+// worst-case bits = 122,917.5 bit/s, docs/can-interface.md) on a 250 kbit/s bus are 49.2 %;
+// with a 50 % budget one more message at 100 Hz (+13,500 bit/s, 54.6 %) is refused and changes
+// nothing, one at 10 Hz (+1,350 bit/s, 49.7 %) is accepted. A construction over budget falls
 // back to the defaults with the status.
 TEST(Publisher, DividersBeyondTheBusBudgetAreRefused) {
   ArrayBus<8> bus;
@@ -108,11 +109,11 @@ TEST(Publisher, DividersBeyondTheBusBudgetAreRefused) {
   c.budget = BusBudget{1000.0, 250000, 0.5};
   Publisher pub(bus, c);
   ASSERT_TRUE(pub.init_status().is_ok());
-  EXPECT_NEAR(c.budget.load(pub.dividers()), 909.5 * 135.0 / 250000.0, 1e-12);
+  EXPECT_NEAR(c.budget.load(pub.dividers()), 910.5 * 135.0 / 250000.0, 1e-12);
   EXPECT_EQ(pub.set_divider(MessageId::kSensorsA, 10).code(), ErrorCode::kResourceExhausted);
   EXPECT_EQ(pub.divider(MessageId::kSensorsA), 0);
   EXPECT_TRUE(pub.set_divider(MessageId::kSensorsA, 100).is_ok());
-  EXPECT_NEAR(c.budget.load(pub.dividers()), 919.5 * 135.0 / 250000.0, 1e-12);
+  EXPECT_NEAR(c.budget.load(pub.dividers()), 920.5 * 135.0 / 250000.0, 1e-12);
   // The rules come first: a divider that breaks them is refused for that, not for the load.
   EXPECT_EQ(pub.set_divider(MessageId::kSensorsB, 15).code(), ErrorCode::kInvalidArgument);
   PublisherConfig over = c;
@@ -167,7 +168,7 @@ TEST(Publisher, RefusedFramesAreCountedNotRetried) {
   Publisher pub(bus, PublisherConfig{});
   pub.publish(epoch_at(0));
   EXPECT_EQ(pub.counters().frames_sent, 0u);
-  EXPECT_EQ(pub.counters().send_failures, 14u);  // the 14 data messages enabled by default
+  EXPECT_EQ(pub.counters().send_failures, 15u);  // the 15 data messages enabled by default
 }
 
 }  // namespace

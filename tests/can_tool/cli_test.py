@@ -65,7 +65,8 @@ def dbc_cycle_times(text):
 def check_dbc_for_a_configured_board(exe, workdir):
     """gfins-can dbc --config: the DBC of the board a gfins-fw configuration describes. The
     expected cycle times are the documented dividers (docs/can-interface.md) at 2 kHz, written
-    out here: 10 -> 5 ms, 20 -> 10 ms, 1000 -> 500 ms; Euler switched off has none."""
+    out here: 10 -> 5 ms, 20 -> 10 ms, 1000 -> 500 ms (the command counters, on every board, at
+    the table's 1000 samples too); Euler switched off has none."""
     cfg = os.path.join(workdir, 'board3.toml')
     with open(cfg, 'w') as f:
         f.write('[adc]\nsample_rate_hz = 2000\n[can]\nnode_id = 3\n[output]\neuler = 0\n')
@@ -75,7 +76,8 @@ def check_dbc_for_a_configured_board(exe, workdir):
     cycle, ids = dbc_cycle_times(open(out).read() if os.path.exists(out) else '')
     want = {'GfinsEpoch': 5, 'GfinsStatus': 5, 'GfinsQuaternion': 5, 'GfinsAngularRate': 5,
             'GfinsAngularAccel': 10, 'GfinsAccel': 5, 'GfinsVelocity': 5, 'GfinsPositionNE': 5,
-            'GfinsPositionD': 5, 'GfinsHealthAdc': 500, 'GfinsHealthSystem': 500}
+            'GfinsPositionD': 5, 'GfinsHealthAdc': 500, 'GfinsHealthSystem': 500,
+            'GfinsCommandCounters': 500}
     check(cycle == want, f'dbc --config: cycle times {cycle}, expected {want}')
     check(ids.get('GfinsEpoch') == 0x100 + 3, f'dbc --config: epoch id {ids.get("GfinsEpoch")}')
     # --node overrides the file's node id; the cycle times stay the file's.
@@ -84,9 +86,9 @@ def check_dbc_for_a_configured_board(exe, workdir):
     check(ids7.get('GfinsEpoch') == 0x100 + 7 and cycle7 == want,
           f'dbc --config --node 7: epoch id {ids7.get("GfinsEpoch")}, cycle times {cycle7}')
     # A configuration the firmware refuses is refused here too, and nothing is written: a node
-    # out of range, and the default dividers at 4 kHz (97.4 % of 500 kbit/s, over the budget).
+    # out of range, and the default dividers at 4 kHz (97.5 % of 500 kbit/s, over the budget).
     for name, text, why in (('bad-node', '[can]\nnode_id = 40\n', 'can.node_id = 40'),
-                            ('over-budget', '[adc]\nsample_rate_hz = 4000\n', '97.4 %')):
+                            ('over-budget', '[adc]\nsample_rate_hz = 4000\n', '97.5 %')):
         bad = os.path.join(workdir, name + '.toml')
         with open(bad, 'w') as f:
             f.write(text)

@@ -21,6 +21,9 @@ class BoardBus final : public hal::CanBus {
  public:
   bool answer = true;
   int sent = 0;
+  // The board's replay rule (docs/can-interface.md, "Sequence numbers"), written from the ICD:
+  // a configuration-changing command must carry a number above the last one taken.
+  std::uint16_t last_sequence = 0;
   // Capture result parts (docs/can-interface.md, "Response parts") the bus loses.
   std::vector<std::uint8_t> lose_parts;
 
@@ -46,6 +49,14 @@ class BoardBus final : public hal::CanBus {
     }
     const can::Command& c = d.command;
     const auto op = static_cast<std::uint8_t>(c.opcode);
+    const bool numbered =
+        c.opcode != can::Opcode::kReportCalibrationId && c.opcode != can::Opcode::kStartCapture;
+    if (numbered && c.sequence <= last_sequence) {
+      rx_.push_back(can::encode_response(
+          {op, c.token, static_cast<can::ResultCode>(11), last_sequence}, kNode));
+      return Status::ok();
+    }
+    if (numbered) last_sequence = c.sequence;
     switch (c.opcode) {
       case can::Opcode::kReportCalibrationId:
         rx_.push_back(can::encode_calibration_id_response(c.token, 0x1234ABCD, kNode));
@@ -105,10 +116,50 @@ TEST(CommandClient, EveryCommandGetsItsResponse) {
     c.token = 10;
     c.message = can::MessageId::kEuler;
     c.divider = 40;
+    c.sequence = static_cast<std::uint16_t>(bus.last_sequence + 1);
     const CommandOutcome r = run_command(bus, c, kNode, short_timeouts());
     EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
     EXPECT_EQ(r.status.token, 10);
   }
+}
+
+// gfins-can cmd without --sequence: sent with 1; a board that has taken numbers answers
+// Replayed with its last one, and the client sends once more with the next (and the next token).
+TEST(CommandClient, WithoutASequenceTheClientTakesTheBoardsNextNumberOnce) {
+  BoardBus bus;
+  bus.last_sequence = 41;
+  can::Command c;
+  c.opcode = can::Opcode::kSetCompensator;
+  c.token = 20;
+  c.sequence = 1;
+  std::string note;
+  CommandOutcome r = run_command_next_sequence(bus, c, kNode, short_timeouts(), &note);
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
+  EXPECT_EQ(r.status.token, 21);
+  EXPECT_EQ(bus.last_sequence, 42);
+  EXPECT_EQ(bus.sent, 2);
+  EXPECT_NE(note.find("41"), std::string::npos) << note;
+  // A fresh board takes 1 at once: one frame, no note.
+  BoardBus fresh;
+  note.clear();
+  r = run_command_next_sequence(fresh, c, kNode, short_timeouts(), &note);
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
+  EXPECT_EQ(fresh.sent, 1);
+  EXPECT_TRUE(note.empty());
+  // A board at the last number refuses: there is no next one (the board must restart).
+  BoardBus full;
+  full.last_sequence = 65535;
+  r = run_command_next_sequence(full, c, kNode, short_timeouts(), &note);
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kRejected);
+  EXPECT_EQ(full.sent, 1);
+  // A command without a number is never repeated.
+  BoardBus quiet;
+  quiet.last_sequence = 9;
+  can::Command id;
+  id.opcode = can::Opcode::kReportCalibrationId;
+  r = run_command_next_sequence(quiet, id, kNode, short_timeouts(), &note);
+  EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
+  EXPECT_EQ(quiet.sent, 1);
 }
 
 TEST(CommandClient, CalibrationIdAndCapture) {

@@ -252,9 +252,9 @@ TEST(DecoderChecks, RestartAndMidEpochStartAreNotProblems) {
   const Decoded d = decode(joined);
   EXPECT_TRUE(d.issues.empty()) << dump(d.issues);
   EXPECT_EQ(d.summary.restarts, 1u);
-  // Sample 0 publishes 14 frames (health, accuracy and aiding counters included); the first 5
-  // are cut, 9 precede epoch 1.
-  EXPECT_EQ(d.summary.leading_frames, 9u);
+  // Sample 0 publishes 15 frames (health, accuracy, aiding and command counters included); the
+  // first 5 are cut, 10 precede epoch 1.
+  EXPECT_EQ(d.summary.leading_frames, 10u);
   EXPECT_EQ(d.epochs, 300u + 200u);  // epochs 1..300 of the first run, 0..199 of the second
 }
 

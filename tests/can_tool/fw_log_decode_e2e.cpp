@@ -262,10 +262,11 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
 
   // Then gfins-can's summary: every epoch, every frame ok, no problem at all (no bad CRC, no
   // counter jump, no drop, duplicate or reorder). Frame counts from the default dividers:
-  // 401 epochs (seq 0, 10, ..., 4000), 201 at divider 20, 5 health frames (seq 0, 1000, ...).
+  // 401 epochs (seq 0, 10, ..., 4000), 201 at divider 20, 5 frames of each 1 Hz message (two
+  // health, the command counters; seq 0, 1000, ...).
   constexpr int kEpochs = kSamples / kEpochDivider + 1;
   constexpr int kHalfRate = kSamples / 20 + 1, kHealth = kSeconds + 1;
-  constexpr int kFrames = 8 * kEpochs + 2 * kHalfRate + 2 * kHealth;
+  constexpr int kFrames = 8 * kEpochs + 2 * kHalfRate + 3 * kHealth;
   const std::string f = std::to_string(kFrames);
   EXPECT_NE(dec.err.find("summary: " + f + " lines, " + f + " frames (" + f + " ok), " +
                          std::to_string(kEpochs) + " epochs, 0 commands, 0 responses, 0 problems"),

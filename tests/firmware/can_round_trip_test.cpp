@@ -170,6 +170,14 @@ TEST(CanOutput, DecodedFramesEqualTheNavStateWithinQuantisation) {
 
 // ---- Commands as frames ---------------------------------------------------------------------
 
+// Sequence numbers for the configuration-changing commands these tests send: each frame gets the
+// next one, so only a test that means to repeat a number does (docs/can-interface.md, "Sequence
+// numbers"). Every test starts a new board, whose last number is 0.
+std::uint16_t next_sequence() {
+  static std::uint16_t n = 0;
+  return ++n;
+}
+
 class CanCommands : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -207,14 +215,17 @@ class CanCommands : public ::testing::Test {
     }
     return out;
   }
-  std::vector<can::ResponseFrame> send(const can::Command& c, std::uint32_t cycles = 2) {
+  std::vector<can::ResponseFrame> send(can::Command c, std::uint32_t cycles = 2) {
+    c.sequence = next_sequence();
     return round_trip(can::encode_command(c, SimRig::kNode), cycles);
   }
   // A reload command: the cycle that reads it posts the request to the worker thread (the loop
   // never waits for file I/O); the first cycle after the worker is done answers. Ordering, not
   // timing: the test waits for the worker, whatever the machine's speed.
-  std::vector<can::ResponseFrame> reload(std::uint8_t token) {
-    auto r = send(cmd(can::Opcode::kReloadCalibration, token), 1);
+  std::vector<can::ResponseFrame> reload(std::uint8_t token, bool forced = false) {
+    can::Command c = cmd(can::Opcode::kReloadCalibration, token);
+    c.forced = forced;
+    auto r = send(c, 1);
     worker_->wait_settled();
     auto more = round_trip_cycles(1);
     r.insert(r.end(), more.begin(), more.end());
@@ -241,6 +252,7 @@ class CanCommands : public ::testing::Test {
     can::Command c;
     c.opcode = op;
     c.token = token;
+    c.sequence = next_sequence();
     return c;
   }
 
@@ -356,18 +368,97 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
 }
 
 // Another board's calibration file put at this board's path, reloaded mid-navigation: refused
-// (Failed), the calibration in use stays. Before, it was taken
-// and the board navigated with the other board's scale factors and misalignments.
-TEST_F(CanCommands, ReloadOfAnotherBoardsFileIsRefused) {
+// with Result 12 (OtherDevice, the ICD's value), counted, the calibration in use stays; sent
+// forced, it is taken. Oracle: the ids and biases the test writes.
+TEST_F(CanCommands, ReloadOfAnotherBoardsFileIsRefusedUnlessForced) {
   const std::uint32_t before = rig_->loop->cal_id();
+  const std::uint32_t refused = rig_->loop->health().command_errors;
   calib_file::CalibrationData other = rig_->factory;
   other.device_id = "other-board-9";
+  other.sensors[1].bias_g += 2e-5;  // another board: another calibration id
   ASSERT_TRUE(calib_file::save_calibration_file(path_, other).is_ok());
-  const auto r = reload(21);
+  auto r = reload(21);
   ASSERT_NE(part(r, 0), nullptr);
-  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kFailed);
+  EXPECT_EQ(static_cast<int>(part(r, 0)->result), 12);
   EXPECT_EQ(rig_->loop->cal_id(), before);
   EXPECT_TRUE(rig_->loop->calibrated());
+  EXPECT_EQ(rig_->loop->health().command_errors, refused + 1);
+  EXPECT_EQ(rig_->loop->health().last_refusal, 12);
+  r = reload(22, true);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(other));
+}
+
+// A configuration-changing frame sent again (a log replayed onto the bus, canplayer) is refused
+// with Result 11 (Replayed) and the last number taken, counted, and changes nothing; the next
+// number is taken. A refused command takes its number too: sent again it is a replay.
+TEST_F(CanCommands, AReplayedCommandIsRefusedAndCounted) {
+  can::Command c = cmd(can::Opcode::kSetCompensator, 23);
+  c.compensator = nav::CompensatorKind::kExact;
+  c.sequence = 500;
+  const hal::CanFrame frame = can::encode_command(c, SimRig::kNode);
+  auto r = round_trip(frame);
+  ASSERT_NE(part(r, 0), nullptr);
+  ASSERT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  // The board's compensator is changed behind the frame's back; the replay must not undo it.
+  c.compensator = nav::CompensatorKind::kNone;
+  c.sequence = 501;
+  r = round_trip(can::encode_command(c, SimRig::kNode));
+  ASSERT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  const std::uint32_t done = rig_->loop->health().commands;
+  r = round_trip(frame);
+  ASSERT_NE(part(r, 0), nullptr);
+  EXPECT_EQ(static_cast<int>(part(r, 0)->result), 11);
+  EXPECT_EQ(part(r, 0)->value, 501u);
+  EXPECT_EQ(rig_->loop->pipeline().config().compensator, nav::CompensatorKind::kNone);
+  EXPECT_EQ(rig_->loop->health().commands_replayed, 1u);
+  EXPECT_EQ(rig_->loop->health().last_refusal, 11);
+  EXPECT_EQ(rig_->loop->health().commands, done);
+  // An equal number is a replay as well; a lower one too.
+  c.sequence = 501;
+  r = round_trip(can::encode_command(c, SimRig::kNode));
+  EXPECT_EQ(static_cast<int>(part(r, 0)->result), 11);
+  c.sequence = 7;
+  r = round_trip(can::encode_command(c, SimRig::kNode));
+  EXPECT_EQ(static_cast<int>(part(r, 0)->result), 11);
+  EXPECT_EQ(rig_->loop->health().commands_replayed, 3u);
+  // A command refused for its argument takes its number: the same frame again is a replay.
+  can::Command bad = cmd(can::Opcode::kSetDivider, 24);
+  bad.message = can::MessageId::kEuler;
+  bad.divider = 15;  // not a multiple of the epoch divider
+  bad.sequence = 600;
+  r = round_trip(can::encode_command(bad, SimRig::kNode));
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOutOfRange);
+  r = round_trip(can::encode_command(bad, SimRig::kNode));
+  EXPECT_EQ(static_cast<int>(part(r, 0)->result), 11);
+  // Commands that change nothing carry no number and are never replays.
+  for (int i = 0; i < 2; ++i) {
+    r = round_trip(can::encode_command(cmd(can::Opcode::kReportCalibrationId, 25), SimRig::kNode));
+    EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  }
+  // The next number is taken.
+  c.sequence = 601;
+  r = round_trip(can::encode_command(c, SimRig::kNode));
+  EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  // What the bus says: GfinsCommandCounters (base 0x200 + node, 1 Hz) decoded from its frame
+  // bytes as the ICD lays them out: done bytes 0-1, refused 2-3, replays byte 4, last refusal
+  // byte 5, settings source byte 6 bits 0-1.
+  rig_->bus->clear_sent();
+  rig_->run_cycles(1000);
+  std::optional<hal::CanFrame> counters;  // sent() returns a copy: keep the frame, not a pointer
+  for (const hal::CanFrame& f : rig_->bus->sent()) {
+    if (f.id == 0x200u + SimRig::kNode) counters = f;
+  }
+  ASSERT_TRUE(counters.has_value()) << "GfinsCommandCounters within a second";
+  const auto u16 = [&](std::size_t at) {
+    return counters->data[at] | (counters->data[at + 1] << 8);
+  };
+  EXPECT_EQ(u16(0), static_cast<int>(rig_->loop->health().commands & 0xFFFFu));
+  EXPECT_EQ(u16(2), static_cast<int>(rig_->loop->health().command_errors & 0xFFFFu));
+  EXPECT_EQ(counters->data[4], 4);      // four replays
+  EXPECT_EQ(counters->data[5], 11);     // the last refusal: Replayed
+  EXPECT_EQ(counters->data[6] & 3, 0);  // no settings store: the configuration's settings
 }
 
 TEST_F(CanCommands, MalformedFramesGetErrorResponsesAndChangeNothing) {
@@ -412,7 +503,8 @@ struct BoardState {
 // A command frame, valid but for what `edit` does to its bytes; the CRC is recomputed afterwards
 // unless the edit is the CRC itself. Layout (docs/can-interface.md, GfinsCommand): byte 0
 // opcode, 1 token, arguments little-endian from byte 2, byte 7 CRC-8.
-hal::CanFrame edited(const can::Command& c, void (*edit)(hal::CanFrame&), bool reseal = true) {
+hal::CanFrame edited(can::Command c, void (*edit)(hal::CanFrame&), bool reseal = true) {
+  c.sequence = next_sequence();
   hal::CanFrame f = can::encode_command(c, SimRig::kNode);
   edit(f);
   if (reseal) can::seal_frame(f);
@@ -464,7 +556,7 @@ constexpr auto kUnknownOpcode = static_cast<can::ResultCode>(1);
 constexpr auto kBusy = static_cast<can::ResultCode>(6);
 
 TEST_F(CanMalformedCommands, EveryOpcodeWithABadCrcBadLengthOrStrayBitsChangesNothing) {
-  for (int op = 1; op <= 7; ++op) {
+  for (int op = 1; op <= 9; ++op) {
     can::Command c = cmd(static_cast<can::Opcode>(op), static_cast<std::uint8_t>(0x30 + op));
     c.heading_rad = 1.0f;  // valid arguments: only the edit makes the frame wrong
     c.compensator = nav::CompensatorKind::kPaper;
@@ -477,14 +569,21 @@ TEST_F(CanMalformedCommands, EveryOpcodeWithABadCrcBadLengthOrStrayBitsChangesNo
                        c, [](hal::CanFrame& f) { f.data[7] ^= 0x5A; }, false),
                    kBadCrc, name + ", CRC");
     expect_refused(edited(c, [](hal::CanFrame& f) { f.len = 7; }), kBadLength, name + ", 7 bytes");
-    // Byte 6 is used by no opcode: a set bit there is not a command the ICD defines.
-    expect_refused(edited(c, [](hal::CanFrame& f) { f.data[6] = 0x01; }), kMalformed,
-                   name + ", stray bit");
+    // A bit the opcode does not use (ICD): byte 6 for the two without a sequence number (bytes
+    // 5-6 carry it for the others), bit 39 (byte 4, bit 7) for those whose arguments end before
+    // it. SetDivider uses every bit: message, divider and sequence fill bytes 2-6.
+    if (op == 5 || op == 6) {
+      expect_refused(edited(c, [](hal::CanFrame& f) { f.data[6] = 0x01; }), kMalformed,
+                     name + ", stray bit in byte 6");
+    } else if (op != 4) {
+      expect_refused(edited(c, [](hal::CanFrame& f) { f.data[4] |= 0x80; }), kMalformed,
+                     name + ", stray bit 39");
+    }
   }
 }
 
 TEST_F(CanMalformedCommands, UnknownOpcodesChangeNothing) {
-  for (const int op : {0, 8, 0x7F, 0xFF}) {
+  for (const int op : {0, 10, 0x7F, 0xFF}) {
     hal::CanFrame f{};
     f.id = 0x600 + SimRig::kNode;  // GfinsCommand, 0x600 + node
     f.len = 8;

@@ -123,13 +123,13 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[output]\neuler = 15\n", {"output.euler = 15", "multiple of output.epoch"}},
       {"[output]\nepoch = 0\nstatus = 0\n", {"output.epoch = 0"}},
       // The bus budget (docs/can-interface.md): at 4 kHz the default dividers send
-      // 4000 x (8/10 + 2/20 + 2/1000) = 3608 frames/s x 135 worst-case bits = 487,080 bit/s,
-      // 97.4 % of 500 kbit/s, over the default 50 %.
+      // 4000 x (8/10 + 2/20 + 3/1000) = 3612 frames/s x 135 worst-case bits = 487,620 bit/s,
+      // 97.5 % of 500 kbit/s, over the default 50 %.
       {"[adc]\nsample_rate_hz = 4000\n",
-       {"output = a worst-case bus load of 97.4 % of 500000 bit/s at adc.sample_rate_hz = 4000",
+       {"output = a worst-case bus load of 97.5 % of 500000 bit/s at adc.sample_rate_hz = 4000",
         "at most can.max_bus_load_percent = 50 %"}},
-      // 1 kHz on a 125 kbit/s bus: 902 x 135 = 121,770 bit/s = 97.4 % of it.
-      {"[can]\nbit_rate = 125000\n", {"output = a worst-case bus load of 97.4 % of 125000 bit/s"}},
+      // 1 kHz on a 125 kbit/s bus: 903 x 135 = 121,905 bit/s = 97.5 % of it.
+      {"[can]\nbit_rate = 125000\n", {"output = a worst-case bus load of 97.5 % of 125000 bit/s"}},
       {"[can]\nbit_rate = 300000\n", {"bad.toml:2: can.bit_rate = 300000", "125000, 250000"}},
       {"[can]\nmax_bus_load_percent = 0\n", {"can.max_bus_load_percent = 0", "(0, 100]"}},
       {"[can]\nmax_bus_load_percent = nan\n", {"can.max_bus_load_percent = nan"}},
@@ -163,8 +163,9 @@ CliResult cli(std::vector<const char*> args) {
 TEST(Config, TheBusBudgetAcceptsWhatFitsAndCountsEveryFrame) {
   constexpr double kBits = 135.0;
   // 1 kHz, aiding off: epoch, status, quaternion, rate, accel, velocity, position NE, D at 100 Hz,
-  // Euler and angular acceleration at 50 Hz, two health messages at 1 Hz.
-  constexpr double kDefaultFrames = 8 * 100.0 + 2 * 50.0 + 2 * 1.0;
+  // Euler and angular acceleration at 50 Hz, two health messages and the command counters at
+  // 1 Hz (the counters' divider is the table's 1000 samples at any rate).
+  constexpr double kDefaultFrames = 8 * 100.0 + 2 * 50.0 + 3 * 1.0;
   const auto load_of = [](const std::string& text) {
     const ConfigResult r = parse_config(text, "t.toml");
     EXPECT_TRUE(r.ok()) << r.error;
@@ -178,12 +179,13 @@ TEST(Config, TheBusBudgetAcceptsWhatFitsAndCountsEveryFrame) {
   EXPECT_NEAR(load_of("[adc]\nsample_rate_hz = 2000\n"), 2 * kDefaultFrames * kBits / 500000.0,
               1e-12);
   EXPECT_NEAR(load_of("[can]\nbit_rate = 250000\n"), kDefaultFrames * kBits / 250000.0, 1e-12);
-  // 4 kHz fits with the dividers scaled by 4 (the same 24.4 %), and with the limit raised.
+  // 4 kHz fits with the dividers scaled by 4 (24.4 %: the same but for the command counters, at
+  // 4 Hz), and with the limit raised.
   EXPECT_NEAR(load_of("[adc]\nsample_rate_hz = 4000\n[output]\nepoch = 40\nstatus = 40\n"
                       "quaternion = 40\neuler = 80\nrate = 40\nangular_accel = 80\naccel = 40\n"
                       "velocity = 40\nposition_ne = 40\nposition_d = 40\nhealth_adc = 4000\n"
                       "health_system = 4000\n"),
-              kDefaultFrames * kBits / 500000.0, 1e-12);
+              (kDefaultFrames + 3.0) * kBits / 500000.0, 1e-12);
   EXPECT_NEAR(load_of("[adc]\nsample_rate_hz = 4000\n[can]\nmax_bus_load_percent = 100\n"),
               4 * kDefaultFrames * kBits / 500000.0, 1e-12);
 }

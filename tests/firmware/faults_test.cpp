@@ -683,9 +683,11 @@ TEST_F(Faults, ACalibrationOfAnotherConverterIsRefusedAtStartAndOnReload) {
   EXPECT_TRUE(load_calibration(c, rig.factory, &rig.factory).from_file);
   // Reload: the other converter's file is refused, this converter's file is taken.
   c.calibration_file = bad;
-  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(ReloadRequest{rig.cal.config})
+                   .set.has_value());
   c.calibration_file = good;
-  EXPECT_TRUE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  EXPECT_TRUE(calibration_reloader(c, converter_lsb(rig.factory))(ReloadRequest{rig.cal.config})
+                  .set.has_value());
   static_cast<void>(std::remove(good.c_str()));
   static_cast<void>(std::remove(bad.c_str()));
 }
@@ -706,13 +708,21 @@ TEST_F(Faults, AReloadKeepsToTheDeviceOfTheCalibrationInUse) {
   };
   auto from_defaults = calibration_reloader(c, converter_lsb(rig.factory), "");
   ASSERT_TRUE(save_as("board-a", 1e-4));
-  EXPECT_TRUE(from_defaults(rig.cal.config).has_value()) << "the first file of a nominal board";
+  EXPECT_TRUE(from_defaults(ReloadRequest{rig.cal.config}).set.has_value())
+      << "the first file of a nominal board";
   ASSERT_TRUE(save_as("board-b", 1e-4));
-  EXPECT_FALSE(from_defaults(rig.cal.config).has_value()) << "board-a's calibration is in use";
+  EXPECT_FALSE(from_defaults(ReloadRequest{rig.cal.config}).set.has_value())
+      << "board-a's calibration is in use";
   ASSERT_TRUE(save_as("board-a", 2e-4));
-  EXPECT_TRUE(from_defaults(rig.cal.config).has_value()) << "board-a recalibrated";
+  EXPECT_TRUE(from_defaults(ReloadRequest{rig.cal.config}).set.has_value())
+      << "board-a recalibrated";
   auto from_file = calibration_reloader(c, converter_lsb(rig.factory), "board-b");
-  EXPECT_FALSE(from_file(rig.cal.config).has_value()) << "started on board-b's file";
+  const ReloadOutcome refused = from_file(ReloadRequest{rig.cal.config});
+  EXPECT_FALSE(refused.set.has_value()) << "started on board-b's file";
+  EXPECT_TRUE(refused.other_device) << "refused for the device, not as a failure";
+  // Forced, the other board's file is taken, and its device is the one in use from then on.
+  EXPECT_TRUE(from_file(ReloadRequest{rig.cal.config, true}).set.has_value());
+  EXPECT_TRUE(from_file(ReloadRequest{rig.cal.config}).set.has_value()) << "board-a now in use";
   static_cast<void>(std::remove(path.c_str()));
 }
 
@@ -748,7 +758,8 @@ TEST_F(Faults, ACalibrationTheCoreRefusesLeavesTheBoardOnItsDefaults) {
   EXPECT_EQ(e.flags & kBitNominalCal, kBitNominalCal);
   EXPECT_EQ(e.mode, kModeNavigating);
   // Reload refuses it; --check-config's note names it.
-  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(rig.cal.config).has_value());
+  EXPECT_FALSE(calibration_reloader(c, converter_lsb(rig.factory))(ReloadRequest{rig.cal.config})
+                   .set.has_value());
   const std::string note = calibration_note(c);
   EXPECT_NE(note.find("the navigation core refuses it"), std::string::npos) << note;
   EXPECT_NE(note.find("UNCALIBRATED"), std::string::npos) << note;
@@ -874,14 +885,14 @@ TEST_F(Faults, TheAlignmentChecksTheMeasuredGravityAgainstTheNavigationGravity) 
 
 TEST_F(Faults, FailedCalibrationReloadKeepsTheCalibrationAnswersFailedAndLogs) {
   SimRig& rig = make();
-  ReloadWorker reload(
-      [](const nav::PipelineConfig<float>&) -> std::optional<CalibrationSet> { return {}; });
+  ReloadWorker reload([](const ReloadRequest&) -> ReloadOutcome { return {}; });
   rig.loop->set_reload_worker(&reload);
   rig.run_cycles(2000);
   const std::uint32_t cal_before = rig.loop->cal_id();
   can::Command c;
   c.opcode = can::Opcode::kReloadCalibration;
   c.token = 9;
+  c.sequence = 1;
   ASSERT_TRUE(rig.bus->inject_rx(can::encode_command(c, SimRig::kNode)));
   rig.run_cycles(1);
   reload.wait_settled();  // the worker's outcome is seen by the next cycle's poll
@@ -906,6 +917,8 @@ std::uint32_t frames_for(const SimRig& rig, std::size_t first, std::size_t last)
     for (std::uint16_t d : rig.config.dividers) {
       if (d != 0 && rig.tap->samples()[i].seq % d == 0) ++n;
     }
+    // GfinsCommandCounters, on every board at the table's 1000 samples.
+    if (rig.tap->samples()[i].seq % 1000 == 0) ++n;
   }
   return n;
 }

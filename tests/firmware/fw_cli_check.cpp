@@ -35,10 +35,11 @@ class FwCli : public test::CliTest {
 
 // The run's own start-up line: present only when the run got as far as starting.
 constexpr const char* kStarted = "sample loop running";
-// --check-config's bus line for the defaults: 902 frames/s (aiding off) x 135 worst-case bits
-// of an 8-byte base frame = 121,770 bit/s, 24.35 % of 500 kbit/s (docs/can-interface.md).
+// --check-config's bus line for the defaults: 903 frames/s (aiding off; the command counters at
+// 1 Hz included) x 135 worst-case bits of an 8-byte base frame = 121,905 bit/s, 24.38 % of
+// 500 kbit/s (docs/can-interface.md).
 constexpr const char* kDefaultLoadLine =
-    "gfins-fw: worst-case bus load 24.35 % of 500000 bit/s (limit 50 %)\n";
+    "gfins-fw: worst-case bus load 24.38 % of 500000 bit/s (limit 50 %)\n";
 
 TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
   struct Case {
@@ -55,9 +56,9 @@ TEST_F(FwCli, CheckConfigAndTheRunRefuseTheSameConfigurations) {
        "gfins-fw: built-in defaults + command line: sim.scenario = \"rest\": runs at 1000 Hz: "
        "adc.sample_rate_hz must be the same\n"},
       // The bus budget: the default dividers at 4 kHz send 3608 frames/s of 135 worst-case bits,
-      // 97.4 % of 500 kbit/s (docs/can-interface.md), over the default 50 %.
+      // 97.5 % of 500 kbit/s (docs/can-interface.md), over the default 50 %.
       {sim_run({"--sample-rate", "4000"}),
-       "gfins-fw: command line: output = a worst-case bus load of 97.4 % of 500000 bit/s at "
+       "gfins-fw: command line: output = a worst-case bus load of 97.5 % of 500000 bit/s at "
        "adc.sample_rate_hz = 4000: must be at most can.max_bus_load_percent = 50 %: raise the "
        "dividers of [output], switch messages off, or raise can.bit_rate\n"},
       {sim_run({}, "nosuchscenario"), ""},  // the loader's message, checked by prefix

@@ -60,6 +60,9 @@ class StallingSink final : public app::EpochSink {
     return n;
   }
   Status set_divider(std::size_t m, std::uint16_t d) override { return next_.set_divider(m, d); }
+  Status set_dividers(const std::array<std::uint16_t, app::kNumMessages>& d) override {
+    return next_.set_dividers(d);
+  }
 
  private:
   app::EpochSink& next_;

@@ -30,7 +30,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       "gfins-fw"};
   std::string config_file, board, spi, chip, line, can_if, can_log, compensator, calib, gravity,
       watchdog, wd_device, level, scenario, scenario_dir, pacing, hil_address, hil_port_file,
-      record, replay;
+      record, replay, settings_file;
   int hil_port = 0;
   double rate = 0, g = 0, lat = 0, height = 0, heading = 0, align = 0, duration = 0;
   std::vector<double> position;
@@ -65,6 +65,9 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   auto* o_log =
       app.add_option("--can-log", can_log, "can.log_file (candump log instead of an interface)");
   auto* o_node = app.add_option("--node-id", node, "can.node_id");
+  auto* o_settings = app.add_option(
+      "--settings-file", settings_file,
+      "can.settings_file: where settings changed over CAN are kept (\"\" = not kept)");
   auto* o_div = app.add_option("--divider", dividers,
                                "output.NAME = N (repeatable), NAME a message of [output]: epoch "
                                "status quaternion euler rate angular_accel accel velocity "
@@ -159,6 +162,10 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_can->count()) c.can_interface = can_if;
   if (o_log->count()) c.can_log = can_log;
   if (o_node->count()) c.node_id = node;
+  if (o_settings->count()) {
+    c.can_settings_file = settings_file;
+    c.can_settings_file_given = true;
+  }
   for (const std::string& d : dividers) {
     const auto eq = d.find('=');
     const int m = eq == std::string::npos ? -1 : message_index(d.substr(0, eq));
@@ -219,6 +226,10 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_dur->count()) c.sim_duration_s = duration;
   if (o_sdir->count()) c.sim_scenario_dir = scenario_dir;
 
+  // The simulated board keeps settings changed over CAN only where it is told to, never in the
+  // board's default place (a test run must not change the next run's node id).
+  if (c.board == BoardKind::kSim && !c.can_settings_file_given) c.can_settings_file.clear();
+
   // What the configuration is made of, for --check-config's verdict.
   std::size_t overrides = 0;
   for (const CLI::Option* o : app.get_options()) {
@@ -243,6 +254,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       {"record.file (--record)", c.record_file},
       {"sim.recording (--replay, read while the run writes)", c.sim_recording},
       {"calibration.file (--calibration, written by the calibrate command)", c.calibration_file},
+      {"can.settings_file (--settings-file, written when a command changes a setting)",
+       c.can_settings_file},
   };
   if (auto clash = drivers::lnx::output_clash(outputs)) {
     out.exit_code = 2;

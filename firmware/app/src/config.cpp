@@ -42,11 +42,14 @@ class Reader {
     throw ConfigError{m.str()};
   }
 
-  void text(const std::string& key, std::string& s) {
+  /// True when the key is in the file.
+  bool text(const std::string& key, std::string& s) {
     if (const toml::node* n = find(key)) {
       if (!n->is_string()) fail(key, n, "must be a string");
       s = n->value<std::string>().value_or("");
+      return true;
     }
+    return false;
   }
   void integer(const std::string& key, int& v, int lo, int hi) {
     if (const toml::node* n = find(key)) {
@@ -191,6 +194,7 @@ void read_all(Reader& r, FwConfig& c) {
   r.integer("can.node_id", c.node_id, 0, kMaxNodeId);
   r.integer("can.bit_rate", c.can_bit_rate, 1, 1000000);
   r.number("can.max_bus_load_percent", c.max_bus_load_percent);
+  if (r.text("can.settings_file", c.can_settings_file)) c.can_settings_file_given = true;
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     int d = c.dividers[m];
     r.integer("output." + std::string(kMessageNames[m]), d, 0, kMaxDivider);

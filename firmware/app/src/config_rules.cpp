@@ -200,6 +200,10 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
       return P{"aiding.gnss_lever_arm_m", num(l), "components must be finite, |x| <= 100 m"};
     }
   }
+  if (!c.can_settings_file.empty() && !valid_path(c.can_settings_file)) {
+    return P{"can.settings_file", quote_text(c.can_settings_file),
+             std::string(kPathRule) + " (or empty: settings changed over CAN are not kept)"};
+  }
   if (!c.calibration_file.empty() && !valid_path(c.calibration_file)) {
     return P{"calibration.file", quote_text(c.calibration_file),
              std::string(kPathRule) + " (or empty for none)"};

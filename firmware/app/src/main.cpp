@@ -17,6 +17,7 @@
 #include <string>
 
 #include "gfins/app/board.hpp"
+#include "gfins/app/can_settings.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
 #include "gfins/app/recorder.hpp"
@@ -52,10 +53,24 @@ long resident_kib() {
   return -1;
 }
 
-int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
+int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
         const std::string& latency_csv) {
   using namespace gfins::app;
   gfins::app::init_spdlog(cfg.log_level);
+  // Settings changed over CAN by an earlier run replace the configuration's node id and dividers
+  // (RestoreDefaults returns to the configuration's). Checked by the configuration's rules; a
+  // file that is not right is ignored and the bus says so (SettingsSource).
+  const CanSettings config_settings = settings_of(cfg);
+  const StartupSettings stored = load_stored_settings(cfg);
+  if (stored.source == SettingsSource::kStoredCorrupt) {
+    spdlog::error("{}", printable_text(stored.message));
+  } else if (!stored.message.empty()) {
+    spdlog::info("{}", printable_text(stored.message));
+  }
+  std::unique_ptr<SettingsWriter> settings_writer;
+  if (!cfg.can_settings_file.empty()) {
+    settings_writer = std::make_unique<SettingsWriter>(cfg.can_settings_file, stored.source);
+  }
   spdlog::info("gfins-fw: board {}, {} Hz, node {}, compensator {}", to_string(cfg.board),
                cfg.sample_rate_hz, cfg.node_id, to_string(cfg.compensator));
 
@@ -117,6 +132,7 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
   loop->set_commands(board.commands);
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);
+  loop->set_settings_port(settings_writer.get());
   // The service status line (systemd STATUS=): the loop leaves its mode and health counters on
   // the board each cycle; the reporter thread formats and sends them, never the loop.
   StatusBoard status_board;
@@ -126,7 +142,9 @@ int run(const gfins::app::BoardTable& boards, const gfins::app::FwConfig& cfg,
     status_reporter =
         std::make_unique<StatusReporter>(*board.watchdog, status_board, cfg.sample_rate_hz);
   }
-  if (const gfins::Status s = loop->configure(cal.set, loop_options(cfg)); !s.is_ok()) {
+  LoopOptions options = loop_options(cfg);
+  options.config_settings = config_settings;
+  if (const gfins::Status s = loop->configure(cal.set, options); !s.is_ok()) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;
   }
@@ -261,6 +279,11 @@ int main(int argc, char** argv) {
       print(stdout, load);
       if (const std::string note = gfins::app::calibration_note(*cli.config); !note.empty()) {
         print(stdout, "gfins-fw: note: " + note + "\n");
+      }
+      gfins::app::FwConfig with_stored = *cli.config;
+      if (const auto stored = gfins::app::load_stored_settings(with_stored);
+          !stored.message.empty()) {
+        print(stdout, "gfins-fw: note: " + stored.message + "\n");
       }
       return 0;
     }

@@ -14,11 +14,15 @@ can::Dividers bus_dividers(const FwConfig& c) {
   // (GfinsAccuracy 5 Hz, GfinsAidingCounters 2.5 Hz at 1 kHz), rounded up to a multiple of the
   // epoch divider as every message must be; without a filter they have nothing to say.
   const std::uint32_t epoch = std::max<std::uint32_t>(c.dividers[0], 1);
-  for (const can::MessageId id : {can::MessageId::kAccuracy, can::MessageId::kAidingCounters}) {
+  // The command counters (1 Hz at 1 kHz) go out on every board: they say where the CAN settings
+  // came from even when no command was sent.
+  for (const can::MessageId id : {can::MessageId::kAccuracy, can::MessageId::kAidingCounters,
+                                  can::MessageId::kCommandCounters}) {
     const std::uint32_t table = can::message(id).default_divider;
     const std::uint32_t div = (table + epoch - 1) / epoch * epoch;
+    const bool on = c.aiding || id == can::MessageId::kCommandCounters;
     d[static_cast<std::size_t>(id)] =
-        c.aiding ? static_cast<std::uint16_t>(std::min<std::uint32_t>(div, kMaxDivider)) : 0;
+        on ? static_cast<std::uint16_t>(std::min<std::uint32_t>(div, kMaxDivider)) : 0;
   }
   return d;
 }
@@ -44,6 +48,12 @@ std::uint32_t PublisherSink::publish(const can::Epoch& e) {
 Status PublisherSink::set_divider(std::size_t message, std::uint16_t divider) {
   if (message >= kNumMessages) return Status(ErrorCode::kOutOfRange, "no such data message");
   return publisher_.set_divider(static_cast<can::MessageId>(message), divider);
+}
+
+Status PublisherSink::set_dividers(const std::array<std::uint16_t, kNumMessages>& dividers) {
+  can::Dividers d = publisher_.dividers();
+  for (std::size_t m = 0; m < kNumMessages; ++m) d[m] = dividers[m];
+  return publisher_.set_dividers(d);
 }
 
 }  // namespace gfins::app

@@ -2,7 +2,7 @@
 
 namespace gfins::app {
 namespace {
-constexpr int kIdle = 0, kRequested = 1, kRunning = 2, kReady = 3, kFailed = 4;
+constexpr int kIdle = 0, kRequested = 1, kRunning = 2, kReady = 3, kFailed = 4, kOtherDevice = 5;
 }
 
 ReloadWorker::ReloadWorker(LoadFn load) : load_(std::move(load)), thread_([this] { run(); }) {}
@@ -19,10 +19,10 @@ ReloadWorker::~ReloadWorker() {
   thread_.join();
 }
 
-bool ReloadWorker::request(const nav::PipelineConfig<float>& current) {
+bool ReloadWorker::request(const ReloadRequest& r) {
   // try_lock: the worker holds the mutex only while copying, never during the load itself.
   if (state_.load() != kIdle || !mutex_.try_lock()) return false;
-  request_config_ = current;
+  request_ = r;
   state_.store(kRequested);
   wake_.notify_one();
   mutex_.unlock();
@@ -34,9 +34,9 @@ ReloadWorker::Poll ReloadWorker::poll(CalibrationSet& out) {
   // seq_cst here) and writes it again only after a new request, which only this side makes
   // after it has stored kIdle. So reading result_ after loading kReady needs no lock.
   const int s = state_.load();
-  if (s == kFailed) {
+  if (s == kFailed || s == kOtherDevice) {
     state_.store(kIdle);
-    return Poll::kFailed;
+    return s == kFailed ? Poll::kFailed : Poll::kOtherDevice;
   }
   if (s != kReady) return Poll::kNothing;
   out = result_;
@@ -58,15 +58,15 @@ void ReloadWorker::run() {
     wake_.wait(lock, [this] { return stop_ || state_.load() == kRequested; });
     if (stop_) return;
     state_.store(kRunning);
-    const nav::PipelineConfig<float> base = request_config_;
+    const ReloadRequest request = request_;
     lock.unlock();
-    std::optional<CalibrationSet> loaded = load_(base);
+    const ReloadOutcome loaded = load_(request);
     lock.lock();
-    if (loaded) {
-      result_ = *loaded;
+    if (loaded.set) {
+      result_ = *loaded.set;
       state_.store(kReady);
     } else {
-      state_.store(kFailed);
+      state_.store(loaded.other_device ? kOtherDevice : kFailed);
     }
     settled_.notify_all();
   }

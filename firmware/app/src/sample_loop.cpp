@@ -37,6 +37,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_ = cal;
   cal_.config = cfg;
   options_ = options;
+  settings_ = options.settings;
   inputs_ = can::InputDecoder(options.node_id);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
   adc_seen_ = adc_.counters();
@@ -92,6 +93,7 @@ SampleLoop::Cycle SampleLoop::step() {
 
   handle_commands(t_cycle_);
   poll_reload(t_cycle_);
+  offer_settings();
 
   // Overrun: this cycle's work ended after the next edge was due (that sample waits, and a
   // second overrun in a row loses it: the ADC overwrites its output buffer).
@@ -189,6 +191,7 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
   epoch_.health = bus_health(health_);
+  epoch_.commands = bus_command_counters(health_, settings_source());
   epoch_.valid = can::Validity::none();  // no sample behind this epoch
   epoch_.accuracy = epoch_accuracy(pipeline_, t_ns);
 }
@@ -379,6 +382,7 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
   epoch_.cal_id = cal_.cal_id;
   health_.log_dropped = log_.dropped();
   epoch_.health = bus_health(health_);
+  epoch_.commands = bus_command_counters(health_, settings_source());
   epoch_.valid = epoch_validity(pipeline_);
   epoch_.accuracy = epoch_accuracy(pipeline_, s.t_ns);
 }
@@ -406,10 +410,15 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
     CommandReply r;
     if (!d.ok()) {
       r.response = can::error_response(d.error);
-      ++health_.command_errors;
+      note_refusal(d.error.code);
       limited_log(LogKind::kCommandRejected, LogLevel::kWarn, t_ns,
                   "command frame id {:#x} rejected: result {} ({} more since the last line)",
                   f.value().id, static_cast<std::int64_t>(d.error.code));
+    } else if (!take_sequence(d.command, r)) {
+      limited_log(LogKind::kCommandRejected, LogLevel::kWarn, t_ns,
+                  "command {} refused as replayed: sequence {} is not above {} ({} more since "
+                  "the last line)",
+                  static_cast<std::int64_t>(d.command.opcode), d.command.sequence, last_sequence_);
     } else {
       execute(d.command, r);
       log(LogLevel::kInfo, t_ns, "command {} token {} -> result {}",
@@ -418,6 +427,62 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
     }
     if (!r.deferred) send_response(r.response);
   }
+}
+
+bool SampleLoop::take_sequence(const can::Command& c, CommandReply& r) {
+  if (!can::carries_sequence(c.opcode)) return true;
+  if (c.sequence > last_sequence_) {
+    last_sequence_ = c.sequence;
+    return true;
+  }
+  r = CommandReply{};
+  r.response = can::Response{static_cast<std::uint8_t>(c.opcode), c.token,
+                             can::ResultCode::kReplayed, last_sequence_};
+  note_refusal(can::ResultCode::kReplayed);
+  return false;
+}
+
+void SampleLoop::note_refusal(can::ResultCode why) {
+  ++health_.command_errors;
+  health_.last_refusal = static_cast<std::uint8_t>(why);
+  if (why == can::ResultCode::kReplayed) ++health_.commands_replayed;
+}
+
+std::uint8_t SampleLoop::settings_source() const {
+  return settings_port_ != nullptr ? settings_port_->source() : 0;
+}
+
+void SampleLoop::offer_settings() {
+  if (!settings_dirty_ || settings_port_ == nullptr) return;
+  if (settings_port_->post(settings_post_)) settings_dirty_ = false;
+}
+
+void SampleLoop::execute_settings(const can::Command& c, CommandReply& r) {
+  // Without a store a node id would be forgotten before it takes effect: refused.
+  if (settings_port_ == nullptr) {
+    r.response.result = can::ResultCode::kFailed;
+    return note_refusal(can::ResultCode::kFailed);
+  }
+  if (c.opcode == can::Opcode::kSetNodeId) {
+    if (c.node_id > can::kMaxNodeId) {
+      r.response.result = can::ResultCode::kOutOfRange;
+      return note_refusal(can::ResultCode::kOutOfRange);
+    }
+    settings_.node_id = c.node_id;
+    settings_post_ = settings_;
+  } else {
+    // The configuration's dividers at once; its node id from the next start.
+    if (!out_.set_dividers(options_.config_settings.dividers).is_ok()) {
+      r.response.result = can::ResultCode::kFailed;
+      return note_refusal(can::ResultCode::kFailed);
+    }
+    settings_ = options_.config_settings;
+    settings_post_.reset();
+  }
+  settings_dirty_ = true;
+  offer_settings();
+  r.response.value = settings_.node_id;
+  ++health_.commands;
 }
 
 void SampleLoop::note_alignment_refusal(std::int64_t t_ns) {
@@ -560,7 +625,7 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
   r.response.token = c.token;
   const auto reject = [&](ResultCode why) {
     r.response.result = why;
-    ++health_.command_errors;
+    note_refusal(why);
   };
   switch (c.opcode) {
     case can::Opcode::kRealign:
@@ -607,6 +672,16 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
                                                                 : ResultCode::kOutOfRange);
       }
       r.response.value = c.divider;
+      if (static_cast<std::size_t>(c.message) < kNumMessages) {
+        settings_.dividers[static_cast<std::size_t>(c.message)] = c.divider;
+        // The epoch divider moves the status divider with it (Publisher::set_divider).
+        if (c.message == can::MessageId::kEpoch) {
+          settings_.dividers[static_cast<std::size_t>(can::MessageId::kStatus)] = c.divider;
+        }
+        settings_post_ = settings_;
+        settings_dirty_ = true;
+        offer_settings();
+      }
       break;
     case can::Opcode::kReportCalibrationId:
       break;
@@ -623,11 +698,16 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
       break;
     case can::Opcode::kReloadCalibration:
       if (reload_ == nullptr) return reject(ResultCode::kFailed);
-      if (reload_pending_ || !reload_->request(cal_.config)) return reject(ResultCode::kBusy);
+      if (reload_pending_ || !reload_->request(ReloadRequest{cal_.config, c.forced})) {
+        return reject(ResultCode::kBusy);
+      }
       reload_pending_ = true;
       reload_token_ = c.token;
       r.deferred = true;  // answered when the worker is done (poll_reload)
       break;
+    case can::Opcode::kSetNodeId:
+    case can::Opcode::kRestoreDefaults:
+      return execute_settings(c, r);
     default:
       return reject(ResultCode::kUnknownOpcode);
   }
@@ -702,8 +782,9 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
       log(LogLevel::kInfo, t_ns, "calibration reloaded: id {:#x}", cal_.cal_id);
     }
   }
+  if (p == ReloadWorker::Poll::kOtherDevice) r.result = can::ResultCode::kOtherDevice;
   if (r.result != can::ResultCode::kOk) {
-    ++health_.command_errors;
+    note_refusal(r.result);
     log(LogLevel::kError, t_ns, "calibration reload failed; the previous calibration (id {}) stays",
         cal_.cal_id);
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "gfins/app/can_settings.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 
 namespace gfins::app {
@@ -75,6 +76,8 @@ LoopOptions loop_options(const FwConfig& c) {
   o.sample_rate_hz = c.sample_rate_hz;
   o.node_id = static_cast<std::uint8_t>(c.node_id);
   o.aiding_inputs = c.aiding && c.aiding_inputs;
+  o.settings = settings_of(c);
+  o.config_settings = o.settings;
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
   o.initial_position_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
@@ -166,39 +169,46 @@ ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
                                           std::optional<std::array<double, 6>> board_lsb,
                                           std::string device_in_use) {
   return [c, board_lsb, in_use = std::move(device_in_use)](
-             const nav::PipelineConfig<float>&) mutable -> std::optional<CalibrationSet> {
+             const ReloadRequest& request) mutable -> ReloadOutcome {
     if (c.calibration_file.empty()) {
       spdlog::error("calibration reload: no calibration file configured");
-      return std::nullopt;
+      return {};
     }
     auto loaded = calib_file::load_calibration_file(c.calibration_file);
     if (!loaded.is_ok()) {
       spdlog::error("calibration reload failed, the calibration in use stays: {}",
                     loaded.status().message());
-      return std::nullopt;
+      return {};
     }
     if (auto why = calibration_refusal(c, loaded.value(), board_lsb ? &*board_lsb : nullptr)) {
       spdlog::error("calibration reload refused, the calibration in use stays: {}: {}",
                     c.calibration_file, *why);
-      return std::nullopt;
+      return {};
     }
     // Another board's file at this path (copied over it, a mixed-up deployment) would scale and
-    // align every channel with that board's errors while the navigation runs: refused. A board on
-    // its nominal defaults takes its first calibration whatever its id.
+    // align every channel with that board's errors while the navigation runs: refused unless the
+    // command says it is meant (forced). A board on its nominal defaults takes its first
+    // calibration whatever its id.
     const std::string& id = loaded.value().device_id;
     if (!in_use.empty() && id != in_use) {
-      spdlog::error(
-          "calibration reload refused, the calibration in use stays: {}: device_id \"{}\" is not "
-          "this board's (\"{}\"); restart the board to change to another board's calibration",
-          c.calibration_file, printable_text(id), printable_text(in_use));
-      return std::nullopt;
+      if (!request.forced) {
+        spdlog::error(
+            "calibration reload refused, the calibration in use stays: {}: device_id \"{}\" is "
+            "not this board's (\"{}\"); send ReloadCalibration forced to take it",
+            c.calibration_file, printable_text(id), printable_text(in_use));
+        ReloadOutcome refused;
+        refused.other_device = true;
+        return refused;
+      }
+      spdlog::warn("calibration reload forced: {}: device_id \"{}\" replaces \"{}\"",
+                   c.calibration_file, printable_text(id), printable_text(in_use));
     }
     CalibrationSet s;
     s.config = pipeline_config(c, loaded.value());
     s.cal_id = calib_file::cal_id_of(loaded.value());
     s.calibrated = true;
     in_use = id;
-    return s;
+    return ReloadOutcome{s, false};
   };
 }
 

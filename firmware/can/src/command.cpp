@@ -103,6 +103,12 @@ DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id) {
       case Field::kCmdForced:
         c.forced = x != 0.0;
         break;
+      case Field::kCmdSequence:
+        c.sequence = static_cast<std::uint16_t>(x);
+        break;
+      case Field::kCmdNodeId:
+        c.node_id = static_cast<std::uint8_t>(x);
+        break;
       default:
         break;
     }
@@ -143,8 +149,17 @@ hal::CanFrame encode_command(const Command& c, std::uint8_t node_id) {
       p = insert_bits(p, sig(m, Field::kCmdPose), c.pose);
       p = insert_bits(p, sig(m, Field::kCmdSamples), c.samples);
       break;
+    case Opcode::kReloadCalibration:
+      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpReloadCalibration), c.forced ? 1u : 0u);
+      break;
+    case Opcode::kSetNodeId:
+      p = insert_bits(p, sig(m, Field::kCmdNodeId), c.node_id);
+      break;
     default:
       break;
+  }
+  if (carries_sequence(c.opcode)) {
+    p = insert_bits(p, sig(m, Field::kCmdSequence, 0, static_cast<std::int16_t>(op)), c.sequence);
   }
   set_payload(f, p);
   seal_frame(f);

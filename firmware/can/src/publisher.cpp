@@ -202,6 +202,16 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index) {
       return e.accuracy.aiding[index % kAidKindCount].rejected;
     case Field::kAidSinceAccepted:
       return static_cast<double>(e.accuracy.aiding[index % kAidKindCount].since_accepted_s);
+    case Field::kCmdAccepted:
+      return e.commands.done;
+    case Field::kCmdRefused:
+      return e.commands.refused;
+    case Field::kCmdReplayed:
+      return e.commands.replayed;
+    case Field::kCmdLastRefusal:
+      return e.commands.last_refusal;
+    case Field::kSettingsSource:
+      return e.commands.settings_source;
     default:
       return 0.0;
   }
@@ -304,6 +314,10 @@ Status Publisher::set_divider(MessageId m, std::uint16_t divider) {
   if (m == MessageId::kStatus) {
     return Status(ErrorCode::kInvalidArgument, "can: the Status divider follows the Epoch's");
   }
+  return set_dividers(d);
+}
+
+Status Publisher::set_dividers(const Dividers& d) {
   Status s = check_dividers(d);
   if (s.is_ok()) s = check_budget(d, budget_);
   if (s.is_ok()) dividers_ = d;

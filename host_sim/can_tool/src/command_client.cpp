@@ -132,4 +132,22 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
   return out;
 }
 
+CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
+                                         const CommandTimeouts& t, std::string* note) {
+  CommandOutcome out = run_command(bus, c, node_id, t);
+  if (!can::carries_sequence(c.opcode) || out.kind != CommandOutcome::Kind::kRejected ||
+      out.status.result != can::ResultCode::kReplayed ||
+      out.status.value >= static_cast<std::uint32_t>(can::kMaxSequence)) {
+    return out;
+  }
+  const auto taken = out.status.value;
+  c.sequence = static_cast<std::uint16_t>(taken + 1);
+  c.token = static_cast<std::uint8_t>(c.token + 1);
+  if (note != nullptr) {
+    *note = "the board had taken sequence number " + std::to_string(taken) + "; sent again with " +
+            std::to_string(c.sequence);
+  }
+  return run_command(bus, c, node_id, t);
+}
+
 }  // namespace gfins::can_tool

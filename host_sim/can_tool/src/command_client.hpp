@@ -30,4 +30,11 @@ struct CommandTimeouts {
 CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t node_id,
                            const CommandTimeouts& t);
 
+/// run_command for a command with a sequence number the sender does not track
+/// (docs/can-interface.md, "Sequence numbers"): sent with c.sequence; when the board answers
+/// Replayed, sent once more with the number after the one the board reported (and the next
+/// token). `note` receives a line saying so. Commands without a sequence number go as they are.
+CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
+                                         const CommandTimeouts& t, std::string* note);
+
 }  // namespace gfins::can_tool

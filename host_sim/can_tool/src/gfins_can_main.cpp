@@ -329,6 +329,7 @@ struct CmdOptions {
   int node = 0;
   int timeout_ms = 1000;
   int token = -1;
+  int sequence = -1;        // -1: 1, and the board's next one when it answers Replayed
   double rate_hz = 1000.0;  // the board's sample rate: sizes a capture's wait (N / rate + 5 s)
 };
 
@@ -368,7 +369,17 @@ int run_cmd(const CmdOptions& o, can::Command c) {
   CommandTimeouts t;
   t.response = std::chrono::milliseconds(o.timeout_ms);
   t.sample_rate_hz = o.rate_hz;
-  const CommandOutcome r = run_command(**bus, c, static_cast<std::uint8_t>(o.node), t);
+  const auto node = static_cast<std::uint8_t>(o.node);
+  CommandOutcome r;
+  if (o.sequence >= 0) {
+    c.sequence = static_cast<std::uint16_t>(o.sequence);
+    r = run_command(**bus, c, node, t);
+  } else {
+    c.sequence = 1;
+    std::string note;
+    r = run_command_next_sequence(**bus, c, node, t, &note);
+    if (!note.empty()) std::fprintf(stderr, "gfins-can cmd: %s\n", note.c_str());
+  }
   if (r.kind == CommandOutcome::Kind::kIncomplete) {
     // Missing statistics are not zeros: print none of them (gfins-can calibrate refuses such a
     // pose too, capture_sequence.cpp).
@@ -630,6 +641,10 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::Range(1, kMaxTimeoutMs))
       ->capture_default_str();
   cmd->add_option("--token", co.token, "token (default: random)")->check(CLI::Range(0, 255));
+  cmd->add_option("--sequence", co.sequence,
+                  "sequence number of a configuration-changing command (default: 1, then once "
+                  "more with the board's next one if it answers Replayed)")
+      ->check(CLI::Range(1, 65535));
   cmd->add_option("--rate", co.rate_hz,
                   "the board's sample rate, Hz (capture: wait N / rate + 5 s for the result)")
       ->check(CLI::Range(1.0, 100000.0))
@@ -670,13 +685,25 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::IsMember(data_names));
   div->add_option("divider", divider, "divider of the sample rate, 0 = off")
       ->required()
-      ->check(CLI::Range(0, 65535));
+      ->check(CLI::Range(0, int{can::kMaxDivider}));
   auto* calid = cmd->add_subcommand("cal-id", "report the calibration identity");
   int pose = 0, samples = 0;
   auto* capture = cmd->add_subcommand("capture", "start a calibration capture for pose k");
   capture->add_option("--pose", pose, "pose index k")->required()->check(CLI::Range(0, 63));
   capture->add_option("--samples", samples, "N samples")->required()->check(CLI::Range(1, 65535));
   auto* reload = cmd->add_subcommand("reload", "reload the calibration file");
+  bool reload_force = false;
+  reload->add_flag("--force", reload_force,
+                   "take the file even when its device_id is not the one of the calibration in "
+                   "use (refused as OtherDevice otherwise)");
+  int new_node = 0;
+  auto* node_id = cmd->add_subcommand(
+      "node-id", "set the node id the board takes at its next start (kept across restarts)");
+  node_id->add_option("id", new_node, "node id 0..15")->required()->check(CLI::Range(0, 15));
+  auto* restore = cmd->add_subcommand(
+      "restore-defaults",
+      "forget the settings kept across restarts: the configuration's dividers at once, its node "
+      "id from the next start");
 
   SequenceCliOptions so;
   auto* calibrate = app.add_subcommand(
@@ -863,6 +890,12 @@ int main_impl(int argc, char** argv) {
     c.samples = static_cast<std::uint16_t>(samples);
   } else if (reload->parsed()) {
     c.opcode = can::Opcode::kReloadCalibration;
+    c.forced = reload_force;
+  } else if (node_id->parsed()) {
+    c.opcode = can::Opcode::kSetNodeId;
+    c.node_id = static_cast<std::uint8_t>(new_node);
+  } else if (restore->parsed()) {
+    c.opcode = can::Opcode::kRestoreDefaults;
   }
   return run_cmd(co, c);
 }

@@ -68,6 +68,11 @@ struct FwConfig {
   int node_id = can::kDefaultNodeId;
   int can_bit_rate = static_cast<int>(can::kDefaultBitRate);  // bit/s of the bus (ip link's)
   double max_bus_load_percent = kDefaultMaxBusLoadPercent;    // the board's worst-case share
+  /// Where settings changed over CAN (node id, dividers) are kept across restarts; "" = not kept.
+  std::string can_settings_file = "/var/lib/gfins/can-settings.toml";
+  /// can.settings_file came from a configuration file or the command line (the simulated board
+  /// keeps settings only then, never in the board's default place).
+  bool can_settings_file_given = false;
 
   // [output]
   std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;

@@ -25,6 +25,9 @@ class RecordingSink final : public EpochSink {
   Status set_divider(std::size_t m, std::uint16_t d) override {
     return next_ != nullptr ? next_->set_divider(m, d) : Status::ok();
   }
+  Status set_dividers(const std::array<std::uint16_t, kNumMessages>& d) override {
+    return next_ != nullptr ? next_->set_dividers(d) : Status::ok();
+  }
   const std::vector<can::Epoch>& epochs() const { return epochs_; }
   std::uint64_t overflow() const { return overflow_; }
 
@@ -43,7 +46,10 @@ class CountingSink final : public EpochSink {
     return 0;
   }
   Status set_divider(std::size_t m, std::uint16_t) override {
-    return m < 14 ? Status::ok() : Status(ErrorCode::kOutOfRange, "no such message");
+    return m < kNumMessages ? Status::ok() : Status(ErrorCode::kOutOfRange, "no such message");
+  }
+  Status set_dividers(const std::array<std::uint16_t, kNumMessages>&) override {
+    return Status::ok();
   }
   const can::Epoch& last() const { return last_; }
   std::uint64_t count() const { return count_; }

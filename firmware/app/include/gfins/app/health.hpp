@@ -29,7 +29,9 @@ struct HealthCounters {
   std::uint32_t loop_overruns = 0;      // a cycle finished after the next edge was due
   std::uint32_t log_dropped = 0;        // log records lost to a full queue
   std::uint32_t commands = 0;           // commands executed
-  std::uint32_t command_errors = 0;     // commands rejected (malformed, out of range, busy)
+  std::uint32_t command_errors = 0;     // commands refused (malformed, out of range, busy, ...)
+  std::uint32_t commands_replayed = 0;  // of which refused for their sequence number
+  std::uint8_t last_refusal = 0;        // can::ResultCode of the last refusal; 0 = none yet
   std::uint32_t aiding_inputs = 0;      // GNSS fixes and headings decoded from input frames
   std::uint32_t aiding_input_errors = 0;  // input frames refused (CRC, length, range, stale id)
   std::uint32_t gravity_mismatches = 0;   // alignments whose |f| disagreed with the gravity model
@@ -57,6 +59,18 @@ inline can::Health bus_health(const HealthCounters& h) {
   c.bus_off_events = h.bus_off_events;
   c.loop_overruns = h.loop_overruns;
   c.log_dropped = h.log_dropped;
+  return c;
+}
+
+/// GfinsCommandCounters out of the loop's counters and the settings' source.
+inline can::CommandCounters bus_command_counters(const HealthCounters& h,
+                                                 std::uint8_t settings_source) {
+  can::CommandCounters c;
+  c.done = h.commands;
+  c.refused = h.command_errors;
+  c.replayed = h.commands_replayed;
+  c.last_refusal = h.last_refusal;
+  c.settings_source = settings_source;
   return c;
 }
 

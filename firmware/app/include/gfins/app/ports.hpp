@@ -7,8 +7,11 @@
 // failed at once, are its only sleeps).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 
+#include "gfins/app/config.hpp"
 #include "gfins/can/epoch.hpp"
 #include "gfins/sample/raw_sample.hpp"
 #include "gfins/status/status.hpp"
@@ -50,6 +53,29 @@ class EpochSink {
   virtual std::uint32_t publish(const can::Epoch& e) = 0;
   /// Divider of message `message` (index in kMessageNames); 0 = off.
   [[nodiscard]] virtual Status set_divider(std::size_t message, std::uint16_t divider) = 0;
+  /// Every divider of kMessageNames at once, under the same rules (nothing changes when refused).
+  [[nodiscard]] virtual Status set_dividers(
+      const std::array<std::uint16_t, kNumMessages>& dividers) = 0;
+};
+
+/// The CAN settings a command can change and the board keeps across restarts
+/// (docs/can-interface.md, "Stored settings"): the node id of the next start and the dividers.
+struct CanSettings {
+  std::uint8_t node_id = can::kDefaultNodeId;
+  std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;
+  friend bool operator==(const CanSettings&, const CanSettings&) = default;
+};
+
+/// Where the loop hands settings a command changed; the store writes them off the loop's thread.
+class SettingsPort {
+ public:
+  virtual ~SettingsPort() = default;
+  /// Loop side, never blocks: keep `s`, or with nullopt forget what is kept (the configuration's
+  /// settings apply from the next start). False when the writer cannot take it now (busy): the
+  /// loop offers it again next cycle.
+  virtual bool post(const std::optional<CanSettings>& s) = 0;
+  /// Where the settings in use came from: GfinsCommandCounters.SettingsSource.
+  virtual std::uint8_t source() const = 0;
 };
 
 }  // namespace gfins::app

@@ -24,6 +24,7 @@ class PublisherSink final : public EpochSink {
                 const can::BusBudget& budget = {});
   std::uint32_t publish(const can::Epoch& e) override;
   Status set_divider(std::size_t message, std::uint16_t divider) override;
+  Status set_dividers(const std::array<std::uint16_t, kNumMessages>& dividers) override;
   const can::Publisher& publisher() const { return publisher_; }
 
  private:

@@ -22,21 +22,34 @@ struct CalibrationSet {
   bool calibrated = false;
 };
 
+/// What a reload asks for: the loop's current configuration to start from, and whether a file of
+/// another device may replace the calibration in use (ReloadCalibration's ReloadForced).
+struct ReloadRequest {
+  nav::PipelineConfig<float> current{};
+  bool forced = false;
+};
+
+/// What a load made of the file: a new set, or nothing and why.
+struct ReloadOutcome {
+  std::optional<CalibrationSet> set;
+  bool other_device = false;  // refused: the file's device_id is not the one in use
+};
+
 class ReloadWorker {
  public:
-  /// `load` runs on the worker thread: a new set, or nullopt when the file is missing or bad
-  /// (it logs why). It is given the loop's current configuration to start from.
-  using LoadFn = std::function<std::optional<CalibrationSet>(const nav::PipelineConfig<float>&)>;
+  /// `load` runs on the worker thread: a new set, or none when the file is missing, bad or
+  /// another device's (it logs why).
+  using LoadFn = std::function<ReloadOutcome(const ReloadRequest&)>;
 
   explicit ReloadWorker(LoadFn load);
   ~ReloadWorker();
   ReloadWorker(const ReloadWorker&) = delete;
   ReloadWorker& operator=(const ReloadWorker&) = delete;
 
-  /// Loop side: starts a reload from `current`; false when one is already running.
-  bool request(const nav::PipelineConfig<float>& current);
+  /// Loop side: starts a reload; false when one is already running.
+  bool request(const ReloadRequest& r);
 
-  enum class Poll : std::uint8_t { kNothing, kReady, kFailed };
+  enum class Poll : std::uint8_t { kNothing, kReady, kFailed, kOtherDevice };
   /// Loop side, non-blocking: kReady copies the new set into `out`. The first poll after the
   /// worker finished sees the outcome (it takes no lock that the worker could be holding).
   Poll poll(CalibrationSet& out);
@@ -49,12 +62,12 @@ class ReloadWorker {
   void run();
 
   LoadFn load_;
-  std::mutex mutex_;  // guards request_config_ and the wake-up; the loop only ever try_locks it
+  std::mutex mutex_;  // guards request_ and the wake-up; the loop only ever try_locks it
   std::condition_variable wake_;     // worker: a request or stop arrived
   std::condition_variable settled_;  // wait_settled(): the worker finished a request
-  nav::PipelineConfig<float> request_config_{};
+  ReloadRequest request_{};
   CalibrationSet result_{};
-  std::atomic<int> state_{0};  // 0 idle, 1 requested, 2 running, 3 ready, 4 failed
+  std::atomic<int> state_{0};  // 0 idle, 1 requested, 2 running, 3 ready, 4 failed, 5 refused
   bool stop_ = false;
   std::thread thread_;
 };

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "gfins/app/health.hpp"
 #include "gfins/app/log_queue.hpp"
@@ -142,6 +143,10 @@ struct LoopOptions {
   std::uint8_t node_id =
       can::kDefaultNodeId;     // the input frames (GNSS, heading) addressed to this node
   bool aiding_inputs = false;  // decode them and offer them to the filter
+  /// The CAN settings in use at start (the stored ones when the board has them) and the
+  /// configuration's own, to which RestoreDefaults returns.
+  CanSettings settings{};
+  CanSettings config_settings{};
 };
 
 class SampleLoop {
@@ -154,6 +159,9 @@ class SampleLoop {
   void set_commands(bool on) { commands_ = on; }
   void set_watchdog(hal::Watchdog* wd) { watchdog_ = wd; }
   void set_reload_worker(ReloadWorker* w) { reload_ = w; }
+  /// Where settings changed by SetDivider, SetNodeId and RestoreDefaults are kept across
+  /// restarts. Null: they last until the board stops, and SetNodeId is refused.
+  void set_settings_port(SettingsPort* p) { settings_port_ = p; }
   /// Where each cycle leaves the mode and health for the service status line (read by another
   /// thread: service_status.hpp).
   void set_status_board(StatusBoard* b) { status_board_ = b; }
@@ -211,6 +219,16 @@ class SampleLoop {
   void capture_add(const RawSample& s, std::uint8_t rails);
   void capture_finish();
   void handle_commands(std::int64_t t_ns);
+  /// A configuration-changing command's sequence number against the last one taken: true (and
+  /// taken) when above it, else `r` is the Replayed refusal.
+  bool take_sequence(const can::Command& c, CommandReply& r);
+  /// Counts a refused command (the response carries `why`).
+  void note_refusal(can::ResultCode why);
+  /// SetNodeId / RestoreDefaults (execute's settings part).
+  void execute_settings(const can::Command& c, CommandReply& r);
+  /// Hands the settings in use to the store; retried each cycle until the store takes them.
+  void offer_settings();
+  std::uint8_t settings_source() const;
   void poll_reload(std::int64_t t_ns);
   /// The response frame, and the calibration identity after a report or reload that succeeded.
   void send_response(const can::Response& r);
@@ -259,6 +277,11 @@ class SampleLoop {
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;
   RecordQueue* recorder_ = nullptr;
+  SettingsPort* settings_port_ = nullptr;
+  CanSettings settings_{};                    // in use (node id: the one of the next start)
+  std::optional<CanSettings> settings_post_;  // what the store is to keep (nullopt: forget)
+  bool settings_dirty_ = false;               // settings_post_ not yet taken by the store
+  std::uint16_t last_sequence_ = 0;           // the last sequence number taken this session
 
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};

@@ -49,11 +49,12 @@ StartupCalibration load_calibration(const FwConfig& c, const calib_file::Calibra
 /// bias and misalignment, no compensation.
 calib_file::CalibrationData nominal_calibration(double volts_per_count);
 
-/// The ReloadWorker's loader for the configured file: a new set on success; logs and nullopt on
+/// The ReloadWorker's loader for the configured file: a new set on success; logs and no set on
 /// failure (the calibration in use stays). With `board_lsb` (the board's converter, from
 /// converter_lsb(defaults)) a file of another converter setting is such a failure too. With
-/// `device_in_use` (StartupCalibration::device_id) a file of another device_id is refused; a
-/// board on its nominal defaults ("") takes the first file, whose id is then the one in use.
+/// `device_in_use` (StartupCalibration::device_id) a file of another device_id is refused
+/// (ReloadOutcome::other_device) unless the request is forced; a board on its nominal defaults
+/// ("") takes the first file, whose id is then the one in use.
 ReloadWorker::LoadFn calibration_reloader(const FwConfig& c,
                                           std::optional<std::array<double, 6>> board_lsb = {},
                                           std::string device_in_use = {});

@@ -22,7 +22,15 @@ enum class Opcode : std::uint8_t {
   kReportCalibrationId = kOpReportCalibrationId,
   kStartCapture = kOpStartCapture,            // calibration capture for pose k with N samples
   kReloadCalibration = kOpReloadCalibration,  // reload the calibration file
+  kSetNodeId = kOpSetNodeId,                  // the node id of the next start (stored)
+  kRestoreDefaults = kOpRestoreDefaults,      // forget the stored CAN settings
 };
+
+/// The opcodes that change the board's state or settings carry a sequence number (Command::
+/// sequence) that must exceed the last one the board took in this session.
+constexpr bool carries_sequence(Opcode op) {
+  return op != Opcode::kReportCalibrationId && op != Opcode::kStartCapture;
+}
 
 /// Result byte of a response (VAL_ table "Result" in the DBC).
 enum class ResultCode : std::uint8_t {
@@ -36,8 +44,10 @@ enum class ResultCode : std::uint8_t {
   kFailed = 7,     // valid command, execution failed (e.g. calibration file unreadable)
   // 8 was "NotReady" in the first drafts of the ICD; no command depends on the mode (every one
   // is valid while aligning or navigating), so it is not a result the board gives.
-  kMoving = 9,    // re-align or reset refused: the board is moving (send it forced to insist)
-  kBusLoad = 10,  // SetDivider refused: the worst-case bus load would exceed the board's budget
+  kMoving = 9,        // re-align or reset refused: the board is moving (send it forced to insist)
+  kBusLoad = 10,      // SetDivider refused: the worst-case bus load would exceed the board's budget
+  kReplayed = 11,     // the sequence number is not above the last one taken (Value = that one)
+  kOtherDevice = 12,  // ReloadCalibration refused: the file is another board's (send it forced)
 };
 
 const char* to_string(ResultCode r);
@@ -52,7 +62,10 @@ struct Command {
   std::uint16_t divider = 0;                                       // kSetDivider, 0 = off
   std::uint8_t pose = 0;                                           // kStartCapture: k
   std::uint16_t samples = 0;                                       // kStartCapture: N >= 1
-  bool forced = false;  // kRealign, kResetNavigation: carry it out even while moving
+  bool forced = false;         // kRealign, kResetNavigation: carry it out even while moving;
+                               // kReloadCalibration: take another board's file
+  std::uint16_t sequence = 0;  // carries_sequence(opcode): 1..65535, above the last one taken
+  std::uint8_t node_id = 0;    // kSetNodeId: 0..kMaxNodeId
 };
 
 struct CommandError {

@@ -124,6 +124,16 @@ struct Accuracy {
   std::array<AidCounter, kAidKindCount> aiding{};  // index = AidKind
 };
 
+/// GfinsCommandCounters: what became of the commands received and where the CAN settings came
+/// from. The counts only grow (sent modulo 2^16, 2^8).
+struct CommandCounters {
+  std::uint32_t done = 0;            // commands carried out
+  std::uint32_t refused = 0;         // commands refused, each answered with its Result
+  std::uint32_t replayed = 0;        // of which refused as Replayed
+  std::uint8_t last_refusal = 0;     // ResultCode of the last refusal; 0 = none yet
+  std::uint8_t settings_source = 0;  // kSettingsSourceValues of message_table.hpp
+};
+
 /// One sample's worth of what may be published. Every value refers to nav.t_ns, the sampling
 /// instant (data-ready edge) of sample nav.seq.
 struct Epoch {
@@ -135,6 +145,7 @@ struct Epoch {
   Health health;
   Validity valid;  // per navigation group; an invalid group is sent as not available
   Accuracy accuracy;
+  CommandCounters commands;
 };
 
 }  // namespace gfins::can

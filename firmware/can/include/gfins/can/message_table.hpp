@@ -80,6 +80,14 @@ enum class Field : std::uint8_t {
   kCmdPose,
   kCmdSamples,
   kCmdForced,
+  kCmdSequence,  // configuration-changing commands: must exceed the last one of the session
+  kCmdNodeId,
+  // command counters and settings (GfinsCommandCounters)
+  kCmdAccepted,
+  kCmdRefused,
+  kCmdReplayed,
+  kCmdLastRefusal,
+  kSettingsSource,
   // aiding inputs (GNSS receiver / heading source -> board)
   kInGnssPos,  // index 0 N, 1 E, 2 D
   kInGnssVel,
@@ -167,8 +175,9 @@ enum class MessageId : std::uint8_t {
   kGnssVelocity,
   kGnssFixInfo,
   kHeadingInput,
+  kCommandCounters,
 };
-inline constexpr std::size_t kMessageCount = 23;
+inline constexpr std::size_t kMessageCount = 24;
 
 /// kInput: aiding measurements sent to the board (GNSS, heading), same framing as data frames
 /// (counter in bits 52..55 = the fix's sequence id, CRC in byte 7), decoded by aiding_input.hpp.
@@ -195,18 +204,20 @@ inline constexpr std::array<ValueName, 6> kModeValues{{{0, "Startup"},
                                                        {4, "Fault"},
                                                        {5, "Replay"}}};
 
-inline constexpr std::array<ValueName, 7> kOpcodeValues{{{1, "Realign"},
+inline constexpr std::array<ValueName, 9> kOpcodeValues{{{1, "Realign"},
                                                          {2, "ResetNavigation"},
                                                          {3, "SetCompensator"},
                                                          {4, "SetDivider"},
                                                          {5, "ReportCalibrationId"},
                                                          {6, "StartCapture"},
-                                                         {7, "ReloadCalibration"}}};
+                                                         {7, "ReloadCalibration"},
+                                                         {8, "SetNodeId"},
+                                                         {9, "RestoreDefaults"}}};
 
 inline constexpr std::array<ValueName, 3> kCompensatorValues{
     {{0, "None"}, {1, "Paper"}, {2, "Exact"}}};
 
-inline constexpr std::array<ValueName, 10> kResultValues{{{0, "Ok"},
+inline constexpr std::array<ValueName, 12> kResultValues{{{0, "Ok"},
                                                           {1, "UnknownOpcode"},
                                                           {2, "BadLength"},
                                                           {3, "BadCrc"},
@@ -215,7 +226,13 @@ inline constexpr std::array<ValueName, 10> kResultValues{{{0, "Ok"},
                                                           {6, "Busy"},
                                                           {7, "Failed"},
                                                           {9, "Moving"},
-                                                          {10, "BusLoad"}}};
+                                                          {10, "BusLoad"},
+                                                          {11, "Replayed"},
+                                                          {12, "OtherDevice"}}};
+
+/// Where the board's CAN settings (node id, dividers) came from (GfinsCommandCounters).
+inline constexpr std::array<ValueName, 4> kSettingsSourceValues{
+    {{0, "Configuration"}, {1, "Stored"}, {2, "StoredCorrupt"}, {3, "SaveFailed"}}};
 
 inline constexpr std::array<ValueName, 18> kMessageIdValues{{{0, "Epoch"},
                                                              {1, "Status"},
@@ -694,14 +711,31 @@ inline constexpr std::uint8_t kOpReportCalibrationId = 5;
 inline constexpr std::uint8_t kOpStartCapture = 6;
 inline constexpr std::uint8_t kOpReloadCalibration = 7;
 inline constexpr std::uint8_t kMaxCapturePose = 63;
+inline constexpr std::uint8_t kOpSetNodeId = 8;
+inline constexpr std::uint8_t kOpRestoreDefaults = 9;
+/// Configuration-changing commands carry a sequence number in bits 40..55: it must exceed the
+/// last one the board took in this session (0 at start-up), so a frame replayed from a log is
+/// refused (docs/can-interface.md, "Sequence numbers").
+inline constexpr std::uint8_t kSequenceStartBit = 40;
+inline constexpr std::uint8_t kSequenceLength = 16;
+inline constexpr double kMaxSequence = 65535.0;
 
-inline constexpr std::array<SignalDef, 11> kCommandSignals{{
+constexpr SignalDef sequence_signal(std::string_view name, std::int16_t op) {
+  return unsigned_int(name, Field::kCmdSequence, 0, kSequenceStartBit, kSequenceLength,
+                      kMaxSequence, op, {}, kAtCommand,
+                      "Sequence number: must exceed the last one the board took since it "
+                      "started (every command carrying one takes it, refused or not); a lower "
+                      "or equal one is refused as Replayed",
+                      1.0);
+}
+
+inline constexpr std::array<SignalDef, 20> kCommandSignals{{
     SignalDef{.name = "Opcode",
               .field = Field::kCmdOpcode,
               .start_bit = 0,
               .length = 8,
               .min = 1.0,
-              .max = 7.0,
+              .max = 9.0,
               .mux = kMultiplexor,
               .values = kOpcodeValues,
               .instant = kAtCommand,
@@ -740,6 +774,19 @@ inline constexpr std::array<SignalDef, 11> kCommandSignals{{
                  kAtCommand, "StartCapture: pose index k"),
     unsigned_int("CaptureSamples", Field::kCmdSamples, 0, 24, 16, 65535.0, kOpStartCapture, {},
                  kAtCommand, "StartCapture: number of samples N", 1.0),
+    unsigned_int("ReloadForced", Field::kCmdForced, 0, 16, 1, 1.0, kOpReloadCalibration, {},
+                 kAtCommand,
+                 "ReloadCalibration: 1 = take the file even when its device_id is not the one "
+                 "of the calibration in use (else refused as OtherDevice)"),
+    unsigned_int("NodeId", Field::kCmdNodeId, 0, 16, 8, double{kMaxNodeId}, kOpSetNodeId, {},
+                 kAtCommand, "SetNodeId: the node id the board takes at its next start"),
+    sequence_signal("RealignSequence", kOpRealign),
+    sequence_signal("ResetSequence", kOpResetNavigation),
+    sequence_signal("CompensatorSequence", kOpSetCompensator),
+    sequence_signal("DividerSequence", kOpSetDivider),
+    sequence_signal("ReloadSequence", kOpReloadCalibration),
+    sequence_signal("NodeIdSequence", kOpSetNodeId),
+    sequence_signal("RestoreSequence", kOpRestoreDefaults),
     crc_signal(),
 }};
 
@@ -802,8 +849,10 @@ inline constexpr std::array<SignalDef, 39> kResponseSignals{{
                          "0x30+c count and flags of channel c+1"},
     unsigned_int("Result", Field::kRspResult, 0, 24, 8, 255.0, kPartStatus, kResultValues,
                  kAtResponse, "Outcome of the command"),
-    unsigned_int("Value", Field::kRspValue, 0, 32, 24, 16777215.0, kPartStatus, {}, kAtResponse,
-                 "Command-specific: the new divider, the accepted N, the failing message id"),
+    unsigned_int(
+        "Value", Field::kRspValue, 0, 32, 24, 16777215.0, kPartStatus, {}, kAtResponse,
+        "Command-specific: the new divider, the accepted N, the new node id; for Replayed the "
+        "last sequence number the board took"),
     unsigned_int("CalId", Field::kRspCalId, 0, 24, 32, 4294967295.0, kPartCalibrationId, {},
                  kAtResponse, "Identity of the calibration in use (0 = nominal)"),
     unsigned_int("DonePose", Field::kRspPose, 0, 24, 8, 255.0, kPartCaptureDone, {}, kOverCapture,
@@ -819,6 +868,27 @@ inline constexpr std::array<SignalDef, 39> kResponseSignals{{
     crc_signal(),
 }};
 #undef GFINS_CAN_CHANNEL_SIGNALS
+
+// Commands and settings (board -> host): what became of the commands received, and where the
+// CAN settings in use came from.
+inline constexpr std::array<SignalDef, 7> kCommandCountersSignals{{
+    wrapping("CommandsDone", Field::kCmdAccepted, 0, 16, "", kCumulative,
+             "Commands carried out, mod 2^16"),
+    wrapping("CommandsRefused", Field::kCmdRefused, 16, 16, "", kCumulative,
+             "Commands refused (each answered with its Result), mod 2^16"),
+    wrapping("ReplaysRefused", Field::kCmdReplayed, 32, 8, "", kCumulative,
+             "Commands refused as Replayed (sequence number not above the last), mod 2^8"),
+    unsigned_int("LastRefusal", Field::kCmdLastRefusal, 0, 40, 8, 255.0, kNotMultiplexed,
+                 kResultValues, kAtSample, "Result of the last refused command (0 = none yet)"),
+    unsigned_int("SettingsSource", Field::kSettingsSource, 0, 48, 2, 3.0, kNotMultiplexed,
+                 kSettingsSourceValues, kAtSample,
+                 "Where the CAN settings in use came from: 0 the configuration (nothing "
+                 "stored), 1 the stored settings, 2 the configuration because the stored "
+                 "settings were unreadable or corrupt, 3 a change could not be stored (in use "
+                 "until the board restarts)"),
+    counter_signal(),
+    crc_signal(),
+}};
 
 // ---------------------------------------------------------------------------------------------
 // The table. Order = MessageId order = transmission order within an epoch.
@@ -873,6 +943,9 @@ inline constexpr std::array<MessageDef, kMessageCount> kMessages{{
      "GNSS fix, frame 4 of 4 (completes the fix): velocity 1 sigma, age, content"},
     {"GfinsHeadingInput", MessageId::kHeadingInput, 0x0B0, MessageKind::kInput, 0,
      kHeadingInputSignals, "GNSS", "External heading for the filter"},
+    {"GfinsCommandCounters", MessageId::kCommandCounters, 0x200, MessageKind::kData, 1000,
+     kCommandCountersSignals, "GFINS",
+     "Commands carried out and refused, the last refusal, where the CAN settings came from"},
 }};
 
 constexpr const MessageDef& message(MessageId id) {

@@ -102,6 +102,8 @@ class Publisher {
   /// (kInvalidArgument / kOutOfRange otherwise) and within the budget (kResourceExhausted);
   /// nothing changes when refused.
   [[nodiscard]] Status set_divider(MessageId m, std::uint16_t divider);
+  /// Replaces every divider at once under the same rules; nothing changes when refused.
+  [[nodiscard]] Status set_dividers(const Dividers& d);
 
   std::uint16_t divider(MessageId m) const { return dividers_[static_cast<std::size_t>(m)]; }
   const Dividers& dividers() const { return dividers_; }

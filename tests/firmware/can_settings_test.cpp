@@ -1,0 +1,374 @@
+// CAN settings kept across restarts (docs/can-interface.md, "Stored settings"): the file's text
+// and checksum against a hand-written FNV-1a, every kind of damage refused with file, line and
+// key, the start-up fallback and its flag, the commands that change and forget the settings on
+// the simulated board, a failed save flagged on the bus, and a restart of the real program.
+#include "gfins/app/can_settings.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "gfins/can/command.hpp"
+#include "sim_rig.hpp"
+#include "support/temp_dir.hpp"
+#ifdef GFINS_FW_EXE
+#include "support/run_cli.hpp"
+#endif
+
+namespace gfins::app {
+namespace {
+
+using gfins::testing::SimRig;
+
+// The [output] keys in the ICD's order (docs/firmware.md), written out here.
+constexpr const char* kKeys[14] = {"epoch",      "status",       "quaternion",    "euler",
+                                   "rate",       "angular_accel", "accel",        "velocity",
+                                   "position_ne", "position_d",  "health_adc",    "health_system",
+                                   "sensors_a",  "sensors_b"};
+
+// FNV-1a 64 (Fowler/Noll/Vo: offset basis 0xcbf29ce484222325, prime 0x100000001b3), written here
+// rather than taken from the project's header.
+std::uint64_t fnv(const std::string& s) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (const char ch : s) {
+    h ^= static_cast<unsigned char>(ch);
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+// The checksum the ICD defines for node id `node` and dividers `d`: FNV-1a of the lines
+// "format_version=1", "node_id=N", "output.NAME=D" in the table's order, each ending in '\n'.
+std::string checksum_of(int node, const std::array<std::uint16_t, 14>& d) {
+  std::string canonical = "format_version=1\nnode_id=" + std::to_string(node) + "\n";
+  for (std::size_t m = 0; m < 14; ++m) {
+    canonical += "output." + std::string(kKeys[m]) + "=" + std::to_string(d[m]) + "\n";
+  }
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "fnv1a64:%016llx", static_cast<unsigned long long>(fnv(canonical)));
+  return buf;
+}
+
+// A settings file as a person would write it from the ICD, with the checksum given.
+std::string file_text(int node, const std::array<std::uint16_t, 14>& d, const std::string& sum,
+                      int version = 1, const std::string& extra = "") {
+  std::ostringstream o;
+  o << "format_version = " << version << "\nnode_id = " << node << "\n" << extra << "[output]\n";
+  for (std::size_t m = 0; m < 14; ++m) o << kKeys[m] << " = " << d[m] << "\n";
+  o << "[integrity]\nchecksum = '" << sum << "'\n";
+  return o.str();
+}
+
+constexpr std::array<std::uint16_t, 14> kDefaults = {10, 10, 10, 20, 10, 20,   10,
+                                                     10, 10, 10, 1000, 1000, 0, 0};
+
+TEST(CanSettingsFile, TextRoundTripsAndTheChecksumIsFnv1a64OfTheCanonicalLines) {
+  CanSettings s;
+  s.node_id = 5;
+  s.dividers = kDefaults;
+  s.dividers[3] = 40;
+  const std::string text = settings_text(s);
+  std::array<std::uint16_t, 14> d = kDefaults;
+  d[3] = 40;
+  EXPECT_NE(text.find("checksum = '" + checksum_of(5, d) + "'"), std::string::npos) << text;
+  const SettingsParse p = parse_settings(text, "s.toml", FwConfig{});
+  ASSERT_TRUE(p.settings) << p.error;
+  EXPECT_EQ(*p.settings, s);
+  // A file written from the ICD by hand (other layout, same values) reads the same.
+  const SettingsParse q = parse_settings(file_text(5, d, checksum_of(5, d)), "h.toml", FwConfig{});
+  ASSERT_TRUE(q.settings) << q.error;
+  EXPECT_EQ(*q.settings, s);
+}
+
+TEST(CanSettingsFile, EveryDamageIsRefusedWithFileLineAndKey) {
+  std::array<std::uint16_t, 14> euler15 = kDefaults;
+  euler15[3] = 15;  // not a multiple of the epoch divider
+  std::array<std::uint16_t, 14> edited = kDefaults;
+  edited[3] = 40;
+  const std::string good_sum = checksum_of(1, kDefaults);
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string expect;
+  };
+  const Case cases[] = {
+      {"a divider edited, checksum not", file_text(1, edited, good_sum),
+       "h.toml:19: integrity.checksum"},
+      {"node id edited", file_text(2, kDefaults, good_sum), "the file was changed or damaged"},
+      {"another version", file_text(1, kDefaults, good_sum, 2),
+       "h.toml:1: format_version = 2: this build reads version 1"},
+      {"a key the version does not have", file_text(1, kDefaults, good_sum, 1, "profile = 1\n"),
+       "h.toml:3: unknown key \"profile\""},
+      {"node id out of range", file_text(16, kDefaults, checksum_of(16, kDefaults)),
+       "h.toml:2: node_id must be an integer 0..15"},
+      {"no checksum", "format_version = 1\nnode_id = 1\n", "output.epoch is missing"},
+      {"TOML syntax", "format_version = \n", "h.toml:1: TOML syntax"},
+      {"checksum right, rules broken", file_text(1, euler15, checksum_of(1, euler15)),
+       "breaks the configuration's rules"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const SettingsParse p = parse_settings(c.text, "h.toml", FwConfig{});
+    EXPECT_FALSE(p.settings);
+    EXPECT_NE(p.error.find(c.expect), std::string::npos) << p.error;
+  }
+  // The same file is valid or not with the configuration it meets: the defaults at 4 kHz exceed
+  // the 50 % bus budget (docs/can-interface.md).
+  FwConfig fast;
+  fast.sample_rate_hz = 4000.0;
+  const SettingsParse p = parse_settings(file_text(1, kDefaults, good_sum), "h.toml", fast);
+  EXPECT_FALSE(p.settings);
+  EXPECT_NE(p.error.find("bus load"), std::string::npos) << p.error;
+}
+
+TEST(CanSettingsFile, StartUpUsesAValidFileAndFallsBackWithAFlag) {
+  gfins::testing::TempDir dir("gfins-settings");
+  FwConfig c;
+  c.can_settings_file.clear();
+  EXPECT_EQ(load_stored_settings(c).source, SettingsSource::kConfiguration);
+  EXPECT_TRUE(load_stored_settings(c).message.empty()) << "nothing configured, nothing to say";
+  c.can_settings_file = (dir.path() / "can.toml").string();
+  StartupSettings s = load_stored_settings(c);
+  EXPECT_EQ(s.source, SettingsSource::kConfiguration);
+  EXPECT_NE(s.message.find("nothing stored yet"), std::string::npos) << s.message;
+  std::array<std::uint16_t, 14> d = kDefaults;
+  d[3] = 40;
+  gfins::testing::write_text(dir.path() / "can.toml", file_text(7, d, checksum_of(7, d)));
+  FwConfig applied = c;
+  s = load_stored_settings(applied);
+  EXPECT_EQ(s.source, SettingsSource::kStored);
+  EXPECT_EQ(applied.node_id, 7);
+  EXPECT_EQ(applied.dividers[3], 40);
+  // One byte off: the configuration's settings, the flag, and a message naming file and key.
+  gfins::testing::write_text(dir.path() / "can.toml", file_text(7, d, checksum_of(7, kDefaults)));
+  FwConfig fallback = c;
+  s = load_stored_settings(fallback);
+  EXPECT_EQ(s.source, SettingsSource::kStoredCorrupt);
+  EXPECT_EQ(fallback.node_id, c.node_id);
+  EXPECT_EQ(fallback.dividers, c.dividers);
+  EXPECT_NE(s.message.find("can.toml:19: integrity.checksum"), std::string::npos) << s.message;
+  // A folder where the file should be: unreadable, flagged alike.
+  std::filesystem::remove(dir.path() / "can.toml");
+  std::filesystem::create_directory(dir.path() / "can.toml");
+  s = load_stored_settings(fallback);
+  EXPECT_EQ(s.source, SettingsSource::kStoredCorrupt);
+  EXPECT_NE(s.message.find("can.toml"), std::string::npos) << s.message;
+}
+
+// ---- On the simulated board ---------------------------------------------------------------
+
+std::uint16_t g_sequence = 0;
+
+can::Command numbered(can::Opcode op) {
+  can::Command c;
+  c.opcode = op;
+  c.token = 0x70;
+  c.sequence = ++g_sequence;
+  return c;
+}
+
+// Sends `c`, runs two cycles, returns the status response's result (or -1 without one).
+int send(SimRig& rig, const can::Command& c, std::uint32_t* value = nullptr) {
+  rig.bus->clear_sent();
+  EXPECT_TRUE(rig.bus->inject_rx(can::encode_command(c, SimRig::kNode)));
+  rig.run_cycles(2);
+  for (const hal::CanFrame& f : rig.bus->sent()) {
+    const auto r = can::decode_response(f);
+    if (r.is_ok() && r->part == can::kPartStatus) {
+      if (value != nullptr) *value = r->value;
+      return static_cast<int>(r->result);
+    }
+  }
+  return -1;
+}
+
+// Frames with identifier `id` in the next `cycles` samples, and the last one's byte 6.
+std::size_t frames(SimRig& rig, std::uint32_t id, std::uint32_t cycles, int* byte6 = nullptr) {
+  rig.bus->clear_sent();
+  rig.run_cycles(cycles);
+  std::size_t n = 0;
+  for (const hal::CanFrame& f : rig.bus->sent()) {
+    if (f.id != id) continue;
+    ++n;
+    if (byte6 != nullptr) *byte6 = f.data[6];
+  }
+  return n;
+}
+
+SettingsParse read_back(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return parse_settings(s.str(), p.string(), FwConfig{});
+}
+
+TEST(StoredSettings, CommandsAreKeptAndRestoreDefaultsForgetsThem) {
+  gfins::testing::TempDir dir("gfins-settings");
+  const std::filesystem::path file = dir.path() / "can.toml";
+  SimRig rig("rest", 8.0);
+  SettingsWriter writer(file.string(), SettingsSource::kConfiguration);
+  rig.loop->set_settings_port(&writer);
+  rig.configure();
+  rig.run_cycles(1500);
+  // GfinsCommandCounters (0x200 + node) byte 6, bits 0-1: where the settings came from.
+  constexpr std::uint32_t kCounters = 0x200 + SimRig::kNode;
+  int byte6 = -1;
+  ASSERT_EQ(frames(rig, kCounters, 1000, &byte6), 1u);
+  EXPECT_EQ(byte6 & 3, 0) << "Configuration";
+
+  can::Command div = numbered(can::Opcode::kSetDivider);
+  div.message = can::MessageId::kEuler;
+  div.divider = 40;
+  ASSERT_EQ(send(rig, div), 0);
+  writer.wait_settled();
+  SettingsParse kept = read_back(file);
+  ASSERT_TRUE(kept.settings) << kept.error;
+  EXPECT_EQ(kept.settings->dividers[3], 40);
+  EXPECT_EQ(kept.settings->node_id, SimRig::kNode);
+  EXPECT_EQ(frames(rig, kCounters, 1000, &byte6), 1u);
+  EXPECT_EQ(byte6 & 3, 1) << "Stored";
+
+  can::Command node = numbered(can::Opcode::kSetNodeId);
+  node.node_id = 5;
+  std::uint32_t value = 0;
+  ASSERT_EQ(send(rig, node, &value), 0);
+  EXPECT_EQ(value, 5u);
+  writer.wait_settled();
+  kept = read_back(file);
+  ASSERT_TRUE(kept.settings) << kept.error;
+  EXPECT_EQ(kept.settings->node_id, 5);
+  EXPECT_EQ(kept.settings->dividers[3], 40) << "the divider stays";
+  // The node id changes at the next start: this run still speaks as node 1.
+  EXPECT_EQ(frames(rig, 0x100 + SimRig::kNode, 100), 10u);
+  EXPECT_EQ(frames(rig, 0x100 + 5, 100), 0u);
+  EXPECT_EQ(frames(rig, 0x130 + SimRig::kNode, 400), 10u) << "Euler every 40 samples";
+
+  ASSERT_EQ(send(rig, numbered(can::Opcode::kRestoreDefaults), &value), 0);
+  EXPECT_EQ(value, SimRig::kNode) << "the configuration's node id from the next start";
+  writer.wait_settled();
+  EXPECT_FALSE(std::filesystem::exists(file));
+  EXPECT_EQ(frames(rig, 0x130 + SimRig::kNode, 400), 20u) << "Euler every 20 samples again";
+  EXPECT_EQ(frames(rig, kCounters, 1000, &byte6), 1u);
+  EXPECT_EQ(byte6 & 3, 0) << "Configuration";
+  EXPECT_EQ(rig.loop->health().command_errors, 0u);
+}
+
+TEST(StoredSettings, WithoutAStoreSetNodeIdIsRefusedAndASaveThatFailsIsFlagged) {
+  SimRig rig("rest", 5.0);
+  rig.configure();
+  rig.run_cycles(1500);
+  can::Command node = numbered(can::Opcode::kSetNodeId);
+  node.node_id = 3;
+  EXPECT_EQ(send(rig, node), 7) << "Failed: a node id that would be forgotten";
+  EXPECT_EQ(rig.loop->health().last_refusal, 7);
+
+  gfins::testing::TempDir dir("gfins-settings");
+  SimRig other("rest", 5.0);
+  // A folder that does not exist: the atomic save cannot create its temporary file.
+  SettingsWriter writer((dir.path() / "missing" / "can.toml").string(),
+                        SettingsSource::kConfiguration);
+  other.loop->set_settings_port(&writer);
+  other.configure();
+  other.run_cycles(1500);
+  can::Command div = numbered(can::Opcode::kSetDivider);
+  div.message = can::MessageId::kEuler;
+  div.divider = 40;
+  ASSERT_EQ(send(other, div), 0) << "the divider is in use";
+  writer.wait_settled();
+  int byte6 = -1;
+  ASSERT_EQ(frames(other, 0x200 + SimRig::kNode, 1000, &byte6), 1u);
+  EXPECT_EQ(byte6 & 3, 3) << "SaveFailed";
+  EXPECT_EQ(frames(other, 0x130 + SimRig::kNode, 400), 10u);
+}
+
+#ifdef GFINS_FW_EXE
+// Node id 5 and Euler every 40 samples set by commands on the in-process board, then gfins-fw
+// started on that file: its CAN log speaks as node 5 at the stored rates and says "Stored". A
+// damaged file gives the configuration's node and "StoredCorrupt", and the run goes on.
+TEST(StoredSettings, SurviveARestartOfTheProgram) {
+  gfins::testing::TempDir dir("gfins-settings");
+  const std::string file = (dir.path() / "can.toml").string();
+  {
+    SimRig rig("rest", 5.0);
+    SettingsWriter writer(file, SettingsSource::kConfiguration);
+    rig.loop->set_settings_port(&writer);
+    rig.configure();
+    rig.run_cycles(1500);
+    can::Command node = numbered(can::Opcode::kSetNodeId);
+    node.node_id = 5;
+    ASSERT_EQ(send(rig, node), 0);
+    can::Command div = numbered(can::Opcode::kSetDivider);
+    div.message = can::MessageId::kEuler;
+    div.divider = 40;
+    ASSERT_EQ(send(rig, div), 0);
+    writer.wait_settled();
+  }
+  // Frames per identifier of a candump log "(t) iface ID#DATA", and the last frame's data.
+  const auto count = [](const std::string& log, std::map<std::uint32_t, std::string>* last) {
+    std::map<std::uint32_t, int> n;
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) {
+      const auto hash = line.find('#');
+      const auto sp = line.rfind(' ', hash);
+      if (hash == std::string::npos || sp == std::string::npos) continue;
+      const auto id = static_cast<std::uint32_t>(std::stoul(line.substr(sp + 1, hash - sp - 1), nullptr, 16));
+      ++n[id];
+      if (last != nullptr) (*last)[id] = line.substr(hash + 1);
+    }
+    return n;
+  };
+  const auto run = [&](const std::string& log) {
+    return test::run_tool(GFINS_FW_EXE,
+                          {"--sim", "rest", "--calibration", "", "--duration", "2",
+                           "--scenario-dir", GFINS_SCENARIO_DIR, "--settings-file", file,
+                           "--can-log", log},
+                          dir.path());
+  };
+  const std::string log = (dir.path() / "stored.log").string();
+  const test::CliResult r = run(log);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("stored CAN settings from"), std::string::npos) << r.err;
+  std::map<std::uint32_t, std::string> last;
+  std::map<std::uint32_t, int> n = count(log, &last);
+  EXPECT_EQ(n[0x101], 0) << "node 1 no more";
+  EXPECT_EQ(n[0x105], 201) << "epochs of node 5: 2 s at 1 kHz, divider 10, seq 0..2000";
+  EXPECT_EQ(n[0x135], 51) << "Euler every 40 samples";
+  ASSERT_EQ(last.count(0x205), 1u);
+  // Data as 16 hex digits: byte 6 is characters 12-13; bits 0-1 = 1, Stored.
+  EXPECT_EQ(std::stoi(last[0x205].substr(12, 2), nullptr, 16) & 3, 1) << last[0x205];
+
+  // The file damaged (a divider changed by hand): the configuration's node 1, flagged, run on.
+  {
+    std::ifstream in(file);
+    std::stringstream s;
+    s << in.rdbuf();
+    std::string text = s.str();
+    const auto at = text.find("euler = 40");
+    ASSERT_NE(at, std::string::npos) << text;
+    text.replace(at, 10, "euler = 80");
+    gfins::testing::write_text(file, text);
+  }
+  const std::string log2 = (dir.path() / "corrupt.log").string();
+  const test::CliResult r2 = run(log2);
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  EXPECT_NE(r2.err.find("stored CAN settings ignored"), std::string::npos) << r2.err;
+  EXPECT_NE(r2.err.find("integrity.checksum"), std::string::npos) << r2.err;
+  last.clear();
+  n = count(log2, &last);
+  EXPECT_EQ(n[0x105], 0);
+  EXPECT_EQ(n[0x101], 201);
+  EXPECT_EQ(n[0x131], 101) << "Euler at the configuration's divider 20";
+  ASSERT_EQ(last.count(0x201), 1u);
+  EXPECT_EQ(std::stoi(last[0x201].substr(12, 2), nullptr, 16) & 3, 2) << "StoredCorrupt";
+}
+#endif
+
+}  // namespace
+}  // namespace gfins::app
