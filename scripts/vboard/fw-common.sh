@@ -6,17 +6,20 @@ fw_scenarios=/opt/share/gfins/scenarios
 # The configuration at the VM's rate, on the gpio-sim chip of this boot (idempotent).
 sed -i "s/^sample_rate_hz = .*/sample_rate_hz = $rate.0/; s/^gpio_chip = .*/gpio_chip = \"$gpiochip\"/" $fw_cfg
 
-# fw_start LOG: starts gfins-fw in the background (fw_pid) and waits up to 20 s for its loop.
+# fw_start LOG [OPTION...]: starts gfins-fw in the background (fw_pid), with the options after the
+# configuration's, and waits up to 20 s for its loop.
 fw_start() {
-  gfins-fw --config $fw_cfg --scenario-dir $fw_scenarios >"$1" 2>&1 &
+  fw_log=$1
+  shift
+  gfins-fw --config $fw_cfg --scenario-dir $fw_scenarios "$@" >"$fw_log" 2>&1 &
   fw_pid=$!
   i=0
-  while [ $i -lt 200 ] && ! grep -q 'sample loop running' "$1"; do
+  while [ $i -lt 200 ] && ! grep -q 'sample loop running' "$fw_log"; do
     kill -0 $fw_pid 2>/dev/null || return 1
     sleep 0.1
     i=$((i + 1))
   done
-  grep -q 'sample loop running' "$1"
+  grep -q 'sample loop running' "$fw_log"
 }
 # fw_stop: SIGTERM, then its exit status in fw_rc.
 fw_stop() {
