@@ -13,7 +13,11 @@
 . /vboard/fw-common.sh
 drdy-toggle "$pull" "$rate" >/tmp/cmd-toggle.log &
 toggle_pid=$!
-fw_start /tmp/cmd-fw.log
+# Settings set by commands (node id, dividers) are kept here across restarts of gfins-fw: the
+# simulated board keeps them only in a file named with --settings-file.
+settings=/tmp/gfins-can-settings.toml
+rm -f $settings
+fw_start /tmp/cmd-fw.log --settings-file $settings
 check cmd-fw-start "gfins-fw runs on vcan0 with data-ready edges" [ $? -eq 0 ]
 # Past the 1 s alignment (navigation.alignment_s): commands like realign need the navigating mode.
 sleep 2
@@ -102,7 +106,6 @@ raw_cmd bad-crc 0242000000000000 03  # ResetNavigation with a wrong CRC byte
 # Stored settings (docs/can-interface.md, "Stored settings"): the divider set above is in the
 # settings file; a node id set by command is taken at the next start of gfins-fw, and
 # RestoreDefaults gives the configuration's node id back at the start after that.
-settings=/tmp/gfins-can-settings.toml
 check cmd-settings-divider "settings file after the divider command: $(grep -c '^euler = 20$' $settings 2>/dev/null) line 'euler = 20'" \
   grep -q '^euler = 20$' $settings
 cmd_ok node-id node-id 2
@@ -114,7 +117,7 @@ epochs_of() {
   grep -c " vcan0 $1#" "$2"
 }
 fw_stop
-fw_start /tmp/cmd-fw-restart.log
+fw_start /tmp/cmd-fw-restart.log --settings-file $settings
 check cmd-settings-restart "gfins-fw started again on the stored settings" [ $? -eq 0 ]
 n2=$(epochs_of 102 /tmp/cmd-restart.log)
 n1=$(grep -c ' vcan0 101#' /tmp/cmd-restart.log)
@@ -125,7 +128,7 @@ rc=$?
 left=$([ -e $settings ] && echo present || echo removed)
 check cmd-settings-restore "restore-defaults exit $rc, settings file $left" [ $rc -eq 0 -a "$left" = removed ]
 fw_stop
-fw_start /tmp/cmd-fw-defaults.log
+fw_start /tmp/cmd-fw-defaults.log --settings-file $settings
 check cmd-settings-defaults-start "gfins-fw started again on the configuration" [ $? -eq 0 ]
 n1=$(epochs_of 101 /tmp/cmd-defaults.log)
 check cmd-settings-defaults "after RestoreDefaults and a restart, 1 s: $n1 epochs of node 1" [ "$n1" -gt 0 ]

@@ -24,6 +24,8 @@ class BoardBus final : public hal::CanBus {
   // The board's replay rule (docs/can-interface.md, "Sequence numbers"), written from the ICD:
   // a configuration-changing command must carry a number above the last one taken.
   std::uint16_t last_sequence = 0;
+  // Another host that takes the next number right after the board answered a query.
+  bool race = false;
   // Capture result parts (docs/can-interface.md, "Response parts") the bus loses.
   std::vector<std::uint8_t> lose_parts;
 
@@ -59,7 +61,12 @@ class BoardBus final : public hal::CanBus {
     if (numbered) last_sequence = c.sequence;
     switch (c.opcode) {
       case can::Opcode::kReportCalibrationId:
+        // Status part first, Value = the last sequence number taken (docs/can-interface.md),
+        // then the calibration id.
+        rx_.push_back(
+            can::encode_response({op, c.token, can::ResultCode::kOk, last_sequence}, kNode));
         rx_.push_back(can::encode_calibration_id_response(c.token, 0x1234ABCD, kNode));
+        if (race) last_sequence = static_cast<std::uint16_t>(last_sequence + 1);
         break;
       case can::Opcode::kStartCapture: {
         rx_.push_back(can::encode_response({op, c.token, can::ResultCode::kOk, c.samples}, kNode));
@@ -123,43 +130,51 @@ TEST(CommandClient, EveryCommandGetsItsResponse) {
   }
 }
 
-// gfins-can cmd without --sequence: sent with 1; a board that has taken numbers answers
-// Replayed with its last one, and the client sends once more with the next (and the next token).
-TEST(CommandClient, WithoutASequenceTheClientTakesTheBoardsNextNumberOnce) {
+// gfins-can cmd without --sequence: the board's last number is read first (ReportCalibrationId's
+// status Value) and the command sent with the next, so no frame is refused as a replay; should
+// another host take that number in between, the command goes once more with the next.
+TEST(CommandClient, WithoutASequenceTheClientAsksTheBoardForItsLastNumber) {
   BoardBus bus;
   bus.last_sequence = 41;
   can::Command c;
   c.opcode = can::Opcode::kSetCompensator;
   c.token = 20;
-  c.sequence = 1;
   std::string note;
   CommandOutcome r = run_command_next_sequence(bus, c, kNode, short_timeouts(), &note);
   EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
-  EXPECT_EQ(r.status.token, 21);
+  EXPECT_EQ(r.status.token, 20);
   EXPECT_EQ(bus.last_sequence, 42);
-  EXPECT_EQ(bus.sent, 2);
-  EXPECT_NE(note.find("41"), std::string::npos) << note;
-  // A fresh board takes 1 at once: one frame, no note.
-  BoardBus fresh;
-  note.clear();
-  r = run_command_next_sequence(fresh, c, kNode, short_timeouts(), &note);
+  EXPECT_EQ(bus.sent, 2) << "the query and the command";
+  EXPECT_NE(note.find("sequence number 42 (the board's last was 41)"), std::string::npos) << note;
+  // Another host took 42 meanwhile: Replayed, then 43 with the next token.
+  BoardBus raced;
+  raced.last_sequence = 41;
+  raced.race = true;
+  r = run_command_next_sequence(raced, c, kNode, short_timeouts(), &note);
   EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
-  EXPECT_EQ(fresh.sent, 1);
-  EXPECT_TRUE(note.empty());
-  // A board at the last number refuses: there is no next one (the board must restart).
+  EXPECT_EQ(r.status.token, 21);
+  EXPECT_EQ(raced.last_sequence, 43);
+  EXPECT_EQ(raced.sent, 3);
+  // A board at the last number: nothing is sent after the query, and the text says why.
   BoardBus full;
   full.last_sequence = 65535;
   r = run_command_next_sequence(full, c, kNode, short_timeouts(), &note);
   EXPECT_EQ(r.kind, CommandOutcome::Kind::kRejected);
   EXPECT_EQ(full.sent, 1);
-  // A command without a number is never repeated.
+  EXPECT_NE(r.text.find("restart"), std::string::npos) << r.text;
+  // A command without a number goes as it is.
   BoardBus quiet;
-  quiet.last_sequence = 9;
   can::Command id;
   id.opcode = can::Opcode::kReportCalibrationId;
   r = run_command_next_sequence(quiet, id, kNode, short_timeouts(), &note);
   EXPECT_EQ(r.kind, CommandOutcome::Kind::kOk) << r.text;
   EXPECT_EQ(quiet.sent, 1);
+  // No board: the query times out and nothing else is sent.
+  BoardBus silent;
+  silent.answer = false;
+  r = run_command_next_sequence(silent, c, kNode, short_timeouts(), &note);
+  EXPECT_NE(r.kind, CommandOutcome::Kind::kOk);
+  EXPECT_EQ(silent.sent, 1);
 }
 
 TEST(CommandClient, CalibrationIdAndCapture) {

@@ -243,3 +243,32 @@ TEST(FileParameterStore, PathsThatNameNoFileAreRefusedAtOpen) {
 
 }  // namespace
 }  // namespace gfins::drivers::lnx
+
+namespace gfins::drivers::lnx {
+namespace {
+
+// remove_file_durably: a regular file goes (its folder synced), nothing there is fine, anything
+// else at the path is refused and left, and a failed folder sync is reported with its errno.
+TEST(RemoveFileDurably, RemovesARegularFileRefusesAnythingElseAndReportsAFailedSync) {
+  const gfins::testing::TempDir dir("gfins-remove");
+  const std::filesystem::path file = dir.path() / "can.toml";
+  gfins::testing::write_text(file, "x = 1\n");
+  EXPECT_TRUE(remove_file_durably(file.string()).is_ok());
+  EXPECT_FALSE(std::filesystem::exists(file));
+  EXPECT_TRUE(remove_file_durably(file.string()).is_ok()) << "nothing there";
+  std::filesystem::create_directory(file);
+  const Status folder = remove_file_durably(file.string());
+  EXPECT_EQ(folder.code(), ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(std::filesystem::is_directory(file)) << "left as it was";
+  std::filesystem::remove(file);
+  gfins::testing::write_text(file, "x = 1\n");
+  // The folder's fsync fails (FailingOs at kSyncDir fails every fsync but a save's temporary's).
+  testing::FailingOs os(SaveStep::kSyncDir, EIO);
+  const Status sync = remove_file_durably(file.string(), os);
+  EXPECT_EQ(sync.code(), ErrorCode::kIoError);
+  EXPECT_EQ(sync.os_error(), EIO);
+  EXPECT_THAT(std::string(sync.message()), ::testing::HasSubstr("fsync of the folder"));
+}
+
+}  // namespace
+}  // namespace gfins::drivers::lnx

@@ -373,6 +373,7 @@ TEST_F(CanCommands, ReloadGoodFileThenBadFileKeepsTheLastGood) {
 TEST_F(CanCommands, ReloadOfAnotherBoardsFileIsRefusedUnlessForced) {
   const std::uint32_t before = rig_->loop->cal_id();
   const std::uint32_t refused = rig_->loop->health().command_errors;
+  const std::uint32_t done = rig_->loop->health().commands;
   calib_file::CalibrationData other = rig_->factory;
   other.device_id = "other-board-9";
   other.sensors[1].bias_g += 2e-5;  // another board: another calibration id
@@ -384,9 +385,11 @@ TEST_F(CanCommands, ReloadOfAnotherBoardsFileIsRefusedUnlessForced) {
   EXPECT_TRUE(rig_->loop->calibrated());
   EXPECT_EQ(rig_->loop->health().command_errors, refused + 1);
   EXPECT_EQ(rig_->loop->health().last_refusal, 12);
+  EXPECT_EQ(rig_->loop->health().commands, done) << "a refused reload is not also done";
   r = reload(22, true);
   ASSERT_NE(part(r, 0), nullptr);
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+  EXPECT_EQ(rig_->loop->health().commands, done + 1);
   EXPECT_EQ(rig_->loop->cal_id(), calib_file::cal_id_of(other));
 }
 
@@ -432,10 +435,12 @@ TEST_F(CanCommands, AReplayedCommandIsRefusedAndCounted) {
   EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOutOfRange);
   r = round_trip(can::encode_command(bad, SimRig::kNode));
   EXPECT_EQ(static_cast<int>(part(r, 0)->result), 11);
-  // Commands that change nothing carry no number and are never replays.
+  // Commands that change nothing carry no number and are never replays; ReportCalibrationId's
+  // status Value is the last number taken, for a host that does not track them.
   for (int i = 0; i < 2; ++i) {
     r = round_trip(can::encode_command(cmd(can::Opcode::kReportCalibrationId, 25), SimRig::kNode));
     EXPECT_EQ(part(r, 0)->result, can::ResultCode::kOk);
+    EXPECT_EQ(part(r, 0)->value, 600u);
   }
   // The next number is taken.
   c.sequence = 601;

@@ -5,6 +5,7 @@
 #include "gfins/app/can_settings.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/can/command.hpp"
 #include "sim_rig.hpp"
 #include "support/temp_dir.hpp"
@@ -27,10 +29,10 @@ namespace {
 using gfins::testing::SimRig;
 
 // The [output] keys in the ICD's order (docs/firmware.md), written out here.
-constexpr const char* kKeys[14] = {"epoch",      "status",       "quaternion",    "euler",
-                                   "rate",       "angular_accel", "accel",        "velocity",
-                                   "position_ne", "position_d",  "health_adc",    "health_system",
-                                   "sensors_a",  "sensors_b"};
+constexpr const char* kKeys[14] = {"epoch",       "status",        "quaternion", "euler",
+                                   "rate",        "angular_accel", "accel",      "velocity",
+                                   "position_ne", "position_d",    "health_adc", "health_system",
+                                   "sensors_a",   "sensors_b"};
 
 // FNV-1a 64 (Fowler/Noll/Vo: offset basis 0xcbf29ce484222325, prime 0x100000001b3), written here
 // rather than taken from the project's header.
@@ -43,73 +45,98 @@ std::uint64_t fnv(const std::string& s) {
   return h;
 }
 
-// The checksum the ICD defines for node id `node` and dividers `d`: FNV-1a of the lines
-// "format_version=1", "node_id=N", "output.NAME=D" in the table's order, each ending in '\n'.
-std::string checksum_of(int node, const std::array<std::uint16_t, 14>& d) {
-  std::string canonical = "format_version=1\nnode_id=" + std::to_string(node) + "\n";
-  for (std::size_t m = 0; m < 14; ++m) {
-    canonical += "output." + std::string(kKeys[m]) + "=" + std::to_string(d[m]) + "\n";
+// What a test stores: a node id (or none, -1) and the dividers set (name -> value).
+struct Stored {
+  int node = -1;
+  std::map<std::string, int> dividers;
+};
+
+// The checksum the ICD defines: FNV-1a of the lines "format_version=1", "node_id=N" (when
+// stored) and "output.NAME=D" for each divider stored, in the table's order, each ending in '\n'.
+std::string checksum_of(const Stored& st) {
+  std::string canonical = "format_version=1\n";
+  if (st.node >= 0) canonical += "node_id=" + std::to_string(st.node) + "\n";
+  for (const char* key : kKeys) {
+    const auto it = st.dividers.find(key);
+    if (it != st.dividers.end()) {
+      canonical += "output." + std::string(key) + "=" + std::to_string(it->second) + "\n";
+    }
   }
   char buf[40];
-  std::snprintf(buf, sizeof buf, "fnv1a64:%016llx", static_cast<unsigned long long>(fnv(canonical)));
+  std::snprintf(buf, sizeof buf, "fnv1a64:%016llx",
+                static_cast<unsigned long long>(fnv(canonical)));
   return buf;
 }
 
-// A settings file as a person would write it from the ICD, with the checksum given.
-std::string file_text(int node, const std::array<std::uint16_t, 14>& d, const std::string& sum,
-                      int version = 1, const std::string& extra = "") {
+// A settings file as a person would write it from the ICD (dividers in the map's order, which is
+// not the table's), with the checksum given.
+std::string file_text(const Stored& st, const std::string& sum, int version = 1,
+                      const std::string& extra = "") {
   std::ostringstream o;
-  o << "format_version = " << version << "\nnode_id = " << node << "\n" << extra << "[output]\n";
-  for (std::size_t m = 0; m < 14; ++m) o << kKeys[m] << " = " << d[m] << "\n";
+  o << "format_version = " << version << "\n";
+  if (st.node >= 0) o << "node_id = " << st.node << "\n";
+  o << extra << "[output]\n";
+  for (const auto& [key, value] : st.dividers) o << key << " = " << value << "\n";
   o << "[integrity]\nchecksum = '" << sum << "'\n";
   return o.str();
 }
 
-constexpr std::array<std::uint16_t, 14> kDefaults = {10, 10, 10, 20, 10, 20,   10,
-                                                     10, 10, 10, 1000, 1000, 0, 0};
+CanSettings settings(const Stored& st) {
+  CanSettings s;
+  if (st.node >= 0) s.node_id = static_cast<std::uint8_t>(st.node);
+  for (std::size_t m = 0; m < 14; ++m) {
+    const auto it = st.dividers.find(kKeys[m]);
+    if (it != st.dividers.end()) s.dividers[m] = static_cast<std::uint16_t>(it->second);
+  }
+  return s;
+}
 
 TEST(CanSettingsFile, TextRoundTripsAndTheChecksumIsFnv1a64OfTheCanonicalLines) {
-  CanSettings s;
-  s.node_id = 5;
-  s.dividers = kDefaults;
-  s.dividers[3] = 40;
-  const std::string text = settings_text(s);
-  std::array<std::uint16_t, 14> d = kDefaults;
-  d[3] = 40;
-  EXPECT_NE(text.find("checksum = '" + checksum_of(5, d) + "'"), std::string::npos) << text;
+  const Stored st{5, {{"euler", 40}, {"accel", 20}}};
+  const std::string text = settings_text(settings(st));
+  EXPECT_NE(text.find("checksum = '" + checksum_of(st) + "'"), std::string::npos) << text;
+  EXPECT_EQ(text.find("epoch ="), std::string::npos) << "only what a command set is stored";
   const SettingsParse p = parse_settings(text, "s.toml", FwConfig{});
   ASSERT_TRUE(p.settings) << p.error;
-  EXPECT_EQ(*p.settings, s);
+  EXPECT_EQ(*p.settings, settings(st));
   // A file written from the ICD by hand (other layout, same values) reads the same.
-  const SettingsParse q = parse_settings(file_text(5, d, checksum_of(5, d)), "h.toml", FwConfig{});
+  const SettingsParse q = parse_settings(file_text(st, checksum_of(st)), "h.toml", FwConfig{});
   ASSERT_TRUE(q.settings) << q.error;
-  EXPECT_EQ(*q.settings, s);
+  EXPECT_EQ(*q.settings, settings(st));
+  // Nothing but a divider, no node id: valid too.
+  const Stored only{-1, {{"euler", 40}}};
+  const SettingsParse r = parse_settings(file_text(only, checksum_of(only)), "o.toml", FwConfig{});
+  ASSERT_TRUE(r.settings) << r.error;
+  EXPECT_FALSE(r.settings->node_id);
 }
 
 TEST(CanSettingsFile, EveryDamageIsRefusedWithFileLineAndKey) {
-  std::array<std::uint16_t, 14> euler15 = kDefaults;
-  euler15[3] = 15;  // not a multiple of the epoch divider
-  std::array<std::uint16_t, 14> edited = kDefaults;
-  edited[3] = 40;
-  const std::string good_sum = checksum_of(1, kDefaults);
+  const Stored good{1, {{"euler", 40}}};
+  const std::string good_sum = checksum_of(good);
+  const Stored edited{1, {{"euler", 80}}};
+  const Stored euler15{1, {{"euler", 15}}};  // not a multiple of the configuration's epoch 10
   struct Case {
     const char* what;
     std::string text;
     std::string expect;
   };
   const Case cases[] = {
-      {"a divider edited, checksum not", file_text(1, edited, good_sum),
-       "h.toml:19: integrity.checksum"},
-      {"node id edited", file_text(2, kDefaults, good_sum), "the file was changed or damaged"},
-      {"another version", file_text(1, kDefaults, good_sum, 2),
+      {"a divider edited, checksum not", file_text(edited, good_sum),
+       "h.toml:6: integrity.checksum"},
+      {"node id edited", file_text(Stored{2, good.dividers}, good_sum),
+       "the file was changed or damaged"},
+      {"a key added", file_text(Stored{1, {{"euler", 40}, {"accel", 20}}}, good_sum),
+       "the file was changed or damaged"},
+      {"another version", file_text(good, good_sum, 2),
        "h.toml:1: format_version = 2: this build reads version 1"},
-      {"a key the version does not have", file_text(1, kDefaults, good_sum, 1, "profile = 1\n"),
+      {"a key the version does not have", file_text(good, good_sum, 1, "profile = 1\n"),
        "h.toml:3: unknown key \"profile\""},
-      {"node id out of range", file_text(16, kDefaults, checksum_of(16, kDefaults)),
+      {"an unknown message", file_text(Stored{1, {{"eulr", 40}}}, good_sum), "unknown key output."},
+      {"node id out of range", file_text(Stored{16, {}}, checksum_of(Stored{16, {}})),
        "h.toml:2: node_id must be an integer 0..15"},
-      {"no checksum", "format_version = 1\nnode_id = 1\n", "output.epoch is missing"},
+      {"no checksum", "format_version = 1\nnode_id = 1\n", "integrity.checksum is missing"},
       {"TOML syntax", "format_version = \n", "h.toml:1: TOML syntax"},
-      {"checksum right, rules broken", file_text(1, euler15, checksum_of(1, euler15)),
+      {"checksum right, rules broken", file_text(euler15, checksum_of(euler15)),
        "breaks the configuration's rules"},
   };
   for (const Case& c : cases) {
@@ -118,47 +145,69 @@ TEST(CanSettingsFile, EveryDamageIsRefusedWithFileLineAndKey) {
     EXPECT_FALSE(p.settings);
     EXPECT_NE(p.error.find(c.expect), std::string::npos) << p.error;
   }
-  // The same file is valid or not with the configuration it meets: the defaults at 4 kHz exceed
-  // the 50 % bus budget (docs/can-interface.md).
+  // The same file is valid or not with the configuration it meets: at 4 kHz the default
+  // dividers exceed the 50 % bus budget (docs/can-interface.md), and a stored euler = 40 does
+  // not bring them back under it.
   FwConfig fast;
   fast.sample_rate_hz = 4000.0;
-  const SettingsParse p = parse_settings(file_text(1, kDefaults, good_sum), "h.toml", fast);
+  const SettingsParse p = parse_settings(file_text(good, good_sum), "h.toml", fast);
   EXPECT_FALSE(p.settings);
   EXPECT_NE(p.error.find("bus load"), std::string::npos) << p.error;
 }
 
-TEST(CanSettingsFile, StartUpUsesAValidFileAndFallsBackWithAFlag) {
+TEST(CanSettingsFile, StartUpUsesAValidFileTheCommandLineWinsAndDamageFallsBackWithAFlag) {
   gfins::testing::TempDir dir("gfins-settings");
+  const std::filesystem::path file = dir.path() / "can.toml";
   FwConfig c;
   c.can_settings_file.clear();
   EXPECT_EQ(load_stored_settings(c).source, SettingsSource::kConfiguration);
   EXPECT_TRUE(load_stored_settings(c).message.empty()) << "nothing configured, nothing to say";
-  c.can_settings_file = (dir.path() / "can.toml").string();
+  c.can_settings_file = file.string();
   StartupSettings s = load_stored_settings(c);
   EXPECT_EQ(s.source, SettingsSource::kConfiguration);
   EXPECT_NE(s.message.find("nothing stored yet"), std::string::npos) << s.message;
-  std::array<std::uint16_t, 14> d = kDefaults;
-  d[3] = 40;
-  gfins::testing::write_text(dir.path() / "can.toml", file_text(7, d, checksum_of(7, d)));
+  const Stored st{7, {{"euler", 40}}};
+  gfins::testing::write_text(file, file_text(st, checksum_of(st)));
   FwConfig applied = c;
+  applied.dividers[4] = 20;  // rate: the configuration's, not stored
   s = load_stored_settings(applied);
   EXPECT_EQ(s.source, SettingsSource::kStored);
+  EXPECT_EQ(s.stored, settings(st));
   EXPECT_EQ(applied.node_id, 7);
   EXPECT_EQ(applied.dividers[3], 40);
+  EXPECT_EQ(applied.dividers[4], 20) << "what no command set stays the configuration's";
+  // The command line wins over the file, and the message says which stored value lost.
+  FwConfig cli = c;
+  cli.node_id = 3;
+  cli.node_id_from_cli = true;
+  cli.dividers[3] = 100;
+  cli.dividers_from_cli = 1u << 3;
+  s = load_stored_settings(cli);
+  EXPECT_EQ(cli.node_id, 3);
+  EXPECT_EQ(cli.dividers[3], 100);
+  EXPECT_NE(s.message.find("node_id = 7 (--node-id 3)"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("output.euler = 40 (--divider euler=100)"), std::string::npos)
+      << s.message;
   // One byte off: the configuration's settings, the flag, and a message naming file and key.
-  gfins::testing::write_text(dir.path() / "can.toml", file_text(7, d, checksum_of(7, kDefaults)));
+  gfins::testing::write_text(file, file_text(Stored{7, {{"euler", 80}}}, checksum_of(st)));
   FwConfig fallback = c;
   s = load_stored_settings(fallback);
   EXPECT_EQ(s.source, SettingsSource::kStoredCorrupt);
   EXPECT_EQ(fallback.node_id, c.node_id);
   EXPECT_EQ(fallback.dividers, c.dividers);
-  EXPECT_NE(s.message.find("can.toml:19: integrity.checksum"), std::string::npos) << s.message;
-  // A folder where the file should be: unreadable, flagged alike.
-  std::filesystem::remove(dir.path() / "can.toml");
-  std::filesystem::create_directory(dir.path() / "can.toml");
+  EXPECT_NE(s.message.find("can.toml:6: integrity.checksum"), std::string::npos) << s.message;
+  // A folder, and a FIFO (which a plain read would wait on forever) where the file should be:
+  // flagged alike, without blocking.
+  std::filesystem::remove(file);
+  std::filesystem::create_directory(file);
   s = load_stored_settings(fallback);
   EXPECT_EQ(s.source, SettingsSource::kStoredCorrupt);
-  EXPECT_NE(s.message.find("can.toml"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("not a regular file"), std::string::npos) << s.message;
+  std::filesystem::remove(file);
+  ASSERT_EQ(::mkfifo(file.c_str(), 0600), 0);
+  s = load_stored_settings(fallback);
+  EXPECT_EQ(s.source, SettingsSource::kStoredCorrupt);
+  EXPECT_NE(s.message.find("not a regular file"), std::string::npos) << s.message;
 }
 
 // ---- On the simulated board ---------------------------------------------------------------
@@ -230,7 +279,8 @@ TEST(StoredSettings, CommandsAreKeptAndRestoreDefaultsForgetsThem) {
   SettingsParse kept = read_back(file);
   ASSERT_TRUE(kept.settings) << kept.error;
   EXPECT_EQ(kept.settings->dividers[3], 40);
-  EXPECT_EQ(kept.settings->node_id, SimRig::kNode);
+  EXPECT_FALSE(kept.settings->node_id) << "only what a command set is stored";
+  EXPECT_FALSE(kept.settings->dividers[0]);
   EXPECT_EQ(frames(rig, kCounters, 1000, &byte6), 1u);
   EXPECT_EQ(byte6 & 3, 1) << "Stored";
 
@@ -267,6 +317,16 @@ TEST(StoredSettings, WithoutAStoreSetNodeIdIsRefusedAndASaveThatFailsIsFlagged) 
   node.node_id = 3;
   EXPECT_EQ(send(rig, node), 7) << "Failed: a node id that would be forgotten";
   EXPECT_EQ(rig.loop->health().last_refusal, 7);
+  // RestoreDefaults needs no store: the configuration's dividers come back.
+  can::Command euler = numbered(can::Opcode::kSetDivider);
+  euler.message = can::MessageId::kEuler;
+  euler.divider = 40;
+  ASSERT_EQ(send(rig, euler), 0);
+  EXPECT_EQ(frames(rig, 0x130 + SimRig::kNode, 400), 10u);
+  std::uint32_t value = 99;
+  EXPECT_EQ(send(rig, numbered(can::Opcode::kRestoreDefaults), &value), 0);
+  EXPECT_EQ(value, SimRig::kNode);
+  EXPECT_EQ(frames(rig, 0x130 + SimRig::kNode, 400), 20u);
 
   gfins::testing::TempDir dir("gfins-settings");
   SimRig other("rest", 5.0);
@@ -285,6 +345,34 @@ TEST(StoredSettings, WithoutAStoreSetNodeIdIsRefusedAndASaveThatFailsIsFlagged) 
   ASSERT_EQ(frames(other, 0x200 + SimRig::kNode, 1000, &byte6), 1u);
   EXPECT_EQ(byte6 & 3, 3) << "SaveFailed";
   EXPECT_EQ(frames(other, 0x130 + SimRig::kNode, 400), 10u);
+}
+
+// The messages the board derives from the epoch divider (its command counters always, the
+// filter's two with aiding) follow a new epoch divider instead of blocking it, and come back with
+// the old one: 1000, 200 and 400 samples rounded up to multiples of 30 are 1020, 210 and 420.
+TEST(StoredSettings, TheBoardsOwnMessagesFollowTheEpochDivider) {
+  for (const bool aiding : {false, true}) {
+    SCOPED_TRACE(aiding);
+    sim_board::MemoryCanBus bus(64);
+    FwConfig c;
+    c.aiding = aiding;
+    c.dividers.fill(0);
+    c.dividers[0] = c.dividers[1] = 10;  // epoch and status alone
+    PublisherSink sink(bus, 1, bus_dividers(c), bus_budget(c));
+    ASSERT_TRUE(sink.publisher().init_status().is_ok());
+    ASSERT_TRUE(sink.set_divider(0, 30).is_ok());
+    const can::Publisher& p = sink.publisher();
+    EXPECT_EQ(p.divider(can::MessageId::kStatus), 30);
+    EXPECT_EQ(p.divider(can::MessageId::kCommandCounters), 1020);
+    EXPECT_EQ(p.divider(can::MessageId::kAccuracy), aiding ? 210 : 0);
+    EXPECT_EQ(p.divider(can::MessageId::kAidingCounters), aiding ? 420 : 0);
+    ASSERT_TRUE(sink.set_dividers(c.dividers).is_ok()) << "RestoreDefaults' path";
+    EXPECT_EQ(p.divider(can::MessageId::kEpoch), 10);
+    EXPECT_EQ(p.divider(can::MessageId::kCommandCounters), 1000);
+    EXPECT_EQ(p.divider(can::MessageId::kAccuracy), aiding ? 200 : 0);
+    // The status divider alone is still refused: it follows the epoch's.
+    EXPECT_FALSE(sink.set_divider(1, 20).is_ok());
+  }
 }
 
 #ifdef GFINS_FW_EXE
@@ -318,21 +406,22 @@ TEST(StoredSettings, SurviveARestartOfTheProgram) {
       const auto hash = line.find('#');
       const auto sp = line.rfind(' ', hash);
       if (hash == std::string::npos || sp == std::string::npos) continue;
-      const auto id = static_cast<std::uint32_t>(std::stoul(line.substr(sp + 1, hash - sp - 1), nullptr, 16));
+      const auto id =
+          static_cast<std::uint32_t>(std::stoul(line.substr(sp + 1, hash - sp - 1), nullptr, 16));
       ++n[id];
       if (last != nullptr) (*last)[id] = line.substr(hash + 1);
     }
     return n;
   };
-  const auto run = [&](const std::string& log) {
-    return test::run_tool(GFINS_FW_EXE,
-                          {"--sim", "rest", "--calibration", "", "--duration", "2",
-                           "--scenario-dir", GFINS_SCENARIO_DIR, "--settings-file", file,
-                           "--can-log", log},
-                          dir.path());
+  const auto run = [&](const std::string& log, std::vector<std::string> source) {
+    std::vector<std::string> args = {"--sim",      "rest", "--calibration",  "",
+                                     "--duration", "2",    "--scenario-dir", GFINS_SCENARIO_DIR,
+                                     "--can-log",  log};
+    args.insert(args.end(), source.begin(), source.end());
+    return test::run_tool(GFINS_FW_EXE, args, dir.path());
   };
   const std::string log = (dir.path() / "stored.log").string();
-  const test::CliResult r = run(log);
+  const test::CliResult r = run(log, {"--settings-file", file});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("stored CAN settings from"), std::string::npos) << r.err;
   std::map<std::uint32_t, std::string> last;
@@ -343,6 +432,19 @@ TEST(StoredSettings, SurviveARestartOfTheProgram) {
   ASSERT_EQ(last.count(0x205), 1u);
   // Data as 16 hex digits: byte 6 is characters 12-13; bits 0-1 = 1, Stored.
   EXPECT_EQ(std::stoi(last[0x205].substr(12, 2), nullptr, 16) & 3, 1) << last[0x205];
+
+  // A configuration file naming the same settings file, without --settings-file: the simulated
+  // board leaves it alone (only the board itself keeps settings in can.settings_file; a replay
+  // would carry out recorded commands again).
+  const std::string cfg = (dir.path() / "fw.toml").string();
+  gfins::testing::write_text(cfg, "[can]\nsettings_file = \"" + file + "\"\n");
+  const std::string log_cfg = (dir.path() / "config.log").string();
+  const test::CliResult rc = run(log_cfg, {"--config", cfg});
+  ASSERT_EQ(rc.exit_code, 0) << rc.err;
+  EXPECT_EQ(rc.err.find("stored CAN settings"), std::string::npos) << rc.err;
+  n = count(log_cfg, nullptr);
+  EXPECT_EQ(n[0x105], 0);
+  EXPECT_EQ(n[0x101], 201) << "the configuration's node 1";
 
   // The file damaged (a divider changed by hand): the configuration's node 1, flagged, run on.
   {
@@ -356,7 +458,7 @@ TEST(StoredSettings, SurviveARestartOfTheProgram) {
     gfins::testing::write_text(file, text);
   }
   const std::string log2 = (dir.path() / "corrupt.log").string();
-  const test::CliResult r2 = run(log2);
+  const test::CliResult r2 = run(log2, {"--settings-file", file});
   ASSERT_EQ(r2.exit_code, 0) << r2.err;
   EXPECT_NE(r2.err.find("stored CAN settings ignored"), std::string::npos) << r2.err;
   EXPECT_NE(r2.err.find("integrity.checksum"), std::string::npos) << r2.err;

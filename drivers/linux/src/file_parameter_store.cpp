@@ -191,6 +191,34 @@ Status FileParameterStore::do_save(std::span<const char> blob) {
   return Status::ok();
 }
 
+Status remove_file_durably(std::string_view path, Os& os) {
+  auto store = FileParameterStore::open(path, os);
+  if (!store.is_ok()) return store.status();
+  return store.value()->remove();
+}
+
+Status FileParameterStore::remove() {
+  struct stat st {};
+  if (os_.lstat(path_.c_str(), &st) != 0) {
+    if (errno == ENOENT) return Status::ok();
+    return Status(ErrorCode::kIoError, "parameter store: cannot look at the file to remove", errno);
+  }
+  if (const char* kind = non_regular_kind(st.st_mode)) {
+    return Status(ErrorCode::kInvalidArgument, not_a_file_message(kind));
+  }
+  if (os_.unlink(path_.c_str()) != 0 && errno != ENOENT) {
+    return Status(ErrorCode::kIoError, "parameter store: unlink of the file failed", errno);
+  }
+  Fd dir_fd(os_, os_.open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC, 0));
+  if (!dir_fd.valid() || os_.fsync(dir_fd.get()) != 0) {
+    return Status(ErrorCode::kIoError,
+                  "parameter store: fsync of the folder failed after the removal; the file is gone "
+                  "but a power cut may bring it back",
+                  errno);
+  }
+  return Status::ok();
+}
+
 Status save_file_atomically(std::string_view path, std::span<const char> blob, Os& os) {
   auto store = FileParameterStore::open(path, os);
   if (!store.is_ok()) return store.status();

@@ -6,7 +6,9 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <span>
+#include <system_error>
 
 #include "gfins/checksum/fnv1a.hpp"
 #include "gfins/drivers/lnx/file_parameter_store.hpp"
@@ -18,10 +20,11 @@ namespace {
 
 /// The lines the checksum covers, in a fixed order (independent of the file's layout).
 std::string canonical(const CanSettings& s) {
-  std::string out = "format_version=" + std::to_string(kSettingsFormatVersion) +
-                    "\nnode_id=" + std::to_string(s.node_id) + "\n";
+  std::string out = "format_version=" + std::to_string(kSettingsFormatVersion) + "\n";
+  if (s.node_id) out += "node_id=" + std::to_string(*s.node_id) + "\n";
   for (std::size_t m = 0; m < kNumMessages; ++m) {
-    out += "output." + std::string(kMessageNames[m]) + "=" + std::to_string(s.dividers[m]) + "\n";
+    if (!s.dividers[m]) continue;
+    out += "output." + std::string(kMessageNames[m]) + "=" + std::to_string(*s.dividers[m]) + "\n";
   }
   return out;
 }
@@ -84,31 +87,51 @@ void reject_unknown(const toml::table& root, const std::string& source) {
 
 }  // namespace
 
-CanSettings settings_of(const FwConfig& c) {
-  CanSettings s;
-  s.node_id = static_cast<std::uint8_t>(c.node_id);
-  s.dividers = c.dividers;
-  return s;
-}
-
-void apply_settings(const CanSettings& s, FwConfig& c) {
-  c.node_id = s.node_id;
-  c.dividers = s.dividers;
-}
-
 std::string settings_text(const CanSettings& s) {
   std::string out =
       "# gfins CAN settings, written by the board when a command changed them\n"
-      "# (docs/can-interface.md, \"Stored settings\"). Do not edit: the checksum covers every "
-      "value;\n# a file that does not match it is ignored and the board says so on the bus.\n";
+      "# (docs/can-interface.md, \"Stored settings\"): only what a command set; the rest is the\n"
+      "# configuration's. Do not edit: the checksum covers every value; a file that does not\n"
+      "# match it is ignored and the board says so on the bus.\n";
   out += "format_version = " + std::to_string(kSettingsFormatVersion) + "\n";
-  out += "node_id = " + std::to_string(s.node_id) + "\n\n[output]\n";
+  if (s.node_id) out += "node_id = " + std::to_string(*s.node_id) + "\n";
+  out += "\n[output]\n";
   for (std::size_t m = 0; m < kNumMessages; ++m) {
-    out += std::string(kMessageNames[m]) + " = " + std::to_string(s.dividers[m]) + "\n";
+    if (!s.dividers[m]) continue;
+    out += std::string(kMessageNames[m]) + " = " + std::to_string(*s.dividers[m]) + "\n";
   }
   out += "\n[integrity]\nchecksum = '" + checksum_text(s) + "'\n";
   return out;
 }
+
+namespace {
+
+/// `s` put into `c`, except what the command line gave; `overridden` names those.
+void apply_stored(const CanSettings& s, FwConfig& c, std::string* overridden) {
+  const auto note = [&](const std::string& what) {
+    if (overridden != nullptr) *overridden += (overridden->empty() ? "" : ", ") + what;
+  };
+  if (s.node_id) {
+    if (c.node_id_from_cli) {
+      note("node_id = " + std::to_string(*s.node_id) + " (--node-id " + std::to_string(c.node_id) +
+           ")");
+    } else {
+      c.node_id = *s.node_id;
+    }
+  }
+  for (std::size_t m = 0; m < kNumMessages; ++m) {
+    if (!s.dividers[m]) continue;
+    if (((c.dividers_from_cli >> m) & 1u) != 0) {
+      note("output." + std::string(kMessageNames[m]) + " = " + std::to_string(*s.dividers[m]) +
+           " (--divider " + std::string(kMessageNames[m]) + "=" + std::to_string(c.dividers[m]) +
+           ")");
+    } else {
+      c.dividers[m] = *s.dividers[m];
+    }
+  }
+}
+
+}  // namespace
 
 SettingsParse parse_settings(std::string_view text, const std::string& source,
                              const FwConfig& base) {
@@ -124,10 +147,13 @@ SettingsParse parse_settings(std::string_view text, const std::string& source,
                std::to_string(kSettingsFormatVersion));
     }
     CanSettings s;
-    s.node_id = static_cast<std::uint8_t>(integer(root, source, "node_id", 0, kMaxNodeId));
+    if (root.get("node_id") != nullptr) {
+      s.node_id = static_cast<std::uint8_t>(integer(root, source, "node_id", 0, kMaxNodeId));
+    }
     for (std::size_t m = 0; m < kNumMessages; ++m) {
-      s.dividers[m] = static_cast<std::uint16_t>(
-          integer(root, source, "output." + std::string(kMessageNames[m]), 0, kMaxDivider));
+      const std::string key = "output." + std::string(kMessageNames[m]);
+      if (root.at_path(key).node() == nullptr) continue;
+      s.dividers[m] = static_cast<std::uint16_t>(integer(root, source, key, 0, kMaxDivider));
     }
     const toml::node* sum = root.at_path("integrity.checksum").node();
     if (sum == nullptr || !sum->is_string()) {
@@ -141,11 +167,11 @@ SettingsParse parse_settings(std::string_view text, const std::string& source,
                "': the file was changed or damaged");
     }
     FwConfig c = base;
-    apply_settings(s, c);
+    apply_stored(s, c, nullptr);
     if (std::optional<ConfigProblem> p = check(c)) {
       fail(source, nullptr,
-           "the stored " + p->key + " = " + p->value + " breaks the configuration's rules: " +
-               p->allowed);
+           "the stored " + p->key + " = " + p->value +
+               " breaks the configuration's rules: " + p->allowed);
     }
     out.settings = s;
   } catch (const toml::parse_error& e) {
@@ -162,19 +188,31 @@ SettingsParse parse_settings(std::string_view text, const std::string& source,
 StartupSettings load_stored_settings(FwConfig& c) {
   StartupSettings out;
   if (c.can_settings_file.empty()) return out;
+  const std::string shown = quote_text(c.can_settings_file);
+  // Only a regular file is read (the board's save only writes one): a FIFO would block the
+  // start, a device would never end.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(c.can_settings_file, ec);
+  if (st.type() == fs::file_type::not_found) {
+    out.message = "can.settings_file " + shown +
+                  ": nothing stored yet, the configuration's node id and dividers are used";
+    return out;
+  }
+  if (!ec && st.type() != fs::file_type::regular) {
+    out.source = SettingsSource::kStoredCorrupt;
+    out.message = "stored CAN settings ignored, the configuration's are used: can.settings_file " +
+                  shown + " is not a regular file (a folder, link, FIFO, device or socket)";
+    return out;
+  }
   std::string text;
   constexpr std::size_t kMaxBytes = hal::ParameterStore::kMaxBytes;
-  const Status st = drivers::lnx::read_text_file(c.can_settings_file.c_str(), kMaxBytes, text);
-  if (!st.is_ok()) {
-    if (st.code() == ErrorCode::kIoError && st.os_error() == ENOENT) {
-      out.message = "can.settings_file " + quote_text(c.can_settings_file) +
-                    ": nothing stored yet, the configuration's node id and dividers are used";
-      return out;
-    }
+  const Status read = drivers::lnx::read_text_file(c.can_settings_file.c_str(), kMaxBytes, text);
+  if (!read.is_ok()) {
     out.source = SettingsSource::kStoredCorrupt;
-    out.message = "stored CAN settings ignored, the configuration's are used: " +
-                  drivers::lnx::text_file_error(c.can_settings_file, st, kMaxBytes,
-                                                "a settings file");
+    out.message =
+        "stored CAN settings ignored, the configuration's are used: " +
+        drivers::lnx::text_file_error(c.can_settings_file, read, kMaxBytes, "a settings file");
     return out;
   }
   const SettingsParse p = parse_settings(text, c.can_settings_file, c);
@@ -183,10 +221,14 @@ StartupSettings load_stored_settings(FwConfig& c) {
     out.message = "stored CAN settings ignored, the configuration's are used: " + p.error;
     return out;
   }
-  apply_settings(*p.settings, c);
+  std::string overridden;
+  apply_stored(*p.settings, c, &overridden);
   out.source = SettingsSource::kStored;
-  out.message = "stored CAN settings from " + quote_text(c.can_settings_file) + ": node id " +
-                std::to_string(p.settings->node_id);
+  out.stored = *p.settings;
+  out.message = "stored CAN settings from " + shown + ": node id " + std::to_string(c.node_id);
+  if (!overridden.empty()) {
+    out.message += "; the command line wins over the stored " + overridden;
+  }
   return out;
 }
 
@@ -204,7 +246,7 @@ SettingsWriter::~SettingsWriter() {
   thread_.join();
 }
 
-bool SettingsWriter::post(const std::optional<CanSettings>& s) {
+bool SettingsWriter::post(const CanSettings& s) {
   // try_lock: the worker holds the mutex only while taking a request, never while writing.
   if (!mutex_.try_lock()) return false;
   pending_ = s;
@@ -219,12 +261,11 @@ void SettingsWriter::wait_settled() {
   settled_.wait(lock, [this] { return !has_pending_ && !busy_; });
 }
 
-void SettingsWriter::write(const std::optional<CanSettings>& s) {
-  if (!s) {
-    // Restore defaults: nothing stored from now on.
-    if (std::remove(path_.c_str()) != 0 && errno != ENOENT) {
-      spdlog::error("can.settings_file {}: cannot remove it: {}", quote_text(path_),
-                    std::strerror(errno));
+void SettingsWriter::write(const CanSettings& s) {
+  if (s.empty()) {
+    // Restore defaults: nothing stored from now on (the removal synced, as a save is).
+    if (const Status st = drivers::lnx::remove_file_durably(path_); !st.is_ok()) {
+      spdlog::error("can.settings_file {}: cannot remove it: {}", quote_text(path_), st.message());
       source_.store(static_cast<std::uint8_t>(SettingsSource::kSaveFailed));
       return;
     }
@@ -232,17 +273,17 @@ void SettingsWriter::write(const std::optional<CanSettings>& s) {
     source_.store(static_cast<std::uint8_t>(SettingsSource::kConfiguration));
     return;
   }
-  const std::string text = settings_text(*s);
+  const std::string text = settings_text(s);
   const Status st = drivers::lnx::save_file_atomically(path_, std::span(text.data(), text.size()));
   if (!st.is_ok()) {
-    spdlog::error("can.settings_file {}: the changed settings could not be stored (in use until "
-                  "the board restarts): {}",
-                  quote_text(path_), st.message());
+    spdlog::error(
+        "can.settings_file {}: the changed settings could not be stored (in use until "
+        "the board restarts): {}",
+        quote_text(path_), st.message());
     source_.store(static_cast<std::uint8_t>(SettingsSource::kSaveFailed));
     return;
   }
-  spdlog::info("CAN settings stored in {} (node id {} from the next start)", quote_text(path_),
-               s->node_id);
+  spdlog::info("CAN settings stored in {}", quote_text(path_));
   source_.store(static_cast<std::uint8_t>(SettingsSource::kStored));
 }
 
@@ -252,7 +293,7 @@ void SettingsWriter::run() {
     wake_.wait(lock, [this] { return stop_ || has_pending_; });
     // A change posted just before the stop is still written.
     if (!has_pending_) return;
-    const std::optional<CanSettings> s = pending_;
+    const CanSettings s = pending_;
     has_pending_ = false;
     busy_ = true;
     lock.unlock();

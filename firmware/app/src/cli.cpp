@@ -161,7 +161,10 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_rate->count()) c.sample_rate_hz = rate;
   if (o_can->count()) c.can_interface = can_if;
   if (o_log->count()) c.can_log = can_log;
-  if (o_node->count()) c.node_id = node;
+  if (o_node->count()) {
+    c.node_id = node;
+    c.node_id_from_cli = true;
+  }
   if (o_settings->count()) {
     c.can_settings_file = settings_file;
     c.can_settings_file_given = true;
@@ -187,6 +190,7 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       return out;
     }
     c.dividers[static_cast<std::size_t>(m)] = static_cast<std::uint16_t>(n);
+    c.dividers_from_cli |= 1u << static_cast<unsigned>(m);
   }
   (void)o_div;
   if (o_comp->count()) {
@@ -226,9 +230,10 @@ CliResult parse_command_line(int argc, const char* const* argv) {
   if (o_dur->count()) c.sim_duration_s = duration;
   if (o_sdir->count()) c.sim_scenario_dir = scenario_dir;
 
-  // The simulated board keeps settings changed over CAN only where it is told to, never in the
-  // board's default place (a test run must not change the next run's node id).
-  if (c.board == BoardKind::kSim && !c.can_settings_file_given) c.can_settings_file.clear();
+  // Only the board itself keeps settings in can.settings_file: the simulated board (also
+  // replaying a recording, whose command frames would be carried out again) and the HIL board
+  // keep them only in a file named with --settings-file, never in the board's place.
+  if (c.board != BoardKind::kLinux && !c.can_settings_file_given) c.can_settings_file.clear();
 
   // What the configuration is made of, for --check-config's verdict.
   std::size_t overrides = 0;
@@ -256,6 +261,8 @@ CliResult parse_command_line(int argc, const char* const* argv) {
       {"calibration.file (--calibration, written by the calibrate command)", c.calibration_file},
       {"can.settings_file (--settings-file, written when a command changes a setting)",
        c.can_settings_file},
+      {"the configuration file (--config, read)", config_file},
+      {"sim.scenario (read)", c.sim_scenario.find('/') != std::string::npos ? c.sim_scenario : ""},
   };
   if (auto clash = drivers::lnx::output_clash(outputs)) {
     out.exit_code = 2;

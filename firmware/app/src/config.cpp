@@ -194,7 +194,7 @@ void read_all(Reader& r, FwConfig& c) {
   r.integer("can.node_id", c.node_id, 0, kMaxNodeId);
   r.integer("can.bit_rate", c.can_bit_rate, 1, 1000000);
   r.number("can.max_bus_load_percent", c.max_bus_load_percent);
-  if (r.text("can.settings_file", c.can_settings_file)) c.can_settings_file_given = true;
+  r.text("can.settings_file", c.can_settings_file);
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     int d = c.dividers[m];
     r.integer("output." + std::string(kMessageNames[m]), d, 0, kMaxDivider);

@@ -60,7 +60,8 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
   // Settings changed over CAN by an earlier run replace the configuration's node id and dividers
   // (RestoreDefaults returns to the configuration's). Checked by the configuration's rules; a
   // file that is not right is ignored and the bus says so (SettingsSource).
-  const CanSettings config_settings = settings_of(cfg);
+  const std::array<std::uint16_t, kNumMessages> config_dividers = cfg.dividers;
+  const auto config_node_id = static_cast<std::uint8_t>(cfg.node_id);
   const StartupSettings stored = load_stored_settings(cfg);
   if (stored.source == SettingsSource::kStoredCorrupt) {
     spdlog::error("{}", printable_text(stored.message));
@@ -143,7 +144,9 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
         std::make_unique<StatusReporter>(*board.watchdog, status_board, cfg.sample_rate_hz);
   }
   LoopOptions options = loop_options(cfg);
-  options.config_settings = config_settings;
+  options.stored = stored.stored;
+  options.config_dividers = config_dividers;
+  options.config_node_id = config_node_id;
   if (const gfins::Status s = loop->configure(cal.set, options); !s.is_ok()) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;
@@ -181,6 +184,9 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
+  // A settings change the writer could not take in the loop's last cycle is handed over now;
+  // the writer saves it before it stops.
+  loop->flush_settings();
   if (status_reporter) {
     status_reporter->stop();
     (void)board.watchdog->notify_status("stopping");

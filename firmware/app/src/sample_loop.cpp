@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <thread>
 
 #include "gfins/app/config.hpp"
 #include "gfins/app/nav_accuracy.hpp"
@@ -37,7 +38,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_ = cal;
   cal_.config = cfg;
   options_ = options;
-  settings_ = options.settings;
+  settings_ = options.stored;
   inputs_ = can::InputDecoder(options.node_id);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
   adc_seen_ = adc_.counters();
@@ -454,34 +455,39 @@ std::uint8_t SampleLoop::settings_source() const {
 
 void SampleLoop::offer_settings() {
   if (!settings_dirty_ || settings_port_ == nullptr) return;
-  if (settings_port_->post(settings_post_)) settings_dirty_ = false;
+  if (settings_port_->post(settings_)) settings_dirty_ = false;
+}
+
+void SampleLoop::flush_settings() {
+  while (settings_dirty_ && settings_port_ != nullptr) {
+    offer_settings();
+    if (settings_dirty_) std::this_thread::yield();
+  }
 }
 
 void SampleLoop::execute_settings(const can::Command& c, CommandReply& r) {
-  // Without a store a node id would be forgotten before it takes effect: refused.
-  if (settings_port_ == nullptr) {
-    r.response.result = can::ResultCode::kFailed;
-    return note_refusal(can::ResultCode::kFailed);
-  }
   if (c.opcode == can::Opcode::kSetNodeId) {
-    if (c.node_id > can::kMaxNodeId) {
-      r.response.result = can::ResultCode::kOutOfRange;
-      return note_refusal(can::ResultCode::kOutOfRange);
+    // Without a store a node id would be forgotten before it takes effect: refused.
+    const can::ResultCode why = settings_port_ == nullptr     ? can::ResultCode::kFailed
+                                : c.node_id > can::kMaxNodeId ? can::ResultCode::kOutOfRange
+                                                              : can::ResultCode::kOk;
+    if (why != can::ResultCode::kOk) {
+      r.response.result = why;
+      return note_refusal(why);
     }
     settings_.node_id = c.node_id;
-    settings_post_ = settings_;
+    r.response.value = c.node_id;
   } else {
     // The configuration's dividers at once; its node id from the next start.
-    if (!out_.set_dividers(options_.config_settings.dividers).is_ok()) {
+    if (!out_.set_dividers(options_.config_dividers).is_ok()) {
       r.response.result = can::ResultCode::kFailed;
       return note_refusal(can::ResultCode::kFailed);
     }
-    settings_ = options_.config_settings;
-    settings_post_.reset();
+    settings_ = CanSettings{};
+    r.response.value = options_.config_node_id;
   }
   settings_dirty_ = true;
   offer_settings();
-  r.response.value = settings_.node_id;
   ++health_.commands;
 }
 
@@ -678,12 +684,14 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
         if (c.message == can::MessageId::kEpoch) {
           settings_.dividers[static_cast<std::size_t>(can::MessageId::kStatus)] = c.divider;
         }
-        settings_post_ = settings_;
         settings_dirty_ = true;
         offer_settings();
       }
       break;
     case can::Opcode::kReportCalibrationId:
+      // The status part's Value: the last sequence number taken, so that a host that does not
+      // track the board's numbers can send the next one (docs/can-interface.md).
+      r.response.value = last_sequence_;
       break;
     case can::Opcode::kStartCapture:
       if (c.samples == 0 || c.samples > kMaxCaptureSamples || c.pose > can::kMaxCapturePose) {
@@ -703,8 +711,8 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
       }
       reload_pending_ = true;
       reload_token_ = c.token;
-      r.deferred = true;  // answered when the worker is done (poll_reload)
-      break;
+      r.deferred = true;  // answered when the worker is done (poll_reload), counted there
+      return;
     case can::Opcode::kSetNodeId:
     case can::Opcode::kRestoreDefaults:
       return execute_settings(c, r);
@@ -779,6 +787,7 @@ void SampleLoop::poll_reload(std::int64_t t_ns) {
       cal_.cal_id = fresh.cal_id;
       cal_.calibrated = fresh.calibrated;
       r.result = can::ResultCode::kOk;
+      ++health_.commands;
       log(LogLevel::kInfo, t_ns, "calibration reloaded: id {:#x}", cal_.cal_id);
     }
   }

@@ -76,8 +76,8 @@ LoopOptions loop_options(const FwConfig& c) {
   o.sample_rate_hz = c.sample_rate_hz;
   o.node_id = static_cast<std::uint8_t>(c.node_id);
   o.aiding_inputs = c.aiding && c.aiding_inputs;
-  o.settings = settings_of(c);
-  o.config_settings = o.settings;
+  o.config_dividers = c.dividers;
+  o.config_node_id = static_cast<std::uint8_t>(c.node_id);
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
   o.initial_position_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),

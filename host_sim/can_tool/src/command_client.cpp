@@ -72,6 +72,7 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
     }
     if (r->part == can::kPartStatus) {
       out.status = *r;
+      out.status_value = r->value;
       if (r->result != can::ResultCode::kOk) {
         out.kind = CommandOutcome::Kind::kRejected;
         out.text = "rejected: " + describe_status(c, *r);
@@ -134,20 +135,41 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
 
 CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
                                          const CommandTimeouts& t, std::string* note) {
-  CommandOutcome out = run_command(bus, c, node_id, t);
-  if (!can::carries_sequence(c.opcode) || out.kind != CommandOutcome::Kind::kRejected ||
-      out.status.result != can::ResultCode::kReplayed ||
-      out.status.value >= static_cast<std::uint32_t>(can::kMaxSequence)) {
-    return out;
+  if (!can::carries_sequence(c.opcode)) return run_command(bus, c, node_id, t);
+  can::Command ask;
+  ask.opcode = can::Opcode::kReportCalibrationId;
+  ask.token = static_cast<std::uint8_t>(c.token - 1);
+  CommandOutcome asked = run_command(bus, ask, node_id, t);
+  if (asked.kind != CommandOutcome::Kind::kOk || !asked.status_value) {
+    asked.text = "could not read the board's last sequence number: " + asked.text;
+    if (asked.kind == CommandOutcome::Kind::kOk) asked.kind = CommandOutcome::Kind::kTimeout;
+    return asked;
   }
-  const auto taken = out.status.value;
-  c.sequence = static_cast<std::uint16_t>(taken + 1);
-  c.token = static_cast<std::uint8_t>(c.token + 1);
-  if (note != nullptr) {
-    *note = "the board had taken sequence number " + std::to_string(taken) + "; sent again with " +
-            std::to_string(c.sequence);
+  const auto max_sequence = static_cast<std::uint32_t>(can::kMaxSequence);
+  std::uint32_t last = *asked.status_value;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    if (last >= max_sequence) {
+      CommandOutcome full;
+      full.kind = CommandOutcome::Kind::kRejected;
+      full.text = "not sent: the board has taken sequence number " + std::to_string(last) +
+                  ", the last of its session; restart it to send configuration-changing commands";
+      return full;
+    }
+    c.sequence = static_cast<std::uint16_t>(last + 1);
+    if (note != nullptr) {
+      *note = "sequence number " + std::to_string(c.sequence) + " (the board's last was " +
+              std::to_string(last) + ")";
+    }
+    CommandOutcome out = run_command(bus, c, node_id, t);
+    // Another host took the number in between: once more with the one after the board's.
+    if (attempt > 0 || out.kind != CommandOutcome::Kind::kRejected ||
+        out.status.result != can::ResultCode::kReplayed || !out.status_value) {
+      return out;
+    }
+    last = *out.status_value;
+    c.token = static_cast<std::uint8_t>(c.token + 1);
   }
-  return run_command(bus, c, node_id, t);
+  return {};  // not reached: the second attempt returns
 }
 
 }  // namespace gfins::can_tool

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "gfins/can/command.hpp"
@@ -13,8 +14,9 @@ struct CommandOutcome {
   // kIncomplete: StartCapture's CaptureDone arrived but some channel frames did not; `text`
   // names them and `capture` must not be used (the missing fields are not measurements).
   enum class Kind { kOk, kRejected, kTimeout, kSendFailed, kIncomplete } kind = Kind::kTimeout;
-  can::ResponseFrame status;   // the status frame (or the calibration id frame)
-  can::CaptureResult capture;  // StartCapture: the collected result
+  can::ResponseFrame status;                  // the status frame (or the calibration id frame)
+  std::optional<std::uint32_t> status_value;  // Value of the status frame, when one came
+  can::CaptureResult capture;                 // StartCapture: the collected result
   bool capture_complete = false;
   std::string text;  // one-paragraph human-readable outcome
 };
@@ -31,9 +33,11 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
                            const CommandTimeouts& t);
 
 /// run_command for a command with a sequence number the sender does not track
-/// (docs/can-interface.md, "Sequence numbers"): sent with c.sequence; when the board answers
-/// Replayed, sent once more with the number after the one the board reported (and the next
-/// token). `note` receives a line saying so. Commands without a sequence number go as they are.
+/// (docs/can-interface.md, "Sequence numbers"): asks the board for the last number it took
+/// (ReportCalibrationId's status Value, token c.token - 1) and sends c with the next; should
+/// another host have taken that one meanwhile (Replayed), sends once more with the number after
+/// the one the board reported (and the next token). `note` receives a line saying what was done.
+/// Commands without a sequence number go as they are.
 CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
                                          const CommandTimeouts& t, std::string* note);
 

@@ -364,6 +364,13 @@ int run_cmd(const CmdOptions& o, can::Command c) {
                  bus.status().message());
     return kExitInput;
   }
+  if (o.sequence >= 0 && !can::carries_sequence(c.opcode)) {
+    std::fprintf(stderr,
+                 "gfins-can cmd: --sequence: %s carries no sequence number (it changes "
+                 "nothing on the board)\n",
+                 can::to_string(c.opcode));
+    return kExitUsage;
+  }
   c.token = static_cast<std::uint8_t>(o.token >= 0 ? static_cast<unsigned>(o.token)
                                                    : std::random_device{}() & 0xFFu);
   CommandTimeouts t;
@@ -375,7 +382,6 @@ int run_cmd(const CmdOptions& o, can::Command c) {
     c.sequence = static_cast<std::uint16_t>(o.sequence);
     r = run_command(**bus, c, node, t);
   } else {
-    c.sequence = 1;
     std::string note;
     r = run_command_next_sequence(**bus, c, node, t, &note);
     if (!note.empty()) std::fprintf(stderr, "gfins-can cmd: %s\n", note.c_str());
@@ -642,8 +648,8 @@ int main_impl(int argc, char** argv) {
       ->capture_default_str();
   cmd->add_option("--token", co.token, "token (default: random)")->check(CLI::Range(0, 255));
   cmd->add_option("--sequence", co.sequence,
-                  "sequence number of a configuration-changing command (default: 1, then once "
-                  "more with the board's next one if it answers Replayed)")
+                  "sequence number of a configuration-changing command (default: the board's "
+                  "last one, read first with ReportCalibrationId, plus 1)")
       ->check(CLI::Range(1, 65535));
   cmd->add_option("--rate", co.rate_hz,
                   "the board's sample rate, Hz (capture: wait N / rate + 5 s for the result)")

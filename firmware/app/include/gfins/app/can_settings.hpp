@@ -28,14 +28,9 @@ enum class SettingsSource : std::uint8_t {
   kSaveFailed = 3,     // a change could not be stored: it is in use until the board restarts
 };
 
-/// The node id and dividers of a configuration.
-CanSettings settings_of(const FwConfig& c);
-/// Puts `s` into `c` (can.node_id, [output]).
-void apply_settings(const CanSettings& s, FwConfig& c);
-
-/// The file's text: format_version, node_id, [output] and [integrity] checksum =
-/// 'fnv1a64:<16 hex digits>' of the canonical lines "format_version=1\nnode_id=N\n" and
-/// "output.NAME=D\n" per message in the table's order.
+/// The file's text: format_version, node_id (when set), [output] (the dividers set) and
+/// [integrity] checksum = 'fnv1a64:<16 hex digits>' of the canonical lines "format_version=1\n",
+/// "node_id=N\n" (when set) and "output.NAME=D\n" per divider set, in the table's order.
 std::string settings_text(const CanSettings& s);
 
 struct SettingsParse {
@@ -50,15 +45,18 @@ SettingsParse parse_settings(std::string_view text, const std::string& source,
 
 struct StartupSettings {
   SettingsSource source = SettingsSource::kConfiguration;
+  CanSettings stored;   // what the file holds (empty when it is missing or refused)
   std::string message;  // what happened; empty when no settings file is configured
 };
-/// Reads c.can_settings_file (when set) and applies a valid one to `c`. Missing: the
-/// configuration's settings. Unreadable, corrupt or refused by the rules: the configuration's
+/// Reads c.can_settings_file (when set) and applies a valid one to `c`: each stored value
+/// replaces the configuration's, except those the command line gave (c.node_id_from_cli,
+/// c.dividers_from_cli), which win and are named in the message. Missing: the configuration's
+/// settings. Not a regular file, unreadable, corrupt or refused by the rules: the configuration's
 /// settings, kStoredCorrupt and a message naming the file and the problem. Never writes.
 StartupSettings load_stored_settings(FwConfig& c);
 
-/// Keeps the settings the loop posts in `path` (atomic save; nullopt removes the file), on its
-/// own thread. The loop's side (post, source) never blocks or allocates.
+/// Keeps the settings the loop posts in `path` (atomic save; empty settings remove the file, its
+/// folder synced), on its own thread. The loop's side (post, source) never blocks or allocates.
 class SettingsWriter final : public SettingsPort {
  public:
   SettingsWriter(std::string path, SettingsSource initial);
@@ -66,7 +64,7 @@ class SettingsWriter final : public SettingsPort {
   SettingsWriter(const SettingsWriter&) = delete;
   SettingsWriter& operator=(const SettingsWriter&) = delete;
 
-  bool post(const std::optional<CanSettings>& s) override;
+  bool post(const CanSettings& s) override;
   std::uint8_t source() const override { return source_.load(); }
 
   /// Host side only (tests, shutdown), blocking: returns once nothing posted waits to be written.
@@ -74,13 +72,13 @@ class SettingsWriter final : public SettingsPort {
 
  private:
   void run();
-  void write(const std::optional<CanSettings>& s);
+  void write(const CanSettings& s);
 
   std::string path_;
   std::mutex mutex_;  // guards pending_, has_pending_, stop_; the loop only ever try_locks it
   std::condition_variable wake_;
   std::condition_variable settled_;
-  std::optional<CanSettings> pending_;
+  CanSettings pending_;
   bool has_pending_ = false;
   bool busy_ = false;  // the worker is writing
   bool stop_ = false;

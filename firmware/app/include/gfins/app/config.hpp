@@ -70,9 +70,13 @@ struct FwConfig {
   double max_bus_load_percent = kDefaultMaxBusLoadPercent;    // the board's worst-case share
   /// Where settings changed over CAN (node id, dividers) are kept across restarts; "" = not kept.
   std::string can_settings_file = "/var/lib/gfins/can-settings.toml";
-  /// can.settings_file came from a configuration file or the command line (the simulated board
-  /// keeps settings only then, never in the board's default place).
+  /// can.settings_file was given on the command line (--settings-file): the simulated and the
+  /// HIL boards keep settings only then, never in the board's place.
   bool can_settings_file_given = false;
+  /// The command line gave can.node_id (--node-id) / these [output] dividers (--divider, bit m =
+  /// message m): they win over the stored settings (docs/can-interface.md, "Stored settings").
+  bool node_id_from_cli = false;
+  std::uint32_t dividers_from_cli = 0;
 
   // [output]
   std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;

@@ -58,11 +58,18 @@ class EpochSink {
       const std::array<std::uint16_t, kNumMessages>& dividers) = 0;
 };
 
-/// The CAN settings a command can change and the board keeps across restarts
-/// (docs/can-interface.md, "Stored settings"): the node id of the next start and the dividers.
+/// The CAN settings commands changed, which the board keeps across restarts
+/// (docs/can-interface.md, "Stored settings"): only what a command set (SetNodeId: the node id
+/// of the next start; SetDivider: that message's divider); the rest is the configuration's.
 struct CanSettings {
-  std::uint8_t node_id = can::kDefaultNodeId;
-  std::array<std::uint16_t, kNumMessages> dividers = kDefaultDividers;
+  std::optional<std::uint8_t> node_id;
+  std::array<std::optional<std::uint16_t>, kNumMessages> dividers{};
+  bool empty() const {
+    for (const auto& d : dividers) {
+      if (d) return false;
+    }
+    return !node_id;
+  }
   friend bool operator==(const CanSettings&, const CanSettings&) = default;
 };
 
@@ -70,10 +77,10 @@ struct CanSettings {
 class SettingsPort {
  public:
   virtual ~SettingsPort() = default;
-  /// Loop side, never blocks: keep `s`, or with nullopt forget what is kept (the configuration's
-  /// settings apply from the next start). False when the writer cannot take it now (busy): the
-  /// loop offers it again next cycle.
-  virtual bool post(const std::optional<CanSettings>& s) = 0;
+  /// Loop side, never blocks: keep `s` (empty: forget what is kept; the configuration's settings
+  /// apply from the next start). False when the writer cannot take it now (busy): the loop
+  /// offers it again next cycle.
+  virtual bool post(const CanSettings& s) = 0;
   /// Where the settings in use came from: GfinsCommandCounters.SettingsSource.
   virtual std::uint8_t source() const = 0;
 };

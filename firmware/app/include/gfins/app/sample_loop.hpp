@@ -143,10 +143,11 @@ struct LoopOptions {
   std::uint8_t node_id =
       can::kDefaultNodeId;     // the input frames (GNSS, heading) addressed to this node
   bool aiding_inputs = false;  // decode them and offer them to the filter
-  /// The CAN settings in use at start (the stored ones when the board has them) and the
-  /// configuration's own, to which RestoreDefaults returns.
-  CanSettings settings{};
-  CanSettings config_settings{};
+  /// What the settings store held at start (commands add to it), and the configuration's
+  /// dividers and node id, to which RestoreDefaults returns.
+  CanSettings stored{};
+  std::array<std::uint16_t, kNumMessages> config_dividers = kDefaultDividers;
+  std::uint8_t config_node_id = can::kDefaultNodeId;
 };
 
 class SampleLoop {
@@ -160,7 +161,8 @@ class SampleLoop {
   void set_watchdog(hal::Watchdog* wd) { watchdog_ = wd; }
   void set_reload_worker(ReloadWorker* w) { reload_ = w; }
   /// Where settings changed by SetDivider, SetNodeId and RestoreDefaults are kept across
-  /// restarts. Null: they last until the board stops, and SetNodeId is refused.
+  /// restarts. Null: they last until the board stops, and SetNodeId is refused (a node id that
+  /// would be forgotten before it takes effect).
   void set_settings_port(SettingsPort* p) { settings_port_ = p; }
   /// Where each cycle leaves the mode and health for the service status line (read by another
   /// thread: service_status.hpp).
@@ -177,6 +179,9 @@ class SampleLoop {
   Cycle step();
 
   const HealthCounters& health() const { return health_; }
+  /// At the end of a run (not from the loop): hands a change the store has not taken yet to
+  /// it, waiting for the store as long as it takes.
+  void flush_settings();
   /// False once the ADC has delivered nothing for kDeadAdcWatchdogNs with read errors: the loop
   /// no longer kicks the watchdog.
   bool kicking_watchdog() const { return !watchdog_held_; }
@@ -226,7 +231,7 @@ class SampleLoop {
   void note_refusal(can::ResultCode why);
   /// SetNodeId / RestoreDefaults (execute's settings part).
   void execute_settings(const can::Command& c, CommandReply& r);
-  /// Hands the settings in use to the store; retried each cycle until the store takes them.
+  /// Hands the settings to the store; retried each cycle until the store takes them.
   void offer_settings();
   std::uint8_t settings_source() const;
   void poll_reload(std::int64_t t_ns);
@@ -278,10 +283,9 @@ class SampleLoop {
   StatusBoard* status_board_ = nullptr;
   RecordQueue* recorder_ = nullptr;
   SettingsPort* settings_port_ = nullptr;
-  CanSettings settings_{};                    // in use (node id: the one of the next start)
-  std::optional<CanSettings> settings_post_;  // what the store is to keep (nullopt: forget)
-  bool settings_dirty_ = false;               // settings_post_ not yet taken by the store
-  std::uint16_t last_sequence_ = 0;           // the last sequence number taken this session
+  CanSettings settings_{};           // what the store is to keep: what commands set
+  bool settings_dirty_ = false;      // settings_ not yet taken by the store
+  std::uint16_t last_sequence_ = 0;  // the last sequence number taken this session
 
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};

@@ -230,6 +230,15 @@ inline constexpr std::array<ValueName, 12> kResultValues{{{0, "Ok"},
                                                           {11, "Replayed"},
                                                           {12, "OtherDevice"}}};
 
+/// GfinsCommandCounters.LastRefusal: the Result of the last refused command; 0 (Ok as a Result)
+/// means no refusal yet.
+constexpr std::array<ValueName, kResultValues.size()> refusal_values() {
+  std::array<ValueName, kResultValues.size()> v = kResultValues;
+  v[0] = ValueName{0, "None"};
+  return v;
+}
+inline constexpr std::array<ValueName, kResultValues.size()> kRefusalValues = refusal_values();
+
 /// Where the board's CAN settings (node id, dividers) came from (GfinsCommandCounters).
 inline constexpr std::array<ValueName, 4> kSettingsSourceValues{
     {{0, "Configuration"}, {1, "Stored"}, {2, "StoredCorrupt"}, {3, "SaveFailed"}}};
@@ -851,8 +860,8 @@ inline constexpr std::array<SignalDef, 39> kResponseSignals{{
                  kAtResponse, "Outcome of the command"),
     unsigned_int(
         "Value", Field::kRspValue, 0, 32, 24, 16777215.0, kPartStatus, {}, kAtResponse,
-        "Command-specific: the new divider, the accepted N, the new node id; for Replayed the "
-        "last sequence number the board took"),
+        "Command-specific: the new divider, the accepted N, the node id of the next start; for "
+        "ReportCalibrationId and Replayed the last sequence number the board took"),
     unsigned_int("CalId", Field::kRspCalId, 0, 24, 32, 4294967295.0, kPartCalibrationId, {},
                  kAtResponse, "Identity of the calibration in use (0 = nominal)"),
     unsigned_int("DonePose", Field::kRspPose, 0, 24, 8, 255.0, kPartCaptureDone, {}, kOverCapture,
@@ -879,7 +888,7 @@ inline constexpr std::array<SignalDef, 7> kCommandCountersSignals{{
     wrapping("ReplaysRefused", Field::kCmdReplayed, 32, 8, "", kCumulative,
              "Commands refused as Replayed (sequence number not above the last), mod 2^8"),
     unsigned_int("LastRefusal", Field::kCmdLastRefusal, 0, 40, 8, 255.0, kNotMultiplexed,
-                 kResultValues, kAtSample, "Result of the last refused command (0 = none yet)"),
+                 kRefusalValues, kAtSample, "Result of the last refused command (0 = none yet)"),
     unsigned_int("SettingsSource", Field::kSettingsSource, 0, 48, 2, 3.0, kNotMultiplexed,
                  kSettingsSourceValues, kAtSample,
                  "Where the CAN settings in use came from: 0 the configuration (nothing "

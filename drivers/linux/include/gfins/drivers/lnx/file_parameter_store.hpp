@@ -43,6 +43,8 @@ class FileParameterStore final : public hal::ParameterStore {
   const std::string& path() const { return path_; }
   /// The atomic save without the store's kMaxBytes limit (a tool's CSV output).
   [[nodiscard]] Status replace(std::span<const char> blob) { return do_save(blob); }
+  /// Removes the file (see remove_file_durably).
+  [[nodiscard]] Status remove();
   /// The step of the last failed save (meaningful only after save() failed).
   SaveStep last_failed_step() const { return last_failed_step_; }
 
@@ -62,5 +64,10 @@ class FileParameterStore final : public hal::ParameterStore {
 
 /// `blob` written to `path` with the store's atomic save and its target check, any size.
 Status save_file_atomically(std::string_view path, std::span<const char> blob, Os& os = real_os());
+
+/// Removes the regular file at `path` (nothing there is fine) and fsyncs its folder, so that the
+/// removal survives a power cut as a save does. A folder, link, FIFO, device or socket at the path
+/// is refused (kInvalidArgument) and left alone.
+Status remove_file_durably(std::string_view path, Os& os = real_os());
 
 }  // namespace gfins::drivers::lnx
