@@ -129,7 +129,12 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
 
   auto loop = std::make_unique<SampleLoop>(*board.source, *board.bus, *board.sink, *board.clock,
                                            *log_queue);
-  if (recorder) loop->set_recorder(&recorder->queue());
+  // The simulated board in fast pacing keeps no real time: it waits for the recorder's writer
+  // rather than lose records when the machine is busy.
+  if (recorder) {
+    loop->set_recorder(&recorder->queue(),
+                       cfg.board == BoardKind::kSim && cfg.pacing == Pacing::kFast);
+  }
   loop->set_commands(board.commands);
   loop->set_watchdog(board.watchdog.get());
   loop->set_reload_worker(&reload);

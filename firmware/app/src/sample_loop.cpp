@@ -59,6 +59,7 @@ SampleLoop::Cycle SampleLoop::step() {
   Cycle cycle = Cycle::kSample;
   if (r.is_ok()) {
     t_cycle_ = r.value().t_ns;
+    wait_for_recorder();
     if (recorder_ != nullptr && !record_sample(*recorder_, r.value())) note_record_dropped();
     on_sample(r.value());
   } else {
@@ -390,6 +391,11 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
 
 // ---- Commands -------------------------------------------------------------------------------
 
+void SampleLoop::wait_for_recorder() const {
+  if (recorder_ == nullptr || !recorder_waits_) return;
+  while (!recorder_->has_room()) std::this_thread::yield();
+}
+
 void SampleLoop::note_record_dropped() {
   ++health_.record_dropped;
   limited_log(LogKind::kRecordDropped, LogLevel::kError, t_cycle_,
@@ -403,6 +409,7 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
   for (int i = 0; i < kMaxCommandsPerCycle; ++i) {
     const Result<hal::CanFrame> f = bus_.receive(0);
     if (!f.is_ok()) return;  // kTimeout: nothing waiting
+    wait_for_recorder();
     if (recorder_ != nullptr && !record_frame(*recorder_, f.value(), t_ns)) note_record_dropped();
     if (options_.aiding_inputs && handle_input(f.value(), t_ns)) continue;
     if (!commands_) continue;

@@ -169,7 +169,12 @@ class SampleLoop {
   void set_status_board(StatusBoard* b) { status_board_ = b; }
   /// The raw-sample recorder's queue (record_queue.hpp): every sample read and every CAN frame
   /// received go into it, in the order the loop handles them. Null: no recording.
-  void set_recorder(RecordQueue* q) { recorder_ = q; }
+  /// With `wait_for_room` (the simulated board in fast pacing, which keeps no real time) the loop
+  /// waits for the writer when the queue is full instead of losing the record.
+  void set_recorder(RecordQueue* q, bool wait_for_room = false) {
+    recorder_ = q;
+    recorder_waits_ = wait_for_room;
+  }
 
   /// Start-up: configures the pipeline (alignment starts with the first sample).
   [[nodiscard]] Status configure(const CalibrationSet& cal, const LoopOptions& options);
@@ -261,6 +266,8 @@ class SampleLoop {
   bool handle_input(const hal::CanFrame& f, std::int64_t t_ns);
   /// A record the recorder's queue refused: counted and logged (rate-limited).
   void note_record_dropped();
+  /// In fast pacing: waits until the recorder's queue has room (see set_recorder).
+  void wait_for_recorder() const;
   /// Once per alignment: the mean |f| at rest against the navigation gravity.
   void check_gravity(std::int64_t t_ns);
   /// Logs why the core refused an alignment window (PipelineCounters::last_refusal), once per
@@ -282,6 +289,7 @@ class SampleLoop {
   ReloadWorker* reload_ = nullptr;
   StatusBoard* status_board_ = nullptr;
   RecordQueue* recorder_ = nullptr;
+  bool recorder_waits_ = false;
   SettingsPort* settings_port_ = nullptr;
   CanSettings settings_{};           // what the store is to keep: what commands set
   bool settings_dirty_ = false;      // settings_ not yet taken by the store

@@ -39,6 +39,11 @@ class SpscRing {
   }
 
   std::uint32_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
+  /// Producer side: whether a push now would find room.
+  bool has_room() const {
+    return head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) <
+           kCapacity;
+  }
   static constexpr std::size_t capacity() { return kCapacity; }
 
  private:
