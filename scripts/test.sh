@@ -191,7 +191,7 @@ fw_debs=(out/deb/gfins-fw_*_amd64.deb)
   { echo "test.sh: expected one out/deb/gfins-fw_*_amd64.deb, found: ${fw_debs[*]}" >&2; exit 1; }
 fw_deb=${fw_debs[0]}
 free_space "before the virtual board"
-./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,gnss,service}" \
+./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,gnss,ids,service}" \
   --deb "$fw_deb"
 
 # A background check's result: its log, and the run fails when it did.

@@ -3,7 +3,7 @@
 # data-ready line and the project's programs, runs the in-VM test (vm-test.sh) and turns the
 # console into a pass/fail and an exit status (0 = every check passed).
 #
-#   scripts/vboard/run.sh [--stages infra,backend,fw,cmd,faults,canlog,gnss,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
+#   scripts/vboard/run.sh [--stages infra,backend,fw,cmd,faults,canlog,gnss,ids,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
 #                         [--build-dir DIR] [--smp N] [--icount SHIFT|off] [--service-icount SHIFT|off]
 #                         [--measure]   (infra also measures the toggler alone at 250-4000 Hz and at full speed)
 #
@@ -14,7 +14,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 
-stages=infra,backend,fw,cmd,faults,canlog,gnss,service
+stages=infra,backend,fw,cmd,faults,canlog,gnss,ids,service
 rate=500
 timeout_s=600
 build_dir=$vboard_repo/build/host-release
@@ -24,7 +24,7 @@ service_icount=off  # systemd boot: icount's sleep=off would warp time over ever
 service_deb=""
 service_config=""
 measure=0
-known_stages=infra,backend,fw,cmd,faults,canlog,gnss,service
+known_stages=infra,backend,fw,cmd,faults,canlog,gnss,ids,service
 # value OPTION ARGS...: the option's value, or a usage error naming the option when none follows
 # (set -u would otherwise stop at "$2: unbound variable").
 value() {
@@ -92,7 +92,7 @@ args=()
 # to date in the build folder first, so a partial build (test.sh builds only what it runs)
 # cannot leave one missing or stale.
 targets=()
-for s in backend fw cmd faults canlog gnss; do
+for s in backend fw cmd faults canlog gnss ids; do
   want "$s" || continue
   [ -e "$here/stage-$s.sh" ] || continue
   while read -r need; do
@@ -126,7 +126,7 @@ fi
 # at the VM's data-ready rate. Stage fw compares the VM's output epoch by epoch with a host-only
 # run: the same configuration and scenario through the same binary in fast pacing, its frames
 # written to a candump log by the file sink and decoded to CSV by gfins-can.
-if want fw || want cmd || want faults || want gnss; then
+if want fw || want cmd || want faults || want gnss || want ids; then
   fwc=$vboard_cache/fw
   mkdir -p "$fwc/scenarios"
   sed "s/^rate_hz = .*/rate_hz = $rate.0/" "$here/vboard-rest.toml" >"$fwc/scenarios/vboard-rest.toml"
@@ -149,7 +149,7 @@ if want fw; then
   # The reference's CPU (libm's ifunc variants follow it); the VM prints the guest's.
   vb_log "stage fw: host CPU $(grep -m1 '^flags' /proc/cpuinfo | tr -s ' \t' ' ')"
 fi
-for s in backend fw cmd faults canlog gnss; do
+for s in backend fw cmd faults canlog gnss ids; do
   want "$s" || continue
   stage_script=$here/stage-$s.sh
   [ -e "$stage_script" ] || vb_die "stage '$s' has no scripts/vboard/stage-$s.sh yet"

@@ -6,7 +6,7 @@
 #   vcan0 down for 1 s, then up   SocketCAN refuses sends (ENETDOWN): CanTxDropped grows, bit 11
 #   data-ready edges stopped 1 s   SIGSTOP/SIGCONT of the toggler: bit 15 "data-ready lost",
 #                                  MissedEdges grows by the edges the ADC would have given
-#   the bus flooded 2 s            cangen -g 0 on 0x7FF: the receive queue overflows, bit 18
+#   the bus flooded 2 s            cangen -g 0 on 0x601: the receive queue overflows, bit 18
 #                                  "CAN frames lost on receive" and a log line with the count;
 #                                  the firmware keeps publishing
 # needs: build:firmware/app/gfins-fw
@@ -81,10 +81,14 @@ check faults-drdy-recovered "alive $(fw_alive); $w_epochs epochs in 2 s after, $
 rx_bit_before=$(bitname $w_flags 18)
 rx_lines_before=$(grep -c 'received CAN frame(s) lost' /tmp/faults-fw.log)
 
-# 0x7FF: the lowest priority identifier, so the firmware's frames still win arbitration on a
-# real bus; on vcan it is the socket queues that fill.
+# At the board's own command identifier (node 1: 0x601): the kernel's receive filter passes the
+# board only its command and input identifiers (docs/can-interface.md, "Identifiers"), so a flood
+# elsewhere never reaches its queue (stage ids); a babbling host at its command identifier does.
+# Eight zero bytes: the CRC-8/SAE-J1850 of identifier 0x601 and seven zeros is 0xC6, not the 0x00
+# in byte 7, so no frame of the flood can pass for a command; each one the loop reads is answered
+# BadCrc and counted.
 dropped_before=$w_dropped
-timeout 2 cangen vcan0 -g 0 -I 7FF -L 8 -i >/dev/null 2>&1 &
+timeout 2 cangen vcan0 -g 0 -I 601 -L 8 -D 0000000000000000 >/dev/null 2>&1 &
 flood_pid=$!
 window flood 2
 wait $flood_pid 2>/dev/null

@@ -4,7 +4,7 @@
 #   VBOARD-CHECK PASS|FAIL <name>: <what was measured>
 # and measurements print "VBOARD-MEASURE <name> <value>"; the last line is
 #   VBOARD-RESULT PASS|FAIL checks=N failed=F
-# Stages come from the kernel command line: vboard.stages=infra,backend,fw,cmd,faults,canlog,gnss (default all).
+# Stages come from the kernel command line: vboard.stages=infra,backend,fw,cmd,faults,canlog,gnss,ids (default all).
 # A stage whose program is missing FAILS naming it: nothing is skipped silently.
 failed=0
 checks=0
@@ -19,13 +19,13 @@ measure() { echo "VBOARD-MEASURE $1 $2"; }
 param() { sed -n "s/.*$1=\([^ ]*\).*/\1/p" /proc/cmdline; }
 
 stages=$(param vboard.stages)
-[ -n "$stages" ] || stages=infra,backend,fw,cmd,faults,canlog,gnss
+[ -n "$stages" ] || stages=infra,backend,fw,cmd,faults,canlog,gnss,ids
 # A stage name this test does not know fails (run.sh checks the names too; this catches a
 # kernel command line written by hand).
 for s in $(echo "$stages" | tr ',' ' '); do
   case $s in
-    infra | backend | fw | cmd | faults | canlog | gnss) ;;
-    *) fail "stage-$s: no such in-VM stage (known: infra, backend, fw, cmd, faults, canlog, gnss)" ;;
+    infra | backend | fw | cmd | faults | canlog | gnss | ids) ;;
+    *) fail "stage-$s: no such in-VM stage (known: infra, backend, fw, cmd, faults, canlog, gnss, ids)" ;;
   esac
 done
 rate=$(param vboard.rate)
@@ -135,7 +135,7 @@ if want infra; then
 fi
 
 uptime_s() { cut -d' ' -f1 /proc/uptime; }
-for s in backend fw cmd faults canlog gnss; do
+for s in backend fw cmd faults canlog gnss ids; do
   want $s || continue
   if [ -e /vboard/stage-$s.sh ]; then
     t0=$(uptime_s)

@@ -323,5 +323,62 @@ TEST_F(FwLogDecode, EveryDecodedSignalEqualsTheHostCoreWithinItsStep) {
       cw.outside, cw.values, cw.first_outside.c_str());
 }
 
+// A board with its identifier groups moved (can.*_id_base; docs/can-interface.md,
+// "Identifiers"): everything it sends is at the moved identifiers, written out here from the
+// bases and the ICD's offsets (GfinsEpoch 0x300 + node 1 = 0x301, GfinsCommandCounters 0x400 +
+// 1); gfins-can finds its epochs only with the board's configuration, and the DBC made from that
+// configuration names the moved identifiers.
+TEST_F(FwLogDecode, AMovedBoardIsDecodedWithItsConfiguration) {
+  const std::string cfg = path("moved.toml"), log = path("moved.log"), dbc = path("moved.dbc");
+  {
+    std::ofstream f(cfg);
+    f << "[can]\ndata_id_base = 0x300\ninput_id_base = 0x2A0\ncommand_id_base = 0x700\n"
+         "response_id_base = 0x710\nreserved_ids = [[0x600, 0x60F]]\n";
+  }
+  const auto fw = run(GFINS_FW_EXE, {"--config", cfg, "--sim", "rest", "--scenario-dir",
+                                     GFINS_SCENARIO_DIR, "--calibration", "", "--can-log", log,
+                                     "--duration", "2", "--watchdog", "none"});
+  ASSERT_EQ(fw.exit_code, 0) << fw.output;
+  // candump lines: "(seconds.micros) iface ID#DATA".
+  std::set<unsigned> ids;
+  std::istringstream lines(test::slurp(log));
+  for (std::string line; std::getline(lines, line);) {
+    const auto sp = line.find(' ', line.find(' ') + 1);
+    const auto hash = line.find('#');
+    ASSERT_NE(hash, std::string::npos) << line;
+    ids.insert(static_cast<unsigned>(std::stoul(line.substr(sp + 1, hash - sp - 1), nullptr, 16)));
+  }
+  ASSERT_FALSE(ids.empty());
+  EXPECT_TRUE(ids.contains(0x301)) << "GfinsEpoch of node 1 at 0x300 + 1";
+  EXPECT_TRUE(ids.contains(0x401)) << "GfinsCommandCounters at 0x300 + 0x100 + 1";
+  for (const unsigned id : ids) {
+    EXPECT_TRUE(id >= 0x301 && id <= 0x40F) << std::hex << "0x" << id << " outside the data group";
+  }
+  // Without the configuration these are no gfins frames: not one epoch.
+  const auto blind = run(GFINS_CAN_EXE, {"decode", log, "--view", "none"});
+  EXPECT_NE(blind.err.find(" 0 epochs,"), std::string::npos) << blind.err;
+  // With it, every epoch (2 s at divider 10: seq 0, 10, ..., 2000) and no problem.
+  const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--config", cfg, "--view", "none"});
+  EXPECT_EQ(dec.exit_code, 0) << dec.err;
+  EXPECT_NE(dec.err.find(" 201 epochs,"), std::string::npos) << dec.err;
+  EXPECT_NE(dec.err.find(" 0 problems"), std::string::npos) << dec.err;
+  // The DBC of that board: BO_ <decimal id> <name>: ...
+  const auto gen = run(GFINS_CAN_EXE, {"dbc", "--config", cfg, "-o", dbc});
+  ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  const std::string text = test::slurp(dbc);
+  for (const char* bo : {"BO_ 769 GfinsEpoch:", "BO_ 1025 GfinsCommandCounters:",
+                         "BO_ 1793 GfinsCommand:", "BO_ 1809 GfinsResponse:"}) {
+    EXPECT_NE(text.find(bo), std::string::npos) << bo;
+  }
+  // A configuration whose groups overlap is refused by gfins-can as by the firmware.
+  {
+    std::ofstream f(cfg);
+    f << "[can]\ncommand_id_base = 0x200\n";
+  }
+  const auto bad = run(GFINS_CAN_EXE, {"decode", log, "--config", cfg});
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("can.command_id_base = 0x200"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace gfins

@@ -178,6 +178,66 @@ std::uint16_t next_sequence() {
   return ++n;
 }
 
+// A board with its identifier groups moved (can.*_id_base; docs/can-interface.md, "Identifiers")
+// to data 0x300, inputs 0x2A0, command 0x700, response 0x710: the identifiers asked below are
+// written out here from those bases and the ICD's offsets (GfinsEpoch first of the data group,
+// the command and the response the only ones of theirs), not computed by the codec.
+TEST(CanIdentifiers, ABoardWithMovedGroupsAnswersAndSendsOnlyThere) {
+  SimRig rig("rest", 3.0);
+  rig.move_ids({0x300, 0x2A0, 0x700, 0x710});
+  rig.configure();
+  rig.run_cycles(1500);
+  ASSERT_EQ(rig.loop->mode(), can::Mode::kNavigating);
+  const can::IdBases moved{{0x300, 0x2A0, 0x700, 0x710}};
+  can::Command ask;
+  ask.opcode = can::Opcode::kReportCalibrationId;
+  ask.token = 41;
+  // The stock command identifier 0x601 carries other equipment's traffic now (an OxTS RT frame
+  // lands there): a frame there, even a valid gfins command, draws no answer at all.
+  const hal::CanFrame stock = can::encode_command(ask, SimRig::kNode);
+  ASSERT_EQ(stock.id, 0x601u);
+  const std::uint32_t done = rig.loop->health().commands;
+  rig.bus->clear_sent();
+  ASSERT_TRUE(rig.bus->inject_rx(stock));
+  hal::CanFrame foreign{};  // an OxTS-like frame: 8 bytes that are no gfins command at all
+  foreign.id = 0x601;
+  foreign.len = 8;
+  foreign.data = {0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88};
+  ASSERT_TRUE(rig.bus->inject_rx(foreign));
+  rig.run_cycles(4);
+  for (const hal::CanFrame& f : rig.bus->sent()) {
+    EXPECT_FALSE(f.id >= 0x680 && f.id <= 0x68F) << "a response at the stock identifiers";
+    EXPECT_FALSE(f.id >= 0x710 && f.id <= 0x71F) << "an answer to a frame that is not ours";
+  }
+  EXPECT_EQ(rig.loop->health().commands, done);
+  EXPECT_EQ(rig.loop->health().command_errors, 0u);
+  // The same command at 0x701 is answered at 0x711 (status part, then the calibration id).
+  const hal::CanFrame ours = can::encode_command(ask, SimRig::kNode, moved);
+  ASSERT_EQ(ours.id, 0x701u);
+  rig.bus->clear_sent();
+  ASSERT_TRUE(rig.bus->inject_rx(ours));
+  rig.run_cycles(12);  // the answer, and an epoch (divider 10) at least
+  int answers = 0;
+  bool epoch_at_moved = false, anything_at_stock = false;
+  for (const hal::CanFrame& f : rig.bus->sent()) {
+    if (f.id == 0x711) {
+      const auto r = can::decode_response(f, moved);
+      ASSERT_TRUE(r.is_ok()) << r.status().message();
+      EXPECT_EQ(r->token, 41);
+      ++answers;
+    }
+    if (f.id == 0x301) epoch_at_moved = true;
+    // Nothing at the stock data identifiers 0x101..0x20F of node 1 or the stock responses.
+    if ((f.id >= 0x100 && f.id <= 0x20F) || (f.id >= 0x680 && f.id <= 0x68F)) {
+      anything_at_stock = true;
+    }
+  }
+  EXPECT_EQ(answers, 2);
+  EXPECT_TRUE(epoch_at_moved);
+  EXPECT_FALSE(anything_at_stock);
+  EXPECT_EQ(rig.loop->health().commands, done + 1);
+}
+
 class CanCommands : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -27,6 +27,8 @@ void expect_defaults(const FwConfig& c) {
   EXPECT_EQ(c.can_interface, d.can_interface);
   EXPECT_EQ(c.can_log, d.can_log);
   EXPECT_EQ(c.node_id, d.node_id);
+  EXPECT_EQ(c.id_bases, d.id_bases);
+  EXPECT_EQ(c.reserved_ids, d.reserved_ids);
   EXPECT_EQ(c.dividers, d.dividers);
   EXPECT_EQ(c.compensator, d.compensator);
   EXPECT_EQ(c.gravity, d.gravity);
@@ -102,6 +104,17 @@ struct BadCase {
   std::vector<const char*> must_contain;  // every fragment must be in the message
 };
 
+// Each case's text, read as the file `name`, is refused with every fragment in the message.
+void expect_refused(const std::vector<BadCase>& cases, const char* name) {
+  for (const BadCase& c : cases) {
+    const ConfigResult r = parse_config(c.text, name);
+    ASSERT_FALSE(r.ok()) << c.text;
+    for (const char* frag : c.must_contain) {
+      EXPECT_NE(r.error.find(frag), std::string::npos) << "'" << frag << "' not in: " << r.error;
+    }
+  }
+}
+
 TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
   const std::vector<BadCase> cases = {
       {"[can]\nnode_id = 40\n", {"bad.toml:2", "can.node_id = 40", "0..15"}},
@@ -143,13 +156,45 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[can\nnode_id = 3\n", {"bad.toml:1", "TOML syntax"}},
       {"[sim]\npacing = \"edge\"\n", {"sim.pacing = \"edge\"", "\"gpio\""}},
   };
-  for (const BadCase& c : cases) {
-    const ConfigResult r = parse_config(c.text, "bad.toml");
-    ASSERT_FALSE(r.ok()) << c.text;
-    for (const char* frag : c.must_contain) {
-      EXPECT_NE(r.error.find(frag), std::string::npos) << "'" << frag << "' not in: " << r.error;
-    }
-  }
+  expect_refused(cases, "bad.toml");
+}
+
+// The identifier groups (docs/can-interface.md, "Identifiers"): each group's span written out
+// here from the message table of that page (data 0x100 + node .. 0x200 + node: 0x110 identifiers;
+// aiding inputs 0x0B0..0x0FF: 0x50; command and response 16 each), not taken from the code.
+TEST(Config, IdentifierGroupsMoveAsAWholeAndNeverOverlap) {
+  const ConfigResult moved = parse_config(
+      "[can]\ndata_id_base = 0x300\ninput_id_base = 0x2A0\ncommand_id_base = 0x700\n"
+      "response_id_base = 0x710\nreserved_ids = [[0x600, 0x60F], [0x181, 0x1DF]]\n",
+      "ids.toml");
+  ASSERT_TRUE(moved.ok()) << moved.error;
+  EXPECT_EQ(moved.config->id_bases, (std::array<int, 4>{0x300, 0x2A0, 0x700, 0x710}));
+  ASSERT_EQ(moved.config->reserved_ids.size(), 2u);
+  EXPECT_EQ(moved.config->reserved_ids[1], (std::array<int, 2>{0x181, 0x1DF}));
+  EXPECT_EQ(validate(*moved.config, "ids.toml"), "");
+
+  const std::vector<BadCase> cases = {
+      // Data 0x100..0x20F against the command group moved to 0x200: one identifier shared.
+      {"[can]\ncommand_id_base = 0x200\n",
+       {"ids.toml:2: can.command_id_base = 0x200",
+        "0x200..0x20F overlap can.data_id_base's "
+        "0x100..0x20F"}},
+      // The stock command group is where OxTS RT frames are: a reserved range says so.
+      {"[can]\nreserved_ids = [[0x600, 0x60F]]\n",
+       {"can.command_id_base = 0x600", "0x600..0x60F overlap the reserved range 0x600..0x60F"}},
+      // The last identifier of a group must fit in 11 bits: data at 0x700 would end at 0x80F.
+      {"[can]\ndata_id_base = 0x700\n", {"can.data_id_base = 0x700", "0..0x6F0"}},
+      {"[can]\nresponse_id_base = 0x7F1\n", {"can.response_id_base = 0x7F1", "0..0x7F0"}},
+      {"[can]\ninput_id_base = 2048\n", {"can.input_id_base = 2048", "0..2047"}},
+      {"[can]\ninput_id_base = -1\n", {"can.input_id_base = -1"}},
+      {"[can]\nreserved_ids = [[0x20, 0x10]]\n", {"can.reserved_ids", "first <= last"}},
+      {"[can]\nreserved_ids = [0x600]\n", {"can.reserved_ids", "[first, last] pairs"}},
+      {"[can]\nreserved_ids = [[0x600, 0x800]]\n", {"can.reserved_ids", "2047 (0x7FF)"}},
+  };
+  expect_refused(cases, "ids.toml");
+  // Touching but not overlapping is allowed: data ends at 0x20F, the inputs start at 0x210.
+  const ConfigResult touching = parse_config("[can]\ninput_id_base = 0x210\n", "ids.toml");
+  EXPECT_TRUE(touching.ok()) << touching.error;
 }
 
 CliResult cli(std::vector<const char*> args) {

@@ -101,6 +101,21 @@ struct SimRig {
     loop->set_commands(true);
   }
 
+  /// Moves the board's identifier groups (config.id_bases, can::IdGroup order) before
+  /// configure(): the publisher and the loop are made again with them.
+  void move_ids(const std::array<int, 4>& bases) {
+    config.id_bases = bases;
+    loop.reset();
+    recording.reset();
+    stalling.reset();
+    publisher = std::make_unique<app::PublisherSink>(
+        *bus, kNode, app::bus_dividers(config), app::bus_budget(config), app::id_bases(config));
+    stalling = std::make_unique<StallingSink>(*publisher, clock);
+    recording = std::make_unique<app::RecordingSink>(stalling.get(), 2 * std::size_t{samples});
+    loop = std::make_unique<app::SampleLoop>(*tap, *bus, *recording, clock, *log);
+    loop->set_commands(true);
+  }
+
   void configure() {
     const Status st = loop->configure(cal, app::loop_options(config));
     if (!st.is_ok()) throw std::runtime_error(st.message());

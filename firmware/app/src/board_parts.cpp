@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 
 #include "boards.hpp"
@@ -71,8 +72,32 @@ std::string open_can_output(const FwConfig& c, hal::Clock& clock, Board& b) {
     };
     return "";
   }
+  // Receive filters (CAN_RAW_FILTER): the kernel passes the loop only the frames addressed to
+  // this board, its command identifier and, when it takes them, its aiding inputs. The loop reads
+  // at most two frames per sample, so other equipment's traffic on a shared bus (3,400 frames/s
+  // of OxTS- and CANopen-like frames in the virtual board's stage ids) would otherwise fill the
+  // socket's receive queue and push a command out (docs/can-interface.md, "Identifiers").
+  static_assert(std::count_if(can::kMessages.begin(), can::kMessages.end(),
+                              [](const can::MessageDef& m) {
+                                return m.kind == can::MessageKind::kCommand ||
+                                       m.kind == can::MessageKind::kInput;
+                              }) <= static_cast<std::ptrdiff_t>(lnx::SocketCan::kMaxFilters),
+                "one receive filter per message the board takes");
+  std::array<lnx::CanFilter, lnx::SocketCan::kMaxFilters> filters{};
+  std::size_t n_filters = 0;
+  const auto node = static_cast<std::uint8_t>(c.node_id);
+  const can::IdBases ids = id_bases(c);
+  for (const can::MessageDef& m : can::kMessages) {
+    const bool wanted = m.kind == can::MessageKind::kCommand ||
+                        (m.kind == can::MessageKind::kInput && c.aiding && c.aiding_inputs);
+    if (wanted) {
+      filters[n_filters++] =
+          lnx::CanFilter{can::can_id(m.id, node, ids), hal::CanFrame::kMaxStandardId, false};
+    }
+  }
   lnx::SocketCanConfig sc;
   sc.interface = c.can_interface;
+  sc.filters = std::span<const lnx::CanFilter>(filters.data(), n_filters);
   auto bus = lnx::SocketCan::open(sc);
   if (!bus.is_ok()) return lnx::describe(c.can_interface, bus.status());
   b.bus = std::move(bus).value();
@@ -94,7 +119,8 @@ std::string open_watchdog(const FwConfig& c, hal::Clock& clock, Board& b) {
 
 void add_can_protocol(const FwConfig& c, Board& b) {
   const auto node = static_cast<std::uint8_t>(c.node_id);
-  b.sink = std::make_unique<PublisherSink>(*b.bus, node, bus_dividers(c), bus_budget(c));
+  b.sink =
+      std::make_unique<PublisherSink>(*b.bus, node, bus_dividers(c), bus_budget(c), id_bases(c));
   b.commands = true;
 }
 

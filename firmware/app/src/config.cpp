@@ -93,6 +93,28 @@ class Reader {
       }
     }
   }
+  // A list of [first, last] CAN identifier pairs (can.reserved_ids).
+  void id_ranges(const std::string& key, std::vector<std::array<int, 2>>& out) {
+    const toml::node* n = find(key);
+    if (n == nullptr) return;
+    const char* rule =
+        "must be a list of [first, last] pairs of 11-bit identifiers, 0 <= first <= last <= "
+        "2047 (0x7FF)";
+    const toml::array* a = n->as_array();
+    if (a == nullptr) fail(key, n, rule);
+    out.clear();
+    for (const toml::node& e : *a) {
+      const toml::array* pair = e.as_array();
+      if (pair == nullptr || pair->size() != 2) fail(key, n, rule);
+      const auto* first = pair->get(0)->as_integer();
+      const auto* last = pair->get(1)->as_integer();
+      if (first == nullptr || last == nullptr || first->get() < 0 || first->get() > last->get() ||
+          last->get() > 0x7FF) {
+        fail(key, n, rule);
+      }
+      out.push_back({static_cast<int>(first->get()), static_cast<int>(last->get())});
+    }
+  }
   // One of `names`; sets `out` to the matching enumerator of `values`.
   template <typename E, std::size_t N>
   void choice(const std::string& key, E& out, const std::array<const char*, N>& names,
@@ -194,6 +216,10 @@ void read_all(Reader& r, FwConfig& c) {
   r.integer("can.node_id", c.node_id, 0, kMaxNodeId);
   r.integer("can.bit_rate", c.can_bit_rate, 1, 1000000);
   r.number("can.max_bus_load_percent", c.max_bus_load_percent);
+  for (std::size_t g = 0; g < kIdBaseKeys.size(); ++g) {
+    r.integer(std::string(kIdBaseKeys[g]), c.id_bases[g], 0, 0x7FF);
+  }
+  r.id_ranges("can.reserved_ids", c.reserved_ids);
   r.text("can.settings_file", c.can_settings_file);
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     int d = c.dividers[m];

@@ -39,6 +39,49 @@ bool valid_ipv4(const std::string& s) {
   return parts == 4;
 }
 
+std::string hex_id(int id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
+  return buf;
+}
+
+// The identifier groups (docs/can-interface.md, "Identifiers"): each within 11 bits, none over
+// another or over a range the bus's other equipment uses (can.reserved_ids).
+std::optional<ConfigProblem> id_problem(const FwConfig& c) {
+  using P = ConfigProblem;
+  const auto range = [&](std::size_t g) {
+    const int first = c.id_bases[g];
+    return std::array<int, 2>{first, first + static_cast<int>(can::id_span(g)) - 1};
+  };
+  const auto shown = [](const std::array<int, 2>& r) { return hex_id(r[0]) + ".." + hex_id(r[1]); };
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    const std::string key(kIdBaseKeys[g]);
+    const std::array<int, 2> r = range(g);
+    if (c.id_bases[g] < 0 || r[1] > 0x7FF) {
+      return P{key, hex_id(c.id_bases[g]),
+               "the group takes " + std::to_string(can::id_span(g)) +
+                   " identifiers (every message of it for node ids 0..15): its base must be 0.." +
+                   hex_id(0x800 - static_cast<int>(can::id_span(g)))};
+    }
+    for (std::size_t h = 0; h < g; ++h) {
+      const std::array<int, 2> o = range(h);
+      if (r[0] <= o[1] && o[0] <= r[1]) {
+        return P{key, hex_id(c.id_bases[g]),
+                 "its identifiers " + shown(r) + " overlap " + std::string(kIdBaseKeys[h]) + "'s " +
+                     shown(o)};
+      }
+    }
+    for (const std::array<int, 2>& res : c.reserved_ids) {
+      if (r[0] <= res[1] && res[0] <= r[1]) {
+        return P{key, hex_id(c.id_bases[g]),
+                 "its identifiers " + shown(r) + " overlap the reserved range " + shown(res) +
+                     " of can.reserved_ids"};
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 // The data-ready line as gfins-fw opens it (open_drdy): all digits = a line offset, anything
 // else a line name; a sign in front of digits is a mistyped offset, not a name.
 std::string drdy_line_problem(const std::string& s) {
@@ -136,6 +179,7 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
              "must be one of 10000, 20000, 50000, 100000, 125000, 250000, 500000, 800000, "
              "1000000 bit/s (the bus's, as `ip link set ... bitrate` sets it)"};
   }
+  if (auto p = id_problem(c)) return p;
   if (!(c.max_bus_load_percent > 0.0 && c.max_bus_load_percent <= 100.0)) {
     return P{"can.max_bus_load_percent", num(c.max_bus_load_percent), "must be in (0, 100]"};
   }

@@ -42,11 +42,19 @@ can::BusBudget bus_budget(const FwConfig& c) {
                         c.max_bus_load_percent / 100.0};
 }
 
+can::IdBases id_bases(const FwConfig& c) {
+  can::IdBases b;
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    b.base[g] = static_cast<std::uint16_t>(c.id_bases[g]);
+  }
+  return b;
+}
+
 double worst_case_bus_load(const FwConfig& c) { return bus_budget(c).load(bus_dividers(c)); }
 
 PublisherSink::PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers,
-                             const can::BusBudget& budget)
-    : publisher_(bus, can::PublisherConfig{node_id, dividers, budget}) {}
+                             const can::BusBudget& budget, const can::IdBases& ids)
+    : publisher_(bus, can::PublisherConfig{node_id, ids, dividers, budget}) {}
 
 std::uint32_t PublisherSink::publish(const can::Epoch& e) {
   const can::PublisherCounters before = publisher_.counters();

@@ -39,7 +39,7 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_.config = cfg;
   options_ = options;
   settings_ = options.stored;
-  inputs_ = can::InputDecoder(options.node_id);
+  inputs_ = can::InputDecoder(options.node_id, options.ids);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
   adc_seen_ = adc_.counters();
   can_seen_ = bus_.counters();
@@ -413,7 +413,7 @@ void SampleLoop::handle_commands(std::int64_t t_ns) {
     if (recorder_ != nullptr && !record_frame(*recorder_, f.value(), t_ns)) note_record_dropped();
     if (options_.aiding_inputs && handle_input(f.value(), t_ns)) continue;
     if (!commands_) continue;
-    const can::DecodedCommand d = can::decode_command(f.value(), options_.node_id);
+    const can::DecodedCommand d = can::decode_command(f.value(), options_.node_id, options_.ids);
     if (!d.addressed) continue;
     CommandReply r;
     if (!d.ok()) {
@@ -612,12 +612,13 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
 
 void SampleLoop::send_response(const can::Response& r) {
   if (!commands_) return;
-  (void)bus_.send(can::encode_response(r, options_.node_id));
+  (void)bus_.send(can::encode_response(r, options_.node_id, options_.ids));
   // The calibration identity follows the response of a report or a reload that succeeded.
   const auto op = static_cast<can::Opcode>(r.opcode);
   if (r.result == can::ResultCode::kOk &&
       (op == can::Opcode::kReportCalibrationId || op == can::Opcode::kReloadCalibration)) {
-    (void)bus_.send(can::encode_calibration_id_response(r.token, cal_.cal_id, options_.node_id));
+    (void)bus_.send(
+        can::encode_calibration_id_response(r.token, cal_.cal_id, options_.node_id, options_.ids));
   }
 }
 
@@ -766,7 +767,7 @@ void SampleLoop::capture_finish() {
       cap.channels[0].count, cap.motion() ? 1 : 0);
   if (!commands_) return;
   for (const hal::CanFrame& f :
-       can::encode_capture_result(cap, capture_.command.token, options_.node_id)) {
+       can::encode_capture_result(cap, capture_.command.token, options_.node_id, options_.ids)) {
     (void)bus_.send(f);
   }
 }

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "gfins/app/can_settings.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 
 namespace gfins::app {
@@ -76,6 +77,7 @@ LoopOptions loop_options(const FwConfig& c) {
   o.sample_rate_hz = c.sample_rate_hz;
   o.node_id = static_cast<std::uint8_t>(c.node_id);
   o.aiding_inputs = c.aiding && c.aiding_inputs;
+  o.ids = id_bases(c);
   o.config_dividers = c.dividers;
   o.config_node_id = static_cast<std::uint8_t>(c.node_id);
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);

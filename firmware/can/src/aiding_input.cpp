@@ -44,9 +44,10 @@ std::uint64_t put(std::uint64_t p, const SignalDef& s, double x) {
   return insert_bits(p, s, encode_signal(s, x).bits);
 }
 
-hal::CanFrame frame_of(MessageId id, std::uint8_t node_id, std::uint64_t p, std::uint8_t counter) {
+hal::CanFrame frame_of(MessageId id, std::uint8_t node_id, const IdBases& ids, std::uint64_t p,
+                       std::uint8_t counter) {
   hal::CanFrame f;
-  f.id = can_id(id, node_id);
+  f.id = can_id(id, node_id, ids);
   f.len = kFrameLength;
   const MessageDef& m = message(id);
   p = insert_bits(p, sig(m, Field::kCounter), counter);
@@ -98,7 +99,7 @@ Result<InputEvent> InputDecoder::reject(InputReject why, ErrorCode code, const c
 
 Result<InputEvent> InputDecoder::add(const hal::CanFrame& f) {
   std::uint8_t node = 0;
-  const MessageDef* m = f.extended ? nullptr : find_message(f.id, &node);
+  const MessageDef* m = f.extended ? nullptr : find_message(f.id, ids_, &node);
   if (m == nullptr || m->kind != MessageKind::kInput || node != node_id_) return InputEvent{};
   last_reject_ = InputReject::kNone;
   if (f.len != kFrameLength) {
@@ -231,7 +232,8 @@ Result<InputEvent> InputDecoder::add_gnss(const MessageDef& m, std::uint64_t p, 
   return e;
 }
 
-std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t node_id) {
+std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t node_id,
+                                             const IdBases& ids) {
   const double na = std::nan("");
   const std::uint8_t id = fix.fix_id & 0x0Fu;
   const auto pos = [&](std::size_t i) { return fix.has_position ? fix.r_n_m[i] : na; };
@@ -240,18 +242,18 @@ std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t no
   const MessageDef& ne = message(MessageId::kGnssPositionNE);
   std::uint64_t p = put(0, sig(ne, Field::kInGnssPos, 0), pos(0));
   p = put(p, sig(ne, Field::kInGnssPos, 1), pos(1));
-  const hal::CanFrame f_ne = frame_of(MessageId::kGnssPositionNE, node_id, p, id);
+  const hal::CanFrame f_ne = frame_of(MessageId::kGnssPositionNE, node_id, ids, p, id);
 
   const MessageDef& d = message(MessageId::kGnssPositionD);
   p = put(0, sig(d, Field::kInGnssPos, 2), pos(2));
   p = put(p, sig(d, Field::kInGnssSigmaPosH), fix.has_position ? fix.sigma_pos_h_m : na);
   p = put(p, sig(d, Field::kInGnssSigmaPosV), fix.has_position ? fix.sigma_pos_v_m : na);
-  const hal::CanFrame f_d = frame_of(MessageId::kGnssPositionD, node_id, p, id);
+  const hal::CanFrame f_d = frame_of(MessageId::kGnssPositionD, node_id, ids, p, id);
 
   const MessageDef& v = message(MessageId::kGnssVelocity);
   p = 0;
   for (std::uint8_t i = 0; i < 3; ++i) p = put(p, sig(v, Field::kInGnssVel, i), vel(i));
-  const hal::CanFrame f_v = frame_of(MessageId::kGnssVelocity, node_id, p, id);
+  const hal::CanFrame f_v = frame_of(MessageId::kGnssVelocity, node_id, ids, p, id);
 
   const MessageDef& info = message(MessageId::kGnssFixInfo);
   p = put(0, sig(info, Field::kInGnssSigmaVel), fix.has_velocity ? fix.sigma_vel_mps : na);
@@ -259,16 +261,16 @@ std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t no
   const auto content = static_cast<std::uint8_t>((fix.has_position ? kContentPosition : 0) |
                                                  (fix.has_velocity ? kContentVelocity : 0));
   p = insert_bits(p, sig(info, Field::kInGnssContent), content);
-  const hal::CanFrame f_info = frame_of(MessageId::kGnssFixInfo, node_id, p, id);
+  const hal::CanFrame f_info = frame_of(MessageId::kGnssFixInfo, node_id, ids, p, id);
   return {f_ne, f_d, f_v, f_info};
 }
 
-hal::CanFrame encode_heading_fix(const HeadingFix& h, std::uint8_t node_id) {
+hal::CanFrame encode_heading_fix(const HeadingFix& h, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = message(MessageId::kHeadingInput);
   std::uint64_t p = put(0, sig(m, Field::kInHeading), h.heading_rad);
   p = put(p, sig(m, Field::kInHeadingSigma), h.sigma_rad);
   p = put(p, sig(m, Field::kInHeadingAge), h.age_s);
-  return frame_of(MessageId::kHeadingInput, node_id, p, h.sequence & 0x0Fu);
+  return frame_of(MessageId::kHeadingInput, node_id, ids, p, h.sequence & 0x0Fu);
 }
 
 }  // namespace gfins::can

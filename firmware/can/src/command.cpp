@@ -55,9 +55,9 @@ const char* to_string(Opcode op) {
   return "Unknown";
 }
 
-DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id) {
+DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id, const IdBases& ids) {
   DecodedCommand d;
-  if (f.extended || f.id != can_id(MessageId::kCommand, node_id)) return d;
+  if (f.extended || f.id != can_id(MessageId::kCommand, node_id, ids)) return d;
   d.addressed = true;
   if (f.len >= 1) d.error.opcode = f.data[0];
   if (f.len >= 2) d.error.token = f.data[1];
@@ -119,10 +119,10 @@ DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id) {
   return d;
 }
 
-hal::CanFrame encode_command(const Command& c, std::uint8_t node_id) {
+hal::CanFrame encode_command(const Command& c, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = cmd_def();
   hal::CanFrame f;
-  f.id = can_id(MessageId::kCommand, node_id);
+  f.id = can_id(MessageId::kCommand, node_id, ids);
   f.len = kFrameLength;
   std::uint64_t p = 0;
   const auto op = static_cast<std::uint8_t>(c.opcode);
@@ -168,10 +168,10 @@ hal::CanFrame encode_command(const Command& c, std::uint8_t node_id) {
 
 namespace {
 hal::CanFrame response_frame(std::uint8_t opcode, std::uint8_t token, std::uint8_t part,
-                             std::uint64_t body, std::uint8_t node_id) {
+                             std::uint64_t body, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = rsp_def();
   hal::CanFrame f;
-  f.id = can_id(MessageId::kResponse, node_id);
+  f.id = can_id(MessageId::kResponse, node_id, ids);
   f.len = kFrameLength;
   std::uint64_t p = body;
   p = insert_bits(p, sig(m, Field::kRspOpcode), opcode);
@@ -187,23 +187,24 @@ std::uint64_t put(std::uint64_t p, const SignalDef& s, double x) {
 }
 }  // namespace
 
-hal::CanFrame encode_response(const Response& r, std::uint8_t node_id) {
+hal::CanFrame encode_response(const Response& r, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = rsp_def();
   std::uint64_t p = 0;
   p = insert_bits(p, sig(m, Field::kRspResult), static_cast<std::uint8_t>(r.result));
   p = insert_bits(p, sig(m, Field::kRspValue), r.value);
-  return response_frame(r.opcode, r.token, kPartStatus, p, node_id);
+  return response_frame(r.opcode, r.token, kPartStatus, p, node_id, ids);
 }
 
 hal::CanFrame encode_calibration_id_response(std::uint8_t token, std::uint32_t cal_id,
-                                             std::uint8_t node_id) {
+                                             std::uint8_t node_id, const IdBases& ids) {
   const std::uint64_t p = insert_bits(0, sig(rsp_def(), Field::kRspCalId), cal_id);
-  return response_frame(kOpReportCalibrationId, token, kPartCalibrationId, p, node_id);
+  return response_frame(kOpReportCalibrationId, token, kPartCalibrationId, p, node_id, ids);
 }
 
 std::array<hal::CanFrame, kCaptureResultFrames> encode_capture_result(const CaptureResult& r,
                                                                       std::uint8_t token,
-                                                                      std::uint8_t node_id) {
+                                                                      std::uint8_t node_id,
+                                                                      const IdBases& ids) {
   const MessageDef& m = rsp_def();
   std::array<hal::CanFrame, kCaptureResultFrames> out{};
   std::size_t n = 0;
@@ -211,25 +212,25 @@ std::array<hal::CanFrame, kCaptureResultFrames> encode_capture_result(const Capt
     const ChannelCapture& ch = r.channels[c];
     out[n++] = response_frame(
         kOpStartCapture, token, static_cast<std::uint8_t>(kPartMean + c),
-        put(0, sig(m, Field::kRspMean, c), static_cast<double>(ch.mean_counts)), node_id);
+        put(0, sig(m, Field::kRspMean, c), static_cast<double>(ch.mean_counts)), node_id, ids);
     out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartStd + c),
                               put(0, sig(m, Field::kRspStd, c), static_cast<double>(ch.std_counts)),
-                              node_id);
+                              node_id, ids);
     std::uint64_t p = put(0, sig(m, Field::kRspCount, c), ch.count);
     p = insert_bits(p, sig(m, Field::kRspSaturated, c), ch.saturated ? 1u : 0u);
     p = insert_bits(p, sig(m, Field::kRspMotion, c), ch.motion ? 1u : 0u);
     out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartCount + c), p,
-                              node_id);
+                              node_id, ids);
   }
   std::uint64_t p = insert_bits(0, sig(m, Field::kRspPose), r.pose);
   p = insert_bits(p, sig(m, Field::kRspSamples), r.samples);
-  out[n] = response_frame(kOpStartCapture, token, kPartCaptureDone, p, node_id);
+  out[n] = response_frame(kOpStartCapture, token, kPartCaptureDone, p, node_id, ids);
   return out;
 }
 
-Result<ResponseFrame> decode_response(const hal::CanFrame& f) {
+Result<ResponseFrame> decode_response(const hal::CanFrame& f, const IdBases& ids) {
   std::uint8_t node = 0;
-  if (f.extended || find_message(f.id, &node) != &rsp_def()) {
+  if (f.extended || find_message(f.id, ids, &node) != &rsp_def()) {
     return Status(ErrorCode::kInvalidArgument, "response: not a GfinsResponse identifier");
   }
   if (f.len != kFrameLength) return Status(ErrorCode::kDataLoss, "response: length is not 8");

@@ -122,6 +122,10 @@ Status check_budget(const Dividers& d, const BusBudget& b) {
 
 Status check_config(const PublisherConfig& c) {
   if (c.node_id > kMaxNodeId) return Status(ErrorCode::kInvalidArgument, "can: node id > 15");
+  if (!id_bases_valid(c.ids)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "can: the identifier groups overlap or leave the 11-bit range");
+  }
   if (const Status s = check_dividers(c.dividers); !s.is_ok()) return s;
   return check_budget(c.dividers, c.budget);
 }
@@ -225,9 +229,10 @@ std::uint8_t selector_count(const MessageDef& m) {
 
 hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
                                 std::uint8_t counter, std::uint32_t* saturated,
-                                std::uint32_t* unavailable, std::uint8_t selector) {
+                                std::uint32_t* unavailable, std::uint8_t selector,
+                                const IdBases& ids) {
   hal::CanFrame f;
-  f.id = m.base_id + node_id;
+  f.id = can_id(m.id, node_id, ids);
   f.len = kFrameLength;
   std::uint64_t p = 0;
   for (const SignalDef& s : m.signals) {
@@ -256,6 +261,7 @@ Publisher::Publisher(hal::CanBus& bus, const PublisherConfig& c) : bus_(&bus) {
   init_status_ = check_config(c);
   if (init_status_.is_ok()) {
     node_id_ = c.node_id;
+    ids_ = c.ids;
     dividers_ = c.dividers;
     budget_ = c.budget;
   } else {
@@ -281,17 +287,17 @@ void Publisher::publish(const Epoch& e) {
     if (d == 0 || e.nav.seq % d != 0) continue;
     // A multiplexed message sends its selector values in turn, one per frame.
     std::uint8_t& sel = selector_[idx(m.id)];
-    frames[n++] = encode_data_frame(m, e, node_id_, counter_, &saturated, &unavailable, sel);
+    frames[n++] = encode_data_frame(m, e, node_id_, counter_, &saturated, &unavailable, sel, ids_);
     const std::uint8_t count = selector_count(m);
     if (count > 0) sel = static_cast<std::uint8_t>((sel + 1u) % count);
   }
   frames[0] = encode_data_frame(message(MessageId::kEpoch), e, node_id_, counter_, &saturated,
-                                &unavailable);
+                                &unavailable, 0, ids_);
   Epoch flagged = e;
   if (saturated != 0) flagged.status_bits |= status_bits::kCanSaturated;
   if (unavailable != 0) flagged.status_bits |= status_bits::kCanNotAvailable;
   frames[1] = encode_data_frame(message(MessageId::kStatus), flagged, node_id_, counter_,
-                                &saturated, &unavailable);
+                                &saturated, &unavailable, 0, ids_);
 
   for (std::size_t i = 0; i < n; ++i) {
     if (bus_->send(frames[i]).is_ok()) {

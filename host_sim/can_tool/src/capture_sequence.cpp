@@ -212,7 +212,7 @@ CommandOutcome capture_once(hal::CanBus& bus, std::uint8_t pose, std::uint16_t s
   c.samples = samples;
   CommandTimeouts t = o.timeouts;
   t.sample_rate_hz = o.sample_rate_hz;
-  return run_command(bus, c, o.node_id, t);
+  return run_command(bus, c, o.node_id, t, o.ids);
 }
 
 SequenceResult run_capture_sequence(hal::CanBus& bus, const std::vector<PlanPose>& plan,

@@ -49,6 +49,7 @@ enum class WaitMode : std::uint8_t {
 
 struct SequenceOptions {
   std::uint8_t node_id = 0;
+  can::IdBases ids;  // the board's identifier groups (docs/can-interface.md, "Identifiers")
   std::uint16_t samples = 2000;  // N per pose
   double sample_rate_hz = 1000.0;
   /// Volts at the sensor per ADC count (QA-1100 chain: 1.2 V / 2^23 / (1/8.33)).

@@ -40,9 +40,9 @@ std::string missing_capture_parts(const std::array<bool, kChannelParts>& seen) {
 }  // namespace
 
 CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t node_id,
-                           const CommandTimeouts& t) {
+                           const CommandTimeouts& t, const can::IdBases& ids) {
   CommandOutcome out;
-  const hal::CanFrame f = can::encode_command(c, node_id);
+  const hal::CanFrame f = can::encode_command(c, node_id, ids);
   const Status sent = bus.send(f);
   if (!sent.is_ok()) {
     out.kind = CommandOutcome::Kind::kSendFailed;
@@ -60,7 +60,7 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
     const Result<hal::CanFrame> rx =
         bus.receive(std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
     if (!rx.is_ok()) continue;  // timeout slices and transient errors: loop checks the deadline
-    const Result<can::ResponseFrame> r = can::decode_response(*rx);
+    const Result<can::ResponseFrame> r = can::decode_response(*rx, ids);
     // The calibration id frame always carries the ReportCalibrationId opcode, also when it
     // follows a reload (firmware/can command.cpp, encode_calibration_id_response).
     const bool id_after_reload = r.is_ok() && c.opcode == can::Opcode::kReloadCalibration &&
@@ -134,12 +134,13 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
 }
 
 CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
-                                         const CommandTimeouts& t, std::string* note) {
-  if (!can::carries_sequence(c.opcode)) return run_command(bus, c, node_id, t);
+                                         const CommandTimeouts& t, std::string* note,
+                                         const can::IdBases& ids) {
+  if (!can::carries_sequence(c.opcode)) return run_command(bus, c, node_id, t, ids);
   can::Command ask;
   ask.opcode = can::Opcode::kReportCalibrationId;
   ask.token = static_cast<std::uint8_t>(c.token - 1);
-  CommandOutcome asked = run_command(bus, ask, node_id, t);
+  CommandOutcome asked = run_command(bus, ask, node_id, t, ids);
   if (asked.kind != CommandOutcome::Kind::kOk || !asked.status_value) {
     asked.text = "could not read the board's last sequence number: " + asked.text;
     if (asked.kind == CommandOutcome::Kind::kOk) asked.kind = CommandOutcome::Kind::kTimeout;
@@ -160,7 +161,7 @@ CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::
       *note = "sequence number " + std::to_string(c.sequence) + " (the board's last was " +
               std::to_string(last) + ")";
     }
-    CommandOutcome out = run_command(bus, c, node_id, t);
+    CommandOutcome out = run_command(bus, c, node_id, t, ids);
     // Another host took the number in between: once more with the one after the board's.
     if (attempt > 0 || out.kind != CommandOutcome::Kind::kRejected ||
         out.status.result != can::ResultCode::kReplayed || !out.status_value) {

@@ -28,9 +28,10 @@ struct CommandTimeouts {
 };
 
 /// Sends `c` to `node_id` and waits. Frames from other nodes, other tokens and data frames are
-/// skipped. Waiting uses the bus's receive timeout and a steady clock.
+/// skipped. Waiting uses the bus's receive timeout and a steady clock. `ids`: the board's
+/// identifier groups (docs/can-interface.md, "Identifiers").
 CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t node_id,
-                           const CommandTimeouts& t);
+                           const CommandTimeouts& t, const can::IdBases& ids = {});
 
 /// run_command for a command with a sequence number the sender does not track
 /// (docs/can-interface.md, "Sequence numbers"): asks the board for the last number it took
@@ -39,6 +40,7 @@ CommandOutcome run_command(hal::CanBus& bus, const can::Command& c, std::uint8_t
 /// the one the board reported (and the next token). `note` receives a line saying what was done.
 /// Commands without a sequence number go as they are.
 CommandOutcome run_command_next_sequence(hal::CanBus& bus, can::Command c, std::uint8_t node_id,
-                                         const CommandTimeouts& t, std::string* note);
+                                         const CommandTimeouts& t, std::string* note,
+                                         const can::IdBases& ids = {});
 
 }  // namespace gfins::can_tool

@@ -207,6 +207,12 @@ StreamDecoder::StreamDecoder(EpochSink on_epoch, IssueSink on_issue)
   for (std::uint8_t node = 0; node <= can::kMaxNodeId; ++node) inputs_.emplace_back(node);
 }
 
+void StreamDecoder::set_id_bases(const can::IdBases& ids) {
+  ids_ = ids;
+  inputs_.clear();
+  for (std::uint8_t node = 0; node <= can::kMaxNodeId; ++node) inputs_.emplace_back(node, ids);
+}
+
 void StreamDecoder::issue(IssueKind k, std::uint64_t line, std::string text) {
   ++summary_.issues[static_cast<std::size_t>(k)];
   if (on_issue_) on_issue_(Issue{k, line, std::move(text)});
@@ -255,7 +261,7 @@ void StreamDecoder::feed_frame(std::uint64_t line_no, std::int64_t time_us,
   }
   last_log_time_us_ = time_us;
   std::uint8_t node = 0;
-  const can::MessageDef* m = f.extended ? nullptr : can::find_message(f.id, &node);
+  const can::MessageDef* m = f.extended ? nullptr : can::find_message(f.id, ids_, &node);
   if (m == nullptr) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "identifier 0x%X%s is not a gfins message", f.id,
@@ -323,7 +329,7 @@ void StreamDecoder::on_input(const hal::CanFrame& f, std::uint8_t node, std::uin
                              std::int64_t time_us) {
   // The board's own codec: what it would accept or reject, and why.
   const Result<can::InputEvent> r = inputs_[node].add(f);
-  const can::MessageDef* m = can::find_message(f.id, nullptr);
+  const can::MessageDef* m = can::find_message(f.id, ids_, nullptr);
   if (!r.is_ok()) {
     issue(IssueKind::kInputRejected, line,
           std::string(m->name) + ": " + can::to_string(inputs_[node].last_reject()) + " (" +

@@ -114,6 +114,9 @@ class StreamDecoder {
   StreamDecoder(EpochSink on_epoch, IssueSink on_issue);
   void set_notice_sink(NoticeSink on_notice) { on_notice_ = std::move(on_notice); }
   void set_input_sink(InputSink on_input) { on_input_ = std::move(on_input); }
+  /// The identifier groups of the boards on the bus (a board configured with can.*_id_base;
+  /// docs/can-interface.md, "Identifiers"). Call before the first frame.
+  void set_id_bases(const can::IdBases& ids);
 
   /// One candump line (parse errors become kMalformedLine issues).
   void feed_line(std::uint64_t line_no, std::string_view line);
@@ -193,6 +196,7 @@ class StreamDecoder {
   InputSink on_input_;
   Summary summary_;
   std::vector<can::InputDecoder> inputs_;  // one per node id
+  can::IdBases ids_{};
   std::int64_t last_log_time_us_ = std::numeric_limits<std::int64_t>::min();
   std::array<NodeState, can::kMaxNodeId + 1> nodes_{};
 };

@@ -54,7 +54,10 @@ std::string type_of(const SignalDef& s) {
 
 }  // namespace
 
-std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
+std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates, const can::IdBases& ids) {
+  // A message's identifier: its group's first one (configurable, can.*_id_base) + its offset in
+  // the group + the node id.
+  const auto id_of = [&](const MessageDef& m) { return can::can_id(m.id, node_id, ids); };
   std::ostringstream o;
   o << "VERSION \"gfins CAN interface, generated from firmware/can message_table.hpp, node "
     << int{node_id} << "\"\n\n\n";
@@ -62,7 +65,7 @@ std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
   o << "BS_:\n\n";
   o << "BU_: GFINS HOST GNSS\n\n\n";
   for (const MessageDef& m : can::kMessages) {
-    const std::uint32_t id = m.base_id + node_id;
+    const std::uint32_t id = id_of(m);
     o << "BO_ " << id << " " << m.name << ": " << int{can::kFrameLength} << " " << m.sender << "\n";
     for (const SignalDef& s : m.signals) {
       o << " SG_ " << s.name << mux_tag(s) << " : " << int{s.start_bit} << "|" << int{s.length}
@@ -77,8 +80,8 @@ std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
   o << "CM_ BU_ HOST \"Receiver of navigation frames, sender of commands\";\n";
   o << "CM_ BU_ GNSS \"GNSS receiver or aiding gateway: sender of the aiding input frames\";\n";
   for (const MessageDef& m : can::kMessages) {
-    const std::uint32_t id = m.base_id + node_id;
-    o << "CM_ BO_ " << id << " \"" << m.comment << ". Identifier 0x" << std::hex << m.base_id
+    const std::uint32_t id = id_of(m);
+    o << "CM_ BO_ " << id << " \"" << m.comment << ". Identifier 0x" << std::hex << id - node_id
       << std::dec << " + node id\";\n";
     for (const SignalDef& s : m.signals) {
       o << "CM_ SG_ " << id << " " << s.name << " \"" << signal_comment(s) << "\";\n";
@@ -100,21 +103,21 @@ std::string generate_dbc(std::uint8_t node_id, const DbcRates& rates) {
   for (const MessageDef& m : can::kMessages) {
     const std::uint16_t divider = rates.dividers[static_cast<std::size_t>(m.id)];
     const int send = m.kind != can::MessageKind::kData ? kEvent : divider == 0 ? kNotSent : kCyclic;
-    o << "BA_ \"GenMsgSendType\" BO_ " << m.base_id + node_id << " " << send << ";\n";
+    o << "BA_ \"GenMsgSendType\" BO_ " << id_of(m) << " " << send << ";\n";
   }
   for (const MessageDef& m : can::kMessages) {
     const std::uint16_t divider = rates.dividers[static_cast<std::size_t>(m.id)];
     if (m.kind != can::MessageKind::kData || divider == 0) continue;
     const double ms = 1000.0 * divider / rates.sample_rate_hz;
-    o << "BA_ \"GenMsgCycleTime\" BO_ " << m.base_id + node_id << " "
-      << std::max<long>(1, std::lround(ms)) << ";\n";
+    o << "BA_ \"GenMsgCycleTime\" BO_ " << id_of(m) << " " << std::max<long>(1, std::lround(ms))
+      << ";\n";
   }
   // Value descriptions: the enumerations, and the not-available raw code of every signal that has
   // one, so a DBC tool shows "NotAvailable" instead of a reading (Qw -1.00024).
   for (const MessageDef& m : can::kMessages) {
     for (const SignalDef& s : m.signals) {
       if (s.values.empty() && !s.has_na) continue;
-      o << "VAL_ " << m.base_id + node_id << " " << s.name;
+      o << "VAL_ " << id_of(m) << " " << s.name;
       for (const can::ValueName& v : s.values) o << " " << v.raw << " \"" << v.name << "\"";
       if (s.has_na) o << " " << s.na_raw << " \"" << kNotAvailableName << "\"";
       o << " ;\n";

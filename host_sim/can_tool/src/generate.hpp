@@ -20,8 +20,10 @@ struct DbcRates {
 
 /// The DBC of one node (identifiers = base + node_id). GenMsgCycleTime of each periodic message
 /// is 1000 x divider / sample rate in whole milliseconds (at least 1); a message switched off
-/// has none.
-std::string generate_dbc(std::uint8_t node_id = can::kDefaultNodeId, const DbcRates& rates = {});
+/// has none. `ids`: the identifier groups of the board (can.*_id_base; docs/can-interface.md,
+/// "Identifiers").
+std::string generate_dbc(std::uint8_t node_id = can::kDefaultNodeId, const DbcRates& rates = {},
+                         const can::IdBases& ids = {});
 
 /// Markdown: one table per message with every signal's type, factor, offset, unit, range,
 /// not-available value and instant.

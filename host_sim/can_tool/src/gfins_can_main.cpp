@@ -86,7 +86,25 @@ struct DecodeOptions {
   std::size_t max_issues = 20;  // printed per kind; all are counted
   bool quiet = false;
   double duration_s = 0.0;  // live: stop after this long (0 = until interrupted)
+  std::string config;       // --config: the boards' identifier groups from this file
+  can::IdBases ids;
 };
+
+/// --config FILE of decode, cmd, calibrate and gnss: the identifier groups (can.*_id_base) of a
+/// board from its gfins-fw configuration, and its can.node_id where `node` is not given on the
+/// command line (`node_given` false). False, after saying why, when the file does not load.
+bool board_from_config(const char* who, const std::string& path, bool node_given, int& node,
+                       can::IdBases& ids) {
+  if (path.empty()) return true;
+  const app::ConfigResult r = app::load_config(path);
+  if (!r.ok()) {
+    std::fprintf(stderr, "gfins-can %s: --config: %s\n", who, r.error.c_str());
+    return false;
+  }
+  ids = app::id_bases(*r.config);
+  if (!node_given) node = r.config->node_id;
+  return true;
+}
 
 /// Decodes every source into `view`; returns the exit code.
 int decode(const DecodeOptions& o, View& view) {
@@ -108,6 +126,7 @@ int decode(const DecodeOptions& o, View& view) {
         }
         ++n;
       });
+  dec.set_id_bases(o.ids);
   dec.set_input_sink([&](const DecodedInput& in) {
     if (o.node < 0 || in.node_id == o.node) view.input(in);
   });
@@ -198,6 +217,8 @@ struct GnssOptions {
   int node = 0;
   double duration_s = 0.0;
   double log_start_s = static_cast<double>(drivers::lnx::kSimulatedLogEpochS);
+  std::string config;
+  can::IdBases ids;
 };
 
 /// gfins-can gnss: the scenario's [gnss] receiver as input frames.
@@ -227,7 +248,7 @@ int run_gnss(const GnssOptions& o) {
                    bus.status().message());
       return kExitInput;
     }
-    const std::uint64_t refused = send_gnss_live(**bus, fixes, *sc->gnss, node);
+    const std::uint64_t refused = send_gnss_live(**bus, fixes, *sc->gnss, node, o.ids);
     std::fprintf(stderr, "gfins-can: %zu fixes sent, %llu frames refused by the bus\n",
                  fixes.size(), static_cast<unsigned long long>(refused));
     return refused == 0 ? kExitOk : kExitInput;
@@ -238,7 +259,7 @@ int run_gnss(const GnssOptions& o) {
                  std::strerror(errno));
     return kExitInput;
   }
-  const bool written = write_gnss_log(out, fixes, *sc->gnss, node, o.log_start_s);
+  const bool written = write_gnss_log(out, fixes, *sc->gnss, node, o.log_start_s, "can0", o.ids);
   return close_output(out, o.output) && written ? kExitOk : kExitInput;
 }
 
@@ -331,6 +352,8 @@ struct CmdOptions {
   int token = -1;
   int sequence = -1;        // -1: 1, and the board's next one when it answers Replayed
   double rate_hz = 1000.0;  // the board's sample rate: sizes a capture's wait (N / rate + 5 s)
+  std::string config;
+  can::IdBases ids;
 };
 
 // The longest response wait a command line may ask for (10 min): longer is a typo, not a board.
@@ -380,10 +403,10 @@ int run_cmd(const CmdOptions& o, can::Command c) {
   CommandOutcome r;
   if (o.sequence >= 0) {
     c.sequence = static_cast<std::uint16_t>(o.sequence);
-    r = run_command(**bus, c, node, t);
+    r = run_command(**bus, c, node, t, o.ids);
   } else {
     std::string note;
-    r = run_command_next_sequence(**bus, c, node, t, &note);
+    r = run_command_next_sequence(**bus, c, node, t, &note, o.ids);
     if (!note.empty()) std::fprintf(stderr, "gfins-can cmd: %s\n", note.c_str());
   }
   if (r.kind == CommandOutcome::Kind::kIncomplete) {
@@ -451,6 +474,8 @@ struct SequenceCliOptions {
   double pose_timeout_s = 60.0;
   int retries = 3;
   int timeout_ms = 1000;
+  std::string config;
+  can::IdBases ids;
 };
 
 /// The whole file under a temporary name, then renamed over the target
@@ -560,6 +585,7 @@ int run_calibrate_sequence(const SequenceCliOptions& o) {
   }
   SequenceOptions so;
   so.node_id = static_cast<std::uint8_t>(o.node);
+  so.ids = o.ids;
   so.samples = static_cast<std::uint16_t>(o.samples);
   so.sample_rate_hz = o.rate_hz;
   so.adc_lsb_v = o.adc_lsb;
@@ -629,6 +655,9 @@ int main_impl(int argc, char** argv) {
   dec->add_option("--max-issues", d.max_issues, "problems printed per kind (all are counted)")
       ->capture_default_str();
   dec->add_option("--duration", d.duration_s, "live: stop after this many seconds");
+  dec->add_option("--config", d.config,
+                  "a gfins-fw configuration file: the identifier groups (can.*_id_base) of the "
+                  "boards on the bus");
   dec->add_flag("-q,--quiet", d.quiet, "do not print each problem, only the summary");
 
   std::string plot_log, plot_png, plot_script;
@@ -651,6 +680,9 @@ int main_impl(int argc, char** argv) {
                   "sequence number of a configuration-changing command (default: the board's "
                   "last one, read first with ReportCalibrationId, plus 1)")
       ->check(CLI::Range(1, 65535));
+  cmd->add_option("--config", co.config,
+                  "the board's gfins-fw configuration file: its identifier groups "
+                  "(can.*_id_base) and, unless --node is given, its can.node_id");
   cmd->add_option("--rate", co.rate_hz,
                   "the board's sample rate, Hz (capture: wait N / rate + 5 s for the result)")
       ->check(CLI::Range(1.0, 100000.0))
@@ -766,6 +798,9 @@ int main_impl(int argc, char** argv) {
   calibrate->add_option("--retries", so.retries, "refused captures of a pose before giving up")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  calibrate->add_option("--config", so.config,
+                        "the board's gfins-fw configuration file: its identifier groups "
+                        "(can.*_id_base) and, unless --node is given, its can.node_id");
   calibrate->add_option("--timeout-ms", so.timeout_ms, "response timeout, ms")
       ->check(CLI::Range(1, kMaxTimeoutMs))
       ->capture_default_str();
@@ -815,6 +850,9 @@ int main_impl(int argc, char** argv) {
   gnss->add_option("--node", go.node, "node id of the board to aid")->check(CLI::Range(0, 15));
   gnss->add_option("--duration", go.duration_s, "seconds of fixes (0 = the scenario's duration)")
       ->check(CLI::Range(0.0, 86400.0));
+  gnss->add_option("--config", go.config,
+                   "the aided board's gfins-fw configuration file: its identifier groups "
+                   "(can.*_id_base) and, unless --node is given, its can.node_id");
   gnss->add_option("--log-start", go.log_start_s,
                    "log time of scenario time 0, s (default 1700000000, the epoch of every "
                    "simulated log)")
@@ -830,7 +868,8 @@ int main_impl(int argc, char** argv) {
   auto* dbc_config_opt = dbc->add_option(
       "--config", dbc_config,
       "a gfins-fw configuration file: the DBC of that board (its can.node_id unless --node "
-      "is given; cycle times from its adc.sample_rate_hz and [output] dividers)");
+      "is given; identifiers from its can.*_id_base; cycle times from its adc.sample_rate_hz and "
+      "[output] dividers)");
 
   try {
     app.parse(argc, argv);
@@ -839,16 +878,32 @@ int main_impl(int argc, char** argv) {
     return rc == 0 ? kExitOk : kExitUsage;
   }
 
-  if (dec->parsed()) return run_decode(d);
-  if (calibrate->parsed()) return run_calibrate_sequence(so);
+  if (dec->parsed()) {
+    int unused_node = 0;
+    if (!board_from_config("decode", d.config, true, unused_node, d.ids)) return kExitInput;
+    return run_decode(d);
+  }
+  if (calibrate->parsed()) {
+    if (!board_from_config("calibrate", so.config, calibrate->count("--node") != 0, so.node,
+                           so.ids)) {
+      return kExitInput;
+    }
+    return run_calibrate_sequence(so);
+  }
 #if GFINS_CAN_HAVE_HIL
   if (hil->parsed()) return run_hil(ho, std::cout, std::cerr);
 #endif
   if (plot->parsed()) return run_plot(plot_log, plot_png, plot_node, plot_script);
-  if (gnss->parsed()) return run_gnss(go);
+  if (gnss->parsed()) {
+    if (!board_from_config("gnss", go.config, gnss->count("--node") != 0, go.node, go.ids)) {
+      return kExitInput;
+    }
+    return run_gnss(go);
+  }
   if (dbc->parsed()) {
     // The configuration first: a file that does not load leaves the output untouched.
     DbcRates rates;
+    can::IdBases dbc_ids;
     if (dbc_config_opt->count() != 0) {
       const app::ConfigResult r = app::load_config(dbc_config);
       if (!r.ok()) {
@@ -857,6 +912,7 @@ int main_impl(int argc, char** argv) {
       }
       rates.sample_rate_hz = r.config->sample_rate_hz;
       rates.dividers = app::bus_dividers(*r.config);
+      dbc_ids = app::id_bases(*r.config);
       if (dbc->count("--node") == 0) dbc_node = static_cast<std::uint8_t>(r.config->node_id);
     }
     std::FILE* out = open_output(dbc_out);
@@ -865,7 +921,7 @@ int main_impl(int argc, char** argv) {
                    std::strerror(errno));
       return kExitInput;
     }
-    const std::string text = generate_dbc(dbc_node, rates);
+    const std::string text = generate_dbc(dbc_node, rates, dbc_ids);
     const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
     return close_output(out, dbc_out) && written ? kExitOk : kExitInput;
   }
@@ -902,6 +958,9 @@ int main_impl(int argc, char** argv) {
     c.node_id = static_cast<std::uint8_t>(new_node);
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
+  }
+  if (!board_from_config("cmd", co.config, cmd->count("--node") != 0, co.node, co.ids)) {
+    return kExitInput;
   }
   return run_cmd(co, c);
 }

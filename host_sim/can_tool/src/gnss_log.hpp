@@ -15,14 +15,16 @@
 namespace gfins::can_tool {
 
 /// Writes every fix's four frames as candump lines on interface `iface`, stamped at the fix's
-/// transmission time + `log_start_s`. False when writing failed.
+/// transmission time + `log_start_s`, at the board's identifier groups `ids`. False when writing
+/// failed.
 bool write_gnss_log(std::FILE* out, const std::vector<sim::GnssSample>& fixes,
                     const sim::GnssSpec& spec, std::uint8_t node_id, double log_start_s,
-                    const std::string& iface = "can0");
+                    const std::string& iface = "can0", const can::IdBases& ids = {});
 
 /// Sends the fixes on `bus`, each at its transmission time after the call (wall clock, steady);
 /// returns the frames the bus refused.
 std::uint64_t send_gnss_live(hal::CanBus& bus, const std::vector<sim::GnssSample>& fixes,
-                             const sim::GnssSpec& spec, std::uint8_t node_id);
+                             const sim::GnssSpec& spec, std::uint8_t node_id,
+                             const can::IdBases& ids = {});
 
 }  // namespace gfins::can_tool

@@ -248,6 +248,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<Issue> issues;
   StreamDecoder dec([&](const DecodedEpoch& e) { epochs.push_back(e); },
                     [&](const Issue& i) { issues.push_back(i); });
+  dec.set_id_bases(lo.ids);  // the board's identifier groups, from the same configuration
   const auto n_samples = static_cast<std::uint32_t>(in.samples.size());
   std::uint32_t sent = 0, acked = 0, naks = 0;
   std::uint64_t can_frames = 0;

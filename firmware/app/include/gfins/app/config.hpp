@@ -53,6 +53,10 @@ inline constexpr std::array<int, 9> kCanBitRates = {10000,  20000,  50000,  1000
 inline constexpr double kDefaultMaxBusLoadPercent =
     50.0;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
 
+/// The keys of FwConfig::id_bases, in can::IdGroup order.
+inline constexpr std::array<std::string_view, 4> kIdBaseKeys = {
+    "can.data_id_base", "can.input_id_base", "can.command_id_base", "can.response_id_base"};
+
 struct FwConfig {
   BoardKind board = BoardKind::kLinux;
 
@@ -68,6 +72,12 @@ struct FwConfig {
   int node_id = can::kDefaultNodeId;
   int can_bit_rate = static_cast<int>(can::kDefaultBitRate);  // bit/s of the bus (ip link's)
   double max_bus_load_percent = kDefaultMaxBusLoadPercent;    // the board's worst-case share
+  /// First identifier of each group (can::IdGroup order: data, input, command, response):
+  /// can.data_id_base, can.input_id_base, can.command_id_base, can.response_id_base.
+  std::array<int, 4> id_bases = {0x100, 0x0B0, 0x600, 0x680};
+  /// Identifier ranges other equipment on the bus uses (can.reserved_ids, [first, last] each):
+  /// no group may overlap one.
+  std::vector<std::array<int, 2>> reserved_ids;
   /// Where settings changed over CAN (node id, dividers) are kept across restarts; "" = not kept.
   std::string can_settings_file = "/var/lib/gfins/can-settings.toml";
   /// can.settings_file was given on the command line (--settings-file): the simulated and the

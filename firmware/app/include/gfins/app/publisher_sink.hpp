@@ -17,11 +17,13 @@ can::Dividers bus_dividers(const FwConfig& c);
 /// The bus the configuration describes (adc.sample_rate_hz, can.bit_rate,
 /// can.max_bus_load_percent): SetDivider is refused beyond it, as the configuration is.
 can::BusBudget bus_budget(const FwConfig& c);
+/// The identifier groups of the configuration (can.data_id_base, ...).
+can::IdBases id_bases(const FwConfig& c);
 
 class PublisherSink final : public EpochSink {
  public:
   PublisherSink(hal::CanBus& bus, std::uint8_t node_id, const can::Dividers& dividers,
-                const can::BusBudget& budget = {});
+                const can::BusBudget& budget = {}, const can::IdBases& ids = {});
   std::uint32_t publish(const can::Epoch& e) override;
   Status set_divider(std::size_t message, std::uint16_t divider) override;
   Status set_dividers(const std::array<std::uint16_t, kNumMessages>& dividers) override;

@@ -143,6 +143,7 @@ struct LoopOptions {
   std::uint8_t node_id =
       can::kDefaultNodeId;     // the input frames (GNSS, heading) addressed to this node
   bool aiding_inputs = false;  // decode them and offer them to the filter
+  can::IdBases ids{};          // the identifier groups (can.*_id_base)
   /// What the settings store held at start (commands add to it), and the configuration's
   /// dividers and node id, to which RestoreDefaults returns.
   CanSettings stored{};

@@ -83,7 +83,8 @@ struct InputEvent {
 /// partial fix it belonged to is dropped.
 class InputDecoder {
  public:
-  explicit InputDecoder(std::uint8_t node_id) : node_id_(node_id) {}
+  explicit InputDecoder(std::uint8_t node_id, const IdBases& ids = {})
+      : node_id_(node_id), ids_(ids) {}
 
   [[nodiscard]] Result<InputEvent> add(const hal::CanFrame& f);
 
@@ -97,6 +98,7 @@ class InputDecoder {
   Result<InputEvent> add_heading(std::uint64_t p, std::uint8_t seq);
 
   std::uint8_t node_id_;
+  IdBases ids_{};
   InputCounters counters_{};
   InputReject last_reject_ = InputReject::kNone;
   // The fix being assembled.
@@ -113,7 +115,9 @@ class InputDecoder {
 /// Host side: the four frames of a fix, in sending order (PositionNE, PositionD, Velocity,
 /// FixInfo), CRC sealed. Parts the fix does not have are sent as not available. Values beyond a
 /// signal's range saturate (σ rounds up: never smaller than stated).
-std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t node_id);
-hal::CanFrame encode_heading_fix(const HeadingFix& h, std::uint8_t node_id);
+std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t node_id,
+                                             const IdBases& ids = {});
+hal::CanFrame encode_heading_fix(const HeadingFix& h, std::uint8_t node_id,
+                                 const IdBases& ids = {});
 
 }  // namespace gfins::can

@@ -86,11 +86,12 @@ struct DecodedCommand {
   bool ok() const { return addressed && error.code == ResultCode::kOk; }
 };
 
-DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id);
+DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id,
+                              const IdBases& ids = {});
 
 /// Host side: a command frame (table-driven, CRC sealed). Arguments beyond their signal's range
 /// are written as given (raw bits) so tests can produce out-of-range commands.
-hal::CanFrame encode_command(const Command& c, std::uint8_t node_id);
+hal::CanFrame encode_command(const Command& c, std::uint8_t node_id, const IdBases& ids = {});
 
 // ---------------------------------------------------------------------------------------------
 // Responses
@@ -103,14 +104,14 @@ struct Response {
 };
 
 /// Part 0 (status) response frame.
-hal::CanFrame encode_response(const Response& r, std::uint8_t node_id);
+hal::CanFrame encode_response(const Response& r, std::uint8_t node_id, const IdBases& ids = {});
 /// The response to a malformed command.
 inline Response error_response(const CommandError& e) {
   return Response{e.opcode, e.token, e.code, 0};
 }
 /// Part 1: the answer to ReportCalibrationId.
 hal::CanFrame encode_calibration_id_response(std::uint8_t token, std::uint32_t cal_id,
-                                             std::uint8_t node_id);
+                                             std::uint8_t node_id, const IdBases& ids = {});
 
 struct ChannelCapture {
   float mean_counts = 0.0f;  // mean ADC code
@@ -138,7 +139,8 @@ struct CaptureResult {
 inline constexpr std::size_t kCaptureResultFrames = 19;
 std::array<hal::CanFrame, kCaptureResultFrames> encode_capture_result(const CaptureResult& r,
                                                                       std::uint8_t token,
-                                                                      std::uint8_t node_id);
+                                                                      std::uint8_t node_id,
+                                                                      const IdBases& ids = {});
 
 /// One decoded response frame (host side).
 struct ResponseFrame {
@@ -161,7 +163,7 @@ struct ResponseFrame {
 
 /// kInvalidArgument: not a response identifier; kDataLoss: wrong length or CRC; kOutOfRange:
 /// unknown part.
-Result<ResponseFrame> decode_response(const hal::CanFrame& f);
+Result<ResponseFrame> decode_response(const hal::CanFrame& f, const IdBases& ids = {});
 
 /// Collects the frames of a capture result (host side).
 class CaptureAssembler {

@@ -976,6 +976,92 @@ constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id) {
   return message(id).base_id + node_id;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Identifier groups (docs/can-interface.md, "Identifiers"). A configuration may move each group
+// as a whole: the data messages, the aiding inputs, the command, the response. A message keeps
+// its offset from its group's first identifier; the node id is added as before.
+
+enum class IdGroup : std::uint8_t { kData, kInput, kCommand, kResponse };
+inline constexpr std::size_t kIdGroupCount = 4;
+
+constexpr std::size_t id_group(MessageKind k) {
+  switch (k) {
+    case MessageKind::kInput:
+      return static_cast<std::size_t>(IdGroup::kInput);
+    case MessageKind::kCommand:
+      return static_cast<std::size_t>(IdGroup::kCommand);
+    case MessageKind::kResponse:
+      return static_cast<std::size_t>(IdGroup::kResponse);
+    case MessageKind::kData:
+      break;
+  }
+  return static_cast<std::size_t>(IdGroup::kData);
+}
+
+/// The table's own first identifier of each group (IdGroup order): the defaults.
+constexpr std::array<std::uint16_t, kIdGroupCount> default_id_bases() {
+  std::array<std::uint16_t, kIdGroupCount> b{0x7FF, 0x7FF, 0x7FF, 0x7FF};
+  for (const MessageDef& m : kMessages) {
+    const std::size_t g = id_group(m.kind);
+    if (m.base_id < b[g]) b[g] = m.base_id;
+  }
+  return b;
+}
+inline constexpr std::array<std::uint16_t, kIdGroupCount> kDefaultIdBases = default_id_bases();
+static_assert(kDefaultIdBases[0] == 0x100 && kDefaultIdBases[1] == 0x0B0 &&
+              kDefaultIdBases[2] == 0x600 && kDefaultIdBases[3] == 0x680);
+
+/// Identifiers a group takes from its first one: its last message's offset plus the 16 node ids.
+constexpr std::uint32_t id_span(std::size_t group) {
+  std::uint32_t span = 0;
+  for (const MessageDef& m : kMessages) {
+    if (id_group(m.kind) != group) continue;
+    const std::uint32_t end = m.base_id - kDefaultIdBases[group] + kNodeIdSpan;
+    if (end > span) span = end;
+  }
+  return span;
+}
+
+/// The first identifier of each group in use (IdGroup order).
+struct IdBases {
+  std::array<std::uint16_t, kIdGroupCount> base = kDefaultIdBases;
+  friend constexpr bool operator==(const IdBases&, const IdBases&) = default;
+};
+
+constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id, const IdBases& ids) {
+  const MessageDef& m = message(id);
+  const std::size_t g = id_group(m.kind);
+  return ids.base[g] + (m.base_id - kDefaultIdBases[g]) + node_id;
+}
+
+/// find_message with the groups at `ids`.
+constexpr const MessageDef* find_message(std::uint32_t can_id, const IdBases& ids,
+                                         std::uint8_t* node_id) {
+  for (const MessageDef& m : kMessages) {
+    const std::size_t g = id_group(m.kind);
+    const std::uint32_t first = ids.base[g] + (m.base_id - kDefaultIdBases[g]);
+    if (can_id >= first && can_id < first + kNodeIdSpan) {
+      if (node_id != nullptr) *node_id = static_cast<std::uint8_t>(can_id - first);
+      return &m;
+    }
+  }
+  return nullptr;
+}
+
+/// Whether the groups at `ids` fit the 11-bit identifier and do not overlap each other.
+constexpr bool id_bases_valid(const IdBases& ids) {
+  for (std::size_t g = 0; g < kIdGroupCount; ++g) {
+    if (ids.base[g] + id_span(g) > 0x800) return false;
+    for (std::size_t h = g + 1; h < kIdGroupCount; ++h) {
+      if (ids.base[g] < ids.base[h] + id_span(h) && ids.base[h] < ids.base[g] + id_span(g)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+static_assert(id_bases_valid(IdBases{}));
+
 /// Index of a signal by name within a message (kNoSignal when absent).
 inline constexpr std::size_t kNoSignal = static_cast<std::size_t>(-1);
 constexpr std::size_t signal_index(const MessageDef& m, std::string_view name) {

@@ -51,6 +51,7 @@ struct BusBudget {
 
 struct PublisherConfig {
   std::uint8_t node_id = 0;  // 0..kMaxNodeId: added to every base identifier
+  IdBases ids{};             // the first identifier of each group (docs/can-interface.md)
   Dividers dividers = default_dividers();
   BusBudget budget;
 };
@@ -80,9 +81,11 @@ double epoch_field(const Epoch& e, Field field, std::uint8_t index);
 /// navigation value or sensor output; a σ does not count: it is N/A without a filter and reads
 /// "at least max" when saturated). A
 /// multiplexed message carries the signals of selector value `selector` (ignored otherwise).
+/// The identifier is the message's with its group at `ids`.
 hal::CanFrame encode_data_frame(const MessageDef& m, const Epoch& e, std::uint8_t node_id,
                                 std::uint8_t counter, std::uint32_t* saturated,
-                                std::uint32_t* unavailable, std::uint8_t selector = 0);
+                                std::uint32_t* unavailable, std::uint8_t selector = 0,
+                                const IdBases& ids = {});
 
 /// Selector values of a multiplexed data message (0..n-1 in turn); 0 when not multiplexed.
 std::uint8_t selector_count(const MessageDef& m);
@@ -114,6 +117,7 @@ class Publisher {
  private:
   hal::CanBus* bus_;
   std::uint8_t node_id_ = 0;
+  IdBases ids_{};
   Dividers dividers_{};
   BusBudget budget_{};
   std::uint8_t counter_ = 0;                            // epoch counter, mod 16
