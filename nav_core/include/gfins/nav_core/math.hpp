@@ -9,6 +9,8 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <type_traits>
 
 namespace gfins::nav {
 
@@ -31,6 +33,34 @@ template <typename T>
 constexpr int padded_rows(int rows) {
   constexpr int kPacket = Eigen::internal::packet_traits<T>::size;
   return (rows + kPacket - 1) / kPacket * kPacket;
+}
+
+/// A 64-bit integer (a time in nanoseconds, a difference of two) as T, rounded to nearest as
+/// static_cast<T> rounds. For float, with 32-bit conversions only: the Cortex-M4F's FPU converts
+/// 32-bit integers (VCVT), while static_cast<float>(int64) calls libgcc's soft-float __aeabi_l2f,
+/// which drags 540 bytes of soft-float add and subtract into the flash image. Magnitudes from
+/// 2^31 on are shifted right into 31 bits with every bit shifted out ORed into the lowest one (a
+/// sticky bit): 31 significant bits are more than float's 24 + 2 that round-to-nearest needs to
+/// round the shorter number exactly as the full one, and the power-of-two scale back is exact.
+template <typename T>
+constexpr T from_int64(std::int64_t v) {
+  if constexpr (!std::is_same_v<T, float>) {
+    return static_cast<T>(v);
+  } else {
+    if (v >= -2147483647 && v <= 2147483647)
+      return static_cast<float>(static_cast<std::int32_t>(v));
+    const bool negative = v < 0;
+    // |v| as unsigned: well defined for INT64_MIN too (two's complement negation modulo 2^64).
+    std::uint64_t m =
+        negative ? ~static_cast<std::uint64_t>(v) + 1u : static_cast<std::uint64_t>(v);
+    float scale = 1.0f;
+    while (m > 0x7FFFFFFFu) {
+      m = (m >> 1) | (m & 1u);  // the sticky bit keeps "something was shifted out"
+      scale *= 2.0f;
+    }
+    const float f = static_cast<float>(static_cast<std::int32_t>(m)) * scale;
+    return negative ? -f : f;
+  }
 }
 
 /// An array of N zero vectors. Eigen leaves fixed-size matrices uninitialised even when

@@ -298,7 +298,7 @@ class ErrorStateFilter {
   bool recent(AidingKind kind, std::int64_t now_ns) const {
     const std::int64_t t = last_accepted_ns(kind);
     if (t == kNever) return false;
-    return static_cast<T>(now_ns - t) * T(1e-9) <= config_.aiding_timeout_s;
+    return from_int64<T>(now_ns - t) * T(1e-9) <= config_.aiding_timeout_s;
   }
 
   UpdateOutcome invalid(AidingKind kind) {
@@ -390,7 +390,7 @@ class ErrorStateFilter {
     T dt_s = T(0);
   };
   static FixAge age_of(const Nav& nav, std::int64_t t_valid_ns) {
-    return FixAge{&nav, static_cast<T>(nav.state().t_ns - t_valid_ns) * T(1e-9)};
+    return FixAge{&nav, from_int64<T>(nav.state().t_ns - t_valid_ns) * T(1e-9)};
   }
 
   /// Replaces rows/columns [i, i+3) of P: each state set from a fix (set_at_fix).
@@ -522,7 +522,7 @@ class ErrorStateFilter {
                             const FixAge& age) {
     if ((lost_ & filter_valid::kRollPitch) == 0) return Relevel::kNotNeeded;
     if (prev_vel_t_ns_ == kNever) return Relevel::kNotYet;
-    const T dt = static_cast<T>(fix.t_valid_ns - prev_vel_t_ns_) * T(1e-9);
+    const T dt = from_int64<T>(fix.t_valid_ns - prev_vel_t_ns_) * T(1e-9);
     HistoryEntry<T> before;
     if (!(dt >= T(0.05) && dt <= T(2)) || !history_.at(prev_vel_t_ns_, nav.state(), before)) {
       return Relevel::kUnable;
@@ -840,7 +840,7 @@ void ErrorStateFilter<T, HistoryCapacity>::refer_to_now(T* h, int rows, const Na
   // out). Φ ≈ I matters: an in-motion start leaves δω at the vehicle's turn rate, 0.3 rad/s, and
   // 100 ms later φ has moved by 0.03 rad and δv by |f| φ Δt; with Φ ≈ I the published σ of the
   // first ten seconds were optimistic (tests/nav_core/pipeline_in_motion_long.cpp).
-  const T dt = static_cast<T>(strapdown.state().t_ns - t_valid_ns) * T(1e-9);
+  const T dt = from_int64<T>(strapdown.state().t_ns - t_valid_ns) * T(1e-9);
   if (!(dt > T(0))) return;
   StateMat f;
   transition_model(strapdown, f);

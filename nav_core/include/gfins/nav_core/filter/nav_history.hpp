@@ -112,7 +112,7 @@ class NavHistory {
   template <typename A, typename B>
   static HistoryEntry<T> interpolate(const A& a, const B& b, std::int64_t t_ns) {
     const std::int64_t span = b.t_ns - a.t_ns;
-    const T w = span > 0 ? static_cast<T>(t_ns - a.t_ns) / static_cast<T>(span) : T(0);
+    const T w = span > 0 ? from_int64<T>(t_ns - a.t_ns) / from_int64<T>(span) : T(0);
     HistoryEntry<T> out;
     out.t_ns = t_ns;
     out.v_n = a.v_n + w * (b.v_n - a.v_n);
