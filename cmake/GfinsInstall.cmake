@@ -84,7 +84,11 @@ if(gfins_tool_targets)
   install(DIRECTORY host_sim/scenarios/ DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scenarios
           COMPONENT tools FILES_MATCHING PATTERN "*.toml")
   file(GLOB gfins_plot_scripts CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/scripts/*.py)
+  # plot_common.py is a module the scripts import from their folder, not a program.
+  list(FILTER gfins_plot_scripts EXCLUDE REGEX "/plot_common\\.py$")
   install(PROGRAMS ${gfins_plot_scripts} DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scripts
+          COMPONENT tools)
+  install(FILES scripts/plot_common.py DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/scripts
           COMPONENT tools)
   install(FILES ${gfins_examples} DESTINATION ${CMAKE_INSTALL_DATADIR}/gfins/examples
           COMPONENT tools)

@@ -16,6 +16,8 @@ import os
 import signal
 import sys
 
+from plot_common import note_nonfinite
+
 # Ctrl-C (SIGINT, which the terminal sends to gfins-sim and this script alike) ends the script
 # the way it ends any command-line program, without a Python traceback: the default action.
 signal.signal(signal.SIGINT, signal.SIG_DFL)
@@ -74,20 +76,6 @@ def column(rows, name, path=None):
                     "out of its panel")
             print(f"plot_covariance: warning: {path}: column {name}{what}", file=sys.stderr)
     return values
-
-
-def note_nonfinite(ax, series):
-    """Say on the panel which of its series, (name, values) pairs, hold no finite value (in the
-    middle) or some non-finite ones (a corner note). The warning on stderr names the file."""
-    empty = [n for n, v in series if not any(math.isfinite(x) for x in v)]
-    gaps = [n for n, v in series if n not in empty and not all(math.isfinite(x) for x in v)]
-    if empty:
-        ax.text(0.5, 0.5, "no finite values:\n" + "\n".join(empty), transform=ax.transAxes,
-                ha="center", va="center", fontsize=9, color="tab:red",
-                bbox={"facecolor": "white", "edgecolor": "tab:red", "alpha": 0.9})
-    if gaps:
-        ax.text(0.99, 0.02, "non-finite values left out: " + ", ".join(gaps),
-                transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="tab:red")
 
 
 def state_columns(header, prefix):

@@ -19,6 +19,8 @@ Matplotlib with the Agg backend (no display needed); numpy comes with matplotlib
 import signal
 import sys
 
+from plot_common import note_nonfinite
+
 # Ctrl-C (SIGINT, which the terminal sends to gfins-sim and this script alike) ends the script
 # the way it ends any command-line program, without a Python traceback: the default action.
 signal.signal(signal.SIGINT, signal.SIG_DFL)
@@ -88,22 +90,6 @@ class Table:
             warn(f"{self.path}: column {name}: {v.size - finite.sum()} of {v.size} values are "
                  f"not finite (NaN or inf): left out of its panel")
         return v
-
-
-def note_nonfinite(ax, series, gaps_ok=False):
-    """Say on the panel which of its series, (name, values) pairs, hold no finite value (in the
-    middle, the panel's axes being otherwise meaningless) or, unless gaps_ok, some non-finite
-    ones (a corner note: the line has gaps there). The warning on stderr names the file."""
-    empty = [n for n, v in series if not np.isfinite(v).any()]
-    gaps = [] if gaps_ok else [n for n, v in series
-                               if np.isfinite(v).any() and not np.isfinite(v).all()]
-    if empty:
-        ax.text(0.5, 0.5, "no finite values:\n" + "\n".join(empty), transform=ax.transAxes,
-                ha="center", va="center", fontsize=9, color="tab:red",
-                bbox={"facecolor": "white", "edgecolor": "tab:red", "alpha": 0.9})
-    if gaps:
-        ax.text(0.99, 0.02, "non-finite values left out: " + ", ".join(gaps),
-                transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="tab:red")
 
 
 def load(path):
