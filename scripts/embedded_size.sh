@@ -15,7 +15,9 @@
 #   2. the largest symbols of the program;
 #   3. every soft-float double routine (__aeabi_d*, __*df2/3, __aeabi_f2d, ...) and double libm
 #      function the program contains (there must be none), with the call path that reaches it
-#      from main, and then the same walk from the per-sample step gfins_nav_step();
+#      from main, and then the same walk from the per-sample step gfins_nav_step(); and libgcc's
+#      soft-float single routines (__aeabi_fadd, __aeabi_l2f, ...: the FPU does single precision,
+#      so none belongs in the image either);
 #   4. the limits check.
 # Exit status: 0 within the limits and free of double arithmetic, 1 when a limit is exceeded or a
 # soft-double routine is present, 2 on usage errors. Limits: GFINS_FLASH_LIMIT / GFINS_RAM_LIMIT
@@ -157,7 +159,21 @@ if bad:
         print("  SOFT DOUBLE: " + path(from_step, f))
     sys.exit(1)
 print("  no soft-float double routine is reachable: the step runs on the FPU in single precision")
-if present:
+# libgcc's single-precision soft-float set (add, subtract, multiply, divide, 64-bit integer
+# conversions) has no place on an FPU either: one static_cast<float>(int64) (__aeabi_l2f) drags
+# the whole object in, 668 B of flash (math.hpp, from_int64).
+soft_single = re.compile(r"^(__aeabi_(f(add|sub|rsub|mul|div)|u?l2f|f2u?lz)|__(add|sub|mul|div)sf3|"
+                         r"__float(un)?disf|__fix(uns)?sfdi)$")
+singles = sorted(f for f in graph if soft_single.match(f))
+print()
+print("== Soft-float single routines in the program (there must be none) ==")
+print("  " + (" ".join(singles) if singles else "(none)"))
+for f in singles:
+    callers = sorted(g for g in graph if f in graph[g])
+    for dem in demangle_all(callers):
+        if dem:
+            print("    called by " + dem[:150])
+if present or singles:
     sys.exit(1)
 PY
 status=0
@@ -181,7 +197,7 @@ if (( ram > ram_limit )); then
   status=1
 fi
 if (( status != 0 )); then
-  echo "  FAIL: see above (limits or soft-float double)" >&2
+  echo "  FAIL: see above (limits, soft-float double or single)" >&2
   exit 1
 fi
-echo "  OK: within the limits, no soft-float double routine in the image"
+echo "  OK: within the limits, no soft-float double or single routine in the image"
