@@ -33,9 +33,10 @@ sent=$(sed -n 's/.*: \([0-9]*\) fixes sent.*/\1/p' /tmp/gnss-send.out)
 check gnss-sent "gfins-can gnss --iface vcan0: exit $gnss_rc, ${sent:-no} fixes sent ($(tr '\n' ' ' </tmp/gnss-send.out | head -c 120))" \
   [ $gnss_rc -eq 0 -a "${sent:-0}" -ge $((gnss_seconds * 5 - 1)) ]
 # After the last fix: the counters' final values (AidingCounters go out every 0.4 s at 1 kHz, each
-# kind every 2 s: 2.5 s of frames hold each kind at least once).
+# kind every 2 s: 3 s of frames hold each kind at least once; BusyBox's timeout takes whole
+# seconds, 2.5 would be 2).
 sleep 0.5
-timeout 2.5 candump -L vcan0 >/tmp/gnss-after.log 2>/dev/null
+timeout 3 candump -L vcan0 >/tmp/gnss-after.log 2>/dev/null
 
 gfins-can decode /tmp/gnss-during.log --view csv -o /tmp/gnss-during.csv --quiet 2>/dev/null
 gfins-can decode /tmp/gnss-after.log --view csv -o /tmp/gnss-after.csv --quiet 2>/dev/null

@@ -149,17 +149,24 @@ struct DriveOutcome {
 
 class FwAidedDrive : public FwAided {
  protected:
-  DriveOutcome run_drive(bool inputs) {
-    const std::string tag = inputs ? "gnss" : "standstill";
+  /// `moved`: the board's data and input identifier groups moved (can.*_id_base), the scenario's
+  /// receiver following them and the decoder reading the board's configuration.
+  DriveOutcome run_drive(bool inputs, bool moved = false) {
+    const std::string tag = std::string(inputs ? "gnss" : "standstill") + (moved ? "-moved" : "");
     const std::string cfg = file(tag + ".toml", std::string("[aiding]\nenabled = true\ninputs = ") +
                                                     (inputs ? "true" : "false") +
-                                                    "\ngnss_lever_arm_m = [-1.0, 0.0, -1.2]\n");
+                                                    "\ngnss_lever_arm_m = [-1.0, 0.0, -1.2]\n" +
+                                                    (moved ? "[can]\ndata_id_base = 0x300\n"
+                                                             "input_id_base = 0x2A0\n"
+                                                           : ""));
     const std::string log = path(tag + ".log"), csv = path(tag + ".csv");
     const auto fw = run(GFINS_FW_EXE, {"--config", cfg, "--sim", "urban-stop-and-go",
                                        "--scenario-dir", GFINS_SCENARIO_DIR, "--calibration", "",
                                        "--can-log", log, "--duration", "60", "--watchdog", "none"});
     EXPECT_EQ(fw.exit_code, 0) << fw.output;
-    const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--view", "csv", "-o", csv});
+    std::vector<std::string> decode = {"decode", log, "--view", "csv", "-o", csv};
+    if (moved) decode.insert(decode.end(), {"--config", cfg});
+    const auto dec = run(GFINS_CAN_EXE, decode);
     EXPECT_EQ(dec.exit_code, 0) << dec.output;
     const auto sc = sim::load_scenario("urban-stop-and-go", GFINS_SCENARIO_DIR);
     EXPECT_TRUE(sc.is_ok());
@@ -240,6 +247,18 @@ TEST_F(FwAidedDrive, GnssInputFramesBoundPositionAndVelocityOnTheBus) {
   EXPECT_LT(c.epochs, 4000u);
   EXPECT_EQ(c.sigma_outside, 0u);
   EXPECT_EQ(c.gnss_accepted, 0u);
+}
+
+// The same drive with the board's data and input groups moved (docs/can-interface.md,
+// "Identifiers"): the receiver sends at the board's input identifiers and every fix is taken as
+// at the stock ones (the same bounds as above; a receiver left at the stock identifiers gave 0).
+TEST_F(FwAidedDrive, GnssInputFramesAtMovedIdentifiersAreTakenAsWell) {
+  const DriveOutcome a = run_drive(true, true);
+  ASSERT_GT(a.epochs, 4000u);
+  EXPECT_LE(a.rms_pos[0], 1.5);
+  EXPECT_LE(a.rms_pos[1], 1.5);
+  EXPECT_EQ(a.sigma_outside, 0u);
+  EXPECT_GE(a.gnss_accepted, 280u);
 }
 
 // Powered up on a moving vehicle: drive-gnss moves at 10 m/s on a weaving road from its first

@@ -370,6 +370,9 @@ TEST_F(FwLogDecode, AMovedBoardIsDecodedWithItsConfiguration) {
                          "BO_ 1793 GfinsCommand:", "BO_ 1809 GfinsResponse:"}) {
     EXPECT_NE(text.find(bo), std::string::npos) << bo;
   }
+  // gfins-can plot reads the log through the same configuration.
+  const auto plot = run(GFINS_CAN_EXE, {"plot", log, "--config", cfg, "-o", path("moved.png")});
+  EXPECT_EQ(plot.exit_code, 0) << plot.err;
   // A configuration whose groups overlap is refused by gfins-can as by the firmware.
   {
     std::ofstream f(cfg);

@@ -179,6 +179,12 @@ TEST(Config, IdentifierGroupsMoveAsAWholeAndNeverOverlap) {
        {"ids.toml:2: can.command_id_base = 0x200",
         "0x200..0x20F overlap can.data_id_base's "
         "0x100..0x20F"}},
+      // Only the data group moved, onto the commands' stock identifiers: the key the file set
+      // is the one named, with its line.
+      {"[can]\ndata_id_base = 0x5F0\n",
+       {"ids.toml:2: can.data_id_base = 0x5F0",
+        "0x5F0..0x6FF overlap can.command_id_base's "
+        "0x600..0x60F"}},
       // The stock command group is where OxTS RT frames are: a reserved range says so.
       {"[can]\nreserved_ids = [[0x600, 0x60F]]\n",
        {"can.command_id_base = 0x600", "0x600..0x60F overlap the reserved range 0x600..0x60F"}},

@@ -26,8 +26,8 @@ TEST(FromInt64, EdgesAndTiesRoundAsTheHardwareDoes) {
   constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min();
   constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
   const std::vector<std::int64_t> edges = {
-      0, 1, -1, 2147483647, -2147483647, 2147483648LL, -2147483648LL, 2147483649LL,
-      -2147483649LL, kMax, kMin, kMin + 1, kMax - 1,
+      0, 1, -1, 2147483647, -2147483647, 2147483648LL, -2147483648LL, 2147483649LL, -2147483649LL,
+      kMax, kMin, kMin + 1, kMax - 1,
       // Ties at a magnitude where float's step is 2^17 (2^40 .. 2^41): exactly half a step above
       // an even and an odd multiple (to even: down, then up), and one unit either side of a tie
       // (decided by the bits a plain truncation to 31 bits would lose: the sticky bit).

@@ -66,9 +66,15 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
     for (std::size_t h = 0; h < g; ++h) {
       const std::array<int, 2> o = range(h);
       if (r[0] <= o[1] && o[0] <= r[1]) {
-        return P{key, hex_id(c.id_bases[g]),
-                 "its identifiers " + shown(r) + " overlap " + std::string(kIdBaseKeys[h]) + "'s " +
-                     shown(o)};
+        // Named after the group that was moved: the one off its default, the later one if both
+        // or neither are (a file that moves only the data group onto the commands' stock
+        // identifiers hears about data_id_base, the key it set, with its line).
+        const bool blame_h =
+            c.id_bases[g] == FwConfig{}.id_bases[g] && c.id_bases[h] != FwConfig{}.id_bases[h];
+        const std::size_t a = blame_h ? h : g, b = blame_h ? g : h;
+        return P{std::string(kIdBaseKeys[a]), hex_id(c.id_bases[a]),
+                 "its identifiers " + shown(range(a)) + " overlap " + std::string(kIdBaseKeys[b]) +
+                     "'s " + shown(range(b))};
       }
     }
     for (const std::array<int, 2>& res : c.reserved_ids) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "gfins/app/board.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/app/sample_clock.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/progress_interval.hpp"
@@ -129,7 +130,8 @@ app::BoardResult make_board(const app::FwConfig& c) {
     }
     std::vector<sim::GnssSample> fixes = sim::GnssModel(*s.gnss, *traj.value()).fixes(duration);
     b->bus = std::make_unique<GnssReceiverBus>(std::move(b->bus), std::move(fixes), *s.gnss,
-                                               static_cast<std::uint8_t>(c.node_id), now_s);
+                                               static_cast<std::uint8_t>(c.node_id),
+                                               app::id_bases(c), now_s);
   }
   // Uncalibrated defaults: the nominal chain (no misalignment, nominal scale factors, no bias).
   // The factory calibration: the scenario's true parameters.

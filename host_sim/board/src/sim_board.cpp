@@ -184,11 +184,13 @@ can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec) {
 
 GnssReceiverBus::GnssReceiverBus(std::unique_ptr<hal::CanBus> inner,
                                  std::vector<sim::GnssSample> fixes, const sim::GnssSpec& spec,
-                                 std::uint8_t node_id, std::function<double()> now_s)
+                                 std::uint8_t node_id, const can::IdBases& ids,
+                                 std::function<double()> now_s)
     : inner_(std::move(inner)),
       fixes_(std::move(fixes)),
       spec_(spec),
       node_id_(node_id),
+      ids_(ids),
       now_s_(std::move(now_s)) {}
 
 Result<hal::CanFrame> GnssReceiverBus::do_receive(std::int64_t timeout_ns) {
@@ -200,7 +202,7 @@ Result<hal::CanFrame> GnssReceiverBus::do_receive(std::int64_t timeout_ns) {
       // board's time of validity (that sample's time - age) is the fix's own.
       can::GnssFix fix = to_gnss_fix(g, spec_);
       fix.age_s = now - g.t_valid_s;
-      pending_ = can::encode_gnss_fix(fix, node_id_);
+      pending_ = can::encode_gnss_fix(fix, node_id_, ids_);
       pending_next_ = 0;
       ++next_;
     }

@@ -295,7 +295,8 @@ std::string output_unwritable(const std::string& path) {
   return {};
 }
 
-int run_plot(const std::string& log, const std::string& png, int node, const std::string& script) {
+int run_plot(const std::string& log, const std::string& png, int node, const std::string& script,
+             const can::IdBases& ids) {
   namespace fs = std::filesystem;
   // Checked before the decode: a figure that cannot be written is a one-line error naming it,
   // not a traceback of the plot script after the work.
@@ -316,6 +317,7 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   o.view = "csv";
   o.output = csv.string();
   o.node = node;
+  o.ids = ids;
   o.quiet = true;
   const int rc = run_decode(o);
   if (rc == kExitInput || rc == kExitUsage || rc == kExitNoFrames) {  // nothing to plot
@@ -667,6 +669,10 @@ int main_impl(int argc, char** argv) {
   plot->add_option("-o,--output", plot_png, "PNG to write")->required();
   plot->add_option("--node", plot_node, "node id to plot (default: all)")->check(CLI::Range(0, 15));
   plot->add_option("--script", plot_script, "plot script (default: the installed plot_can.py)");
+  std::string plot_config;
+  plot->add_option("--config", plot_config,
+                   "a gfins-fw configuration file: the identifier groups (can.*_id_base) of the "
+                   "boards in the log");
 
   CmdOptions co;
   auto* cmd = app.add_subcommand("cmd", "send one command and wait for its response");
@@ -893,7 +899,12 @@ int main_impl(int argc, char** argv) {
 #if GFINS_CAN_HAVE_HIL
   if (hil->parsed()) return run_hil(ho, std::cout, std::cerr);
 #endif
-  if (plot->parsed()) return run_plot(plot_log, plot_png, plot_node, plot_script);
+  if (plot->parsed()) {
+    int unused_node = 0;
+    can::IdBases plot_ids;
+    if (!board_from_config("plot", plot_config, true, unused_node, plot_ids)) return kExitInput;
+    return run_plot(plot_log, plot_png, plot_node, plot_script, plot_ids);
+  }
   if (gnss->parsed()) {
     if (!board_from_config("gnss", go.config, gnss->count("--node") != 0, go.node, go.ids)) {
       return kExitInput;

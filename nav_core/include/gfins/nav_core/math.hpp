@@ -38,7 +38,7 @@ constexpr int padded_rows(int rows) {
 /// A 64-bit integer (a time in nanoseconds, a difference of two) as T, rounded to nearest as
 /// static_cast<T> rounds. For float, with 32-bit conversions only: the Cortex-M4F's FPU converts
 /// 32-bit integers (VCVT), while static_cast<float>(int64) calls libgcc's soft-float __aeabi_l2f,
-/// which drags 540 bytes of soft-float add and subtract into the flash image. Magnitudes from
+/// which drags 668 bytes of soft-float add and subtract into the flash image. Magnitudes from
 /// 2^31 on are shifted right into 31 bits with every bit shifted out ORed into the lowest one (a
 /// sticky bit): 31 significant bits are more than float's 24 + 2 that round-to-nearest needs to
 /// round the shorter number exactly as the full one, and the power-of-two scale back is exact.

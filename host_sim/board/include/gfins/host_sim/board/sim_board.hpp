@@ -299,9 +299,11 @@ can::GnssFix to_gnss_fix(const sim::GnssSample& s, const sim::GnssSpec& spec);
 /// it was valid; everything else goes to and comes from `inner`.
 class GnssReceiverBus final : public hal::CanBus {
  public:
-  /// `now_s`: the scenario time of the last sample the loop read.
+  /// `now_s`: the scenario time of the last sample the loop read; `ids`: the board's identifier
+  /// groups (can.*_id_base), at which the receiver sends.
   GnssReceiverBus(std::unique_ptr<hal::CanBus> inner, std::vector<sim::GnssSample> fixes,
-                  const sim::GnssSpec& spec, std::uint8_t node_id, std::function<double()> now_s);
+                  const sim::GnssSpec& spec, std::uint8_t node_id, const can::IdBases& ids,
+                  std::function<double()> now_s);
   std::size_t fixes_sent() const { return next_; }
 
  private:
@@ -315,6 +317,7 @@ class GnssReceiverBus final : public hal::CanBus {
   std::vector<sim::GnssSample> fixes_;
   sim::GnssSpec spec_;
   std::uint8_t node_id_;
+  can::IdBases ids_;
   std::function<double()> now_s_;
   std::size_t next_ = 0;
   std::array<hal::CanFrame, 4> pending_{};
