@@ -4,6 +4,7 @@
 #include "boards.hpp"
 #include "gfins/app/board.hpp"
 #include "gfins/app/publisher_sink.hpp"
+#include "gfins/app/startup.hpp"
 #include "gfins/drivers/lnx/candump.hpp"
 #include "gfins/drivers/lnx/candump_file_bus.hpp"
 #include "gfins/drivers/lnx/dev_watchdog.hpp"
@@ -85,14 +86,13 @@ std::string open_can_output(const FwConfig& c, hal::Clock& clock, Board& b) {
                 "one receive filter per message the board takes");
   std::array<lnx::CanFilter, lnx::SocketCan::kMaxFilters> filters{};
   std::size_t n_filters = 0;
-  const auto node = static_cast<std::uint8_t>(c.node_id);
-  const can::IdBases ids = id_bases(c);
+  const LoopOptions loop = loop_options(c);  // the node, groups and inputs the loop will take
   for (const can::MessageDef& m : can::kMessages) {
     const bool wanted = m.kind == can::MessageKind::kCommand ||
-                        (m.kind == can::MessageKind::kInput && c.aiding && c.aiding_inputs);
+                        (m.kind == can::MessageKind::kInput && loop.aiding_inputs);
     if (wanted) {
-      filters[n_filters++] =
-          lnx::CanFilter{can::can_id(m.id, node, ids), hal::CanFrame::kMaxStandardId, false};
+      filters[n_filters++] = lnx::CanFilter{can::can_id(m.id, loop.node_id, loop.ids),
+                                            hal::CanFrame::kMaxStandardId, false};
     }
   }
   lnx::SocketCanConfig sc;

@@ -54,6 +54,9 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
     return std::array<int, 2>{first, first + static_cast<int>(can::id_span(g)) - 1};
   };
   const auto shown = [](const std::array<int, 2>& r) { return hex_id(r[0]) + ".." + hex_id(r[1]); };
+  const auto overlap = [](const std::array<int, 2>& a, const std::array<int, 2>& b) {
+    return a[0] <= b[1] && b[0] <= a[1];
+  };
   for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
     const std::string key(kIdBaseKeys[g]);
     const std::array<int, 2> r = range(g);
@@ -64,13 +67,12 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
                    hex_id(0x800 - static_cast<int>(can::id_span(g)))};
     }
     for (std::size_t h = 0; h < g; ++h) {
-      const std::array<int, 2> o = range(h);
-      if (r[0] <= o[1] && o[0] <= r[1]) {
+      if (overlap(r, range(h))) {
         // Named after the group that was moved: the one off its default, the later one if both
         // or neither are (a file that moves only the data group onto the commands' stock
         // identifiers hears about data_id_base, the key it set, with its line).
         const bool blame_h =
-            c.id_bases[g] == FwConfig{}.id_bases[g] && c.id_bases[h] != FwConfig{}.id_bases[h];
+            c.id_bases[g] == can::kDefaultIdBases[g] && c.id_bases[h] != can::kDefaultIdBases[h];
         const std::size_t a = blame_h ? h : g, b = blame_h ? g : h;
         return P{std::string(kIdBaseKeys[a]), hex_id(c.id_bases[a]),
                  "its identifiers " + shown(range(a)) + " overlap " + std::string(kIdBaseKeys[b]) +
@@ -78,7 +80,7 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
       }
     }
     for (const std::array<int, 2>& res : c.reserved_ids) {
-      if (r[0] <= res[1] && res[0] <= r[1]) {
+      if (overlap(r, res)) {
         return P{key, hex_id(c.id_bases[g]),
                  "its identifiers " + shown(r) + " overlap the reserved range " + shown(res) +
                      " of can.reserved_ids"};

@@ -54,7 +54,7 @@ inline constexpr double kDefaultMaxBusLoadPercent =
     50.0;  // SCHED_FIFO range 1..99 (sched(7)); 0 = do not ask
 
 /// The keys of FwConfig::id_bases, in can::IdGroup order.
-inline constexpr std::array<std::string_view, 4> kIdBaseKeys = {
+inline constexpr std::array<std::string_view, can::kIdGroupCount> kIdBaseKeys = {
     "can.data_id_base", "can.input_id_base", "can.command_id_base", "can.response_id_base"};
 
 struct FwConfig {
@@ -74,7 +74,8 @@ struct FwConfig {
   double max_bus_load_percent = kDefaultMaxBusLoadPercent;    // the board's worst-case share
   /// First identifier of each group (can::IdGroup order: data, input, command, response):
   /// can.data_id_base, can.input_id_base, can.command_id_base, can.response_id_base.
-  std::array<int, 4> id_bases = {0x100, 0x0B0, 0x600, 0x680};
+  std::array<int, can::kIdGroupCount> id_bases = {can::kDefaultIdBases[0], can::kDefaultIdBases[1],
+                                                  can::kDefaultIdBases[2], can::kDefaultIdBases[3]};
   /// Identifier ranges other equipment on the bus uses (can.reserved_ids, [first, last] each):
   /// no group may overlap one.
   std::vector<std::array<int, 2>> reserved_ids;

@@ -961,21 +961,6 @@ constexpr const MessageDef& message(MessageId id) {
   return kMessages[static_cast<std::size_t>(id)];
 }
 
-/// The message a standard identifier belongs to and its node id; nullptr when unknown.
-constexpr const MessageDef* find_message(std::uint32_t can_id, std::uint8_t* node_id) {
-  for (const MessageDef& m : kMessages) {
-    if (can_id >= m.base_id && can_id < m.base_id + kNodeIdSpan) {
-      if (node_id != nullptr) *node_id = static_cast<std::uint8_t>(can_id - m.base_id);
-      return &m;
-    }
-  }
-  return nullptr;
-}
-
-constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id) {
-  return message(id).base_id + node_id;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Identifier groups (docs/can-interface.md, "Identifiers"). A configuration may move each group
 // as a whole: the data messages, the aiding inputs, the command, the response. A message keeps
@@ -1034,7 +1019,8 @@ constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id, const IdBases
   return ids.base[g] + (m.base_id - kDefaultIdBases[g]) + node_id;
 }
 
-/// find_message with the groups at `ids`.
+/// The message a standard identifier belongs to, with the groups at `ids`, and its node id;
+/// nullptr when unknown.
 constexpr const MessageDef* find_message(std::uint32_t can_id, const IdBases& ids,
                                          std::uint8_t* node_id) {
   for (const MessageDef& m : kMessages) {
@@ -1046,6 +1032,14 @@ constexpr const MessageDef* find_message(std::uint32_t can_id, const IdBases& id
     }
   }
   return nullptr;
+}
+
+/// The stock groups' identifier of a message, and the message of a stock identifier.
+constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id) {
+  return can_id(id, node_id, IdBases{});
+}
+constexpr const MessageDef* find_message(std::uint32_t can_id, std::uint8_t* node_id) {
+  return find_message(can_id, IdBases{}, node_id);
 }
 
 /// Whether the groups at `ids` fit the 11-bit identifier and do not overlap each other.
