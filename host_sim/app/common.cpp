@@ -361,9 +361,10 @@ void print_run_table(std::FILE* f, const SeriesStats& uncompensated,
     }
     std::fprintf(f,
                  "; standstill decisions vetoed (moving) %u, GNSS lock-out resets %u, "
-                 "divergence restarts %u, covariance resets %u\n",
+                 "divergence restarts %u, re-levels at rest %u (among the ZUPTs), covariance "
+                 "resets %u\n",
                  rep.motion_vetoes, rep.filter.gnss_lockout_resets, rep.filter.divergence_restarts,
-                 rep.filter.covariance_resets);
+                 rep.filter.rest_relevels, rep.filter.covariance_resets);
   }
 }
 

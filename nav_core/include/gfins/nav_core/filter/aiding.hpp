@@ -7,7 +7,9 @@
 //     propagates its covariance over the time since the previous propagation, and at the first
 //     propagation after a detector decision of "at rest" it applies the zero-velocity update
 //     (ZUPT) and, only when the ZUPT was accepted, the zero-rate update (ZARU), each through its
-//     χ² gate: once per decision, about the window just seen. Holding a decision over the next
+//     χ² gate: once per decision, about the window just seen; when the filter's tilt is lost or
+//     past its validity horizon the decision re-levels the board from the window's mean specific
+//     force instead (ErrorStateFilter::relevel_at_rest). Holding a decision over the next
 //     window applied ZUPTs up to a window into the motion that ends a stop (the board starting
 //     off, 0.15 m/s at 1.5 m/s² after 0.1 s, claimed 0 within the ZUPT's σ): the velocity σ was
 //     optimistic after every stop (NEES 1.36 per state over 100 runs of urban-stop-and-go,
@@ -197,6 +199,10 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
   if (!fresh) return;
   if (still_ && config_.standstill_updates && moving_) {
     ++motion_vetoes_;
+  } else if (still_ && config_.standstill_updates && filter_.relevel_wanted()) {
+    // No ZUPT brings a lost or far-off tilt back: the window's mean specific force levels it.
+    (void)filter_.relevel_at_rest(nav, detector_.mean_f(),
+                                  detector_.sigma2_f() / static_cast<T>(config_.standstill.window));
   } else if (still_ && config_.standstill_updates) {
     if (filter_.update_zupt(nav).status == UpdateStatus::kAccepted) {
       (void)filter_.update_zaru(nav);

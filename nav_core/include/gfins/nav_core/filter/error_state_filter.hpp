@@ -156,6 +156,7 @@ struct FilterCounters {
   std::uint32_t covariance_resets = 0;    // non-finite or negative diagonal found and reset
   std::uint32_t gnss_lockout_resets = 0;  // FilterConfig::gnss_lockout_fixes reached
   std::uint32_t divergence_restarts = 0;  // FilterConfig::diverged_sigma_tilt_rad, max_rate_rps
+  std::uint32_t rest_relevels = 0;        // relevel_at_rest
 };
 
 template <typename T, int HistoryCapacity = 32>
@@ -255,6 +256,36 @@ class ErrorStateFilter {
 
   /// Zero angular rate at standstill (3-D).
   UpdateOutcome update_zaru(Nav& nav);
+
+  /// At rest with the tilt lost (a divergence restart, an in-motion start) or far off
+  /// (relevel_wanted()), where a ZUPT cannot help: the linear update would converge to a wrong
+  /// attitude, and after a drive on accelerometers alone its gate refuses a velocity error of
+  /// hundreds of m/s. The mean specific
+  /// force of a window at rest is gravity's reaction, [0, 0, −g] in NED (the static alignment's
+  /// levelling, alignment.hpp), so the attitude is turned to put Ĉ f̄_b on the down axis, the
+  /// heading kept (turn_onto); velocity and rate are set to zero. Tilt variance per axis:
+  /// (var_f_mean + the largest f-bias variance of P) / |f̄|², the window mean's noise and what the
+  /// filter does not know of the bias, each a specific-force error δf giving δf / g of tilt; taken
+  /// uncorrelated with the bias (a wider P than the exact φ = δβ/g coupling: pessimistic, never
+  /// optimistic). Velocity and rate variances those of the ZUPT and ZARU. Counted as an accepted
+  /// ZUPT (it sets the velocity) and in FilterCounters::rest_relevels. The caller says the board
+  /// is at rest (the standstill detector, no GNSS saying it moves). kInvalid when the tilt is not
+  /// wanted or f̄_b is not finite or not within 90° of the down axis.
+  UpdateOutcome relevel_at_rest(Nav& nav, const Vec3<T>& f_mean_b, T var_f_mean);
+
+  /// The tilt is lost (a divergence restart or an in-motion start) until a re-level finds it.
+  bool tilt_lost() const { return (lost_ & filter_valid::kRollPitch) != 0; }
+  /// A standstill should re-level rather than update (relevel_at_rest): the tilt is lost, or its
+  /// 1σ is above the validity horizon valid_sigma_tilt_rad (roll and pitch not published). A
+  /// tilt that far off is outside the linear model a ZUPT works through (after 35 s of driving
+  /// on accelerometers alone the error was 26° with a 1σ under the divergence limit, and the
+  /// ZUPTs at the stop that followed were accepted and left it there), and one window's level
+  /// is far better than it.
+  bool relevel_wanted() const {
+    using namespace filt_idx;
+    const T horizon = config_.valid_sigma_tilt_rad * config_.valid_sigma_tilt_rad;
+    return tilt_lost() || !(p_(kPhi, kPhi) <= horizon && p_(kPhi + 1, kPhi + 1) <= horizon);
+  }
 
   /// GNSS antenna position valid at fix.t_valid_ns (≤ now, within the history).
   UpdateOutcome update_gnss_position(Nav& nav, const GnssFix<T>& fix);
@@ -532,6 +563,26 @@ class ErrorStateFilter {
     const Vec3<T> f_true = (fix.value_n - prev_vel_n_) / dt - g;
     const T sigma_tilt = T(1.41421356) * fix.sigma.maxCoeff() / dt / f_true.norm();
     if (!(sigma_tilt < config_.diverged_sigma_tilt_rad / T(2))) return Relevel::kUnable;
+    // The heading is kept when the track or an external heading sets it (heading_from_track_
+    // after an in-motion start; heading_aligned_ when a heading came before the tilt was found).
+    if (!turn_onto(nav, f_est, f_true, heading_from_track_ || heading_aligned_)) {
+      return Relevel::kUnable;
+    }
+    using namespace filt_idx;
+    for (int i = 0; i < 2; ++i) {
+      set_at_fix(kPhi + i, sigma_tilt * sigma_tilt, age);
+    }
+    lost_ &= static_cast<std::uint8_t>(~filter_valid::kRollPitch);
+    return Relevel::kDone;
+  }
+
+  /// The attitude turned so that f_est (a specific force in the estimated n frame) lies along
+  /// f_true (the same in the true n frame); only the directions count. Without keep_heading f_est
+  /// is first turned about the down axis to f_true's azimuth (a heading change); what remains is a
+  /// rotation about a horizontal axis, the tilt error, so a heading error never becomes tilt. With
+  /// keep_heading the yaw angle is the same after as before. False (nothing changed) when the two
+  /// are 90° or more apart. One body for the re-level from GNSS and at rest.
+  bool turn_onto(Nav& nav, const Vec3<T>& f_est, const Vec3<T>& f_true, bool keep_heading) {
     // The turn about down from f̂'s azimuth to f's: c = cos, s = sin of it (none when either has
     // no horizontal part).
     const T c = f_est.x() * f_true.x() + f_est.y() * f_true.y();
@@ -539,9 +590,6 @@ class ErrorStateFilter {
     const T r = std::sqrt(c * c + s * s);
     Vec3<T> f_turned = f_est;
     Vec3<T> yaw = Vec3<T>::Zero();
-    // The heading is kept when the track or an external heading sets it (heading_from_track_
-    // after an in-motion start; heading_aligned_ when a heading came before the tilt was found).
-    const bool keep_heading = heading_from_track_ || heading_aligned_;
     if (r > T(0) && !keep_heading) {
       f_turned.x() = (c * f_est.x() - s * f_est.y()) / r;
       f_turned.y() = (s * f_est.x() + c * f_est.y()) / r;
@@ -554,7 +602,7 @@ class ErrorStateFilter {
     if (keep_heading) axis.z() = T(0);
     const T sin_a = axis.norm();
     const T cos_a = f_turned.dot(f_true);
-    if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return Relevel::kUnable;
+    if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return false;
     const Vec3<T> tilt =
         sin_a > T(0) ? Vec3<T>(axis * (std::atan2(sin_a, cos_a) / sin_a)) : Vec3<T>::Zero();
     // q ← exp(tilt) ⊗ exp(yaw) ⊗ q̂; a kept heading is then put back: a turn of tens of degrees
@@ -568,12 +616,7 @@ class ErrorStateFilter {
       nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
       history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
     }
-    using namespace filt_idx;
-    for (int i = 0; i < 2; ++i) {
-      set_at_fix(kPhi + i, sigma_tilt * sigma_tilt, age);
-    }
-    lost_ &= static_cast<std::uint8_t>(~filter_valid::kRollPitch);
-    return Relevel::kDone;
+    return true;
   }
 
   /// The heading of the GNSS track (FilterConfig::track_heading_sigma_rad), valid at the fix's
@@ -913,6 +956,36 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_zaru(Nav& nav) {
 }
 
 template <typename T, int HistoryCapacity>
+UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::relevel_at_rest(Nav& nav,
+                                                                    const Vec3<T>& f_mean_b,
+                                                                    T var_f_mean) {
+  using namespace filt_idx;
+  const T g2 = f_mean_b.squaredNorm();
+  if (!started_ || !relevel_wanted() || !f_mean_b.allFinite() || !(g2 > T(0)) ||
+      !(var_f_mean >= T(0)) ||
+      !turn_onto(nav, nav.state().q_nb * f_mean_b, Vec3<T>(T(0), T(0), T(-1)), true)) {
+    return invalid(AidingKind::kZupt);
+  }
+  const Vec3<T> dv = nav.state().v_n;
+  const Vec3<T> dw = nav.state().w_b;
+  nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), dv, dw);
+  history_.shift(Vec3<T>::Zero(), Vec3<T>::Zero(), dv);
+  T bias_var = T(0);
+  for (int i = 0; i < 3; ++i) bias_var = std::max(bias_var, p_(kBiasF + i, kBiasF + i));
+  const T tilt_var = (var_f_mean + bias_var) / g2;
+  const T vel_var = config_.zupt_sigma_mps * config_.zupt_sigma_mps;
+  const T rate_var = config_.zaru_sigma_rps * config_.zaru_sigma_rps;
+  for (int i = 0; i < 3; ++i) {
+    if (i < 2) set_uncorrelated(kPhi + i, tilt_var);
+    set_uncorrelated(kVel + i, vel_var);
+    set_uncorrelated(kRate + i, rate_var);
+  }
+  lost_ &= static_cast<std::uint8_t>(~filter_valid::kRollPitch);
+  ++counters_.rest_relevels;
+  return accepted_reset(AidingKind::kZupt, nav);
+}
+
+template <typename T, int HistoryCapacity>
 UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_gnss_position(Nav& nav,
                                                                          const GnssFix<T>& fix) {
   HistoryEntry<T> at;
@@ -973,9 +1046,15 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
   NavAccuracy<T> a;
   const Mat3<T> j = euler_error_jacobian(nav.q_nb);
   const Mat3<T> ce = j * p_.template block<3, 3>(kPhi, kPhi) * j.transpose();
+  // While the heading is unknown (variance π², decoupled: outside the linear model) so is the
+  // direction of the horizontal velocity the board has gained since it was last set (a ZUPT at
+  // rest, a GNSS fix): v = R(δψ) v̂ with δψ anywhere, E|v̂ − v|² = 2 |v̂_h|² (1 − E cos δψ), so
+  // |v̂_h|² per axis is added. Without it the N and E σ of a board that re-levelled at a stop and
+  // drove off stayed at the ZUPT's while its velocity turned with the heading error.
+  const T heading_var = heading_aligned_ ? T(0) : nav.v_n.template head<2>().squaredNorm();
   for (int i = 0; i < 3; ++i) {
     a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
-    a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i));
+    a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i) + (i < 2 ? heading_var : T(0)));
     a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
   }
   constexpr T kNotAvailable = std::numeric_limits<T>::quiet_NaN();

@@ -101,7 +101,8 @@ class StandstillDetector {
     const Vec3<T> mean_w = sum_w_ / w;
     const T scatter_w = sum_wdot2_ - w * mean_w.squaredNorm();  // Σ‖ω̇_k − mean ω̇‖²
     statistic_ = (scatter / var_f_ + scatter_w / var_wdot_) / w;
-    const T g_err = std::abs((f_ref_ + mean_d).norm() - config_.gravity_mps2);
+    mean_f_ = f_ref_ + mean_d;
+    const T g_err = std::abs(mean_f_.norm() - config_.gravity_mps2);
     at_rest_ = statistic_ <= threshold_ && g_err <= config_.gravity_tolerance_mps2 &&
                mean_w.norm() <= wdot_tolerance_;
     ++windows_;
@@ -113,6 +114,9 @@ class StandstillDetector {
   bool at_rest() const { return at_rest_; }
   T statistic() const { return statistic_; }
   T threshold() const { return threshold_; }
+  /// The last complete window's mean specific force (body, m/s²).
+  const Vec3<T>& mean_f() const { return mean_f_; }
+  /// Per-axis variance of one sample's f (σ² M Mᵀ; the window mean's is this / W).
   T sigma2_f() const { return var_f_; }
   T sigma2_wdot() const { return var_wdot_; }
   std::uint32_t windows() const { return windows_; }
@@ -124,6 +128,7 @@ class StandstillDetector {
   T var_wdot_ = T(1);
   T threshold_ = T(0);
   Vec3<T> f_ref_ = Vec3<T>::Zero();
+  Vec3<T> mean_f_ = Vec3<T>::Zero();
   Vec3<T> sum_d_ = Vec3<T>::Zero();
   T sum_d2_ = T(0);
   Vec3<T> sum_w_ = Vec3<T>::Zero();

@@ -1,0 +1,176 @@
+// The re-level at rest of Aiding (filter/aiding.hpp, ErrorStateFilter::relevel_at_rest): a board
+// whose tilt is lost (here an in-motion start, lose_attitude; a divergence restart takes the same
+// path) and whose attitude is 20° of roll and 15° of pitch off stands still. No ZUPT can bring
+// that back; the window's mean specific force must.
+//
+// The truth is written here: the board at rest at roll 5°, pitch −3°, heading 40°, the array's
+// forward physics (filter_truth.hpp) with a constant bias per sensor and white noise. Tolerances:
+//  - roll and pitch within 4σ of the σ the filter publishes: the error is the window mean's noise
+//    plus the bias seen through the solve, both Gaussian, and the published σ covers them (it
+//    leaves out their correlation, so it is wider, not narrower); false failure below 6.4e-5 per
+//    axis and run for an honest σ. A sign or axis slip in the turn leaves tens of degrees.
+//  - that σ, just after the re-level, below 0.003°: the noise (1e-3 m/s² per sensor, 100-sample
+//    window) and the bias prior (2e-4 m/s² per sensor) give 1.6e-4 m/s² per axis, 1.6e-5 rad
+//    (0.0009°) of tilt; a variance not divided by g² gives a σ 9.8 times larger (checked).
+//  - the heading kept within 0.01°: nothing at rest observes it, and the turn that levels a 25°
+//    tilt moves the yaw angle by about roll × pitch (over 1°) unless it is put back.
+//  - the velocity within 0.03 m/s of zero (3σ of the ZUPT's 0.01 m/s): before the re-level the
+//    wrong tilt had made it grow by g sin 25° ≈ 4 m/s² over each window.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gfins/nav_core/filter/aiding.hpp"
+#include "nav_core/filter_truth.hpp"
+
+namespace gfins::nav {
+namespace {
+
+constexpr double kRateHz = 1000.0;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kNoise = 1e-3;  // white noise per sensor and sample, m/s² (about 0.1 mg)
+constexpr double kBias = 2e-4;   // constant bias per sensor, 1σ, m/s² (about 20 µg)
+
+struct Stand {
+  ArraySolver<double> solver = ArraySolver<double>::create(table1_geometry(0.1)).value();
+  Strapdown<double> nav{solver, GravityModel<double>::constant(testing::kG)};
+  Aiding<double> aiding;
+  testing::Truth truth = testing::rest(quat_from_euler(5.0 * kDeg, -3.0 * kDeg, 40.0 * kDeg));
+  testing::SensorErrors errors;
+  Vec6<double> ideal;
+
+  // init_sigma_tilt_rad: the filter's initial tilt 1σ; lose: an in-motion start on top (the tilt
+  // lost, whatever its σ).
+  Stand(bool standstill_updates, unsigned seed, double init_sigma_tilt_rad = 0.01, bool lose = true)
+      : errors(kBias, kNoise, seed) {
+    ideal = testing::ideal_outputs(solver.geometry(), truth);
+    testing::Truth wrong = truth;
+    wrong.q_nb = quat_from_euler(25.0 * kDeg, 12.0 * kDeg, 40.0 * kDeg);
+    wrong.v_n = Vec3<double>(7.0, -2.0, 0.5);
+    NavState<double> s = testing::nav_state_of<double>(wrong);
+    s.status |= nav_status::kAligned;
+    nav.initialize(s, errors.apply(ideal));
+    AidingConfig<double> c;
+    c.enabled = true;
+    c.standstill_updates = standstill_updates;
+    c.filter.heading_known = !lose;
+    c.filter.init_sigma_tilt_rad = init_sigma_tilt_rad;
+    c.filter.noise.white_sigma_mps2.fill(kNoise);
+    c.filter.noise.bias_sigma_mps2.fill(kBias);
+    c.standstill.white_sigma_mps2 = kNoise;
+    c.standstill.gravity_mps2 = testing::kG;
+    EXPECT_TRUE(aiding.configure(solver, c).is_ok());
+    aiding.start(nav);
+    if (lose) aiding.lose_attitude(nav);
+  }
+
+  void run(int samples) {
+    const double h = 1.0 / kRateHz;
+    for (int k = 0; k < samples; ++k) {
+      ++n_;
+      nav.step(errors.apply(ideal), h, std::int64_t{n_} * 1'000'000,
+               static_cast<std::uint32_t>(n_));
+      aiding.after_step(nav, h);
+    }
+  }
+  Vec3<double> euler_error() const {
+    const Vec3<double> d = euler_from_quat(nav.state().q_nb) - euler_from_quat(truth.q_nb);
+    return Vec3<double>(std::remainder(d(0), 2 * 180.0 * kDeg),
+                        std::remainder(d(1), 2 * 180.0 * kDeg),
+                        std::remainder(d(2), 2 * 180.0 * kDeg));
+  }
+  NavAccuracy<double> accuracy() const { return aiding.accuracy(nav.state()); }
+  const FilterCounters& counters() const { return aiding.filter().counters(); }
+
+ private:
+  int n_ = 0;
+};
+
+TEST(AidingRestRelevel, AStandstillLevelsALostTiltAndKeepsTheHeading) {
+  Stand b(true, 11);
+  b.run(50);  // half a detector window: nothing decided yet
+  EXPECT_TRUE(b.aiding.filter().tilt_lost());
+  EXPECT_TRUE(std::isnan(b.accuracy().euler_sigma_rad(0)));
+  EXPECT_EQ(b.accuracy().valid & filter_valid::kRollPitch, 0);
+
+  b.run(50);  // the first window's decision, applied at the propagation with its last sample
+  const FilterCounters& c = b.counters();
+  EXPECT_EQ(c.rest_relevels, 1u);
+  EXPECT_FALSE(b.aiding.filter().tilt_lost());
+  const auto check_tilt = [&b](double sigma_max_rad) {
+    const NavAccuracy<double> a = b.accuracy();
+    const Vec3<double> e = b.euler_error();
+    for (int i = 0; i < 2; ++i) {
+      SCOPED_TRACE(i == 0 ? "roll" : "pitch");
+      ASSERT_TRUE(std::isfinite(a.euler_sigma_rad(i)));
+      EXPECT_LT(a.euler_sigma_rad(i), sigma_max_rad);
+      EXPECT_LE(std::abs(e(i)), 4.0 * a.euler_sigma_rad(i));
+    }
+  };
+  check_tilt(0.003 * kDeg);
+
+  // 0.9 s more at rest: the ZUPT and ZARU hold it (the tilt σ grows with what the ZARU's 1e-3
+  // rad/s leaves of the rate, about 1e-4 rad per window: 0.05° bounds nine windows of it).
+  b.run(900);
+  EXPECT_EQ(c.rest_relevels, 1u);  // once: the tilt is found, then the ZUPTs hold it
+  EXPECT_GE(c.accepted[static_cast<std::size_t>(AidingKind::kZupt)], 5u);
+  check_tilt(0.05 * kDeg);
+  const NavAccuracy<double> a = b.accuracy();
+  const Vec3<double> e = b.euler_error();
+  EXPECT_LT(std::abs(e(2)), 0.01 * kDeg);
+  // Roll and pitch are published; heading, velocity and position are not (the heading is not
+  // known, so neither is the velocity's direction once the board moves off).
+  EXPECT_EQ(a.valid, filter_valid::kRollPitch);
+  EXPECT_LT(b.nav.state().v_n.norm(), 0.03);
+}
+
+TEST(AidingRestRelevel, WithoutStandstillUpdatesTheTiltStaysLost) {
+  Stand b(false, 11);  // negative control: the same board, the standstill updates off
+  b.run(1000);
+  EXPECT_EQ(b.counters().rest_relevels, 0u);
+  EXPECT_TRUE(b.aiding.filter().tilt_lost());
+  EXPECT_TRUE(std::isnan(b.accuracy().euler_sigma_rad(0)));
+  EXPECT_EQ(b.accuracy().valid & filter_valid::kRollPitch, 0);
+  EXPECT_GT(std::abs(b.euler_error()(0)), 10.0 * kDeg);
+}
+
+TEST(AidingRestRelevel, ATiltWhoseSigmaIsPastTheValidityHorizonIsRelevelledToo) {
+  // Not lost, but the filter's tilt 1σ (0.1 rad, 5.7°) is past the 1° horizon: roll and pitch are
+  // not published, and a 25° error is outside what the ZUPT's linear model can bring back. The
+  // heading is known and kept.
+  Stand b(true, 12, 0.1, false);
+  EXPECT_FALSE(b.aiding.filter().tilt_lost());
+  EXPECT_TRUE(b.aiding.filter().relevel_wanted());
+  b.run(100);
+  EXPECT_EQ(b.counters().rest_relevels, 1u);
+  EXPECT_FALSE(b.aiding.filter().relevel_wanted());
+  const NavAccuracy<double> a = b.accuracy();
+  const Vec3<double> e = b.euler_error();
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_LT(a.euler_sigma_rad(i), 0.003 * kDeg);
+    EXPECT_LE(std::abs(e(i)), 4.0 * a.euler_sigma_rad(i));
+  }
+  EXPECT_LT(std::abs(e(2)), 0.01 * kDeg);
+  EXPECT_NE(a.valid & filter_valid::kRollPitch, 0);
+}
+
+TEST(AidingRestRelevel, ATiltWithinTheValidityHorizonIsLeftToTheZupt) {
+  // The filter's tilt 1σ at 0.57° (the default P0), not lost: the tilt is the filter's to
+  // estimate (with its correlations), and a re-level is refused and counted as invalid.
+  Stand b(true, 11, 0.01, false);
+  EXPECT_FALSE(b.aiding.filter().relevel_wanted());
+  const std::uint32_t invalid_before =
+      b.counters().invalid[static_cast<std::size_t>(AidingKind::kZupt)];
+  Strapdown<double> copy = b.nav;
+  ErrorStateFilter<double> filter = b.aiding.filter();
+  const UpdateOutcome o = filter.relevel_at_rest(copy, Vec3<double>(0, 0, -testing::kG), 1e-8);
+  EXPECT_EQ(o.status, UpdateStatus::kInvalid);
+  EXPECT_EQ(filter.counters().invalid[static_cast<std::size_t>(AidingKind::kZupt)],
+            invalid_before + 1);
+  EXPECT_EQ(filter.counters().rest_relevels, 0u);
+  b.run(1000);  // and the pipeline leaves it to the ZUPT
+  EXPECT_EQ(b.counters().rest_relevels, 0u);
+}
+
+}  // namespace
+}  // namespace gfins::nav
