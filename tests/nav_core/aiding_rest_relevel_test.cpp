@@ -41,12 +41,19 @@ struct Stand {
 
   // init_sigma_tilt_rad: the filter's initial tilt 1σ; lose: an in-motion start on top (the tilt
   // lost, whatever its σ).
-  Stand(bool standstill_updates, unsigned seed, double init_sigma_tilt_rad = 0.01, bool lose = true)
+  // wrong_roll_deg: the strapdown's roll at the start (the truth's is 5°); moving: the true
+  // velocity is 30 m/s north (a straight drive at constant speed, which reads like rest), the
+  // strapdown's too.
+  Stand(bool standstill_updates, unsigned seed, double init_sigma_tilt_rad = 0.01, bool lose = true,
+        double wrong_roll_deg = 25.0, bool moving = false)
       : errors(kBias, kNoise, seed) {
     ideal = testing::ideal_outputs(solver.geometry(), truth);
     testing::Truth wrong = truth;
-    wrong.q_nb = quat_from_euler(25.0 * kDeg, 12.0 * kDeg, 40.0 * kDeg);
-    wrong.v_n = Vec3<double>(7.0, -2.0, 0.5);
+    wrong.q_nb = quat_from_euler(wrong_roll_deg * kDeg, 12.0 * kDeg, 40.0 * kDeg);
+    // Lost: the velocity is anything (7 m/s); not lost, the filter's velocity is right.
+    wrong.v_n = moving ? Vec3<double>(30.0, 0.0, 0.0)
+                       : (lose ? Vec3<double>(7.0, -2.0, 0.5) : Vec3<double>::Zero());
+    if (moving) truth.v_n = wrong.v_n;
     NavState<double> s = testing::nav_state_of<double>(wrong);
     s.status |= nav_status::kAligned;
     nav.initialize(s, errors.apply(ideal));
@@ -55,6 +62,7 @@ struct Stand {
     c.standstill_updates = standstill_updates;
     c.filter.heading_known = !lose;
     c.filter.init_sigma_tilt_rad = init_sigma_tilt_rad;
+    c.filter.init_sigma_vel_mps = 0.05;
     c.filter.noise.white_sigma_mps2.fill(kNoise);
     c.filter.noise.bias_sigma_mps2.fill(kBias);
     c.standstill.white_sigma_mps2 = kNoise;
@@ -135,10 +143,11 @@ TEST(AidingRestRelevel, WithoutStandstillUpdatesTheTiltStaysLost) {
 }
 
 TEST(AidingRestRelevel, ATiltWhoseSigmaIsPastTheValidityHorizonIsRelevelledToo) {
-  // Not lost, but the filter's tilt 1σ (0.1 rad, 5.7°) is past the 1° horizon: roll and pitch are
-  // not published, and a 25° error is outside what the ZUPT's linear model can bring back. The
-  // heading is known and kept.
-  Stand b(true, 12, 0.1, false);
+  // Not lost, but the filter's tilt 1σ (0.3 rad, 17°) is past the 1° horizon: roll and pitch are
+  // not published, and a 20-25° error is outside what the ZUPT's linear model can bring back. The
+  // velocity is known, and the window's drift (g sin 25° over 0.1 s) passes the gate with that
+  // tilt σ. The heading is known and kept.
+  Stand b(true, 12, 0.3, false);
   EXPECT_FALSE(b.aiding.filter().tilt_lost());
   EXPECT_TRUE(b.aiding.filter().relevel_wanted());
   b.run(100);
@@ -152,6 +161,35 @@ TEST(AidingRestRelevel, ATiltWhoseSigmaIsPastTheValidityHorizonIsRelevelledToo) 
   }
   EXPECT_LT(std::abs(e(2)), 0.01 * kDeg);
   EXPECT_NE(a.valid & filter_valid::kRollPitch, 0);
+}
+
+TEST(AidingRestRelevel, ATiltMoreThanAQuarterTurnOffIsLevelledToo) {
+  // A lost tilt can be past 90° (the unaided drive: 89° after 10 s); at rest f̄ is exact, so the
+  // level takes any angle short of upside-down exactly. Strapdown roll 130° against the truth's 5°.
+  Stand b(true, 13, 0.01, true, 130.0);
+  b.run(100);
+  EXPECT_EQ(b.counters().rest_relevels, 1u);
+  const NavAccuracy<double> a = b.accuracy();
+  const Vec3<double> e = b.euler_error();
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(std::isfinite(a.euler_sigma_rad(i)));
+    EXPECT_LE(std::abs(e(i)), 4.0 * a.euler_sigma_rad(i)) << i;
+  }
+}
+
+TEST(AidingRestRelevel, ACruiseThatReadsLikeRestIsNotLevelledToAStop) {
+  // A straight drive at 30 m/s (the specific force is gravity's alone, as at rest) with the tilt
+  // σ past the horizon and the velocity known to 0.05 m/s: the re-level's velocity gate refuses
+  // a zero velocity (NIS ≈ 30² / 0.05² against 16.3), counted as a rejected ZUPT and a motion
+  // veto, and the velocity stays. Without the gate it was set to zero with the ZUPT's σ.
+  Stand b(true, 14, 0.1, false, 25.0, true);
+  ASSERT_TRUE(b.aiding.filter().relevel_wanted());
+  b.run(1000);
+  EXPECT_EQ(b.counters().rest_relevels, 0u);
+  EXPECT_EQ(b.counters().accepted[static_cast<std::size_t>(AidingKind::kZupt)], 0u);
+  EXPECT_EQ(b.counters().rejected[static_cast<std::size_t>(AidingKind::kZupt)], 10u);
+  EXPECT_EQ(b.aiding.motion_vetoes(), 10u);
+  EXPECT_GT(b.nav.state().v_n.x(), 25.0);
 }
 
 TEST(AidingRestRelevel, ATiltWithinTheValidityHorizonIsLeftToTheZupt) {

@@ -353,6 +353,10 @@ TEST(FilterAlgebraTest, AFixValidEarlierIsReferredToNow) {
       const HeadingFix<double> fix{d.then.t_ns, 0.3, 0.02};
       constexpr int kD = filt_idx::kPhi + 2;
       StateMat independent = p;
+      // The horizontal velocity gained while the heading was unknown: its variance for a heading
+      // error anywhere, 1.5 |v_h|² per axis (docs/math.md, "Re-level at rest"), goes in first.
+      const double v2 = board.nav.state().v_n.head<2>().squaredNorm();
+      for (int i = 0; i < 2; ++i) independent(filt_idx::kVel + i, filt_idx::kVel + i) += 1.5 * v2;
       independent.row(kD).setZero();
       independent.col(kD).setZero();
       independent(kD, kD) = fix.sigma_rad * fix.sigma_rad;

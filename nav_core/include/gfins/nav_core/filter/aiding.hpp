@@ -94,7 +94,7 @@ class Aiding {
   const AidingConfig<T>& config() const { return config_; }
   std::uint32_t propagation_errors() const { return propagation_errors_; }
   /// Standstill decisions not applied because the board moves: vetoed by GNSS, or
-  /// the ZUPT was rejected (no ZARU then either).
+  /// the ZUPT (or the re-level's velocity gate) was rejected (no ZARU then either).
   std::uint32_t motion_vetoes() const { return motion_vetoes_; }
 
  private:
@@ -201,8 +201,9 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
     ++motion_vetoes_;
   } else if (still_ && config_.standstill_updates && filter_.relevel_wanted()) {
     // No ZUPT brings a lost or far-off tilt back: the window's mean specific force levels it.
-    (void)filter_.relevel_at_rest(nav, detector_.mean_f(),
-                                  detector_.sigma2_f() / static_cast<T>(config_.standstill.window));
+    const UpdateOutcome o = filter_.relevel_at_rest(
+        nav, detector_.mean_f(), detector_.sigma2_f() / static_cast<T>(config_.standstill.window));
+    if (o.status == UpdateStatus::kRejected) ++motion_vetoes_;
   } else if (still_ && config_.standstill_updates) {
     if (filter_.update_zupt(nav).status == UpdateStatus::kAccepted) {
       (void)filter_.update_zaru(nav);

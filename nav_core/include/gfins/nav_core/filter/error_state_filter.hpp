@@ -260,17 +260,16 @@ class ErrorStateFilter {
   /// At rest with the tilt lost (a divergence restart, an in-motion start) or far off
   /// (relevel_wanted()), where a ZUPT cannot help: the linear update would converge to a wrong
   /// attitude, and after a drive on accelerometers alone its gate refuses a velocity error of
-  /// hundreds of m/s. The mean specific
-  /// force of a window at rest is gravity's reaction, [0, 0, −g] in NED (the static alignment's
-  /// levelling, alignment.hpp), so the attitude is turned to put Ĉ f̄_b on the down axis, the
-  /// heading kept (turn_onto); velocity and rate are set to zero. Tilt variance per axis:
-  /// (var_f_mean + the largest f-bias variance of P) / |f̄|², the window mean's noise and what the
-  /// filter does not know of the bias, each a specific-force error δf giving δf / g of tilt; taken
-  /// uncorrelated with the bias (a wider P than the exact φ = δβ/g coupling: pessimistic, never
-  /// optimistic). Velocity and rate variances those of the ZUPT and ZARU. Counted as an accepted
-  /// ZUPT (it sets the velocity) and in FilterCounters::rest_relevels. The caller says the board
-  /// is at rest (the standstill detector, no GNSS saying it moves). kInvalid when the tilt is not
-  /// wanted or f̄_b is not finite or not within 90° of the down axis.
+  /// hundreds of m/s. The mean specific force of a window at rest is gravity's reaction,
+  /// [0, 0, −g] in NED (the static alignment's levelling, alignment.hpp), so the attitude is
+  /// turned to put Ĉ f̄_b on the down axis, the heading kept (turn_onto); velocity and rate are
+  /// set to zero with the ZUPT's and ZARU's variances. The tilt is the bias seen through the level
+  /// plus the window mean's noise var_f_mean / |f̄|² per axis, with its correlations (below). Unless
+  /// the velocity is lost, the ZUPT's χ² gate on the filter's own velocity comes first (kRejected,
+  /// counted: a straight drive at constant speed reads like rest). Counted as an accepted ZUPT
+  /// (it sets the velocity) and in FilterCounters::rest_relevels. The caller says the board is at
+  /// rest (the standstill detector, no GNSS saying it moves). kInvalid when no re-level is wanted,
+  /// f̄_b is not finite, or it points exactly up.
   UpdateOutcome relevel_at_rest(Nav& nav, const Vec3<T>& f_mean_b, T var_f_mean);
 
   /// The tilt is lost (a divergence restart or an in-motion start) until a re-level finds it.
@@ -581,8 +580,11 @@ class ErrorStateFilter {
   /// is first turned about the down axis to f_true's azimuth (a heading change); what remains is a
   /// rotation about a horizontal axis, the tilt error, so a heading error never becomes tilt. With
   /// keep_heading the yaw angle is the same after as before. False (nothing changed) when the two
-  /// are 90° or more apart. One body for the re-level from GNSS and at rest.
-  bool turn_onto(Nav& nav, const Vec3<T>& f_est, const Vec3<T>& f_true, bool keep_heading) {
+  /// are 90° or more apart (a difference of two noisy GNSS velocities), or with any_angle (at rest:
+  /// f̄ is exact, and a lost tilt can be past 90°) only when they are exactly opposite (no axis).
+  /// One body for the re-level from GNSS and at rest.
+  bool turn_onto(Nav& nav, const Vec3<T>& f_est, const Vec3<T>& f_true, bool keep_heading,
+                 bool any_angle = false) {
     // The turn about down from f̂'s azimuth to f's: c = cos, s = sin of it (none when either has
     // no horizontal part).
     const T c = f_est.x() * f_true.x() + f_est.y() * f_true.y();
@@ -602,7 +604,8 @@ class ErrorStateFilter {
     if (keep_heading) axis.z() = T(0);
     const T sin_a = axis.norm();
     const T cos_a = f_turned.dot(f_true);
-    if (!(cos_a > T(0)) || !std::isfinite(sin_a)) return false;
+    if (!std::isfinite(sin_a) || !std::isfinite(cos_a)) return false;
+    if (!(cos_a > T(0)) && !(any_angle && sin_a > T(0))) return false;
     const Vec3<T> tilt =
         sin_a > T(0) ? Vec3<T>(axis * (std::atan2(sin_a, cos_a) / sin_a)) : Vec3<T>::Zero();
     // q ← exp(tilt) ⊗ exp(yaw) ⊗ q̂; a kept heading is then put back: a turn of tens of degrees
@@ -962,27 +965,87 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::relevel_at_rest(Nav& nav,
   using namespace filt_idx;
   const T g2 = f_mean_b.squaredNorm();
   if (!started_ || !relevel_wanted() || !f_mean_b.allFinite() || !(g2 > T(0)) ||
-      !(var_f_mean >= T(0)) ||
-      !turn_onto(nav, nav.state().q_nb * f_mean_b, Vec3<T>(T(0), T(0), T(-1)), true)) {
+      !(var_f_mean >= T(0))) {
+    return invalid(AidingKind::kZupt);
+  }
+  const T vel_var = config_.zupt_sigma_mps * config_.zupt_sigma_mps;
+  // The ZUPT's gate, unless the velocity is lost: a straight drive at constant speed reads like
+  // rest to accelerometers, and the filter's own velocity is what tells them apart.
+  float nis = 0.0F;
+  if ((lost_ & filter_valid::kVelocity) == 0) {
+    Mat3<T> s = p_.template block<3, 3>(kVel, kVel);
+    for (int i = 0; i < 3; ++i) s(i, i) += vel_var;
+    const Eigen::LLT<Mat3<T>> llt(s);
+    if (llt.info() != Eigen::Success) return invalid(AidingKind::kZupt);
+    const Vec3<T> v = nav.state().v_n;
+    const T q = v.dot(llt.solve(v));
+    nis = static_cast<float>(q);
+    if (config_.innovation_gate && !(q <= gate_3_)) {
+      ++counters_.rejected[static_cast<std::size_t>(AidingKind::kZupt)];
+      return UpdateOutcome{UpdateStatus::kRejected, nis};
+    }
+  }
+  if (!turn_onto(nav, nav.state().q_nb * f_mean_b, Vec3<T>(T(0), T(0), T(-1)), true, true)) {
     return invalid(AidingKind::kZupt);
   }
   const Vec3<T> dv = nav.state().v_n;
   const Vec3<T> dw = nav.state().w_b;
   nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), dv, dw);
   history_.shift(Vec3<T>::Zero(), Vec3<T>::Zero(), dv);
-  T bias_var = T(0);
-  for (int i = 0; i < 3; ++i) bias_var = std::max(bias_var, p_(kBiasF + i, kBiasF + i));
-  const T tilt_var = (var_f_mean + bias_var) / g2;
-  const T vel_var = config_.zupt_sigma_mps * config_.zupt_sigma_mps;
   const T rate_var = config_.zaru_sigma_rps * config_.zaru_sigma_rps;
   for (int i = 0; i < 3; ++i) {
-    if (i < 2) set_uncorrelated(kPhi + i, tilt_var);
     set_uncorrelated(kVel + i, vel_var);
     set_uncorrelated(kRate + i, rate_var);
   }
+  // The level absorbs the bias: at rest the filter's own model then gives no horizontal δv̇,
+  // F_vφ φ_h + F_vβ δβ = 0 (rows N, E; φ_D does not enter them with f vertical), so
+  // φ_h = A δβ + n with A = −F_vφ,h⁻¹ F_vβ, n the window mean's noise (σ_f²/W / |f̄|² per axis).
+  // Taking φ uncorrelated with δβ instead let the ZUPTs that follow, which see g φ + δβ, narrow
+  // the tilt σ below its error (1/1.4 of it over a long stop).
+  StateMat f;
+  transition_model(nav, f);
+  Eigen::Matrix<T, 2, 2> fvp;
+  Eigen::Matrix<T, 2, 6> fvb;
+  for (int r = 0; r < 2; ++r) {
+    for (int c = 0; c < 2; ++c) fvp(r, c) = f(kVel + r, kPhi + c);
+    for (int c = 0; c < 6; ++c) fvb(r, c) = f(kVel + r, kBiasWdot + c);
+  }
+  // F_vφ,h is ±|f̄| times a rotation at rest (f vertical after the level); should it ever not be
+  // invertible the tilt is taken uncorrelated, with the largest f-bias variance added instead.
+  const bool coupled = std::abs(fvp.determinant()) > T(1e-6) * g2;
+  const Eigen::Matrix<T, 2, 6> a =
+      coupled ? Eigen::Matrix<T, 2, 6>(-fvp.inverse() * fvb) : Eigen::Matrix<T, 2, 6>::Zero();
+  const T noise_var =
+      (var_f_mean +
+       (coupled ? T(0) : p_.template block<3, 3>(kBiasF, kBiasF).diagonal().maxCoeff())) /
+      g2;
+  // Rows of the tilt: A times the bias rows (the tilt's own columns last, from those rows).
+  T row[2][kStates];
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < kStates; ++j) {
+      T sum = T(0);
+      for (int k = 0; k < 6; ++k) sum += a(i, k) * p_(kBiasWdot + k, j);
+      row[i][j] = sum;
+    }
+  }
+  for (int i = 0; i < 2; ++i) {
+    for (int l = 0; l < 2; ++l) {
+      T sum = T(0);
+      for (int k = 0; k < 6; ++k) sum += row[i][kBiasWdot + k] * a(l, k);
+      row[i][kPhi + l] = sum + (i == l ? noise_var : T(0));
+    }
+  }
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < kStates; ++j) {
+      p_(kPhi + i, j) = row[i][j];
+      p_(j, kPhi + i) = row[i][j];
+    }
+  }
   lost_ &= static_cast<std::uint8_t>(~filter_valid::kRollPitch);
   ++counters_.rest_relevels;
-  return accepted_reset(AidingKind::kZupt, nav);
+  UpdateOutcome out = accepted_reset(AidingKind::kZupt, nav);
+  out.nis = nis;
+  return out;
 }
 
 template <typename T, int HistoryCapacity>
@@ -1034,6 +1097,11 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav,
   }
   const Measurement<T, 1> m = heading_measurement(at.q_nb, fix.yaw_rad, fix.sigma_rad);
   if (!heading_aligned_) {
+    // The horizontal velocity gained while the heading was unknown points along the old heading:
+    // its variance for a heading error anywhere (accuracy()) goes into P before the heading is
+    // set, when the heading's decoupled variance stops standing for it.
+    const T v2 = nav.state().v_n.template head<2>().squaredNorm();
+    for (int i = 0; i < 2; ++i) p_(filt_idx::kVel + i, filt_idx::kVel + i) += T(1.5) * v2;
     set_heading(nav, m.y(0), fix.sigma_rad, age_of(nav, fix.t_valid_ns));
     return accepted_reset(AidingKind::kHeading, nav);
   }
@@ -1048,10 +1116,12 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
   const Mat3<T> ce = j * p_.template block<3, 3>(kPhi, kPhi) * j.transpose();
   // While the heading is unknown (variance π², decoupled: outside the linear model) so is the
   // direction of the horizontal velocity the board has gained since it was last set (a ZUPT at
-  // rest, a GNSS fix): v = R(δψ) v̂ with δψ anywhere, E|v̂ − v|² = 2 |v̂_h|² (1 − E cos δψ), so
-  // |v̂_h|² per axis is added. Without it the N and E σ of a board that re-levelled at a stop and
-  // drove off stayed at the ZUPT's while its velocity turned with the heading error.
-  const T heading_var = heading_aligned_ ? T(0) : nav.v_n.template head<2>().squaredNorm();
+  // rest, a GNSS fix): v = R(δψ) v̂ with δψ uniform, E|v̂ − v|² = 2 |v̂_h|², 1.5 |v̂_h|² along the
+  // track and 0.5 |v̂_h|² across it, so 1.5 |v̂_h|² per axis is added (the whole v̂_h, not the part
+  // gained since the last fix: wider after a GNSS velocity fix). Without it the N and E σ of a
+  // board that re-levelled at a stop and drove off stayed at the ZUPT's while its velocity turned
+  // with the heading error.
+  const T heading_var = heading_aligned_ ? T(0) : T(1.5) * nav.v_n.template head<2>().squaredNorm();
   for (int i = 0; i < 3; ++i) {
     a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
     a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i) + (i < 2 ? heading_var : T(0)));

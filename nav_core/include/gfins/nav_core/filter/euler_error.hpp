@@ -11,9 +11,10 @@
 // σ grow without bound there, which is the truth about those angles.
 #pragma once
 
-#include <cstdint>
-
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "gfins/nav_core/filter/measurement.hpp"
 
@@ -22,11 +23,15 @@ namespace gfins::nav {
 /// J = ∂(Euler error)/∂φ at the attitude q_nb (rows roll, pitch, yaw).
 template <typename T>
 Mat3<T> euler_error_jacobian(const Quat<T>& q_nb) {
-  const Vec3<T> e = euler_from_quat(q_nb);
-  const T cp = std::cos(e.y());
-  const T tp = std::tan(e.y());
-  const T cy = std::cos(e.z());
-  const T sy = std::sin(e.z());
+  // cos θ, sin θ, cos ψ, sin ψ of euler_from_quat's angles, read off C = C_n^b ᵀ's first column
+  // [cψ cθ, sψ cθ, −sθ] (no trigonometric function: cθ ≥ 0 for θ in [−90°, 90°]). At gimbal
+  // lock ψ is atan2(0, 0) = 0 there, and cθ is kept at the scalar's ε so J stays finite (huge).
+  const Mat3<T> m = q_nb.toRotationMatrix();
+  const T h = std::sqrt(m(0, 0) * m(0, 0) + m(1, 0) * m(1, 0));
+  const T cp = std::max(h, std::numeric_limits<T>::epsilon());
+  const T tp = std::clamp(-m(2, 0), T(-1), T(1)) / cp;
+  const T cy = h > T(0) ? m(0, 0) / h : T(1);
+  const T sy = h > T(0) ? m(1, 0) / h : T(0);
   Mat3<T> j;
   j << -cy / cp, -sy / cp, T(0),  //
       sy, -cy, T(0),              //
