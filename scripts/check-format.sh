@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Fails when clang-format would change any tracked C++ file (run with --fix to reformat).
+# Fails when clang-format would change any C++ file of the tree, tracked or new and not ignored
+# (run with --fix to reformat): a file written but not yet added is checked before its commit.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cc')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.hpp' '*.h' '*.cc')
 if [ "${1:-}" = "--fix" ]; then
   clang-format -i "${files[@]}"
   exit 0

@@ -90,7 +90,8 @@ Mat3<T> skew(const Vec3<T>& v) {
 /// double's std::sin and std::cos). The core's angles are rotation angles and Euler angles, a few
 /// π at most. newlib's sinf and cosf carry a range reduction for any float (its Payne-Hanek
 /// table and kernel, 3.1 KB of the Cortex-M4F image's flash), needed only far outside them; from
-/// 2^20 rad on, and for a non-finite x, both are NaN (not available, never a wrong number).
+/// 2^12 turns (25,736 rad) on, and for a non-finite x, both are NaN (not available, never a wrong
+/// number).
 /// double: std::sin and std::cos.
 template <typename T>
 void sin_cos(T x, T& s, T& c) {
@@ -98,11 +99,12 @@ void sin_cos(T x, T& s, T& c) {
     constexpr float kTwoPi = 6.28318530717958647692F;
     constexpr float kPi = 3.14159265358979323846F;
     constexpr float kHalfPi = 1.57079632679489661923F;
-    // Two-constant reduction: 2π = kTwoPiHi + kTwoPiLo, kTwoPiHi exact in float with few bits, so
-    // k·kTwoPiHi is exact for |k| < 2^12.
+    // Two-constant reduction: 2π = kTwoPiHi + kTwoPiLo, kTwoPiHi = 201/32 with 8 significant
+    // bits, so k·kTwoPiHi is exact for |k| < 2^16; kTwoPiLo's rounding times k stays below 3e-7
+    // for |k| ≤ 2^12 (|x| < 25,736 rad), where the guard below stops.
     constexpr float kTwoPiHi = 6.28125F;
     constexpr float kTwoPiLo = 1.9353071795864769e-3F;
-    if (!(std::fabs(x) < 1048576.0F)) {  // 2^20 rad, or not finite: never a core angle
+    if (!(std::fabs(x) < 25736.0F)) {  // 2^12 turns, or not finite: never a core angle
       s = std::numeric_limits<float>::quiet_NaN();
       c = s;
       return;
