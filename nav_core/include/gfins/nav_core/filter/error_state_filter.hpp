@@ -341,6 +341,27 @@ class ErrorStateFilter {
            fix.sigma.allFinite() && history_.at(fix.t_valid_ns, nav.state(), at);
   }
 
+  /// The innovation test of every update: S = H P Hᵀ + R, positive definite (Cholesky as the
+  /// test; M ≤ 3, so its inverse is closed-form), NIS = yᵀ S⁻¹ y against `gate`. kAccepted: it
+  /// passes (P Hᵀ and S⁻¹ left for the gain); kRejected counted; kInvalid counted.
+  template <int M>
+  UpdateOutcome innovation_test(const Measurement<T, M>& m, AidingKind kind, T gate,
+                                Eigen::Matrix<T, kStates, M>& pht, Eigen::Matrix<T, M, M>& s_inv) {
+    pht = p_.lazyProduct(m.h.transpose());
+    Eigen::Matrix<T, M, M> s = m.h.lazyProduct(pht) + m.r;
+    s = (s + s.transpose()) / T(2);
+    const Eigen::LLT<Eigen::Matrix<T, M, M>> llt(s);
+    if (llt.info() != Eigen::Success) return invalid(kind);
+    s_inv = s.inverse();
+    const T nis = m.y.dot(s_inv * m.y);
+    if (!std::isfinite(nis)) return invalid(kind);
+    if (config_.innovation_gate && nis > gate) {
+      ++counters_.rejected[static_cast<std::size_t>(kind)];
+      return UpdateOutcome{UpdateStatus::kRejected, static_cast<float>(nis)};
+    }
+    return UpdateOutcome{UpdateStatus::kAccepted, static_cast<float>(nis)};
+  }
+
   /// The linearised update: gate, gain, Joseph form, feedback.
   /// t_valid_ns: when the measurement was valid (refer_to_now).
   template <int M>
@@ -349,19 +370,10 @@ class ErrorStateFilter {
     const auto k_idx = static_cast<std::size_t>(kind);
     if (!m.y.allFinite()) return invalid(kind);
     refer_to_now(m.h.data(), M, nav, t_valid_ns);
-    const Eigen::Matrix<T, kStates, M> pht = p_.lazyProduct(m.h.transpose());
-    Eigen::Matrix<T, M, M> s = m.h.lazyProduct(pht) + m.r;
-    s = (s + s.transpose()) / T(2);
-    // S must be positive definite (Cholesky as the test); M ≤ 3, so its inverse is closed-form.
-    const Eigen::LLT<Eigen::Matrix<T, M, M>> llt(s);
-    if (llt.info() != Eigen::Success) return invalid(kind);
-    const Eigen::Matrix<T, M, M> s_inv = s.inverse();
-    const T nis = m.y.dot(s_inv * m.y);
-    if (!std::isfinite(nis)) return invalid(kind);
-    if (config_.innovation_gate && nis > gate) {
-      ++counters_.rejected[k_idx];
-      return UpdateOutcome{UpdateStatus::kRejected, static_cast<float>(nis)};
-    }
+    Eigen::Matrix<T, kStates, M> pht;
+    Eigen::Matrix<T, M, M> s_inv;
+    const UpdateOutcome tested = innovation_test(m, kind, gate, pht, s_inv);
+    if (tested.status != UpdateStatus::kAccepted) return tested;
     const Eigen::Matrix<T, kStates, M> k = pht.lazyProduct(s_inv);
     StateVec dx = k * m.y;
     if (!heading_aligned_) dx(filt_idx::kPhi + 2) = T(0);  // heading is not estimated yet
@@ -379,7 +391,7 @@ class ErrorStateFilter {
     found(kind);
     ++counters_.accepted[k_idx];
     last_accepted_ns_[k_idx] = nav.state().t_ns;
-    return UpdateOutcome{UpdateStatus::kAccepted, static_cast<float>(nis)};
+    return UpdateOutcome{UpdateStatus::kAccepted, tested.nis};
   }
 
   /// An accepted fix of `kind` sets the quantity it measures again after a divergence restart:
@@ -720,6 +732,12 @@ class ErrorStateFilter {
     lost_ &= static_cast<std::uint8_t>(~filter_valid::kHeading);
   }
 
+  /// Per horizontal axis, the variance of a horizontal velocity v̂_h whose direction is off by a
+  /// heading error anywhere (accuracy()): 1.5 |v̂_h|².
+  static T unknown_heading_vel_var(const NavState<T>& x) {
+    return T(1.5) * x.v_n.template head<2>().squaredNorm();
+  }
+
   /// While the heading is unknown its error is a nuisance of variance π² outside the linear
   /// model: its correlations are dropped so no update moves it or is moved by it.
   void decouple_heading() {
@@ -973,21 +991,17 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::relevel_at_rest(Nav& nav,
     return invalid(AidingKind::kZupt);
   }
   const T vel_var = config_.zupt_sigma_mps * config_.zupt_sigma_mps;
-  // The ZUPT's gate, unless the velocity is lost: a straight drive at constant speed reads like
-  // rest to accelerometers, and the filter's own velocity is what tells them apart.
+  // The ZUPT's own innovation test, unless the velocity is lost: a straight drive at constant
+  // speed reads like rest to accelerometers, and the filter's own velocity tells them apart.
   float nis = 0.0F;
   if ((lost_ & filter_valid::kVelocity) == 0) {
-    Mat3<T> s = p_.template block<3, 3>(kVel, kVel);
-    for (int i = 0; i < 3; ++i) s(i, i) += vel_var;
-    const Eigen::LLT<Mat3<T>> llt(s);
-    if (llt.info() != Eigen::Success) return invalid(AidingKind::kZupt);
-    const Vec3<T> v = nav.state().v_n;
-    const T q = v.dot(llt.solve(v));
-    nis = static_cast<float>(q);
-    if (config_.innovation_gate && !(q <= gate_3_)) {
-      ++counters_.rejected[static_cast<std::size_t>(AidingKind::kZupt)];
-      return UpdateOutcome{UpdateStatus::kRejected, nis};
-    }
+    Eigen::Matrix<T, kStates, 3> pht;
+    Mat3<T> s_inv;
+    const UpdateOutcome tested =
+        innovation_test(zupt_measurement(nav.state(), config_.zupt_sigma_mps), AidingKind::kZupt,
+                        gate_3_, pht, s_inv);
+    if (tested.status != UpdateStatus::kAccepted) return tested;
+    nis = tested.nis;
   }
   if (!turn_onto(nav, nav.state().q_nb * f0, Vec3<T>(T(0), T(0), T(-1)), true, true)) {
     return invalid(AidingKind::kZupt);
@@ -1104,8 +1118,8 @@ UpdateOutcome ErrorStateFilter<T, HistoryCapacity>::update_heading(Nav& nav,
     // The horizontal velocity gained while the heading was unknown points along the old heading:
     // its variance for a heading error anywhere (accuracy()) goes into P before the heading is
     // set, when the heading's decoupled variance stops standing for it.
-    const T v2 = nav.state().v_n.template head<2>().squaredNorm();
-    for (int i = 0; i < 2; ++i) p_(filt_idx::kVel + i, filt_idx::kVel + i) += T(1.5) * v2;
+    const T var = unknown_heading_vel_var(nav.state());
+    for (int i = 0; i < 2; ++i) p_(filt_idx::kVel + i, filt_idx::kVel + i) += var;
     set_heading(nav, m.y(0), fix.sigma_rad, age_of(nav, fix.t_valid_ns));
     return accepted_reset(AidingKind::kHeading, nav);
   }
@@ -1125,7 +1139,7 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
   // gained since the last fix: wider after a GNSS velocity fix). Without it the N and E σ of a
   // board that re-levelled at a stop and drove off stayed at the ZUPT's while its velocity turned
   // with the heading error.
-  const T heading_var = heading_aligned_ ? T(0) : T(1.5) * nav.v_n.template head<2>().squaredNorm();
+  const T heading_var = heading_aligned_ ? T(0) : unknown_heading_vel_var(nav);
   for (int i = 0; i < 3; ++i) {
     a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
     a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i) + (i < 2 ? heading_var : T(0)));
