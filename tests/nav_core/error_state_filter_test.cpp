@@ -553,6 +553,144 @@ TEST(ErrorStateFilterTest, ExternalHeadingIsComparedAtItsTimeOfValidity) {
   EXPECT_EQ(heading_with_age(true, kNow - 2.0).outcome.status, UpdateStatus::kInvalid);
 }
 
+// ---- Position σ while the heading is unknown ---------------------------------------------------
+
+// A level straight drive written here: from rest at yaw 40°, 1 m/s² along the heading for 10 s
+// (50 m, 10 m/s), then 10 m/s. The board starts with its heading 1 rad off (heading unknown,
+// σ_ψ = π): it integrates the same accelerations along the wrong direction, so its displacement d
+// is the true one turned by 1 rad and its position error is 2 sin(0.5) ≈ 0.96 |d| (240 m after
+// 30 s). For a heading error δψ uniform on the circle the error (R(δψ) − I) d has, per axis,
+// E e_N² = E(cos δψ − 1)² d_N² + E sin²δψ d_E² = 1.5 d_N² + 0.5 d_E² (and E e_E² alike): the
+// published σ² must exceed the filter's own P_pp by at least that, and the filter adds 1.5 |d|²
+// (the bound for any direction of d), so by at most that. The outputs are ideal and the filter is
+// told so (sensor noise and bias 1e-6 m/s², initial tilt 1e-4 rad, velocity 0.01 m/s): P_pp
+// alone then has a σ of about 55 m at 30 s (the accelerating phase through the linearised heading
+// coupling), which would leave the 240 m error at over 4σ.
+struct StraightDrive {
+  static constexpr double kYaw = 40 * kPi / 180, kAccel = 1, kAccelS = 10;
+  testing::Truth operator()(double t) const {
+    testing::Truth x;
+    x.q_nb = quat_from_rotation_vector<double>(Vec3<double>(0, 0, kYaw));
+    const Vec3<double> u(std::cos(kYaw), std::sin(kYaw), 0);
+    const double ta = std::min(t, kAccelS);
+    const double speed = kAccel * ta;
+    const double dist = 0.5 * kAccel * ta * ta + speed * (t - ta);
+    x.a_n = t < kAccelS ? Vec3<double>(kAccel * u) : Vec3<double>::Zero();
+    x.v_n = speed * u;
+    x.r_n = dist * u;
+    return x;
+  }
+};
+
+struct HeadingUnknownDrive {
+  static constexpr double kRate = 200;
+  ErrorStateFilter<double> filter;
+  ArraySolver<double> solver = ArraySolver<double>::create(table1_geometry(0.1)).value();
+  Strapdown<double> nav{solver, GravityModel<double>::constant(testing::kG)};
+  StraightDrive truth;
+  long k = 0;
+
+  HeadingUnknownDrive() {
+    RunSpec spec;
+    spec.rate_hz = kRate;
+    spec.noise = 1e-6;
+    spec.bias_sigma = 1e-6;
+    spec.init_rate = 1e-6;
+    spec.init_tilt = 1e-4;
+    spec.init_vel = 0.01;
+    auto config = testing::filter_config(spec);
+    config.heading_known = false;
+    config.track_min_speed_mps = 1e9;  // no heading from a GNSS track: fixes set it here
+    NavState<double> init = testing::nav_state_of<double>(truth(0));
+    init.q_nb = quat_from_rotation_vector<double>(Vec3<double>(0, 0, 1.0)) * init.q_nb;
+    init.status = nav_status::kAligned;
+    nav.initialize(init, testing::ideal_outputs(solver.geometry(), truth(0)));
+    EXPECT_TRUE(filter.configure(config).is_ok());
+    filter.start(nav);
+  }
+
+  double t() const { return static_cast<double>(k) / kRate; }
+
+  void drive_to(double t_end) {
+    while (t() < t_end - 0.5 / kRate) {
+      ++k;
+      nav.step(testing::ideal_outputs(solver.geometry(), truth(t())), 1.0 / kRate,
+               std::llround(t() * 1e9), static_cast<std::uint32_t>(k));
+      if (k % 10 == 0) {
+        EXPECT_TRUE(filter.propagate(nav, 10 / kRate).is_ok());
+      }
+    }
+  }
+
+  Vec3<double> sigma2() const { return filter.accuracy(nav.state()).pos_sigma_m.array().square(); }
+  Vec3<double> p_pp() const {
+    return filter.covariance().block<3, 3>(filt_idx::kPos, filt_idx::kPos).diagonal();
+  }
+  Vec3<double> error() const { return nav.state().r_n - truth(t()).r_n; }
+
+  /// The published σ² over P_pp against the bounds above, for the displacement from `anchor`.
+  void expect_displacement_term(const Vec3<double>& anchor, const char* where) const {
+    const Vec3<double> d = nav.state().r_n - anchor;
+    const Vec3<double> extra = sigma2() - p_pp();
+    const double uniform[2] = {1.5 * d.x() * d.x() + 0.5 * d.y() * d.y(),
+                               0.5 * d.x() * d.x() + 1.5 * d.y() * d.y()};
+    for (int i = 0; i < 2; ++i) {
+      // 1e-9: the rounding of sqrt and square in double around σ² ~ 1e5 m².
+      EXPECT_GE(extra(i), uniform[i] * (1 - 1e-9)) << where << ", axis " << i;
+      EXPECT_LE(extra(i), 1.5 * d.head<2>().squaredNorm() * (1 + 1e-9)) << where << ", axis " << i;
+    }
+    // Covered as well: the actual error within 3σ per horizontal axis.
+    const Vec3<double> s = sigma2().cwiseSqrt();
+    EXPECT_LE(std::abs(error().x()) / s.x(), 3.0) << where;
+    EXPECT_LE(std::abs(error().y()) / s.y(), 3.0) << where;
+  }
+};
+
+TEST(ErrorStateFilterTest, PositionSigmaCoversTheDistanceDrivenWithTheHeadingUnknown) {
+  static HeadingUnknownDrive run;
+  run.drive_to(30);
+  const double driven = run.truth(30).r_n.norm();
+  std::printf(
+      "after %.0f m with the heading 1 rad off: error %.1f m, σ N %.1f E %.1f m "
+      "(P_pp alone: %.1f m)\n",
+      driven, run.error().head<2>().norm(), std::sqrt(run.sigma2().x()),
+      std::sqrt(run.sigma2().y()), std::sqrt(run.p_pp().x()));
+  // The physics of the test, not of the filter: the displacement turned by 1 rad (ideal outputs;
+  // 1 % for the strapdown's integration error).
+  ASSERT_NEAR(run.error().head<2>().norm(), 2 * std::sin(0.5) * driven, 0.01 * driven);
+  run.expect_displacement_term(run.truth(0).r_n, "heading unknown");
+  EXPECT_EQ(run.filter.accuracy(run.nav.state()).valid & filter_valid::kPosition, 0);
+  // A heading fix sets the heading but does not move the position: P_pp takes the term over, and
+  // the published σ stays what it was (1e-9: rounding).
+  const Vec3<double> before = run.sigma2();
+  HeadingFix<double> fix;
+  fix.t_valid_ns = run.nav.state().t_ns;
+  fix.yaw_rad = StraightDrive::kYaw;
+  fix.sigma_rad = 0.5 * kPi / 180;
+  ASSERT_EQ(run.filter.update_heading(run.nav, fix).status, UpdateStatus::kReset);
+  ASSERT_TRUE(run.filter.heading_aligned());
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(run.sigma2()(i), before(i), 1e-9 * before(i));
+  // And a σ of 300 m does not pass for a valid position (horizon valid_sigma_pos_m).
+  EXPECT_EQ(run.filter.accuracy(run.nav.state()).valid & filter_valid::kPosition, 0);
+}
+
+TEST(ErrorStateFilterTest, AGnssPositionStartsTheDistanceDrivenWithTheHeadingUnknownAgain) {
+  // A position fix at 20 s while the heading is unknown sets the position: only the displacement
+  // after it (100 m at 10 m/s) turns with the heading error from then on, not the 250 m since the
+  // start (which would give σ ≥ √1.5 × 250 m = 306 m per axis).
+  static HeadingUnknownDrive run;
+  run.drive_to(20);
+  GnssFix<double> fix;
+  fix.t_valid_ns = run.nav.state().t_ns;
+  fix.value_n = run.truth(20).r_n;
+  fix.sigma = Vec3<double>::Constant(1.0);
+  ASSERT_EQ(run.filter.update_gnss_position(run.nav, fix).status, UpdateStatus::kReset);
+  run.drive_to(30);
+  const double since_fix = (run.truth(30).r_n - run.truth(20).r_n).norm();
+  ASSERT_NEAR(run.error().head<2>().norm(), 2 * std::sin(0.5) * since_fix, 0.02 * since_fix);
+  run.expect_displacement_term(fix.value_n, "after the position fix");
+}
+
 // ---- Euler σ: the Jacobian against finite differences of the Euler angles -------------------
 
 TEST(ErrorStateFilterTest, EulerJacobianMatchesFiniteDifferences) {

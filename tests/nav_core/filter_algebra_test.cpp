@@ -66,6 +66,7 @@ struct MovingBoard {
   Strapdown<double> nav{solver, GravityModel<double>::normal(0.4328416544945937, 50.0)};
   Filter filter;
   testing::Truth truth;
+  Vec3<double> last_position_fix = Vec3<double>::Zero();  // no lever arm: the array's position
 
   explicit MovingBoard(std::uint64_t seed, bool heading_known = true)
       : rng(seed), solver(ArraySolver<double>::create(calibrated_cube(rng)).value()) {
@@ -105,6 +106,7 @@ struct MovingBoard {
       const UpdateStatus applied =
           filter.heading_aligned() ? UpdateStatus::kAccepted : UpdateStatus::kReset;
       ASSERT_EQ(filter.update_gnss_position(nav, fix).status, applied);
+      last_position_fix = fix.value_n;
       fix.value_n = nav.state().v_n + Vec3<double>(0.02, 0.01, -0.03);
       fix.sigma = Vec3<double>::Constant(0.1);
       ASSERT_EQ(filter.update_gnss_velocity(nav, fix).status, applied);
@@ -357,6 +359,9 @@ TEST(FilterAlgebraTest, AFixValidEarlierIsReferredToNow) {
       // error anywhere, 1.5 |v_h|² per axis (docs/math.md, "Re-level at rest"), goes in first.
       const double v2 = board.nav.state().v_n.head<2>().squaredNorm();
       for (int i = 0; i < 2; ++i) independent(filt_idx::kVel + i, filt_idx::kVel + i) += 1.5 * v2;
+      // So does the displacement since the last GNSS position set the position: 1.5 |Δr_h|².
+      const double r2 = (board.nav.state().r_n - board.last_position_fix).head<2>().squaredNorm();
+      for (int i = 0; i < 2; ++i) independent(filt_idx::kPos + i, filt_idx::kPos + i) += 1.5 * r2;
       independent.row(kD).setZero();
       independent.col(kD).setZero();
       independent(kD, kD) = fix.sigma_rad * fix.sigma_rad;

@@ -199,16 +199,20 @@ void Aiding<T>::after_step(Nav& nav, T dt_s) {
   if (!fresh || !still_ || !config_.standstill_updates) return;
   if (moving_) {
     ++motion_vetoes_;
-  } else if (filter_.relevel_wanted()) {
+    return;
+  }
+  if (filter_.relevel_wanted()) {
     // No ZUPT brings a lost or far-off tilt back: the window's mean specific force levels it.
     const UpdateOutcome o = filter_.relevel_at_rest(
         nav, detector_.mean_f(), detector_.sigma2_f() / static_cast<T>(config_.standstill.window));
     if (o.status == UpdateStatus::kRejected) ++motion_vetoes_;
-  } else if (filter_.update_zupt(nav).status == UpdateStatus::kAccepted) {
-    (void)filter_.update_zaru(nav);
-  } else {
-    ++motion_vetoes_;
+    return;
   }
+  if (filter_.update_zupt(nav).status != UpdateStatus::kAccepted) {
+    ++motion_vetoes_;
+    return;
+  }
+  (void)filter_.update_zaru(nav);
 }
 
 template <typename T>

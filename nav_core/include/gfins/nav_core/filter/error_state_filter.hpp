@@ -482,6 +482,7 @@ class ErrorStateFilter {
     const Vec3<T> dr = at.r_n + at.q_nb * config_.gnss_lever_arm_b - fix.value_n;
     nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
     history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
+    heading_anchor_r_ = at.r_n - dr;  // the displacement with the unknown heading starts here
     const T l2 = config_.gnss_lever_arm_b.squaredNorm();
     reset_block(filt_idx::kPos, fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(l2),
                 age_of(nav, fix.t_valid_ns));
@@ -529,7 +530,9 @@ class ErrorStateFilter {
     nav.apply_correction(phi, Vec3<T>::Zero(), dv, Vec3<T>::Zero());
     history_.shift(phi, Vec3<T>::Zero(), dv);
     reset_block(kVel, var, age);
-    if (track) set_heading_variance(std::sqrt(var.template head<2>().maxCoeff()) / speed, age);
+    if (track) {
+      set_heading_variance(nav.state(), std::sqrt(var.template head<2>().maxCoeff()) / speed, age);
+    }
     return accepted_reset(AidingKind::kGnssVelocity, nav);
   }
 
@@ -721,10 +724,17 @@ class ErrorStateFilter {
     const Vec3<T> phi(T(0), T(0), -dyaw);
     nav.apply_correction(phi, Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero());
     history_.shift(phi, Vec3<T>::Zero(), Vec3<T>::Zero());
-    set_heading_variance(sigma_rad, age);
+    set_heading_variance(nav.state(), sigma_rad, age);
   }
 
-  void set_heading_variance(T sigma_rad, const FixAge& age) {
+  /// x: the state the heading is set at. The position gained while the heading was unknown points
+  /// along the old heading: its variance for a heading error anywhere (accuracy()) goes into P
+  /// before the heading is set, when the heading's decoupled variance stops standing for it.
+  void set_heading_variance(const NavState<T>& x, T sigma_rad, const FixAge& age) {
+    if (!heading_aligned_) {
+      const T var = unknown_heading_pos_var(x);
+      for (int i = 0; i < 2; ++i) p_(filt_idx::kPos + i, filt_idx::kPos + i) += var;
+    }
     set_at_fix(filt_idx::kPhi + 2, sigma_rad * sigma_rad, age);
     heading_aligned_ = true;
     // The tilt stays lost: only a re-level finds it (relevel_from_gnss). An external heading
@@ -736,6 +746,12 @@ class ErrorStateFilter {
   /// heading error anywhere (accuracy()): 1.5 |v̂_h|².
   static T unknown_heading_vel_var(const NavState<T>& x) {
     return T(1.5) * x.v_n.template head<2>().squaredNorm();
+  }
+
+  /// The same for the horizontal position: the displacement since heading_anchor_r_ turns with the
+  /// heading error, 1.5 |r̂_h − r_anchor,h|² per axis.
+  T unknown_heading_pos_var(const NavState<T>& x) const {
+    return T(1.5) * (x.r_n - heading_anchor_r_).template head<2>().squaredNorm();
   }
 
   /// While the heading is unknown its error is a nuisance of variance π² outside the linear
@@ -772,6 +788,10 @@ class ErrorStateFilter {
   bool configured_ = false;
   bool started_ = false;
   bool heading_aligned_ = true;
+  // While the heading is unknown: the position from which the board's displacement is along a
+  // heading that may be off by any angle (the start, a divergence restart, the last GNSS position
+  // reset). Only the displacement since it adds to the position variance (accuracy()).
+  Vec3<T> heading_anchor_r_ = Vec3<T>::Zero();
   // filter_valid bits of the quantities whose σ are not available: after a divergence restart
   // the covariance no longer describes their errors (the linear model had failed before the test
   // fired, and the restart widens the attitude and rate only). Each comes back when a fix sets
@@ -808,6 +828,7 @@ void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
   p_(kPhi + 1, kPhi + 1) = tilt2;
   p_(kPhi + 2, kPhi + 2) = kPi * kPi;
   heading_aligned_ = false;
+  heading_anchor_r_ = x.r_n;
   prev_vel_t_ns_ = kNever;  // a velocity difference across the diverged stretch means nothing
   lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
           filter_valid::kPosition;
@@ -831,6 +852,7 @@ void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
   history_.clear();
   history_.push(nav.state());
   heading_aligned_ = config_.heading_known;
+  heading_anchor_r_ = nav.state().r_n;
   last_accepted_ns_.fill(kNever);
   gnss_rejected_run_.fill(0);
   lost_ = 0;
@@ -1138,12 +1160,14 @@ NavAccuracy<T> ErrorStateFilter<T, HistoryCapacity>::accuracy(const NavState<T>&
   // track and 0.5 |v̂_h|² across it, so 1.5 |v̂_h|² per axis is added (the whole v̂_h, not the part
   // gained since the last fix: wider after a GNSS velocity fix). Without it the N and E σ of a
   // board that re-levelled at a stop and drove off stayed at the ZUPT's while its velocity turned
-  // with the heading error.
-  const T heading_var = heading_aligned_ ? T(0) : unknown_heading_vel_var(nav);
+  // with the heading error. The position likewise: 1.5 |r̂_h − r_anchor,h|² per axis for the
+  // displacement since the last point the position was set or the heading lost.
+  const T heading_vel_var = heading_aligned_ ? T(0) : unknown_heading_vel_var(nav);
+  const T heading_pos_var = heading_aligned_ ? T(0) : unknown_heading_pos_var(nav);
   for (int i = 0; i < 3; ++i) {
     a.euler_sigma_rad(i) = std::sqrt(ce(i, i));
-    a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i) + (i < 2 ? heading_var : T(0)));
-    a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i));
+    a.vel_sigma_mps(i) = std::sqrt(p_(kVel + i, kVel + i) + (i < 2 ? heading_vel_var : T(0)));
+    a.pos_sigma_m(i) = std::sqrt(p_(kPos + i, kPos + i) + (i < 2 ? heading_pos_var : T(0)));
   }
   constexpr T kNotAvailable = std::numeric_limits<T>::quiet_NaN();
   if (!started_) {  // nothing estimated yet: no σ, not a zero one
