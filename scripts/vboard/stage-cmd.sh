@@ -104,13 +104,16 @@ raw_cmd short-frame 0142 02         # 2 bytes: length not 8
 raw_cmd bad-crc 0242000000000000 03  # ResetNavigation with a wrong CRC byte
 
 # Stored settings (docs/can-interface.md, "Stored settings"): the divider set above is in the
-# settings file; a node id set by command is taken at the next start of gfins-fw, and
-# RestoreDefaults gives the configuration's node id back at the start after that.
+# settings file; a node id and a data group base set by command are taken at the next start of
+# gfins-fw, and RestoreDefaults gives the configuration's back at the start after that.
 check cmd-settings-divider "settings file after the divider command: $(grep -c '^euler = 20$' $settings 2>/dev/null) line 'euler = 20'" \
   grep -q '^euler = 20$' $settings
 cmd_ok node-id node-id 2
 check cmd-settings-node "settings file node_id: $(sed -n 's/^node_id = //p' $settings 2>/dev/null)" \
   grep -q '^node_id = 2$' $settings
+cmd_ok id-base id-base data 0x300
+check cmd-settings-id-base "settings file data_id_base: $(sed -n 's/^data_id_base = //p' $settings 2>/dev/null)" \
+  grep -q '^data_id_base = 0x300$' $settings
 # epochs_of ID LOG: GfinsEpoch frames of one node id (0x100 + node) in 1 s of candump.
 epochs_of() {
   timeout 1 candump -L vcan0 >"$2" 2>/dev/null
@@ -119,9 +122,9 @@ epochs_of() {
 fw_stop
 fw_start /tmp/cmd-fw-restart.log --settings-file $settings
 check cmd-settings-restart "gfins-fw started again on the stored settings" [ $? -eq 0 ]
-n2=$(epochs_of 102 /tmp/cmd-restart.log)
-n1=$(grep -c ' vcan0 101#' /tmp/cmd-restart.log)
-check cmd-settings-node-after-restart "after the restart, 1 s: $n2 epochs of node 2, $n1 of node 1" \
+n2=$(epochs_of 302 /tmp/cmd-restart.log)
+n1=$(grep -c ' vcan0 10[12]#' /tmp/cmd-restart.log)
+check cmd-settings-node-after-restart "after the restart, 1 s: $n2 epochs of node 2 on 0x302 (data group at 0x300), $n1 on 0x101/0x102" \
   [ "$n2" -gt 0 -a "$n1" -eq 0 ]
 gfins-can cmd --iface vcan0 --node 2 --timeout-ms 2000 restore-defaults >/tmp/cmd-restore.out 2>&1
 rc=$?

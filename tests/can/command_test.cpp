@@ -54,6 +54,10 @@ TEST(Command, EveryCommandRoundTrips) {
   cmds.push_back(c);
   c.opcode = Opcode::kRestoreDefaults;
   cmds.push_back(c);
+  c.opcode = Opcode::kSetIdBase;
+  c.id_group = IdGroup::kResponse;
+  c.id_base = 0x7EF;
+  cmds.push_back(c);
   for (const Command& in : cmds) {
     SCOPED_TRACE(to_string(in.opcode));
     const hal::CanFrame f = encode_command(in, kNode);
@@ -83,6 +87,10 @@ TEST(Command, EveryCommandRoundTrips) {
         break;
       case Opcode::kSetNodeId:
         EXPECT_EQ(d.command.node_id, 15);
+        break;
+      case Opcode::kSetIdBase:
+        EXPECT_EQ(d.command.id_group, IdGroup::kResponse);
+        EXPECT_EQ(d.command.id_base, 0x7EF);
         break;
       default:
         break;
@@ -157,6 +165,36 @@ TEST(Command, SequenceNodeIdAndReloadForcedAtTheIcdBits) {
   EXPECT_EQ(f.data[2], 7);
   EXPECT_EQ(f.data[5], 0xEF);
   EXPECT_EQ(f.data[6], 0xBE);
+}
+
+// ICD: SetIdBase (opcode 10) has IdGroup in byte 2 (0 data, 1 input, 2 command, 3 response)
+// and IdBase in bits 24..34 (byte 3, and bits 0-2 of byte 4), then the sequence number. Frames
+// written byte by byte here.
+TEST(Command, SetIdBaseAtTheIcdBits) {
+  // Group 1 (input), base 0x5A3: byte 3 = 0xA3, byte 4 = 0x05.
+  DecodedCommand d = decode_command(raw_command({10, 9, 1, 0xA3, 0x05, 4, 0}), kNode);
+  ASSERT_TRUE(d.ok()) << d.error.message;
+  EXPECT_EQ(d.command.opcode, Opcode::kSetIdBase);
+  EXPECT_EQ(d.command.id_group, IdGroup::kInput);
+  EXPECT_EQ(d.command.id_base, 0x5A3);
+  EXPECT_EQ(d.command.sequence, 4);
+  EXPECT_EQ(decode_command(raw_command({10, 9, 4, 0, 1, 4, 0}), kNode).error.code,
+            ResultCode::kOutOfRange);  // group 4 does not exist
+  EXPECT_EQ(decode_command(raw_command({10, 9, 0, 0, 0x08, 4, 0}), kNode).error.code,
+            ResultCode::kMalformed);  // bit 35: above the 11-bit base
+  EXPECT_EQ(decode_command(raw_command({10, 9, 0, 0, 3, 0, 0}), kNode).error.code,
+            ResultCode::kOutOfRange);  // no sequence number
+  Command c;
+  c.opcode = Opcode::kSetIdBase;
+  c.id_group = IdGroup::kCommand;
+  c.id_base = 0x7FF;
+  c.sequence = 0x0102;
+  const hal::CanFrame f = encode_command(c, kNode);
+  EXPECT_EQ(f.data[2], 2);
+  EXPECT_EQ(f.data[3], 0xFF);
+  EXPECT_EQ(f.data[4], 0x07);
+  EXPECT_EQ(f.data[5], 0x02);
+  EXPECT_EQ(f.data[6], 0x01);
 }
 
 TEST(Command, SetDividerReachesTheAccuracyMessages) {

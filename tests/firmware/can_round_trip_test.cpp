@@ -648,7 +648,7 @@ TEST_F(CanMalformedCommands, EveryOpcodeWithABadCrcBadLengthOrStrayBitsChangesNo
 }
 
 TEST_F(CanMalformedCommands, UnknownOpcodesChangeNothing) {
-  for (const int op : {0, 10, 0x7F, 0xFF}) {
+  for (const int op : {0, 11, 0x7F, 0xFF}) {
     hal::CanFrame f{};
     f.id = 0x600 + SimRig::kNode;  // GfinsCommand, 0x600 + node
     f.len = 8;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -45,14 +46,20 @@ std::uint64_t fnv(const std::string& s) {
   return h;
 }
 
-// What a test stores: a node id (or none, -1) and the dividers set (name -> value).
+// What a test stores: a node id (or none, -1), the dividers set (name -> value) and the
+// identifier groups moved (data, input, command, response; -1 = not moved).
 struct Stored {
   int node = -1;
   std::map<std::string, int> dividers;
+  std::array<int, 4> id_bases = {-1, -1, -1, -1};
 };
 
+constexpr const char* kGroupKeys[4] = {"data_id_base", "input_id_base", "command_id_base",
+                                       "response_id_base"};
+
 // The checksum the ICD defines: FNV-1a of the lines "format_version=1", "node_id=N" (when
-// stored) and "output.NAME=D" for each divider stored, in the table's order, each ending in '\n'.
+// stored), "output.NAME=D" for each divider stored, in the table's order, and "GROUP_id_base=B"
+// (decimal) for each group moved, data to response, each ending in '\n'.
 std::string checksum_of(const Stored& st) {
   std::string canonical = "format_version=1\n";
   if (st.node >= 0) canonical += "node_id=" + std::to_string(st.node) + "\n";
@@ -60,6 +67,11 @@ std::string checksum_of(const Stored& st) {
     const auto it = st.dividers.find(key);
     if (it != st.dividers.end()) {
       canonical += "output." + std::string(key) + "=" + std::to_string(it->second) + "\n";
+    }
+  }
+  for (std::size_t g = 0; g < 4; ++g) {
+    if (st.id_bases[g] >= 0) {
+      canonical += std::string(kGroupKeys[g]) + "=" + std::to_string(st.id_bases[g]) + "\n";
     }
   }
   char buf[40];
@@ -75,6 +87,9 @@ std::string file_text(const Stored& st, const std::string& sum, int version = 1,
   std::ostringstream o;
   o << "format_version = " << version << "\n";
   if (st.node >= 0) o << "node_id = " << st.node << "\n";
+  for (std::size_t g = 4; g-- > 0;) {  // not the canonical order
+    if (st.id_bases[g] >= 0) o << kGroupKeys[g] << " = " << st.id_bases[g] << "\n";
+  }
   o << extra << "[output]\n";
   for (const auto& [key, value] : st.dividers) o << key << " = " << value << "\n";
   o << "[integrity]\nchecksum = '" << sum << "'\n";
@@ -87,6 +102,9 @@ CanSettings settings(const Stored& st) {
   for (std::size_t m = 0; m < 14; ++m) {
     const auto it = st.dividers.find(kKeys[m]);
     if (it != st.dividers.end()) s.dividers[m] = static_cast<std::uint16_t>(it->second);
+  }
+  for (std::size_t g = 0; g < 4; ++g) {
+    if (st.id_bases[g] >= 0) s.id_bases[g] = static_cast<std::uint16_t>(st.id_bases[g]);
   }
   return s;
 }
@@ -108,6 +126,17 @@ TEST(CanSettingsFile, TextRoundTripsAndTheChecksumIsFnv1a64OfTheCanonicalLines) 
   const SettingsParse r = parse_settings(file_text(only, checksum_of(only)), "o.toml", FwConfig{});
   ASSERT_TRUE(r.settings) << r.error;
   EXPECT_FALSE(r.settings->node_id);
+  // Identifier groups moved by SetIdBase: written in hex, covered by the checksum in decimal.
+  const Stored ids{-1, {}, {0x300, -1, 0x100, -1}};
+  const std::string ids_text = settings_text(settings(ids));
+  EXPECT_NE(ids_text.find("data_id_base = 0x300\n"), std::string::npos) << ids_text;
+  EXPECT_NE(ids_text.find("checksum = '" + checksum_of(ids) + "'"), std::string::npos) << ids_text;
+  const SettingsParse t = parse_settings(ids_text, "i.toml", FwConfig{});
+  ASSERT_TRUE(t.settings) << t.error;
+  EXPECT_EQ(*t.settings, settings(ids));
+  const SettingsParse u = parse_settings(file_text(ids, checksum_of(ids)), "j.toml", FwConfig{});
+  ASSERT_TRUE(u.settings) << u.error;
+  EXPECT_EQ(*u.settings, settings(ids));
 }
 
 TEST(CanSettingsFile, EveryDamageIsRefusedWithFileLineAndKey) {
@@ -138,6 +167,12 @@ TEST(CanSettingsFile, EveryDamageIsRefusedWithFileLineAndKey) {
       {"TOML syntax", "format_version = \n", "h.toml:1: TOML syntax"},
       {"checksum right, rules broken", file_text(euler15, checksum_of(euler15)),
        "breaks the configuration's rules"},
+      {"a group moved onto another",
+       file_text(Stored{-1, {}, {-1, -1, 0x100, -1}},
+                 checksum_of(Stored{-1, {}, {-1, -1, 0x100, -1}})),
+       "the stored can.command_id_base = 0x100 breaks the configuration's rules"},
+      {"a base past 11 bits", file_text(Stored{-1, {}, {0x800, -1, -1, -1}}, good_sum),
+       "h.toml:2: data_id_base must be an integer 0..2047"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
@@ -347,6 +382,65 @@ TEST(StoredSettings, WithoutAStoreSetNodeIdIsRefusedAndASaveThatFailsIsFlagged) 
   EXPECT_EQ(frames(other, 0x130 + SimRig::kNode, 400), 10u);
 }
 
+// SetIdBase stores a group's base for the next start. The groups of the next start are the
+// configuration's with the stored ones and the new one; the ICD's stock groups (data 0x100, input
+// 0x0B0, command 0x600, response 0x680, each its messages' offsets plus 16 node ids) and a
+// reserved range 0x700..0x70F are written out here.
+TEST(StoredSettings, SetIdBaseIsKeptForTheNextStartAndRefusedWhereItWouldCollide) {
+  gfins::testing::TempDir dir("gfins-settings");
+  const std::filesystem::path file = dir.path() / "can.toml";
+  SimRig rig("rest", 5.0);
+  rig.config.reserved_ids = {{0x700, 0x70F}};
+  SettingsWriter writer(file.string(), SettingsSource::kConfiguration);
+  rig.loop->set_settings_port(&writer);
+  rig.configure();
+  rig.run_cycles(1500);
+  const auto set_base = [&](can::IdGroup g, std::uint16_t base, std::uint32_t* value = nullptr) {
+    can::Command c = numbered(can::Opcode::kSetIdBase);
+    c.id_group = g;
+    c.id_base = base;
+    return send(rig, c, value);
+  };
+  std::uint32_t value = 0;
+  ASSERT_EQ(set_base(can::IdGroup::kData, 0x300, &value), 0);
+  EXPECT_EQ(value, 0x300u);
+  writer.wait_settled();
+  SettingsParse kept = read_back(file);
+  ASSERT_TRUE(kept.settings) << kept.error;
+  EXPECT_EQ(kept.settings->id_bases[0], 0x300);
+  EXPECT_FALSE(kept.settings->id_bases[2]);
+  // This run keeps its identifiers: the epoch still on 0x100 + node.
+  EXPECT_EQ(frames(rig, 0x100 + SimRig::kNode, 100), 10u);
+  EXPECT_EQ(frames(rig, 0x300 + SimRig::kNode, 100), 0u);
+  // Refused (Result 4, nothing stored): the command group onto the data group's next-start
+  // 0x300, the response group over the reserved 0x700..0x70F, the input group past 0x7FF.
+  EXPECT_EQ(set_base(can::IdGroup::kCommand, 0x300), 4);
+  EXPECT_EQ(set_base(can::IdGroup::kResponse, 0x6F8), 4);
+  EXPECT_EQ(set_base(can::IdGroup::kInput, 0x7F8), 4);
+  EXPECT_EQ(rig.loop->health().last_refusal, 4);
+  // The command group onto the configuration's data identifiers is free at the next start.
+  ASSERT_EQ(set_base(can::IdGroup::kCommand, 0x100), 0);
+  writer.wait_settled();
+  kept = read_back(file);
+  ASSERT_TRUE(kept.settings) << kept.error;
+  EXPECT_EQ(kept.settings->id_bases[0], 0x300);
+  EXPECT_EQ(kept.settings->id_bases[2], 0x100);
+  EXPECT_FALSE(kept.settings->id_bases[1]);
+  EXPECT_FALSE(kept.settings->id_bases[3]);
+  ASSERT_EQ(send(rig, numbered(can::Opcode::kRestoreDefaults)), 0);
+  writer.wait_settled();
+  EXPECT_FALSE(std::filesystem::exists(file));
+
+  // Without a store the base would be forgotten before it takes effect: refused (Result 7).
+  SimRig bare("rest", 5.0);
+  bare.configure();
+  bare.run_cycles(1500);
+  can::Command c = numbered(can::Opcode::kSetIdBase);
+  c.id_group = can::IdGroup::kData;
+  c.id_base = 0x300;
+  EXPECT_EQ(send(bare, c), 7);
+}
+
 // The messages the board derives from the epoch divider (its command counters always, the
 // filter's two with aiding) follow a new epoch divider instead of blocking it, and come back with
 // the old one: 1000, 200 and 400 samples rounded up to multiples of 30 are 1020, 210 and 420.
@@ -395,6 +489,10 @@ TEST(StoredSettings, SurviveARestartOfTheProgram) {
     div.message = can::MessageId::kEuler;
     div.divider = 40;
     ASSERT_EQ(send(rig, div), 0);
+    can::Command ids = numbered(can::Opcode::kSetIdBase);
+    ids.id_group = can::IdGroup::kData;
+    ids.id_base = 0x300;
+    ASSERT_EQ(send(rig, ids), 0);
     writer.wait_settled();
   }
   // Frames per identifier of a candump log "(t) iface ID#DATA", and the last frame's data.
@@ -427,11 +525,13 @@ TEST(StoredSettings, SurviveARestartOfTheProgram) {
   std::map<std::uint32_t, std::string> last;
   std::map<std::uint32_t, int> n = count(log, &last);
   EXPECT_EQ(n[0x101], 0) << "node 1 no more";
-  EXPECT_EQ(n[0x105], 201) << "epochs of node 5: 2 s at 1 kHz, divider 10, seq 0..2000";
-  EXPECT_EQ(n[0x135], 51) << "Euler every 40 samples";
-  ASSERT_EQ(last.count(0x205), 1u);
+  EXPECT_EQ(n[0x105], 0) << "the data group moved to 0x300";
+  EXPECT_EQ(n[0x305], 201) << "epochs of node 5: 2 s at 1 kHz, divider 10, seq 0..2000";
+  EXPECT_EQ(n[0x335], 51) << "Euler (0x130 + node in the stock group) every 40 samples";
+  EXPECT_NE(r.err.find("can.data_id_base 0x300"), std::string::npos) << r.err;
+  ASSERT_EQ(last.count(0x405), 1u);
   // Data as 16 hex digits: byte 6 is characters 12-13; bits 0-1 = 1, Stored.
-  EXPECT_EQ(std::stoi(last[0x205].substr(12, 2), nullptr, 16) & 3, 1) << last[0x205];
+  EXPECT_EQ(std::stoi(last[0x405].substr(12, 2), nullptr, 16) & 3, 1) << last[0x405];
 
   // A configuration file naming the same settings file, without --settings-file: the simulated
   // board leaves it alone (only the board itself keeps settings in can.settings_file; a replay

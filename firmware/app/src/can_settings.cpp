@@ -18,6 +18,17 @@
 namespace gfins::app {
 namespace {
 
+/// A group's key in the file: the configuration's without "can." (data_id_base, ...).
+std::string_view id_base_key(std::size_t g) { return kIdBaseKeys[g].substr(4); }
+
+/// The group whose key `name` is, or kIdGroupCount.
+std::size_t id_base_group(std::string_view name) {
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    if (id_base_key(g) == name) return g;
+  }
+  return can::kIdGroupCount;
+}
+
 /// The lines the checksum covers, in a fixed order (independent of the file's layout).
 std::string canonical(const CanSettings& s) {
   std::string out = "format_version=" + std::to_string(kSettingsFormatVersion) + "\n";
@@ -25,6 +36,10 @@ std::string canonical(const CanSettings& s) {
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     if (!s.dividers[m]) continue;
     out += "output." + std::string(kMessageNames[m]) + "=" + std::to_string(*s.dividers[m]) + "\n";
+  }
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    if (!s.id_bases[g]) continue;
+    out += std::string(id_base_key(g)) + "=" + std::to_string(*s.id_bases[g]) + "\n";
   }
   return out;
 }
@@ -64,7 +79,9 @@ std::int64_t integer(const toml::table& t, const std::string& source, const std:
 void reject_unknown(const toml::table& root, const std::string& source) {
   for (const auto& [k, node] : root) {
     const std::string_view name = k.str();
-    if (name == "format_version" || name == "node_id") continue;
+    if (name == "format_version" || name == "node_id" || id_base_group(name) < can::kIdGroupCount) {
+      continue;
+    }
     if (name == "output" && node.is_table()) {
       for (const auto& [mk, mnode] : *node.as_table()) {
         if (message_index(mk.str()) < 0) {
@@ -95,6 +112,12 @@ std::string settings_text(const CanSettings& s) {
       "# match it is ignored and the board says so on the bus.\n";
   out += "format_version = " + std::to_string(kSettingsFormatVersion) + "\n";
   if (s.node_id) out += "node_id = " + std::to_string(*s.node_id) + "\n";
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    if (!s.id_bases[g]) continue;
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%03X", static_cast<unsigned>(*s.id_bases[g]));
+    out += std::string(id_base_key(g)) + " = " + hex + "\n";
+  }
   out += "\n[output]\n";
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     if (!s.dividers[m]) continue;
@@ -118,6 +141,9 @@ void apply_stored(const CanSettings& s, FwConfig& c, std::string* overridden) {
     } else {
       c.node_id = *s.node_id;
     }
+  }
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    if (s.id_bases[g]) c.id_bases[g] = *s.id_bases[g];
   }
   for (std::size_t m = 0; m < kNumMessages; ++m) {
     if (!s.dividers[m]) continue;
@@ -149,6 +175,11 @@ SettingsParse parse_settings(std::string_view text, const std::string& source,
     CanSettings s;
     if (root.get("node_id") != nullptr) {
       s.node_id = static_cast<std::uint8_t>(integer(root, source, "node_id", 0, kMaxNodeId));
+    }
+    for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+      const std::string key(id_base_key(g));
+      if (root.get(key) == nullptr) continue;
+      s.id_bases[g] = static_cast<std::uint16_t>(integer(root, source, key, 0, 0x7FF));
     }
     for (std::size_t m = 0; m < kNumMessages; ++m) {
       const std::string key = "output." + std::string(kMessageNames[m]);
@@ -226,6 +257,12 @@ StartupSettings load_stored_settings(FwConfig& c) {
   out.source = SettingsSource::kStored;
   out.stored = *p.settings;
   out.message = "stored CAN settings from " + shown + ": node id " + std::to_string(c.node_id);
+  for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
+    if (!p.settings->id_bases[g]) continue;
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%03X", static_cast<unsigned>(*p.settings->id_bases[g]));
+    out.message += ", " + std::string(kIdBaseKeys[g]) + " " + hex;
+  }
   if (!overridden.empty()) {
     out.message += "; the command line wins over the stored " + overridden;
   }

@@ -20,6 +20,7 @@
 #include "gfins/app/can_settings.hpp"
 #include "gfins/app/config.hpp"
 #include "gfins/app/logger.hpp"
+#include "gfins/app/publisher_sink.hpp"
 #include "gfins/app/recorder.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/service_status.hpp"
@@ -62,6 +63,7 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
   // file that is not right is ignored and the bus says so (SettingsSource).
   const std::array<std::uint16_t, kNumMessages> config_dividers = cfg.dividers;
   const auto config_node_id = static_cast<std::uint8_t>(cfg.node_id);
+  const gfins::can::IdBases config_ids = id_bases(cfg);
   const StartupSettings stored = load_stored_settings(cfg);
   if (stored.source == SettingsSource::kStoredCorrupt) {
     spdlog::error("{}", printable_text(stored.message));
@@ -152,6 +154,7 @@ int run(const gfins::app::BoardTable& boards, gfins::app::FwConfig cfg,
   options.stored = stored.stored;
   options.config_dividers = config_dividers;
   options.config_node_id = config_node_id;
+  options.config_ids = config_ids;
   if (const gfins::Status s = loop->configure(cal.set, options); !s.is_ok()) {
     spdlog::critical("navigation core rejected the configuration: {}", s.message());
     return 1;

@@ -484,6 +484,31 @@ void SampleLoop::execute_settings(const can::Command& c, CommandReply& r) {
     }
     settings_.node_id = c.node_id;
     r.response.value = c.node_id;
+  } else if (c.opcode == can::Opcode::kSetIdBase) {
+    // Stored for the next start, as the node id; refused without a store, and when the groups of
+    // the next start (the configuration's, the ones stored before, this one) would leave 11 bits,
+    // overlap each other or a reserved range: the board would come up deaf or on others' IDs.
+    const auto g = static_cast<std::size_t>(c.id_group);
+    can::IdBases next = options_.config_ids;
+    for (std::size_t h = 0; h < can::kIdGroupCount; ++h) {
+      if (settings_.id_bases[h]) next.base[h] = *settings_.id_bases[h];
+    }
+    next.base[g] = c.id_base;
+    bool fits = can::id_bases_valid(next);
+    for (std::size_t h = 0; h < can::kIdGroupCount; ++h) {
+      for (const std::array<std::uint32_t, 2>& res : options_.reserved_ids) {
+        fits = fits && !can::id_group_overlaps(next, h, res[0], res[1]);
+      }
+    }
+    const can::ResultCode why = settings_port_ == nullptr ? can::ResultCode::kFailed
+                                : !fits                   ? can::ResultCode::kOutOfRange
+                                                          : can::ResultCode::kOk;
+    if (why != can::ResultCode::kOk) {
+      r.response.result = why;
+      return note_refusal(why);
+    }
+    settings_.id_bases[g] = c.id_base;
+    r.response.value = c.id_base;
   } else {
     // The configuration's dividers at once; its node id from the next start.
     if (!out_.set_dividers(options_.config_dividers).is_ok()) {
@@ -722,6 +747,7 @@ void SampleLoop::execute(const can::Command& c, CommandReply& r) {
       r.deferred = true;  // answered when the worker is done (poll_reload), counted there
       return;
     case can::Opcode::kSetNodeId:
+    case can::Opcode::kSetIdBase:
     case can::Opcode::kRestoreDefaults:
       return execute_settings(c, r);
     default:

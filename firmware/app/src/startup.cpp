@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -80,6 +81,11 @@ LoopOptions loop_options(const FwConfig& c) {
   o.ids = id_bases(c);
   o.config_dividers = c.dividers;
   o.config_node_id = static_cast<std::uint8_t>(c.node_id);
+  o.config_ids = o.ids;
+  for (const std::array<int, 2>& r : c.reserved_ids) {
+    o.reserved_ids.push_back({static_cast<std::uint32_t>(std::max(r[0], 0)),
+                              static_cast<std::uint32_t>(std::max(r[1], 0))});
+  }
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
   o.initial_position_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),

@@ -109,6 +109,12 @@ DecodedCommand decode_command(const hal::CanFrame& f, std::uint8_t node_id, cons
       case Field::kCmdNodeId:
         c.node_id = static_cast<std::uint8_t>(x);
         break;
+      case Field::kCmdIdGroup:
+        c.id_group = static_cast<IdGroup>(x);
+        break;
+      case Field::kCmdIdBase:
+        c.id_base = static_cast<std::uint16_t>(x);
+        break;
       default:
         break;
     }
@@ -154,6 +160,10 @@ hal::CanFrame encode_command(const Command& c, std::uint8_t node_id, const IdBas
       break;
     case Opcode::kSetNodeId:
       p = insert_bits(p, sig(m, Field::kCmdNodeId), c.node_id);
+      break;
+    case Opcode::kSetIdBase:
+      p = insert_bits(p, sig(m, Field::kCmdIdGroup), static_cast<std::uint8_t>(c.id_group));
+      p = insert_bits(p, sig(m, Field::kCmdIdBase), c.id_base);
       break;
     default:
       break;

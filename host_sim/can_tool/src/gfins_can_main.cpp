@@ -744,6 +744,18 @@ int main_impl(int argc, char** argv) {
   auto* node_id = cmd->add_subcommand(
       "node-id", "set the node id the board takes at its next start (kept across restarts)");
   node_id->add_option("id", new_node, "node id 0..15")->required()->check(CLI::Range(0, 15));
+  std::string id_group_name;
+  int new_base = 0;
+  auto* id_base = cmd->add_subcommand(
+      "id-base",
+      "move an identifier group from the board's next start (kept across restarts; refused when "
+      "it would overlap another group or can.reserved_ids)");
+  id_base->add_option("group", id_group_name, "data | input | command | response")
+      ->required()
+      ->check(CLI::IsMember({"data", "input", "command", "response"}));
+  id_base->add_option("base", new_base, "the group's first identifier, 0..0x7FF (0x... or decimal)")
+      ->required()
+      ->check(CLI::Range(0, 0x7FF));
   auto* restore = cmd->add_subcommand(
       "restore-defaults",
       "forget the settings kept across restarts: the configuration's dividers at once, its node "
@@ -967,6 +979,13 @@ int main_impl(int argc, char** argv) {
   } else if (node_id->parsed()) {
     c.opcode = can::Opcode::kSetNodeId;
     c.node_id = static_cast<std::uint8_t>(new_node);
+  } else if (id_base->parsed()) {
+    c.opcode = can::Opcode::kSetIdBase;
+    c.id_group = id_group_name == "data"      ? can::IdGroup::kData
+                 : id_group_name == "input"   ? can::IdGroup::kInput
+                 : id_group_name == "command" ? can::IdGroup::kCommand
+                                              : can::IdGroup::kResponse;
+    c.id_base = static_cast<std::uint16_t>(new_base);
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
   }

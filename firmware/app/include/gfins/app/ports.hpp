@@ -60,13 +60,18 @@ class EpochSink {
 
 /// The CAN settings commands changed, which the board keeps across restarts
 /// (docs/can-interface.md, "Stored settings"): only what a command set (SetNodeId: the node id
-/// of the next start; SetDivider: that message's divider); the rest is the configuration's.
+/// of the next start; SetDivider: that message's divider; SetIdBase: an identifier group's base
+/// of the next start); the rest is the configuration's.
 struct CanSettings {
   std::optional<std::uint8_t> node_id;
   std::array<std::optional<std::uint16_t>, kNumMessages> dividers{};
+  std::array<std::optional<std::uint16_t>, can::kIdGroupCount> id_bases{};
   bool empty() const {
     for (const auto& d : dividers) {
       if (d) return false;
+    }
+    for (const auto& b : id_bases) {
+      if (b) return false;
     }
     return !node_id;
   }

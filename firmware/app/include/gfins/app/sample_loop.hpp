@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "gfins/app/health.hpp"
 #include "gfins/app/log_queue.hpp"
@@ -149,6 +150,11 @@ struct LoopOptions {
   CanSettings stored{};
   std::array<std::uint16_t, kNumMessages> config_dividers = kDefaultDividers;
   std::uint8_t config_node_id = can::kDefaultNodeId;
+  /// The configuration's identifier groups and the ranges other equipment uses
+  /// (can.reserved_ids, [first, last]): what SetIdBase checks a new base against, with the bases
+  /// stored before it.
+  can::IdBases config_ids{};
+  std::vector<std::array<std::uint32_t, 2>> reserved_ids;
 };
 
 class SampleLoop {

@@ -24,6 +24,7 @@ enum class Opcode : std::uint8_t {
   kReloadCalibration = kOpReloadCalibration,  // reload the calibration file
   kSetNodeId = kOpSetNodeId,                  // the node id of the next start (stored)
   kRestoreDefaults = kOpRestoreDefaults,      // forget the stored CAN settings
+  kSetIdBase = kOpSetIdBase,                  // an identifier group's base of the next start
 };
 
 /// The opcodes that change the board's state or settings carry a sequence number (Command::
@@ -66,6 +67,8 @@ struct Command {
                                // kReloadCalibration: take another board's file
   std::uint16_t sequence = 0;  // carries_sequence(opcode): 1..65535, above the last one taken
   std::uint8_t node_id = 0;    // kSetNodeId: 0..kMaxNodeId
+  IdGroup id_group = IdGroup::kData;  // kSetIdBase: the group
+  std::uint16_t id_base = 0;          // kSetIdBase: its first identifier, 0..0x7FF
 };
 
 struct CommandError {

@@ -82,6 +82,8 @@ enum class Field : std::uint8_t {
   kCmdForced,
   kCmdSequence,  // configuration-changing commands: must exceed the last one of the session
   kCmdNodeId,
+  kCmdIdGroup,
+  kCmdIdBase,
   // command counters and settings (GfinsCommandCounters)
   kCmdAccepted,
   kCmdRefused,
@@ -204,15 +206,20 @@ inline constexpr std::array<ValueName, 6> kModeValues{{{0, "Startup"},
                                                        {4, "Fault"},
                                                        {5, "Replay"}}};
 
-inline constexpr std::array<ValueName, 9> kOpcodeValues{{{1, "Realign"},
-                                                         {2, "ResetNavigation"},
-                                                         {3, "SetCompensator"},
-                                                         {4, "SetDivider"},
-                                                         {5, "ReportCalibrationId"},
-                                                         {6, "StartCapture"},
-                                                         {7, "ReloadCalibration"},
-                                                         {8, "SetNodeId"},
-                                                         {9, "RestoreDefaults"}}};
+inline constexpr std::array<ValueName, 10> kOpcodeValues{{{1, "Realign"},
+                                                          {2, "ResetNavigation"},
+                                                          {3, "SetCompensator"},
+                                                          {4, "SetDivider"},
+                                                          {5, "ReportCalibrationId"},
+                                                          {6, "StartCapture"},
+                                                          {7, "ReloadCalibration"},
+                                                          {8, "SetNodeId"},
+                                                          {9, "RestoreDefaults"},
+                                                          {10, "SetIdBase"}}};
+
+/// The identifier groups (IdGroup order) as SetIdBase names them.
+inline constexpr std::array<ValueName, 4> kIdGroupValues{
+    {{0, "Data"}, {1, "Input"}, {2, "Command"}, {3, "Response"}}};
 
 inline constexpr std::array<ValueName, 3> kCompensatorValues{
     {{0, "None"}, {1, "Paper"}, {2, "Exact"}}};
@@ -722,6 +729,7 @@ inline constexpr std::uint8_t kOpReloadCalibration = 7;
 inline constexpr std::uint8_t kMaxCapturePose = 63;
 inline constexpr std::uint8_t kOpSetNodeId = 8;
 inline constexpr std::uint8_t kOpRestoreDefaults = 9;
+inline constexpr std::uint8_t kOpSetIdBase = 10;
 /// Configuration-changing commands carry a sequence number in bits 40..55: it must exceed the
 /// last one the board took in this session (0 at start-up), so a frame replayed from a log is
 /// refused (docs/can-interface.md, "Sequence numbers").
@@ -738,13 +746,13 @@ constexpr SignalDef sequence_signal(std::string_view name, std::int16_t op) {
                       1.0);
 }
 
-inline constexpr std::array<SignalDef, 20> kCommandSignals{{
+inline constexpr std::array<SignalDef, 23> kCommandSignals{{
     SignalDef{.name = "Opcode",
               .field = Field::kCmdOpcode,
               .start_bit = 0,
               .length = 8,
               .min = 1.0,
-              .max = 9.0,
+              .max = 10.0,
               .mux = kMultiplexor,
               .values = kOpcodeValues,
               .instant = kAtCommand,
@@ -789,6 +797,12 @@ inline constexpr std::array<SignalDef, 20> kCommandSignals{{
                  "of the calibration in use (else refused as OtherDevice)"),
     unsigned_int("NodeId", Field::kCmdNodeId, 0, 16, 8, double{kMaxNodeId}, kOpSetNodeId, {},
                  kAtCommand, "SetNodeId: the node id the board takes at its next start"),
+    unsigned_int("IdGroup", Field::kCmdIdGroup, 0, 16, 8, 3.0, kOpSetIdBase, kIdGroupValues,
+                 kAtCommand, "SetIdBase: the identifier group to move"),
+    unsigned_int("IdBase", Field::kCmdIdBase, 0, 24, 11, 2047.0, kOpSetIdBase, {}, kAtCommand,
+                 "SetIdBase: the group's first identifier from the next start (its messages keep "
+                 "their offsets; refused when the group would leave 11 bits or overlap another "
+                 "group or can.reserved_ids)"),
     sequence_signal("RealignSequence", kOpRealign),
     sequence_signal("ResetSequence", kOpResetNavigation),
     sequence_signal("CompensatorSequence", kOpSetCompensator),
@@ -796,6 +810,7 @@ inline constexpr std::array<SignalDef, 20> kCommandSignals{{
     sequence_signal("ReloadSequence", kOpReloadCalibration),
     sequence_signal("NodeIdSequence", kOpSetNodeId),
     sequence_signal("RestoreSequence", kOpRestoreDefaults),
+    sequence_signal("IdBaseSequence", kOpSetIdBase),
     crc_signal(),
 }};
 
@@ -1040,6 +1055,12 @@ constexpr std::uint32_t can_id(MessageId id, std::uint8_t node_id) {
 }
 constexpr const MessageDef* find_message(std::uint32_t can_id, std::uint8_t* node_id) {
   return find_message(can_id, IdBases{}, node_id);
+}
+
+/// Whether group `g` at `ids` takes any identifier of [first, last].
+constexpr bool id_group_overlaps(const IdBases& ids, std::size_t g, std::uint32_t first,
+                                 std::uint32_t last) {
+  return ids.base[g] <= last && first < ids.base[g] + id_span(g);
 }
 
 /// Whether the groups at `ids` fit the 11-bit identifier and do not overlap each other.
