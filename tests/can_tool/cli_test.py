@@ -190,6 +190,13 @@ def main():
             (['cmd', '--iface', 'no-such-can9', 'realign', '--heading-deg', '9x'], 'not a number'),
             # the board refuses a GfinsStatus divider (it follows GfinsEpoch's): not offered
             (['cmd', '--iface', 'no-such-can9', 'divider', 'GfinsStatus', '10'], 'Status divider'),
+            # identifier bases: hexadecimal with 0x only (candump's "300" is 0x300, strtoll's
+            # 300 decimal and "0300" octal), within 11 bits, a group the table has
+            (['cmd', '--iface', 'no-such-can9', 'id-base', 'data', '300'], 'bare 300'),
+            (['cmd', '--iface', 'no-such-can9', 'id-base', 'data', '0300'], 'octal-looking 0300'),
+            (['cmd', '--iface', 'no-such-can9', 'id-base', 'data', '0x800'], 'base past 11 bits'),
+            (['cmd', '--iface', 'no-such-can9', 'id-base', 'data', '0x'], 'no digits'),
+            (['cmd', '--iface', 'no-such-can9', 'id-base', 'gnss', '0x300'], 'no such group'),
             (['calibrate', '--iface', 'no-such-can9', '--adc-lsb', '1e-6', '-o',
               os.path.join(a.workdir, 'm.csv'), '--timeout-ms', '-1'], 'calibrate timeout')):
         r = run([exe] + argv)
@@ -198,7 +205,9 @@ def main():
     # ... while the valid forms get past the command line (to the missing interface: exit 2)
     for argv in (['cmd', '--iface', 'no-such-can9', 'realign', '--heading-deg', '-180'],
                  ['cmd', '--iface', 'no-such-can9', '--rate', '250', '--timeout-ms', '1', 'reset'],
-                 ['cmd', '--iface', 'no-such-can9', 'divider', 'GfinsEpoch', '20']):
+                 ['cmd', '--iface', 'no-such-can9', 'divider', 'GfinsEpoch', '20'],
+                 ['cmd', '--iface', 'no-such-can9', 'id-base', 'data', '0x300'],
+                 ['cmd', '--iface', 'no-such-can9', 'id-base', 'response', '0X7EF']):
         r = run([exe] + argv)
         check(r.returncode == 2 and 'no-such-can9' in r.stderr.decode(),
               f'{argv}: exit {r.returncode}, expected 2: {r.stderr.decode()}')

@@ -7,11 +7,11 @@
 // as if it observed the tilt, and after a long stop the σ is below the error.
 //
 // The setting makes the bias's part of the tilt the larger one: a 300 µg bias per sensor (the
-// level's A δβ about 0.01°), and a ZARU of 1e-5 rad/s (a board on a bench: the rate it leaves
-// makes the tilt σ grow less than the bias term). With the ZARU's default 1e-3 rad/s the tilt σ is
-// dominated by that growth, 2.4 times the error in σ, and the correlation's absence does not show
-// (mean q 0.91 with it, 0.99 without). Here: 1.91 with it, 3.79 without (measured; the bound
-// below fails the latter).
+// level's A δβ up to about 3e-3 / 9.8 rad ≈ 0.018°), and a ZARU of 1e-5 rad/s (a board on a
+// bench: the rate it leaves makes the tilt σ grow less than the bias term). With the ZARU's
+// default 1e-3 rad/s the tilt σ is dominated by that growth (mean q 0.91, the σ about 1.5 times
+// what the errors give) and the correlation's absence does not show (0.99 without it). Here:
+// 1.91 with it, 3.79 without (measured; the bound below fails the latter).
 //
 // Monte-Carlo over kRuns boards (aiding_stand.hpp: a constant bias per sensor drawn per seed, white
 // noise), each levelled at its first standstill window and then held by ZUPTs and ZARUs for

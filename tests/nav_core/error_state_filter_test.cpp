@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "nav_core/filter_run.hpp"
 
@@ -647,7 +648,10 @@ struct HeadingUnknownDrive {
 };
 
 TEST(ErrorStateFilterTest, PositionSigmaCoversTheDistanceDrivenWithTheHeadingUnknown) {
-  static HeadingUnknownDrive run;
+  // On the heap: the filter's matrices and history stay off the stack (a fresh one per test, so
+  // --gtest_repeat finds the same start).
+  const auto own = std::make_unique<HeadingUnknownDrive>();
+  HeadingUnknownDrive& run = *own;
   run.drive_to(30);
   const double driven = run.truth(30).r_n.norm();
   std::printf(
@@ -678,7 +682,8 @@ TEST(ErrorStateFilterTest, AGnssPositionStartsTheDistanceDrivenWithTheHeadingUnk
   // A position fix at 20 s while the heading is unknown sets the position: only the displacement
   // after it (100 m at 10 m/s) turns with the heading error from then on, not the 250 m since the
   // start (which would give σ ≥ √1.5 × 250 m = 306 m per axis).
-  static HeadingUnknownDrive run;
+  const auto own = std::make_unique<HeadingUnknownDrive>();
+  HeadingUnknownDrive& run = *own;
   run.drive_to(20);
   GnssFix<double> fix;
   fix.t_valid_ns = run.nav.state().t_ns;
@@ -689,6 +694,24 @@ TEST(ErrorStateFilterTest, AGnssPositionStartsTheDistanceDrivenWithTheHeadingUnk
   const double since_fix = (run.truth(30).r_n - run.truth(20).r_n).norm();
   ASSERT_NEAR(run.error().head<2>().norm(), 2 * std::sin(0.5) * since_fix, 0.02 * since_fix);
   run.expect_displacement_term(fix.value_n, "after the position fix");
+}
+
+TEST(ErrorStateFilterTest, ARestartWithTheHeadingUnknownKeepsTheDistanceDrivenInP) {
+  // An in-motion start (lose_attitude: the same restart as a divergence) after 30 s driven with
+  // the heading unknown moves the anchor to here; the 1.5 |d|² of the 250 m driven so far must go
+  // into P_pp first, since that position error is still there (1e-9: rounding).
+  const auto own = std::make_unique<HeadingUnknownDrive>();
+  HeadingUnknownDrive& run = *own;
+  run.drive_to(30);
+  const Vec3<double> d = run.nav.state().r_n - run.truth(0).r_n;
+  const Vec3<double> before = run.p_pp();
+  run.filter.lose_attitude(run.nav);
+  const Vec3<double> after = run.p_pp();
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_GE(after(i), (before(i) + 1.5 * d.head<2>().squaredNorm()) * (1 - 1e-9)) << "axis " << i;
+  }
+  // The position is not published until a fix sets it (lost), and then from that fix on.
+  EXPECT_TRUE(std::isnan(run.filter.accuracy(run.nav.state()).pos_sigma_m.x()));
 }
 
 // ---- Euler σ: the Jacobian against finite differences of the Euler angles -------------------

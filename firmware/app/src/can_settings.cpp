@@ -226,8 +226,10 @@ StartupSettings load_stored_settings(FwConfig& c) {
   std::error_code ec;
   const fs::file_status st = fs::symlink_status(c.can_settings_file, ec);
   if (st.type() == fs::file_type::not_found) {
-    out.message = "can.settings_file " + shown +
-                  ": nothing stored yet, the configuration's node id and dividers are used";
+    out.message =
+        "can.settings_file " + shown +
+        ": nothing stored yet, the configuration's node id, dividers and identifier groups are "
+        "used";
     return out;
   }
   if (!ec && st.type() != fs::file_type::regular) {

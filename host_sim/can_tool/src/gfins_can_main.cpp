@@ -745,7 +745,7 @@ int main_impl(int argc, char** argv) {
       "node-id", "set the node id the board takes at its next start (kept across restarts)");
   node_id->add_option("id", new_node, "node id 0..15")->required()->check(CLI::Range(0, 15));
   std::string id_group_name;
-  int new_base = 0;
+  std::string new_base_text;
   auto* id_base = cmd->add_subcommand(
       "id-base",
       "move an identifier group from the board's next start (kept across restarts; refused when "
@@ -753,9 +753,26 @@ int main_impl(int argc, char** argv) {
   id_base->add_option("group", id_group_name, "data | input | command | response")
       ->required()
       ->check(CLI::IsMember({"data", "input", "command", "response"}));
-  id_base->add_option("base", new_base, "the group's first identifier, 0..0x7FF (0x... or decimal)")
+  // Hexadecimal with its 0x, as candump and the ICD write identifiers: a bare "300" would be
+  // decimal to strtoll and "0300" octal, and a base that collides with nothing is accepted and
+  // taken at the next start.
+  id_base
+      ->add_option("base", new_base_text,
+                   "the group's first identifier, 0x000..0x7FF (hexadecimal, with 0x)")
       ->required()
-      ->check(CLI::Range(0, 0x7FF));
+      ->check(CLI::Validator(
+          [](const std::string& t) -> std::string {
+            const bool hex = t.size() >= 3 && t.size() <= 5 && t[0] == '0' &&
+                             (t[1] == 'x' || t[1] == 'X') &&
+                             t.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
+            if (!hex || std::stoul(t.substr(2), nullptr, 16) > 0x7FF) {
+              return "an identifier 0x000..0x7FF, hexadecimal with its 0x (as candump writes it "
+                     "without), not " +
+                     app::quote_text(t).substr(0, 40);
+            }
+            return "";
+          },
+          "0x000..0x7FF"));
   auto* restore = cmd->add_subcommand(
       "restore-defaults",
       "forget the settings kept across restarts: the configuration's dividers at once, its node "
@@ -985,7 +1002,7 @@ int main_impl(int argc, char** argv) {
                  : id_group_name == "input"   ? can::IdGroup::kInput
                  : id_group_name == "command" ? can::IdGroup::kCommand
                                               : can::IdGroup::kResponse;
-    c.id_base = static_cast<std::uint16_t>(new_base);
+    c.id_base = static_cast<std::uint16_t>(std::stoul(new_base_text.substr(2), nullptr, 16));
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
   }

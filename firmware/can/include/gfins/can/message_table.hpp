@@ -875,8 +875,9 @@ inline constexpr std::array<SignalDef, 39> kResponseSignals{{
                  kAtResponse, "Outcome of the command"),
     unsigned_int(
         "Value", Field::kRspValue, 0, 32, 24, 16777215.0, kPartStatus, {}, kAtResponse,
-        "Command-specific: the new divider, the accepted N, the node id of the next start; for "
-        "ReportCalibrationId and Replayed the last sequence number the board took"),
+        "Command-specific: the new divider, the accepted N, the node id or the group base of the "
+        "next start; for ReportCalibrationId and Replayed the last sequence number the board "
+        "took"),
     unsigned_int("CalId", Field::kRspCalId, 0, 24, 32, 4294967295.0, kPartCalibrationId, {},
                  kAtResponse, "Identity of the calibration in use (0 = nominal)"),
     unsigned_int("DonePose", Field::kRspPose, 0, 24, 8, 255.0, kPartCaptureDone, {}, kOverCapture,

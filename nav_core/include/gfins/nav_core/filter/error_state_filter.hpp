@@ -818,8 +818,15 @@ void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
   const NavState<T>& x = nav.state();
   const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
   nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
-  const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
+  Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
   const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
+  if (!heading_aligned_) {
+    // The heading was unknown already: the displacement since the anchor keeps its error when
+    // the anchor moves here (accuracy()).
+    const T var = unknown_heading_pos_var(x);
+    pos_var.x() += var;
+    pos_var.y() += var;
+  }
   p_ = initial_covariance();
   // Half the limit: the restart must leave room before the test fires again.
   const T tilt2 = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad / T(4);
