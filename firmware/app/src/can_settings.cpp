@@ -113,10 +113,7 @@ std::string settings_text(const CanSettings& s) {
   out += "format_version = " + std::to_string(kSettingsFormatVersion) + "\n";
   if (s.node_id) out += "node_id = " + std::to_string(*s.node_id) + "\n";
   for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
-    if (!s.id_bases[g]) continue;
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%03X", static_cast<unsigned>(*s.id_bases[g]));
-    out += std::string(id_base_key(g)) + " = " + hex + "\n";
+    if (s.id_bases[g]) out += std::string(id_base_key(g)) + " = " + hex_id(*s.id_bases[g]) + "\n";
   }
   out += "\n[output]\n";
   for (std::size_t m = 0; m < kNumMessages; ++m) {
@@ -260,10 +257,9 @@ StartupSettings load_stored_settings(FwConfig& c) {
   out.stored = *p.settings;
   out.message = "stored CAN settings from " + shown + ": node id " + std::to_string(c.node_id);
   for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
-    if (!p.settings->id_bases[g]) continue;
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%03X", static_cast<unsigned>(*p.settings->id_bases[g]));
-    out.message += ", " + std::string(kIdBaseKeys[g]) + " " + hex;
+    if (p.settings->id_bases[g]) {
+      out.message += ", " + std::string(kIdBaseKeys[g]) + " " + hex_id(*p.settings->id_bases[g]);
+    }
   }
   if (!overridden.empty()) {
     out.message += "; the command line wins over the stored " + overridden;

@@ -12,6 +12,13 @@
 #include "gfins/app/publisher_sink.hpp"
 
 namespace gfins::app {
+
+std::string hex_id(int id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
+  return buf;
+}
+
 namespace {
 
 // Linux interface names: 1..15 bytes (IFNAMSIZ 16 with the NUL), no '/', no whitespace.
@@ -37,12 +44,6 @@ bool valid_ipv4(const std::string& s) {
     i = j + 1;
   }
   return parts == 4;
-}
-
-std::string hex_id(int id) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
-  return buf;
 }
 
 // The identifier groups (docs/can-interface.md, "Identifiers"): each within 11 bits, none over

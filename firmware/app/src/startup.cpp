@@ -82,9 +82,9 @@ LoopOptions loop_options(const FwConfig& c) {
   o.config_dividers = c.dividers;
   o.config_node_id = static_cast<std::uint8_t>(c.node_id);
   o.config_ids = o.ids;
+  // The configuration's reader admits 0 <= first <= last <= 0x7FF only (can.reserved_ids).
   for (const std::array<int, 2>& r : c.reserved_ids) {
-    o.reserved_ids.push_back({static_cast<std::uint32_t>(std::max(r[0], 0)),
-                              static_cast<std::uint32_t>(std::max(r[1], 0))});
+    o.reserved_ids.push_back({static_cast<std::uint32_t>(r[0]), static_cast<std::uint32_t>(r[1])});
   }
   o.initial_heading_rad = static_cast<float>(c.heading_deg * kRadPerDeg);
   o.initial_position_n =

@@ -197,6 +197,9 @@ std::string preflight(const FwConfig& c, const BoardTable& boards, const std::st
 /// it would navigate UNCALIBRATED (not an error: the run starts, flagged, docs/firmware.md).
 std::string calibration_note(const FwConfig& c);
 
+/// A CAN identifier as the ICD writes it: 0x and three upper-case hexadecimal digits.
+std::string hex_id(int id);
+
 /// `s` in double quotes with '"', '\', control characters (C0, DEL, C1) and the bytes of invalid
 /// UTF-8 escaped (\uXXXX, \xNN), cut to 60 characters: a value as a message shows it.
 std::string quote_text(std::string_view s);
