@@ -384,6 +384,46 @@ TEST(ErrorStateFilterTest, ARestartForgetsThePreviousFix) {
   EXPECT_GT(r.tilt_deg(), 25.0);
 }
 
+// A re-level after a restart turns the yaw to the fixes' azimuth while the heading stays unknown
+// (below the track speed): a new heading, as unknown as the old one. Each leg keeps its own
+// heading's error, and the position σ adds 1.5 (|d₁| + |d₂|)² per axis (docs/math.md: Minkowski's
+// bound for the sum of the legs' errors); the heading fix that comes later moves it into P_pp.
+// Truth written here: level, heading north, from rest at 0.5 m/s² north (2 m/s after 4 s, below
+// the 3 m/s of the track); the estimate level and 90° off in heading, so the fixes' f has an
+// azimuth and the re-level at the second fix (2 s) turns the yaw by about 90°. Exact algebra:
+// 1e-9 relative is rounding. With the anchor left at the restart the fix adds 1.5 |d₁ + d₂|²
+// (14 % less here); with the anchor moved and the first leg forgotten, 1.5 |d₂|².
+TEST(ErrorStateFilterTest, AReLevelThatTurnsTheYawStartsANewLegOfTheUnknownHeading) {
+  const Quat<double> turned(Eigen::AngleAxisd(kPi / 2, Vec3<double>::UnitZ()));
+  TiltedRestart r(turned, Vec3<double>::Zero(), Vec3<double>(0.5, 0, 0));
+  const Vec3<double> start = r.nav.state().r_n;  // the restart's anchor
+  auto p_pp = [&r] { return r.filter.covariance().block<2, 2>(filt_idx::kPos, filt_idx::kPos); };
+  r.run(1.995, 1.0);  // the first fix, at 1 s: velocity reset, nothing to difference yet
+  const double yaw_before = euler_from_quat(r.nav.state().q_nb).z();
+  r.run(0.005, 1.0);  // the second fix, at 2 s: the re-level
+  ASSERT_GT(std::abs(wrap_pi(euler_from_quat(r.nav.state().q_nb).z() - yaw_before)), 1.0)
+      << "the re-level turned the yaw";
+  ASSERT_FALSE(r.filter.heading_aligned());
+  const Vec3<double> relevel = r.nav.state().r_n;
+  r.run(0.99, 1.0);  // 1 s more, before the third fix
+  const Vec3<double> now = r.nav.state().r_n;
+  const double d1 = (relevel - start).head<2>().norm();
+  const double d2 = (now - relevel).head<2>().norm();
+  ASSERT_GT(d1, 0.5);  // about 1 m
+  ASSERT_GT(d2, 0.5);  // about 1.25 m
+  // Not in line (0.93 here: the fixes reset the velocity north while the acceleration is
+  // integrated along the wrong heading before the re-level), or the two bounds would be one.
+  ASSERT_LT((now - start).head<2>().norm(), 0.97 * (d1 + d2)) << "the legs are not in line";
+  const Eigen::Matrix2d before_fix = p_pp();
+  const HeadingFix<double> heading{r.nav.state().t_ns, 0.0, 0.01};
+  ASSERT_EQ(r.filter.update_heading(r.nav, heading).status, UpdateStatus::kReset);
+  const Eigen::Matrix2d after_fix = p_pp();
+  const double legs = 1.5 * (d1 + d2) * (d1 + d2);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(after_fix(i, i) - before_fix(i, i), legs, 1e-9 * after_fix(i, i)) << "axis " << i;
+  }
+}
+
 // Lever arm of 1 m (0.6 m forward, 0.8 m up: the up part offsets the height by 0.8 m whatever the
 // heading) and 100 ms latency (1 m along track at 10 m/s). Modelled, the errors stay within 3σ
 // (≥ 95 % of the epoch-axis pairs after the first 10 s; for a consistent filter the expected
@@ -696,22 +736,26 @@ TEST(ErrorStateFilterTest, AGnssPositionStartsTheDistanceDrivenWithTheHeadingUnk
   run.expect_displacement_term(fix.value_n, "after the position fix");
 }
 
-TEST(ErrorStateFilterTest, ARestartWithTheHeadingUnknownKeepsTheDistanceDrivenInP) {
+TEST(ErrorStateFilterTest, ARestartWithTheHeadingUnknownKeepsTheDistanceDriven) {
   // An in-motion start (lose_attitude: the same restart as a divergence) after 30 s driven with
-  // the heading unknown moves the anchor to here; the 1.5 |d|² of the 250 m driven so far must go
-  // into P_pp first, since that position error is still there (1e-9: rounding).
+  // the heading unknown moves the anchor to here; the 250 m driven so far keep their error, so a
+  // heading fix right after the restart must put their 1.5 |d|² into P_pp (1e-9: rounding), as
+  // it does without the restart.
   const auto own = std::make_unique<HeadingUnknownDrive>();
   HeadingUnknownDrive& run = *own;
   run.drive_to(30);
   const Vec3<double> d = run.nav.state().r_n - run.truth(0).r_n;
-  const Vec3<double> before = run.p_pp();
   run.filter.lose_attitude(run.nav);
-  const Vec3<double> after = run.p_pp();
-  for (int i = 0; i < 2; ++i) {
-    EXPECT_GE(after(i), (before(i) + 1.5 * d.head<2>().squaredNorm()) * (1 - 1e-9)) << "axis " << i;
-  }
   // The position is not published until a fix sets it (lost), and then from that fix on.
   EXPECT_TRUE(std::isnan(run.filter.accuracy(run.nav.state()).pos_sigma_m.x()));
+  const Vec3<double> before = run.p_pp();
+  const HeadingFix<double> heading{run.nav.state().t_ns, 0.0, 0.01};
+  ASSERT_EQ(run.filter.update_heading(run.nav, heading).status, UpdateStatus::kReset);
+  const Vec3<double> after = run.p_pp();
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(after(i) - before(i), 1.5 * d.head<2>().squaredNorm(), 1e-9 * after(i))
+        << "axis " << i;
+  }
 }
 
 // ---- Euler σ: the Jacobian against finite differences of the Euler angles -------------------

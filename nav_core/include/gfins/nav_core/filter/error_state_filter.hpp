@@ -482,7 +482,7 @@ class ErrorStateFilter {
     const Vec3<T> dr = at.r_n + at.q_nb * config_.gnss_lever_arm_b - fix.value_n;
     nav.apply_correction(Vec3<T>::Zero(), dr, Vec3<T>::Zero(), Vec3<T>::Zero());
     history_.shift(Vec3<T>::Zero(), dr, Vec3<T>::Zero());
-    heading_anchor_r_ = at.r_n - dr;  // the displacement with the unknown heading starts here
+    start_heading_legs(at.r_n - dr);  // the displacement with the unknown heading starts here
     const T l2 = config_.gnss_lever_arm_b.squaredNorm();
     reset_block(filt_idx::kPos, fix.sigma.cwiseProduct(fix.sigma) + Vec3<T>::Constant(l2),
                 age_of(nav, fix.t_valid_ns));
@@ -579,9 +579,11 @@ class ErrorStateFilter {
     if (!(sigma_tilt < config_.diverged_sigma_tilt_rad / T(2))) return Relevel::kUnable;
     // The heading is kept when the track or an external heading sets it (heading_from_track_
     // after an in-motion start; heading_aligned_ when a heading came before the tilt was found).
-    if (!turn_onto(nav, f_est, f_true, heading_from_track_ || heading_aligned_)) {
-      return Relevel::kUnable;
-    }
+    const bool keep_heading = heading_from_track_ || heading_aligned_;
+    if (!turn_onto(nav, f_est, f_true, keep_heading)) return Relevel::kUnable;
+    // A turn to f's azimuth is a new heading, as unknown as the old one: the displacement driven
+    // along the old one keeps its error, the next leg gets its own.
+    if (!keep_heading) close_heading_leg(nav.state());
     using namespace filt_idx;
     for (int i = 0; i < 2; ++i) {
       set_at_fix(kPhi + i, sigma_tilt * sigma_tilt, age);
@@ -735,6 +737,7 @@ class ErrorStateFilter {
       const T var = unknown_heading_pos_var(x);
       for (int i = 0; i < 2; ++i) p_(filt_idx::kPos + i, filt_idx::kPos + i) += var;
     }
+    start_heading_legs(x.r_n);
     set_at_fix(filt_idx::kPhi + 2, sigma_rad * sigma_rad, age);
     heading_aligned_ = true;
     // The tilt stays lost: only a re-level finds it (relevel_from_gnss). An external heading
@@ -748,10 +751,28 @@ class ErrorStateFilter {
     return T(1.5) * x.v_n.template head<2>().squaredNorm();
   }
 
-  /// The same for the horizontal position: the displacement since heading_anchor_r_ turns with the
-  /// heading error, 1.5 |r̂_h − r_anchor,h|² per axis.
+  /// The same for the horizontal position: the displacement d since heading_anchor_r_ turns with
+  /// the heading error, 1.5 |d_h|² per axis for one leg. Legs driven along different heading
+  /// errors (heading_legs_m_) add up by length: the per-axis error is a sum of the legs' errors,
+  /// and by Minkowski's inequality its RMS is at most the sum of theirs, √1.5 Σ|d_k,h|, whatever
+  /// the correlation of the heading errors (docs/math.md).
   T unknown_heading_pos_var(const NavState<T>& x) const {
-    return T(1.5) * (x.r_n - heading_anchor_r_).template head<2>().squaredNorm();
+    const T d = heading_legs_m_ + (x.r_n - heading_anchor_r_).template head<2>().norm();
+    return T(1.5) * d * d;
+  }
+
+  /// The heading changes while it stays unknown (a restart, a re-level's turn about down): the leg
+  /// driven since the anchor keeps its heading's error, the next one gets another.
+  void close_heading_leg(const NavState<T>& x) {
+    heading_legs_m_ += (x.r_n - heading_anchor_r_).template head<2>().norm();
+    heading_anchor_r_ = x.r_n;
+  }
+
+  /// The displacement with an unknown heading counts from r on (the start; the position or the
+  /// heading set).
+  void start_heading_legs(const Vec3<T>& r) {
+    heading_anchor_r_ = r;
+    heading_legs_m_ = T(0);
   }
 
   /// While the heading is unknown its error is a nuisance of variance π² outside the linear
@@ -789,9 +810,13 @@ class ErrorStateFilter {
   bool started_ = false;
   bool heading_aligned_ = true;
   // While the heading is unknown: the position from which the board's displacement is along a
-  // heading that may be off by any angle (the start, a divergence restart, the last GNSS position
-  // reset). Only the displacement since it adds to the position variance (accuracy()).
+  // heading that may be off by any angle (the start, a restart, a re-level's turn about down, the
+  // last GNSS position reset). The displacement since it, and the legs closed before it since the
+  // position or the heading was last set, add to the position variance (accuracy()).
   Vec3<T> heading_anchor_r_ = Vec3<T>::Zero();
+  // The horizontal lengths of the legs closed since then, each driven along its own unknown
+  // heading (unknown_heading_pos_var()).
+  T heading_legs_m_ = T(0);
   // filter_valid bits of the quantities whose σ are not available: after a divergence restart
   // the covariance no longer describes their errors (the linear model had failed before the test
   // fired, and the restart widens the attitude and rate only). Each comes back when a fix sets
@@ -818,15 +843,15 @@ void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
   const NavState<T>& x = nav.state();
   const Vec3<T> dw = x.w_b.allFinite() ? x.w_b : Vec3<T>::Zero();
   nav.apply_correction(Vec3<T>::Zero(), Vec3<T>::Zero(), Vec3<T>::Zero(), dw);
-  Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
-  const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
-  if (!heading_aligned_) {
-    // The heading was unknown already: the displacement since the anchor keeps its error when
-    // the anchor moves here (accuracy()).
-    const T var = unknown_heading_pos_var(x);
-    pos_var.x() += var;
-    pos_var.y() += var;
+  // The heading was unknown already: the displacement since the anchor keeps its error, and the
+  // heading after the restart is another unknown one (accuracy()).
+  if (heading_aligned_) {
+    start_heading_legs(x.r_n);
+  } else {
+    close_heading_leg(x);
   }
+  const Vec3<T> pos_var = p_.template block<3, 3>(kPos, kPos).diagonal();
+  const Vec3<T> vel_var = p_.template block<3, 3>(kVel, kVel).diagonal();
   p_ = initial_covariance();
   // Half the limit: the restart must leave room before the test fires again.
   const T tilt2 = config_.diverged_sigma_tilt_rad * config_.diverged_sigma_tilt_rad / T(4);
@@ -835,7 +860,6 @@ void ErrorStateFilter<T, HistoryCapacity>::forget(Nav& nav, bool divergence) {
   p_(kPhi + 1, kPhi + 1) = tilt2;
   p_(kPhi + 2, kPhi + 2) = kPi * kPi;
   heading_aligned_ = false;
-  heading_anchor_r_ = x.r_n;
   prev_vel_t_ns_ = kNever;  // a velocity difference across the diverged stretch means nothing
   lost_ = filter_valid::kRollPitch | filter_valid::kHeading | filter_valid::kVelocity |
           filter_valid::kPosition;
@@ -859,7 +883,7 @@ void ErrorStateFilter<T, HistoryCapacity>::start(Nav& nav) {
   history_.clear();
   history_.push(nav.state());
   heading_aligned_ = config_.heading_known;
-  heading_anchor_r_ = nav.state().r_n;
+  start_heading_legs(nav.state().r_n);
   last_accepted_ns_.fill(kNever);
   gnss_rejected_run_.fill(0);
   lost_ = 0;
