@@ -12,7 +12,8 @@ packages=(
   libgpiod-dev gpiod can-utils libsystemd-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev
   python3 python3-matplotlib python3-numpy python3-can nodejs
-  clang lld clang-format clang-tidy valgrind  # clang, lld: the sanitizer preset (host-debug)
+  clang lld clang-format valgrind  # clang, lld: the sanitizer preset (host-debug)
+  clang-tidy-22  # scripts/check-tidy.sh (version 22: docs/ci.md, "clang-tidy 22")
   libclang-rt-14-dev  # the sanitizer runtimes and libFuzzer (host-debug, host-tsan, tests/fuzz)
   cppcheck  # scripts/check-cppcheck.sh
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib

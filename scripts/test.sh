@@ -31,7 +31,8 @@ step_table() {
 }
 tidy_pid=""
 cppcheck_pid=""
-trap 'rc=$?; for p in $tidy_pid $cppcheck_pid; do kill -- "-$p" 2>/dev/null; done; step_table; rm -rf "$log_dir"; exit $rc' EXIT
+vboard_pid=""
+trap 'rc=$?; for p in $tidy_pid $cppcheck_pid $vboard_pid; do kill -- "-$p" 2>/dev/null; done; step_table; rm -rf "$log_dir"; exit $rc' EXIT
 step() {
   step_close
   children_cpu
@@ -157,42 +158,55 @@ step "host-release: installed programs away from the trees (tests/install/instal
 step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
 ./tests/install/runnable_docs.py --build build/host-release
 
-step "cortex-m4f: bare-metal build of the navigation core and the soft-double check"
-# --fresh: the toolchain's flags (-flto among them) reach an existing build folder only on a new
-# cache; a stale one links without LTO and over the flash limit.
-cmake --preset cortex-m4f --fresh >/dev/null
-cmake --build --preset cortex-m4f -j "$jobs"
-# The limits (flash, RAM, no soft-float double) are a test of that tree: GFINS_M4F_*_LIMIT.
-ctest --preset cortex-m4f | tail -n 40
-
-# The board's program cross-built for 32-bit armhf (ARM code generation, 32-bit size_t and long,
-# the hard-float ABI, every warning an error) and packaged with the amd64 packages from the
-# host-release tree above (CPack, lintian). The tests of the code that runs on the board (label
-# `board`) cross-built and run under qemu-arm-static (preset armhf-linux) or qemu-aarch64-static
-# (preset aarch64-linux; the whole suite: aarch64-linux-all) are one command each, run before a
-# release (docs/deploy.md): per commit they compiled the same sources a third time, about 430 s of
-# the run, for targets whose code x86-64 and the bare-metal ARM build bracket (docs/ci.md, "The
-# 40-minute budget"). The armhf tools and both arm64 packages are made on request
-# (scripts/package.sh armhf-linux, scripts/package.sh aarch64-linux).
-step "armhf cross build of gfins-fw, Debian packages (amd64; armhf gfins-fw) and lintian"
-./scripts/install-cross-deps.sh
-./scripts/package.sh host-release armhf-linux:board
-
-# One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
-# backends' real-kernel checks), fw / cmd / faults (the unchanged gfins-fw paced by the gpio-sim
-# line, on vcan0: output within one quantisation step of a host-only run, every CAN command,
-# kernel-made faults) and canlog; a second boot runs service (systemd: the amd64 package above
-# installed in a clean root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in
-# docs/ci.md.
-step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd"
+# The virtual board runs QEMU's one TCG thread: a core's worth of CPU for 5-7 minutes, with the
+# other core idle. So it starts in the background here, once the amd64 package it installs is
+# made, and the bare-metal and armhf builds run beside it at nice 10 (CFS weight 110 against the
+# VM's 1024: the VM keeps its core, the builds take the other; the data-ready stages run on
+# instruction-counted guest time, and the systemd stage ran beside clang-tidy's two nice-19 jobs
+# the same way before). Its log is printed when it is collected, after the armhf step. apt runs
+# first for both (scripts/vboard/install-deps.sh, scripts/install-cross-deps.sh): one apt at a
+# time, and run.sh then finds its packages present.
+step "Debian packages (amd64, from the host-release tree) and lintian; the virtual board started"
+./scripts/package.sh host-release
 # scripts/package.sh keeps one version per package and architecture in out/deb: the one it made.
 fw_debs=(out/deb/gfins-fw_*_amd64.deb)
 [ ${#fw_debs[@]} -eq 1 ] && [ -e "${fw_debs[0]}" ] ||
   { echo "test.sh: expected one out/deb/gfins-fw_*_amd64.deb, found: ${fw_debs[*]}" >&2; exit 1; }
 fw_deb=${fw_debs[0]}
+./scripts/vboard/install-deps.sh
+./scripts/install-cross-deps.sh
 free_space "before the virtual board"
+# One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
+# backends' real-kernel checks), fw / cmd / faults (the unchanged gfins-fw paced by the gpio-sim
+# line, on vcan0: output within one quantisation step of a host-only run, every CAN command,
+# kernel-made faults) and canlog; a second boot runs service (systemd: the amd64 package above
+# installed in a clean root, READY=1, watchdog pings, a SIGSTOP'd loop restarted). Costs in
+# docs/ci.md. Its own process group (set -m), stopped if the script ends early.
+set -m
 ./scripts/vboard/run.sh --stages "${GFINS_VBOARD_STAGES:-infra,backend,fw,cmd,faults,canlog,gnss,ids,service}" \
-  --deb "$fw_deb"
+  --deb "$fw_deb" >"$log_dir/vboard.log" 2>&1 &
+vboard_pid=$!
+set +m
+echo "test.sh: the virtual board runs in the background (its log follows when it ends)"
+
+step "cortex-m4f: bare-metal build of the navigation core and the soft-double check (beside the virtual board)"
+# --fresh: the toolchain's flags (-flto among them) reach an existing build folder only on a new
+# cache; a stale one links without LTO and over the flash limit.
+cmake --preset cortex-m4f --fresh >/dev/null
+nice -n 10 cmake --build --preset cortex-m4f -j "$jobs"
+# The limits (flash, RAM, no soft-float double) are a test of that tree: GFINS_M4F_*_LIMIT.
+ctest --preset cortex-m4f | tail -n 40
+
+# The board's program cross-built for 32-bit armhf (ARM code generation, 32-bit size_t and long,
+# the hard-float ABI, every warning an error) and packaged (CPack, lintian). The tests of the code
+# that runs on the board (label `board`) cross-built and run under qemu-arm-static (preset
+# armhf-linux) or qemu-aarch64-static (preset aarch64-linux; the whole suite: aarch64-linux-all)
+# are one command each, run before a release (docs/deploy.md): per commit they compiled the same
+# sources a third time, about 430 s of the run, for targets whose code x86-64 and the bare-metal
+# ARM build bracket (docs/ci.md, "The 40-minute budget"). The armhf tools and both arm64 packages
+# are made on request (scripts/package.sh armhf-linux, scripts/package.sh aarch64-linux).
+step "armhf cross build of gfins-fw, its Debian package and lintian (beside the virtual board)"
+nice -n 10 ./scripts/package.sh armhf-linux:board
 
 # A background check's result: its log, and the run fails when it did.
 collect() {  # collect NAME PID LOG
@@ -201,6 +215,10 @@ collect() {  # collect NAME PID LOG
   cat "$3"
   [ "$rc" -eq 0 ] || { echo "test.sh: $1 failed (exit $rc)" >&2; exit 1; }
 }
+
+step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd (started before the bare-metal build)"
+collect "the virtual board" "$vboard_pid" "$log_dir/vboard.log"
+vboard_pid=""
 
 step "clang-tidy (started after the format check, at the lowest priority)"
 collect clang-tidy "$tidy_pid" "$log_dir/tidy.log"

@@ -92,7 +92,7 @@ int cmd_consistency(const std::string& name, const ConsistencyOptions& c,
   // not leave the old ones looking like its own.
   for (const char* f : {"summary.txt", "nees.csv", "nis.csv", "consistency.png"}) {
     std::error_code ec;
-    std::filesystem::remove(cmd.dir + "/" + f, ec);
+    (void)std::filesystem::remove(cmd.dir + "/" + f, ec);  // false: not there (ec tells errors)
     if (ec) {
       return fail({ErrorCode::kIoError,
                    "cannot remove the earlier " + cmd.dir + "/" + f + ": " + ec.message()},

@@ -50,11 +50,11 @@ std::string parent_dir(const std::string& file) {
 int fail_after_start(const std::string& out_dir, const StreamTargets& t, const HostError& e) {
   std::error_code ec;
   for (const std::string* csv : {&t.uncompensated_csv, &t.compensated_csv}) {
-    if (!csv->empty()) std::filesystem::remove(*csv, ec);
+    if (!csv->empty()) (void)std::filesystem::remove(*csv, ec);  // best effort: failing already
   }
   // Figures of an earlier run in the folder would now sit beside this run's summary.
   for (const char* png : {"accel_errors.png", "nav_errors.png"}) {
-    std::filesystem::remove(std::filesystem::path(out_dir) / png, ec);
+    (void)std::filesystem::remove(std::filesystem::path(out_dir) / png, ec);
   }
   const std::string summary_path = out_dir + "/summary.txt";
   if (std::FILE* f = std::fopen(summary_path.c_str(), "w"); f != nullptr) {

@@ -36,7 +36,6 @@ SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock&
       sample_clock_(sample_clock),
       pacing_(pacing),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / sample_rate_hz))),
-      period_s_(1.0 / sample_rate_hz),
       remaining_(samples) {
   // Real time: the first edge one period from now, so the loop starts on a fresh period.
   if (pacing_ == Pacing::kRealTime) t0_ns_ = clock_.now_ns() + period_ns_;
@@ -50,7 +49,6 @@ SimSampleSource::SimSampleSource(SensorStream& stream, ChipAdc& adc, hal::Clock&
       sample_clock_(nullptr),
       pacing_(Pacing::kGpio),
       period_ns_(0),
-      period_s_(0.0),
       remaining_(samples),
       drdy_(&drdy) {}
 

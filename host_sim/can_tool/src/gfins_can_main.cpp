@@ -291,7 +291,7 @@ std::string output_unwritable(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "ab");
   if (f == nullptr) return std::strerror(errno);
   (void)std::fclose(f);  // nothing was written: a close error says nothing about the figure
-  if (!existed) fs::remove(path, ec);
+  if (!existed) (void)fs::remove(path, ec);  // the probe's own file: best effort
   return {};
 }
 
@@ -322,7 +322,7 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   const int rc = run_decode(o);
   if (rc == kExitInput || rc == kExitUsage || rc == kExitNoFrames) {  // nothing to plot
     std::error_code ec;
-    fs::remove(csv, ec);
+    (void)fs::remove(csv, ec);  // a temporary file: best effort
     return rc;
   }
   const fs::path py = script.empty() ? find_script("plot_can.py") : fs::path(script);
@@ -338,7 +338,7 @@ int run_plot(const std::string& log, const std::string& png, int node, const std
   std::string detail;
   const Status s = run_without_shell(argv, &detail);
   std::error_code ec;
-  fs::remove(csv, ec);
+  (void)fs::remove(csv, ec);  // a temporary file: best effort
   if (!s.is_ok()) {
     std::fprintf(stderr, "gfins-can plot: %s (%s)\n", s.message(), detail.c_str());
     return kExitPlot;

@@ -57,6 +57,7 @@ class GnssFeeder {
 
   template <typename T>
   void offer_due(nav::NavPipeline<T>& p, double t_s) {
+    if (!spec_) return;  // fixes come with a [gnss] table only
     for (; next_ < fixes_.size() && fixes_[next_].t_send_s <= t_s; ++next_) {
       const GnssSample& g = fixes_[next_];
       nav::GnssFix<T> pos;

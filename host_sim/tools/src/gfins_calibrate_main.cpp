@@ -74,7 +74,7 @@ std::string output_unwritable(const std::string& output) {
     return "cannot create a file in its folder '" + dir.string() + "': " + std::strerror(errno);
   }
   static_cast<void>(std::fclose(f));
-  fs::remove(probe, ec);
+  (void)fs::remove(probe, ec);  // the probe's own file: best effort
   return {};
 }
 

@@ -32,8 +32,8 @@
 
 struct gpiod_chip;
 struct gpiod_line;
-struct gpiod_line_event;
-struct timespec;
+struct gpiod_line_event;  // NOLINT(readability-identifier-naming): libgpiod's
+struct timespec;          // NOLINT(readability-identifier-naming): <time.h>'s
 
 namespace gfins::drivers::lnx {
 

@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
-struct timespec;  // <time.h>
+struct timespec;  // NOLINT(readability-identifier-naming): <time.h>'s
 
 namespace gfins::drivers::lnx {
 

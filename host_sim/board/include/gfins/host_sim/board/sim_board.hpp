@@ -138,7 +138,6 @@ class SimSampleSource final : public app::SampleSource {
   app::SampleClock* sample_clock_;
   Pacing pacing_;
   std::int64_t period_ns_;
-  double period_s_;
   std::int64_t t0_ns_ = 0;
   std::uint32_t next_seq_ = 0;
   std::uint32_t remaining_;
