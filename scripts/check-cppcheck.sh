@@ -14,8 +14,8 @@ build=${1:-build/host-release}
 }
 db_dir=$(mktemp -d)
 trap 'rm -rf "$db_dir"' EXIT
-# One entry per source file of the tree (the core's sources are compiled twice, once more with
-# EIGEN_RUNTIME_NO_MALLOC for the heap checks; generated sources in the build folder are not ours).
+# One entry per source file of the tree (a file two targets compile has two; generated sources in
+# the build folder are not ours).
 python3 - "$build/compile_commands.json" "$db_dir/compile_commands.json" "$PWD" <<'PY'
 import json, os, sys
 entries, out, root = json.load(open(sys.argv[1])), sys.argv[2], os.path.realpath(sys.argv[3])

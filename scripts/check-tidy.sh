@@ -8,9 +8,8 @@ build=${1:-build/host-release}
 [ -f "$build/compile_commands.json" ] || { echo "check-tidy: no $build/compile_commands.json" >&2; exit 1; }
 # Only the files this build compiles: a file of another configuration (no_plugin_boards.cpp, built
 # when GFINS_SIM_BOARD is OFF) has no entry, and clang-tidy would guess its flags from a neighbour.
-# A file compiled twice (the core's sources again with EIGEN_RUNTIME_NO_MALLOC for the heap
-# checks) has two entries, and clang-tidy would check it once per entry: the first entry of each
-# file goes into a database of its own (the second adds only a macro and -UNDEBUG).
+# A file compiled twice (by two targets) has two entries, and clang-tidy would check it once per
+# entry: the first entry of each file goes into a database of its own.
 # clang-tidy 22 (Debian 12's clang-tidy-22): from version 22 on clang-tidy no longer matches its
 # checks against the declarations of system headers (Eigen, toml++, spdlog, CLI11, libstdc++),
 # whose findings it then discarded; version 14 spent most of its time there, 3-4 times the time

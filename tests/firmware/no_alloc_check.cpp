@@ -12,8 +12,8 @@
 
 #include "gfins/app/recorder.hpp"
 
-#include "heap_counter.hpp"
 #include "sim_rig.hpp"
+#include "support/heap_counter.hpp"
 
 namespace gfins::app {
 namespace {

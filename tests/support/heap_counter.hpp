@@ -71,3 +71,17 @@ int posix_memalign(void** out, std::size_t align, std::size_t n) noexcept {
 }
 }
 #endif
+
+namespace gfins::testing {
+
+/// The heap calls of the whole process since it was made: the window of a no-heap check
+/// (nav_core_no_malloc_check, calibration_no_malloc_check, firmware_no_alloc_check).
+class HeapWindow {
+ public:
+  long allocations() const { return HeapCounter::calls() - start_; }
+
+ private:
+  long start_ = HeapCounter::calls();
+};
+
+}  // namespace gfins::testing
