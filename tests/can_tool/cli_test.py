@@ -99,6 +99,48 @@ def check_dbc_for_a_configured_board(exe, workdir):
               f'dbc --config {name}: exit {r.returncode}, written {os.path.exists(dbc)}: {err}')
 
 
+def check_id_base_option(exe, workdir):
+    """--id-base GROUP=0xBASE: a group moved on top of --config, as SetIdBase moves it on the
+    board. The DBC of a board whose data group starts at 0x300 must be the same, byte for byte,
+    whether the move comes from --id-base or from a configuration file's can.data_id_base (the
+    firmware's loader, a separate path); its epoch is at 0x300 + node (the ICD's offset 0 of the
+    data group). Groups that would overlap are refused naming the ranges (exit 2), a malformed
+    spec is a command-line error (exit 1)."""
+    cfg = os.path.join(workdir, 'data300.toml')
+    with open(cfg, 'w') as f:
+        f.write('[can]\nnode_id = 1\ndata_id_base = 0x300\n')
+    stock = os.path.join(workdir, 'stock1.toml')  # the same rates and dividers, stock groups
+    with open(stock, 'w') as f:
+        f.write('[can]\nnode_id = 1\n')
+    by_file = run([exe, 'dbc', '--config', cfg])
+    by_option = run([exe, 'dbc', '--config', stock, '--id-base', 'data=0x300'])
+    check(by_file.returncode == 0 and by_option.returncode == 0,
+          f'dbc with a moved data group: exit {by_file.returncode} / {by_option.returncode}: '
+          f'{by_file.stderr.decode()} {by_option.stderr.decode()}')
+    check(by_file.stdout == by_option.stdout and by_option.stdout,
+          'dbc --id-base data=0x300 differs from the DBC of can.data_id_base = 0x300')
+    _, ids = dbc_cycle_times(run([exe, 'dbc', '--id-base', 'data=0x300']).stdout.decode())
+    check(ids.get('GfinsEpoch') == 0x301, f'dbc --id-base data=0x300: epoch id {ids.get("GfinsEpoch")}')
+    # on top of --config, later specs winning: back to the stock 0x100
+    r = run([exe, 'dbc', '--config', cfg, '--id-base', 'Data=0x200', '--id-base', 'data=0x100'])
+    _, ids = dbc_cycle_times(r.stdout.decode())
+    check(r.returncode == 0 and ids.get('GfinsEpoch') == 0x101,
+          f'dbc --config --id-base data=0x100: exit {r.returncode}, epoch id {ids.get("GfinsEpoch")}')
+    # onto the stock command group (0x600..): refused with the ranges, nothing decoded or written
+    out = os.path.join(workdir, 'collide.dbc')
+    r = run([exe, 'dbc', '--id-base', 'data=0x600', '-o', out])
+    err = r.stderr.decode()
+    check(r.returncode == 2 and 'overlap' in err and 'Command 0x600' in err and
+          not os.path.exists(out), f'dbc --id-base data=0x600: exit {r.returncode}: {err}')
+    r = run([exe, 'decode', '--id-base', 'command=0x100', os.devnull])
+    check(r.returncode == 2 and 'overlap' in r.stderr.decode(),
+          f'decode --id-base command=0x100: exit {r.returncode}: {r.stderr.decode()}')
+    for spec in ('data=300', 'data=0300', 'data=0x800', 'gnss=0x300', 'data', '=0x300', 'data='):
+        r = run([exe, 'dbc', '--id-base', spec])
+        check(r.returncode == 1, f'dbc --id-base {spec!r}: exit {r.returncode}, expected 1: '
+              f'{r.stderr.decode()}')
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--gfins-can', required=True)
@@ -321,6 +363,7 @@ def main():
                   f'gfins-can-gen {argv}: no message naming the tool: {r.stderr.decode()!r}')
 
     check_dbc_for_a_configured_board(exe, a.workdir)
+    check_id_base_option(exe, a.workdir)
 
     print(f'cli: {len(failures)} failed checks')
     for f in failures:

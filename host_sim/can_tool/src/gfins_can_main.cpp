@@ -35,6 +35,7 @@
 #include "gfins/version/version.hpp"
 #include "gnss_log.hpp"
 #include "host_io.hpp"
+#include "id_base_option.hpp"
 #include "views.hpp"
 #if GFINS_CAN_HAVE_HIL
 #include "hil.hpp"
@@ -90,20 +91,49 @@ struct DecodeOptions {
   can::IdBases ids;
 };
 
-/// --config FILE of decode, cmd, calibrate and gnss: the identifier groups (can.*_id_base) of a
-/// board from its gfins-fw configuration, and its can.node_id where `node` is not given on the
-/// command line (`node_given` false). False, after saying why, when the file does not load.
-bool board_from_config(const char* who, const std::string& path, bool node_given, int& node,
+/// --config FILE of decode, plot, cmd, calibrate and gnss: the identifier groups (can.*_id_base)
+/// of a board from its gfins-fw configuration, and its can.node_id where `node` is not given on
+/// the command line (`node_given` false); then the groups of --id-base (`moved`) on top. False,
+/// after saying why, when the file does not load or the groups do not fit.
+bool board_from_config(const char* who, const std::string& path,
+                       const std::vector<std::string>& moved, bool node_given, int& node,
                        can::IdBases& ids) {
-  if (path.empty()) return true;
-  const app::ConfigResult r = app::load_config(path);
-  if (!r.ok()) {
-    std::fprintf(stderr, "gfins-can %s: --config: %s\n", who, r.error.c_str());
+  if (!path.empty()) {
+    const app::ConfigResult r = app::load_config(path);
+    if (!r.ok()) {
+      std::fprintf(stderr, "gfins-can %s: --config: %s\n", who, r.error.c_str());
+      return false;
+    }
+    ids = app::id_bases(*r.config);
+    if (!node_given) node = r.config->node_id;
+  }
+  if (const std::string p = apply_id_bases(moved, ids); !p.empty()) {
+    std::fprintf(stderr, "gfins-can %s: --id-base: %s\n", who, p.c_str());
     return false;
   }
-  ids = app::id_bases(*r.config);
-  if (!node_given) node = r.config->node_id;
   return true;
+}
+
+/// --id-base GROUP=0xBASE of the subcommands that take --config: a group as a SetIdBase command
+/// moved it on the board (kept there across restarts), for a board whose configuration file does
+/// not say so. Repeatable; applied after --config.
+void add_id_base_option(CLI::App* sub, std::vector<std::string>& moved) {
+  sub->add_option("--id-base", moved,
+                  "GROUP=0xBASE: that identifier group (data, input, command, response) starts "
+                  "at BASE (hexadecimal with its 0x), as `cmd id-base` moved it on the board; "
+                  "repeatable, on top of --config")
+      // One value per --id-base (a file name after it stays a file name), every one kept.
+      ->expected(1)
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::Validator(
+          [](const std::string& t) {
+            std::size_t g = 0;
+            std::uint16_t b = 0;
+            const std::string p = parse_id_base(t, g, b);
+            return p.empty() ? p : p + ", not " + app::quote_text(t).substr(0, 40);
+          },
+          "GROUP=0xBASE"));
 }
 
 /// Decodes every source into `view`; returns the exit code.
@@ -648,6 +678,8 @@ int main_impl(int argc, char** argv) {
   app.require_subcommand(1);
 
   DecodeOptions d;
+  // --id-base of every subcommand that takes --config: one subcommand runs, so one list.
+  std::vector<std::string> id_base_moved;
   auto* dec = app.add_subcommand("decode", "decode candump logs ('-' = stdin) or a live interface");
   dec->add_option("sources", d.sources, "candump log files, '-' for stdin");
   dec->add_option("--iface", d.iface, "live SocketCAN interface (e.g. can0, vcan0)");
@@ -657,6 +689,7 @@ int main_impl(int argc, char** argv) {
   dec->add_option("--max-issues", d.max_issues, "problems printed per kind (all are counted)")
       ->capture_default_str();
   dec->add_option("--duration", d.duration_s, "live: stop after this many seconds");
+  add_id_base_option(dec, id_base_moved);
   dec->add_option("--config", d.config,
                   "a gfins-fw configuration file: the identifier groups (can.*_id_base) of the "
                   "boards on the bus");
@@ -670,6 +703,7 @@ int main_impl(int argc, char** argv) {
   plot->add_option("--node", plot_node, "node id to plot (default: all)")->check(CLI::Range(0, 15));
   plot->add_option("--script", plot_script, "plot script (default: the installed plot_can.py)");
   std::string plot_config;
+  add_id_base_option(plot, id_base_moved);
   plot->add_option("--config", plot_config,
                    "a gfins-fw configuration file: the identifier groups (can.*_id_base) of the "
                    "boards in the log");
@@ -686,6 +720,7 @@ int main_impl(int argc, char** argv) {
                   "sequence number of a configuration-changing command (default: the board's "
                   "last one, read first with ReportCalibrationId, plus 1)")
       ->check(CLI::Range(1, 65535));
+  add_id_base_option(cmd, id_base_moved);
   cmd->add_option("--config", co.config,
                   "the board's gfins-fw configuration file: its identifier groups "
                   "(can.*_id_base) and, unless --node is given, its can.node_id");
@@ -762,15 +797,10 @@ int main_impl(int argc, char** argv) {
       ->required()
       ->check(CLI::Validator(
           [](const std::string& t) -> std::string {
-            const bool hex = t.size() >= 3 && t.size() <= 5 && t[0] == '0' &&
-                             (t[1] == 'x' || t[1] == 'X') &&
-                             t.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
-            if (!hex || std::stoul(t.substr(2), nullptr, 16) > 0x7FF) {
-              return "an identifier 0x000..0x7FF, hexadecimal with its 0x (as candump writes it "
-                     "without), not " +
-                     app::quote_text(t).substr(0, 40);
-            }
-            return "";
+            const std::string p = hex_id_problem(t);
+            return p.empty() ? p
+                             : p + " (as candump writes it without), not " +
+                                   app::quote_text(t).substr(0, 40);
           },
           "0x000..0x7FF"));
   auto* restore = cmd->add_subcommand(
@@ -833,6 +863,7 @@ int main_impl(int argc, char** argv) {
   calibrate->add_option("--retries", so.retries, "refused captures of a pose before giving up")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  add_id_base_option(calibrate, id_base_moved);
   calibrate->add_option("--config", so.config,
                         "the board's gfins-fw configuration file: its identifier groups "
                         "(can.*_id_base) and, unless --node is given, its can.node_id");
@@ -885,6 +916,7 @@ int main_impl(int argc, char** argv) {
   gnss->add_option("--node", go.node, "node id of the board to aid")->check(CLI::Range(0, 15));
   gnss->add_option("--duration", go.duration_s, "seconds of fixes (0 = the scenario's duration)")
       ->check(CLI::Range(0.0, 86400.0));
+  add_id_base_option(gnss, id_base_moved);
   gnss->add_option("--config", go.config,
                    "the aided board's gfins-fw configuration file: its identifier groups "
                    "(can.*_id_base) and, unless --node is given, its can.node_id");
@@ -900,6 +932,7 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::Range(0, 15));
   dbc->add_option("-o,--output", dbc_out, "write here instead of stdout");
   std::string dbc_config;
+  add_id_base_option(dbc, id_base_moved);
   auto* dbc_config_opt = dbc->add_option(
       "--config", dbc_config,
       "a gfins-fw configuration file: the DBC of that board (its can.node_id unless --node "
@@ -915,12 +948,13 @@ int main_impl(int argc, char** argv) {
 
   if (dec->parsed()) {
     int unused_node = 0;
-    if (!board_from_config("decode", d.config, true, unused_node, d.ids)) return kExitInput;
+    if (!board_from_config("decode", d.config, id_base_moved, true, unused_node, d.ids))
+      return kExitInput;
     return run_decode(d);
   }
   if (calibrate->parsed()) {
-    if (!board_from_config("calibrate", so.config, calibrate->count("--node") != 0, so.node,
-                           so.ids)) {
+    if (!board_from_config("calibrate", so.config, id_base_moved, calibrate->count("--node") != 0,
+                           so.node, so.ids)) {
       return kExitInput;
     }
     return run_calibrate_sequence(so);
@@ -931,11 +965,13 @@ int main_impl(int argc, char** argv) {
   if (plot->parsed()) {
     int unused_node = 0;
     can::IdBases plot_ids;
-    if (!board_from_config("plot", plot_config, true, unused_node, plot_ids)) return kExitInput;
+    if (!board_from_config("plot", plot_config, id_base_moved, true, unused_node, plot_ids))
+      return kExitInput;
     return run_plot(plot_log, plot_png, plot_node, plot_script, plot_ids);
   }
   if (gnss->parsed()) {
-    if (!board_from_config("gnss", go.config, gnss->count("--node") != 0, go.node, go.ids)) {
+    if (!board_from_config("gnss", go.config, id_base_moved, gnss->count("--node") != 0, go.node,
+                           go.ids)) {
       return kExitInput;
     }
     return run_gnss(go);
@@ -954,6 +990,10 @@ int main_impl(int argc, char** argv) {
       rates.dividers = app::bus_dividers(*r.config);
       dbc_ids = app::id_bases(*r.config);
       if (dbc->count("--node") == 0) dbc_node = static_cast<std::uint8_t>(r.config->node_id);
+    }
+    if (const std::string p = apply_id_bases(id_base_moved, dbc_ids); !p.empty()) {
+      std::fprintf(stderr, "gfins-can: dbc --id-base: %s\n", p.c_str());
+      return kExitInput;
     }
     std::FILE* out = open_output(dbc_out);
     if (out == nullptr) {
@@ -998,15 +1038,13 @@ int main_impl(int argc, char** argv) {
     c.node_id = static_cast<std::uint8_t>(new_node);
   } else if (id_base->parsed()) {
     c.opcode = can::Opcode::kSetIdBase;
-    c.id_group = id_group_name == "data"      ? can::IdGroup::kData
-                 : id_group_name == "input"   ? can::IdGroup::kInput
-                 : id_group_name == "command" ? can::IdGroup::kCommand
-                                              : can::IdGroup::kResponse;
+    c.id_group = static_cast<can::IdGroup>(id_group_index(id_group_name));
     c.id_base = static_cast<std::uint16_t>(std::stoul(new_base_text.substr(2), nullptr, 16));
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
   }
-  if (!board_from_config("cmd", co.config, cmd->count("--node") != 0, co.node, co.ids)) {
+  if (!board_from_config("cmd", co.config, id_base_moved, cmd->count("--node") != 0, co.node,
+                         co.ids)) {
     return kExitInput;
   }
   return run_cmd(co, c);
