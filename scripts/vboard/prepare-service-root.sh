@@ -5,7 +5,7 @@
 # creates the user, enables the unit). Needs the initramfs staged by make-initramfs.sh (the
 # modules and drdy-toggle come from there).
 #
-#   prepare-service-root.sh [--deb FILE] [--fw-config FILE] [--rate HZ] -o DIR
+#   prepare-service-root.sh [--deb FILE] [--fw-config FILE] [--rate HZ] [--soak S] -o DIR
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
@@ -13,12 +13,14 @@ source "$here/common.sh"
 deb=""
 fw_config=""
 rate=500
+soak=0
 out=""
 while [ $# -gt 0 ]; do
   case $1 in
     --deb) deb=$2; shift 2 ;;
     --fw-config) fw_config=$2; shift 2 ;;
     --rate) rate=$2; shift 2 ;;
+    --soak) soak=$2; shift 2 ;;
     -o) out=$2; shift 2 ;;
     *) vb_die "prepare-service-root.sh: unknown argument '$1'" ;;
   esac
@@ -63,7 +65,7 @@ cp "$staged/vboard/drdy-toggle" "$out/vboard/"
 cp "$here/service/"*.sh "$out/vboard/"
 chmod +x "$out/vboard/"*.sh
 echo "RATE=$rate" >"$out/vboard/rate.env"
-echo "WANT_FW=$([ -n "$deb" ] && echo 1 || echo 0)" >"$out/vboard/service.env"
+{ echo "WANT_FW=$([ -n "$deb" ] && echo 1 || echo 0)"; echo "SOAK_S=$soak"; } >"$out/vboard/service.env"
 for u in "$here/service/"*.service; do
   cp "$u" "$out/etc/systemd/system/"
 done

@@ -6,6 +6,8 @@
 #   scripts/vboard/run.sh [--stages infra,backend,fw,cmd,faults,canlog,gnss,ids,service] [--deb FILE] [--fw-config FILE] [--rate HZ] [--timeout S]
 #                         [--build-dir DIR] [--smp N] [--icount SHIFT|off] [--service-icount SHIFT|off]
 #                         [--measure]   (infra also measures the toggler alone at 250-4000 Hz and at full speed)
+#                         [--soak S]    (service, with --deb: S seconds of the firmware under systemd with can0
+#                                        taken down and up every minute and a second node flooding it; not in CI)
 #
 # Every step is idempotent and cached under .cache/vboard (see common.sh): the first run
 # installs the host packages, downloads the kernel, headers and source (about 220 MB) and builds
@@ -24,6 +26,7 @@ service_icount=off  # systemd boot: icount's sleep=off would warp time over ever
 service_deb=""
 service_config=""
 measure=0
+soak_s=0
 known_stages=infra,backend,fw,cmd,faults,canlog,gnss,ids,service
 # value OPTION ARGS...: the option's value, or a usage error naming the option when none follows
 # (set -u would otherwise stop at "$2: unbound variable").
@@ -33,7 +36,7 @@ value() {
 }
 while [ $# -gt 0 ]; do
   case $1 in
-    --stages | --rate | --timeout | --build-dir | --smp | --icount | --service-icount | --deb | --fw-config)
+    --stages | --rate | --timeout | --build-dir | --smp | --icount | --service-icount | --deb | --fw-config | --soak)
       v=$(value "$@") || exit 1
       case $1 in
         --stages) stages=$v ;;
@@ -45,6 +48,7 @@ while [ $# -gt 0 ]; do
         --service-icount) service_icount=$v ;;
         --deb) service_deb=$v ;;
         --fw-config) service_config=$v ;;
+        --soak) soak_s=$v ;;
       esac
       shift 2 ;;
     --measure) measure=1; shift ;;
@@ -73,6 +77,13 @@ for ic in "$icount" "$service_icount"; do
   [ "$ic" = off ] || [[ $ic =~ ^[0-9]+$ ]] || vb_die "run.sh: icount shift '$ic' is neither a whole number nor 'off'"
 done
 if [ -n "$service_deb" ]; then [ -f "$service_deb" ] || vb_die "run.sh: --deb $service_deb: no such file"; fi
+[[ $soak_s =~ ^[0-9]+$ ]] || vb_die "run.sh: --soak '$soak_s' is not a whole number of seconds"
+if [ "$soak_s" -gt 0 ]; then
+  [ -n "$service_deb" ] && case ",$stages," in *,service,*) true ;; *) false ;; esac ||
+    vb_die "run.sh: --soak needs the service stage and --deb (it soaks the installed firmware)"
+  # The service boot's own checks take about 3 minutes of wall time under TCG.
+  timeout_s=$((timeout_s + soak_s))
+fi
 if [ -n "$service_config" ]; then [ -f "$service_config" ] || vb_die "run.sh: --fw-config $service_config: no such file"; fi
 t_start=$(date +%s)
 elapsed() { echo $(($(date +%s) - t_start)); }
@@ -230,6 +241,7 @@ if want service; then
   sargs=(--rate "$rate" -o "$sroot")
   if [ -n "$service_deb" ]; then sargs+=(--deb "$service_deb"); fi
   if [ -n "$service_config" ]; then sargs+=(--fw-config "$service_config"); fi
+  sargs+=(--soak "$soak_s")
   "$here/prepare-service-root.sh" "${sargs[@]}"
   icount=$service_icount
   boot service "vboard.root=9p" \

@@ -144,6 +144,56 @@ if [ "$WANT_FW" = 1 ]; then
       fail "fw-status-text: StatusText '$text', expected '(navigating|DEGRADED ...) at $RATE Hz, calibration ...; faults: ...'"
     fi
 
+    # Soak (run.sh --soak S, on request: not in CI). S seconds of the installed firmware under
+    # systemd on a misbehaving bus: a second node floods can0 (cangen: random 11-bit identifiers,
+    # lengths and data, a frame every millisecond, its commands' identifiers included) and every
+    # 60 s can0 goes down for 2 s and comes back. Passes when the watchdog never fired (the same
+    # PID, NRestarts unchanged, no 'Watchdog timeout' in the journal), the firmware's frames are
+    # on can0 after the last flap, and its resident memory grew by at most 1 MiB (it allocates
+    # nothing after start-up and locks its memory: a leak of one small block per flooded frame
+    # would be about 10 MiB over 10 minutes).
+    if [ "${SOAK_S:-0}" -gt 0 ]; then
+      rss() { sed -n 's/^VmRSS:[[:space:]]*\([0-9]*\) kB/\1/p' "/proc/$1/status"; }
+      secs() { cut -d. -f1 /proc/uptime; }
+      look
+      soak_nr=$nr
+      rss0=$(rss "$pid")
+      wd0=$(journalctl -u gfins-fw --no-pager | grep -c 'Watchdog timeout')
+      say "VBOARD-INFO soak: ${SOAK_S} s from uptime $(up) s, PID $pid, VmRSS ${rss0} kB, status '$(prop gfins-fw StatusText)'"
+      t_end=$(($(secs) + SOAK_S))
+      flaps=0
+      while [ "$(secs)" -lt "$t_end" ]; do
+        cangen can0 -g 1 -I r -L r -D r -i >/dev/null 2>&1 &
+        flood=$!
+        left=$((t_end - $(secs)))
+        sleep $((left < 58 ? (left > 0 ? left : 1) : 58))
+        kill "$flood" 2>/dev/null
+        wait "$flood" 2>/dev/null
+        ip link set can0 down
+        sleep 2
+        ip link set can0 up
+        flaps=$((flaps + 1))
+        say "VBOARD-INFO soak: flap $flaps at uptime $(up) s, VmRSS $(rss "$pid") kB, status '$(prop gfins-fw StatusText)'"
+      done
+      look
+      rss1=$(rss "$pid")
+      wd1=$(journalctl -u gfins-fw --no-pager | grep -c 'Watchdog timeout')
+      if [ "$st $mp $nr" = "active $pid $soak_nr" ] && [ "$wd1" = "$wd0" ]; then
+        pass "fw-soak-watchdog: ${SOAK_S} s, $flaps flaps of can0 under a flood: same PID $pid, NRestarts $nr, no watchdog timeout"
+      else
+        fail "fw-soak-watchdog: after ${SOAK_S} s: state $st, PID $pid -> $mp, NRestarts $soak_nr -> $nr, watchdog timeouts in the journal $wd0 -> $wd1"
+      fi
+      if [ -n "$rss0" ] && [ -n "$rss1" ] && [ $((rss1 - rss0)) -le 1024 ]; then
+        pass "fw-soak-memory: VmRSS ${rss0} kB -> ${rss1} kB"
+      else
+        fail "fw-soak-memory: VmRSS ${rss0:-?} kB -> ${rss1:-?} kB (more than 1 MiB of growth)"
+      fi
+      frames=$(timeout 5 candump -n 20 can0 | wc -l)
+      [ "$frames" -eq 20 ] && pass "fw-soak-frames: 20 frames on can0 after the last flap" ||
+        fail "fw-soak-frames: $frames of 20 frames within 5 s after the last flap"
+      journalctl -u gfins-fw --no-pager | grep -iE 'can0|bus|flood|malformed' | tail -n 6 | sed 's/^/VBOARD-LOG fw: /' | tee -a $out
+    fi
+
     # A hung loop: stop the process; the watchdog must fire and systemd restart it.
     before=$nr
     kill -STOP "$pid"
