@@ -158,10 +158,10 @@ step "host-release: installed programs away from the trees (tests/install/instal
 step "host-release: the documentation's runnable commands (tests/install/runnable_docs.py)"
 ./tests/install/runnable_docs.py --build build/host-release
 
-# The virtual board runs QEMU's one TCG thread: a core's worth of CPU for 5-7 minutes, with the
-# other core idle. So it starts in the background here, once the amd64 package it installs is
-# made, and the bare-metal and armhf builds run beside it at nice 10 (CFS weight 110 against the
-# VM's 1024: the VM keeps its core, the builds take the other; the data-ready stages run on
+# The virtual board's boots run QEMU's one TCG thread (its fresh-cache set-up before them uses
+# both cores: docs/ci.md, "Where the budget stands"). It starts in the background here, once the
+# amd64 package it installs is made, and the bare-metal and armhf builds run beside it at nice 10
+# (CFS weight 110 against the VM's 1024: the VM keeps its core; the data-ready stages run on
 # instruction-counted guest time, and the systemd stage ran beside clang-tidy's two nice-19 jobs
 # the same way before). Its log is printed when it is collected, after the armhf step. apt runs
 # first for both (scripts/vboard/install-deps.sh, scripts/install-cross-deps.sh): one apt at a
