@@ -38,11 +38,12 @@ tarball=$(compgen -G "$root/usr/src/linux-source-*.tar.*" | head -n 1 || true)
 [ -n "$tarball" ] || vb_die "no linux-source tarball under $root/usr/src: run scripts/vboard/fetch-kernel.sh"
 top=$(basename "$tarball" | sed 's/\.tar\..*$//')
 vb_log "extracting gpio-sim sources from $(basename "$tarball")"
-tar -xf "$tarball" -C "$src" --strip-components=3 \
-  "$top/drivers/gpio/gpio-sim.c" "$top/drivers/gpio/gpiolib.h" ||
-  vb_die "drivers/gpio/gpio-sim.c or gpiolib.h missing from $(basename "$tarball")"
-tar -xf "$tarball" -C "$src" --strip-components=3 "$top/kernel/irq/irq_sim.c" ||
-  vb_die "kernel/irq/irq_sim.c missing from $(basename "$tarball")"
+# One pass, and --occurrence ends it at the last of the three (kernel/ comes after drivers/): the
+# 138 MB tarball is otherwise decompressed to its end once per call (two calls: 17 CPU s; this:
+# 7 CPU s).
+tar -xf "$tarball" -C "$src" --strip-components=3 --occurrence \
+  "$top/drivers/gpio/gpio-sim.c" "$top/drivers/gpio/gpiolib.h" "$top/kernel/irq/irq_sim.c" ||
+  vb_die "drivers/gpio/gpio-sim.c, drivers/gpio/gpiolib.h or kernel/irq/irq_sim.c missing from $(basename "$tarball")"
 
 grep -q 'handle_simple_irq(irq_to_desc(irqnum));' "$src/irq_sim.c" ||
   vb_die "irq_sim.c no longer calls handle_simple_irq(irq_to_desc(irqnum)): the irq_to_desc substitution needs revisiting for $kver"

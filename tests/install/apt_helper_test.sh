@@ -59,13 +59,17 @@ chmod +x "$bin"/*
 failures=0
 # run_case NAME SCRIPT MISSING BROKEN EXPECT_RC EXPECT_TEXT
 run_case() {
-  local name=$1 script=$2 missing=$3 broken=$4 want_rc=$5 want_text=$6 rc=0 updates
+  local name=$1 script=$2 missing=$3 broken=$4 want_rc=$5 want_text=$6 rc=0 updates safe_io
   : >"$work/apt.log"
   FAKE_APT_LOG=$work/apt.log FAKE_MISSING=$missing FAKE_APT_BROKEN=$broken \
     GFINS_APT_RETRY_PAUSE_S=0 PATH="$bin:$PATH" "$repo/$script" >"$work/out" 2>&1 || rc=$?
   updates=$(grep -c ' update' "$work/apt.log" || true)
-  if [ "$rc" -ne "$want_rc" ] || ! grep -qF -- "$want_text" "$work/out" || [ "$updates" -ne 3 ]; then
-    echo "FAIL $name: exit $rc (want $want_rc), $updates apt-get update calls (want 3), output:"
+  # Every real install (not install-cross-deps.sh's simulation, -s) skips dpkg's fsync per file.
+  safe_io=$(grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -vcF -- '--force-unsafe-io' || true)
+  if [ "$rc" -ne "$want_rc" ] || ! grep -qF -- "$want_text" "$work/out" || [ "$updates" -ne 3 ] ||
+    [ "$safe_io" -ne 0 ]; then
+    echo "FAIL $name: exit $rc (want $want_rc), $updates apt-get update calls (want 3)," \
+      "$safe_io install(s) without --force-unsafe-io (want 0), output:"
     sed 's/^/    /' "$work/out"
     failures=$((failures + 1))
   else
