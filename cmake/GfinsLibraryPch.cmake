@@ -9,37 +9,8 @@
 # (clang-tidy and cppcheck read the release tree's commands too). The navigation core and the
 # freestanding libraries are not listed: few units, spent instantiating templates, not parsing
 # (docs/ci.md, "Precompiled headers for the libraries").
+include(GfinsLinkClosure)
 option(GFINS_LIB_PCH "Precompiled headers for the host libraries and programs (clang)" ON)
-
-# gfins_compile_closure(<target> <out-var>): the targets whose usage requirements (include folders,
-# definitions) reach <target>'s compile: its own links and, through them, their interface links
-# (not a static library's private links, $<LINK_ONLY:...>, which reach only the link).
-function(gfins_compile_closure target out)
-  set(seen "")
-  get_target_property(todo ${target} LINK_LIBRARIES)
-  if(NOT todo)
-    set(todo "")
-  endif()
-  while(todo)
-    list(POP_FRONT todo t)
-    if(NOT TARGET ${t})
-      continue()  # a plain library name, a generator expression ($<LINK_ONLY:...> among them)
-    endif()
-    get_target_property(real ${t} ALIASED_TARGET)
-    if(real)
-      set(t ${real})
-    endif()
-    if(t IN_LIST seen)
-      continue()
-    endif()
-    list(APPEND seen ${t})
-    get_target_property(iface ${t} INTERFACE_LINK_LIBRARIES)
-    if(iface)
-      list(APPEND todo ${iface})
-    endif()
-  endwhile()
-  set(${out} ${seen} PARENT_SCOPE)
-endfunction()
 
 # gfins_library_pch(<target>...): each target gets its precompiled header, with what its compile
 # closure makes available (Eigen, spdlog, the TOML include).
@@ -57,7 +28,7 @@ function(gfins_library_pch)
     if(units LESS 3)
       continue()
     endif()
-    gfins_compile_closure(${t} closure)
+    gfins_link_closure(${t} closure COMPILE)
     set(headers <algorithm> <array> <atomic> <chrono> <cmath> <cstdint> <cstdio> <cstring>
                 <filesystem> <fstream> <functional> <memory> <mutex> <optional> <span>
                 <sstream> <string> <string_view> <thread> <utility> <vector>)

@@ -3,8 +3,15 @@
 # must not reach a folder above it. Checked at configure time, so a forbidden link fails every
 # build on every preset.
 
-# gfins_link_closure(<target> <out-var>): the targets (ALIAS names resolved) in the closure.
+# gfins_link_closure(<target> <out-var> [COMPILE]): the targets (ALIAS names resolved) in the
+# closure. With COMPILE, only those whose usage requirements (include folders, definitions) reach
+# <target>'s compile: its own links and, through them, their interface links, not a static
+# library's private links ($<LINK_ONLY:...>), which reach only the link.
 function(gfins_link_closure target out)
+  set(compile_only OFF)
+  if(ARGC GREATER 2 AND ARGV2 STREQUAL "COMPILE")
+    set(compile_only ON)
+  endif()
   set(seen "")
   set(todo ${target})
   while(todo)
@@ -22,7 +29,7 @@ function(gfins_link_closure target out)
     list(APPEND seen ${t})
     get_target_property(type ${t} TYPE)
     set(libs "")
-    if(NOT type STREQUAL "INTERFACE_LIBRARY")
+    if(NOT type STREQUAL "INTERFACE_LIBRARY" AND (NOT compile_only OR t STREQUAL target))
       get_target_property(direct ${t} LINK_LIBRARIES)
       if(direct)
         list(APPEND libs ${direct})
@@ -34,10 +41,15 @@ function(gfins_link_closure target out)
     endif()
     foreach(l IN LISTS libs)
       # $<LINK_ONLY:x> (static libraries' private links) still ends up in the link.
-      string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" l "${l}")
+      if(NOT compile_only)
+        string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" l "${l}")
+      endif()
       list(APPEND todo ${l})
     endforeach()
   endwhile()
+  if(compile_only)
+    list(REMOVE_ITEM seen ${target})
+  endif()
   set(${out} ${seen} PARENT_SCOPE)
 endfunction()
 
