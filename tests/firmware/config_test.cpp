@@ -185,9 +185,19 @@ TEST(Config, IdentifierGroupsMoveAsAWholeAndNeverOverlap) {
        {"ids.toml:2: can.data_id_base = 0x5F0",
         "0x5F0..0x6FF overlap can.command_id_base's "
         "0x600..0x60F"}},
+      // One identifier shared at the other end: the moved group's last is the data group's first.
+      {"[can]\ncommand_id_base = 0x0F1\n",
+       {"ids.toml:2: can.command_id_base = 0x0F1",
+        "0x0F1..0x100 overlap can.data_id_base's "
+        "0x100..0x20F"}},
       // The stock command group is where OxTS RT frames are: a reserved range says so.
       {"[can]\nreserved_ids = [[0x600, 0x60F]]\n",
        {"can.command_id_base = 0x600", "0x600..0x60F overlap the reserved range 0x600..0x60F"}},
+      // A reserved range that ends on a group's first identifier, and one that starts on its last.
+      {"[can]\nreserved_ids = [[0x0F0, 0x100]]\n",
+       {"can.data_id_base = 0x100", "0x100..0x20F overlap the reserved range 0x0F0..0x100"}},
+      {"[can]\nreserved_ids = [[0x20F, 0x20F]]\n",
+       {"can.data_id_base = 0x100", "0x100..0x20F overlap the reserved range 0x20F..0x20F"}},
       // The last identifier of a group must fit in 11 bits: data at 0x700 would end at 0x80F.
       {"[can]\ndata_id_base = 0x700\n", {"can.data_id_base = 0x700", "0..0x6F0"}},
       {"[can]\nresponse_id_base = 0x7F1\n", {"can.response_id_base = 0x7F1", "0..0x7F0"}},

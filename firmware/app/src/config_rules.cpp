@@ -55,9 +55,10 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
     return std::array<int, 2>{first, first + static_cast<int>(can::id_span(g)) - 1};
   };
   const auto shown = [](const std::array<int, 2>& r) { return hex_id(r[0]) + ".." + hex_id(r[1]); };
-  const auto overlap = [](const std::array<int, 2>& a, const std::array<int, 2>& b) {
-    return a[0] <= b[1] && b[0] <= a[1];
-  };
+  // The groups checked so far, at their bases (each within 0..0x7FF once it passed the first
+  // test below): overlaps are the message table's rule (can::id_group_overlaps), the one the
+  // board applies to SetIdBase.
+  can::IdBases ids{};
   for (std::size_t g = 0; g < can::kIdGroupCount; ++g) {
     const std::string key(kIdBaseKeys[g]);
     const std::array<int, 2> r = range(g);
@@ -67,8 +68,11 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
                    " identifiers (every message of it for node ids 0..15): its base must be 0.." +
                    hex_id(0x800 - static_cast<int>(can::id_span(g)))};
     }
+    ids.base[g] = static_cast<std::uint16_t>(c.id_bases[g]);
+    const auto first = static_cast<std::uint32_t>(r[0]);
+    const auto last = static_cast<std::uint32_t>(r[1]);
     for (std::size_t h = 0; h < g; ++h) {
-      if (overlap(r, range(h))) {
+      if (can::id_group_overlaps(ids, h, first, last)) {
         // Named after the group that was moved: the one off its default, the later one if both
         // or neither are (a file that moves only the data group onto the commands' stock
         // identifiers hears about data_id_base, the key it set, with its line).
@@ -80,8 +84,10 @@ std::optional<ConfigProblem> id_problem(const FwConfig& c) {
                      "'s " + shown(range(b))};
       }
     }
+    // The configuration's reader admits 0 <= first <= last <= 0x7FF only (can.reserved_ids).
     for (const std::array<int, 2>& res : c.reserved_ids) {
-      if (overlap(r, res)) {
+      if (can::id_group_overlaps(ids, g, static_cast<std::uint32_t>(res[0]),
+                                 static_cast<std::uint32_t>(res[1]))) {
         return P{key, hex_id(c.id_bases[g]),
                  "its identifiers " + shown(r) + " overlap the reserved range " + shown(res) +
                      " of can.reserved_ids"};

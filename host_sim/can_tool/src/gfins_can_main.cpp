@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -1039,7 +1040,13 @@ int main_impl(int argc, char** argv) {
   } else if (id_base->parsed()) {
     c.opcode = can::Opcode::kSetIdBase;
     c.id_group = static_cast<can::IdGroup>(id_group_index(id_group_name));
-    c.id_base = static_cast<std::uint16_t>(std::stoul(new_base_text.substr(2), nullptr, 16));
+    const std::optional<std::uint16_t> base = hex_id_value(new_base_text);
+    if (!base) {  // the option's validator refuses it first
+      std::fprintf(stderr, "gfins-can cmd id-base: BASE must be %s\n",
+                   hex_id_problem(new_base_text).c_str());
+      return kExitUsage;
+    }
+    c.id_base = *base;
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
   }

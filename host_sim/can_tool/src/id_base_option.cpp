@@ -18,11 +18,18 @@ std::size_t id_group_index(const std::string& name) {
   return can::kIdGroupCount;
 }
 
-std::string hex_id_problem(const std::string& text) {
+std::optional<std::uint16_t> hex_id_value(const std::string& text) {
   const bool hex = text.size() >= 3 && text.size() <= 5 && text[0] == '0' &&
                    (text[1] == 'x' || text[1] == 'X') &&
                    text.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
-  if (hex && std::stoul(text.substr(2), nullptr, 16) <= 0x7FF) return "";
+  if (!hex) return std::nullopt;
+  const unsigned long v = std::stoul(text.substr(2), nullptr, 16);  // at most 3 hex digits
+  if (v > 0x7FF) return std::nullopt;
+  return static_cast<std::uint16_t>(v);
+}
+
+std::string hex_id_problem(const std::string& text) {
+  if (hex_id_value(text)) return "";
   // Without the 0x a "300" would be decimal to strtoll and "0300" octal.
   return "an identifier 0x000..0x7FF, hexadecimal with its 0x";
 }
@@ -34,8 +41,9 @@ std::string parse_id_base(const std::string& spec, std::size_t& group, std::uint
     return "GROUP=0xBASE with GROUP one of data, input, command, response";
   }
   const std::string value = spec.substr(eq + 1);
-  if (std::string p = hex_id_problem(value); !p.empty()) return "its BASE must be " + p;
-  base = static_cast<std::uint16_t>(std::stoul(value.substr(2), nullptr, 16));
+  const std::optional<std::uint16_t> v = hex_id_value(value);
+  if (!v) return "its BASE must be " + hex_id_problem(value);
+  base = *v;
   return "";
 }
 

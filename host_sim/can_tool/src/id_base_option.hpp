@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,10 @@ namespace gfins::can_tool {
 /// The IdGroup index of a group name (data, input, command, response; any case), or
 /// can::kIdGroupCount when it names none.
 std::size_t id_group_index(const std::string& name);
+
+/// The value of an 11-bit identifier written in hexadecimal with its 0x (0x000..0x7FF, as the ICD
+/// writes identifiers); nullopt for any other text.
+std::optional<std::uint16_t> hex_id_value(const std::string& text);
 
 /// "" when `text` is an 11-bit identifier written in hexadecimal with its 0x (0x000..0x7FF, as
 /// the ICD writes identifiers), else what is wrong with it.
