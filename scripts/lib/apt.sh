@@ -42,9 +42,10 @@ apt_update() {
   return 0
 }
 
-# dpkg without an fsync per unpacked file (dpkg(1), --force-unsafe-io): what a fresh machine's
-# install of several hundred packages spends most of its time on, and what only a power loss in
-# the middle of the install would need (the packages are then installed again).
+# dpkg without an fsync per unpacked file (dpkg(1), --force-unsafe-io): only a power loss in the
+# middle of the install would need them (the packages are then installed again), and on a disk
+# whose syncs are slow they are much of a fresh machine's install. On the development machine's
+# virtio disk the install is CPU-bound and the option changes nothing (docs/ci.md, "Smaller cuts").
 apt_dpkg_options=(-o "Dpkg::Options::=--force-unsafe-io")
 
 # apt_install PACKAGE...: install without recommends; on failure name the package that fails.
