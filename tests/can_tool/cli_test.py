@@ -99,6 +99,24 @@ def check_dbc_for_a_configured_board(exe, workdir):
               f'dbc --config {name}: exit {r.returncode}, written {os.path.exists(dbc)}: {err}')
 
 
+def check_empty_config_name(exe, workdir):
+    """--config '' names no file: every subcommand that takes --config refuses it as a file that
+    cannot be opened (exit 2), the way a missing file is refused, instead of running on the
+    stock identifiers (decode used to go on and report no frame, exit 7)."""
+    log = os.path.join(workdir, 'empty-config.log')
+    with open(log, 'w') as f:
+        f.write('(0.000000) can0 101#0000000000000000\n')
+    for argv in (['decode', log], ['plot', log, '-o', os.path.join(workdir, 'empty-config.png')],
+                 ['dbc'], ['gnss', 'drive-gnss', '--duration', '1'],
+                 ['cmd', '--iface', 'vcan-none', 'realign', '--heading-deg', '0'],
+                 ['calibrate', '--iface', 'vcan-none', '--adc-lsb', '1e-6', '-o',
+                  os.path.join(workdir, 'empty-config.csv')]):
+        r = run([exe] + argv[:1] + ['--config', ''] + argv[1:])
+        err = r.stderr.decode()
+        check(r.returncode == 2 and '--config' in err and 'cannot open' in err,
+              f'{argv[0]} --config \'\': exit {r.returncode}: {err.strip()[:200]}')
+
+
 def check_id_base_option(exe, workdir):
     """--id-base GROUP=0xBASE: a group moved on top of --config, as SetIdBase moves it on the
     board. The DBC of a board whose data group starts at 0x300 must be the same, byte for byte,
@@ -364,6 +382,7 @@ def main():
 
     check_dbc_for_a_configured_board(exe, a.workdir)
     check_id_base_option(exe, a.workdir)
+    check_empty_config_name(exe, a.workdir)
 
     print(f'cli: {len(failures)} failed checks')
     for f in failures:

@@ -92,14 +92,16 @@ struct DecodeOptions {
   can::IdBases ids;
 };
 
-/// --config FILE of decode, plot, cmd, calibrate and gnss: the identifier groups (can.*_id_base)
-/// of a board from its gfins-fw configuration, and its can.node_id where `node` is not given on
-/// the command line (`node_given` false); then the groups of --id-base (`moved`) on top. False,
-/// after saying why, when the file does not load or the groups do not fit.
-bool board_from_config(const char* who, const std::string& path,
+/// --config FILE of decode, plot, cmd, calibrate, gnss and dbc: the identifier groups
+/// (can.*_id_base) of a board from its gfins-fw configuration, and its can.node_id where `node` is
+/// not given on the command line (`node_given` false); then the groups of --id-base (`moved`) on
+/// top. `sub` is the subcommand: a --config it was given is loaded even when empty (and refused
+/// then). `loaded`, when not null, receives the configuration a file gave. False, after saying
+/// why, when the file does not load or the groups do not fit.
+bool board_from_config(const char* who, const CLI::App* sub, const std::string& path,
                        const std::vector<std::string>& moved, bool node_given, int& node,
-                       can::IdBases& ids) {
-  if (!path.empty()) {
+                       can::IdBases& ids, std::optional<app::FwConfig>* loaded = nullptr) {
+  if (sub->count("--config") != 0) {
     const app::ConfigResult r = app::load_config(path);
     if (!r.ok()) {
       std::fprintf(stderr, "gfins-can %s: --config: %s\n", who, r.error.c_str());
@@ -107,6 +109,7 @@ bool board_from_config(const char* who, const std::string& path,
     }
     ids = app::id_bases(*r.config);
     if (!node_given) node = r.config->node_id;
+    if (loaded != nullptr) *loaded = *r.config;
   }
   if (const std::string p = apply_id_bases(moved, ids); !p.empty()) {
     std::fprintf(stderr, "gfins-can %s: --id-base: %s\n", who, p.c_str());
@@ -934,7 +937,7 @@ int main_impl(int argc, char** argv) {
   dbc->add_option("-o,--output", dbc_out, "write here instead of stdout");
   std::string dbc_config;
   add_id_base_option(dbc, id_base_moved);
-  auto* dbc_config_opt = dbc->add_option(
+  dbc->add_option(
       "--config", dbc_config,
       "a gfins-fw configuration file: the DBC of that board (its can.node_id unless --node "
       "is given; identifiers from its can.*_id_base; cycle times from its adc.sample_rate_hz and "
@@ -949,13 +952,13 @@ int main_impl(int argc, char** argv) {
 
   if (dec->parsed()) {
     int unused_node = 0;
-    if (!board_from_config("decode", d.config, id_base_moved, true, unused_node, d.ids))
+    if (!board_from_config("decode", dec, d.config, id_base_moved, true, unused_node, d.ids))
       return kExitInput;
     return run_decode(d);
   }
   if (calibrate->parsed()) {
-    if (!board_from_config("calibrate", so.config, id_base_moved, calibrate->count("--node") != 0,
-                           so.node, so.ids)) {
+    if (!board_from_config("calibrate", calibrate, so.config, id_base_moved,
+                           calibrate->count("--node") != 0, so.node, so.ids)) {
       return kExitInput;
     }
     return run_calibrate_sequence(so);
@@ -966,13 +969,13 @@ int main_impl(int argc, char** argv) {
   if (plot->parsed()) {
     int unused_node = 0;
     can::IdBases plot_ids;
-    if (!board_from_config("plot", plot_config, id_base_moved, true, unused_node, plot_ids))
+    if (!board_from_config("plot", plot, plot_config, id_base_moved, true, unused_node, plot_ids))
       return kExitInput;
     return run_plot(plot_log, plot_png, plot_node, plot_script, plot_ids);
   }
   if (gnss->parsed()) {
-    if (!board_from_config("gnss", go.config, id_base_moved, gnss->count("--node") != 0, go.node,
-                           go.ids)) {
+    if (!board_from_config("gnss", gnss, go.config, id_base_moved, gnss->count("--node") != 0,
+                           go.node, go.ids)) {
       return kExitInput;
     }
     return run_gnss(go);
@@ -981,20 +984,16 @@ int main_impl(int argc, char** argv) {
     // The configuration first: a file that does not load leaves the output untouched.
     DbcRates rates;
     can::IdBases dbc_ids;
-    if (dbc_config_opt->count() != 0) {
-      const app::ConfigResult r = app::load_config(dbc_config);
-      if (!r.ok()) {
-        std::fprintf(stderr, "gfins-can: dbc --config: %s\n", r.error.c_str());
-        return kExitInput;
-      }
-      rates.sample_rate_hz = r.config->sample_rate_hz;
-      rates.dividers = app::bus_dividers(*r.config);
-      dbc_ids = app::id_bases(*r.config);
-      if (dbc->count("--node") == 0) dbc_node = static_cast<std::uint8_t>(r.config->node_id);
-    }
-    if (const std::string p = apply_id_bases(id_base_moved, dbc_ids); !p.empty()) {
-      std::fprintf(stderr, "gfins-can: dbc --id-base: %s\n", p.c_str());
+    int node = dbc_node;
+    std::optional<app::FwConfig> loaded;
+    if (!board_from_config("dbc", dbc, dbc_config, id_base_moved, dbc->count("--node") != 0, node,
+                           dbc_ids, &loaded)) {
       return kExitInput;
+    }
+    dbc_node = static_cast<std::uint8_t>(node);  // 0..15: --node's range or the file's checked one
+    if (loaded) {
+      rates.sample_rate_hz = loaded->sample_rate_hz;
+      rates.dividers = app::bus_dividers(*loaded);
     }
     std::FILE* out = open_output(dbc_out);
     if (out == nullptr) {
@@ -1050,7 +1049,7 @@ int main_impl(int argc, char** argv) {
   } else if (restore->parsed()) {
     c.opcode = can::Opcode::kRestoreDefaults;
   }
-  if (!board_from_config("cmd", co.config, id_base_moved, cmd->count("--node") != 0, co.node,
+  if (!board_from_config("cmd", cmd, co.config, id_base_moved, cmd->count("--node") != 0, co.node,
                          co.ids)) {
     return kExitInput;
   }
