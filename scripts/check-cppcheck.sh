@@ -29,21 +29,8 @@ for e in entries:
     f = os.path.realpath(os.path.join(e["directory"], e["file"]))
     if f.startswith(root + "/build/") or not f.startswith(root + "/") or "/baremetal/" in f:
         continue
-    if f not in first:
-        e = dict(e)
-        if "command" in e:
-            e["command"] = re.sub(r" -isystem +\S+", "", e["command"])
-        else:
-            args, kept, skip = e["arguments"], [], False
-            for a in args:
-                if skip:
-                    skip = False
-                elif a == "-isystem":
-                    skip = True
-                elif not a.startswith("-isystem"):
-                    kept.append(a)
-            e["arguments"] = kept
-        first[f] = e
+    if f not in first:  # CMake writes each entry's "command" as one string
+        first[f] = dict(e, command=re.sub(r" -isystem +\S+", "", e["command"]))
 json.dump(list(first.values()), open(out, "w"))
 print(f"check-cppcheck: {len(first)} files", file=sys.stderr)
 PY
