@@ -4,15 +4,28 @@
 # -dev packages the firmware and its tests link with (multiarch, next to the host's), and
 # qemu-user-static to run the cross-built unit tests. Idempotent; run as root on Debian 12.
 # Fails naming the package apt cannot install.
+#   install-cross-deps.sh [ARCH...]   ARCH: arm64, armhf (default: both). One architecture is
+#   half the download and half the foreign package lists of `apt-get update`: scripts/test.sh,
+#   which builds the armhf package only, asks for armhf.
 set -euo pipefail
 apt_tag=install-cross-deps
 source "$(dirname "$0")/lib/apt.sh"
 
-archs=(arm64 armhf)
+archs=("$@")
+[ ${#archs[@]} -gt 0 ] || archs=(arm64 armhf)
 target_dev=(libgpiod-dev libsystemd-dev libgtest-dev libgmock-dev libtomlplusplus-dev
             libspdlog-dev libfmt-dev)
-packages=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static binfmt-support)
+packages=(qemu-user-static binfmt-support)
+qemu_handlers=()
 for a in "${archs[@]}"; do
+  case "$a" in
+    arm64) packages+=(g++-aarch64-linux-gnu) qemu_handlers+=(qemu-aarch64) ;;
+    armhf) packages+=(g++-arm-linux-gnueabihf) qemu_handlers+=(qemu-arm) ;;
+    *)
+      echo "install-cross-deps: unknown architecture '$a' (arm64 or armhf)" >&2
+      exit 2
+      ;;
+  esac
   for p in "${target_dev[@]}"; do packages+=("$p:$a"); done
 done
 
@@ -24,7 +37,7 @@ enable_binfmt() {
   [ -e /proc/sys/fs/binfmt_misc/status ] ||
     mount -t binfmt_misc binfmt_misc /proc/sys/fs/binfmt_misc ||
     { echo "install-cross-deps: cannot mount binfmt_misc: cross-built programs started by tests will fail" >&2; return 1; }
-  for h in qemu-aarch64 qemu-arm; do
+  for h in "${qemu_handlers[@]}"; do
     [ -e "/proc/sys/fs/binfmt_misc/$h" ] || update-binfmts --enable "$h" ||
       { echo "install-cross-deps: update-binfmts --enable $h failed" >&2; return 1; }
   done
@@ -51,8 +64,8 @@ for a in "${archs[@]}"; do
     added=1
   fi
 done
-policy=$(apt-cache policy "libgpiod-dev:${archs[0]}" "libgpiod-dev:${archs[1]}")
-if [ $added -eq 1 ] || [ "$(grep -c 'Candidate: [0-9]' <<<"$policy")" -ne 2 ]; then
+policy=$(apt-cache policy "${archs[@]/#/libgpiod-dev:}")
+if [ $added -eq 1 ] || [ "$(grep -c 'Candidate: [0-9]' <<<"$policy")" -ne ${#archs[@]} ]; then
   apt_update
 fi
 echo "install-cross-deps: installing ${#missing[@]} package(s): ${missing[*]}"

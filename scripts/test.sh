@@ -57,6 +57,14 @@ prune_programs() {
   printf 'test.sh: removed %d programs of %s (%d MiB)\n' "$n" "$1" $((bytes / 1048576))
 }
 
+# A background check's result: its log, and the run fails when it did.
+collect() {  # collect NAME PID LOG
+  local rc=0
+  wait "$2" || rc=$?
+  cat "$3"
+  [ "$rc" -eq 0 ] || { echo "test.sh: $1 failed (exit $rc)" >&2; exit 1; }
+}
+
 step "install packages"
 free_space "at the start"
 ./scripts/install-deps.sh
@@ -81,6 +89,15 @@ tidy_pid=$!
 nice -n 19 ./scripts/check-cppcheck.sh build/host-release >"$log_dir/cppcheck.log" 2>&1 &
 cppcheck_pid=$!
 set +m
+# The packages of the virtual board and of the armhf build (qemu-system, the kernel's build tools,
+# the armhf compiler and the board's -dev libraries for armhf only: docs/ci.md, "apt beside the
+# compiles") install in the background while the host trees compile: on a fresh machine they took
+# 150 s in the packages step, much of it waiting for the mirror. One apt at a time: the two in
+# turn, after install-deps.sh above. Collected before the packages step; never killed (a dpkg
+# stopped half-way leaves the machine's package database to repair).
+{ ./scripts/vboard/install-deps.sh && ./scripts/install-cross-deps.sh armhf; } \
+  >"$log_dir/apt-later.log" 2>&1 &
+apt_pid=$!
 
 step "host-debug (ASan + UBSan): build"
 cmake --preset host-debug >/dev/null
@@ -163,18 +180,18 @@ step "host-release: the documentation's runnable commands (tests/install/runnabl
 # amd64 package it installs is made, and the bare-metal and armhf builds run beside it at nice 10
 # (CFS weight 110 against the VM's 1024: the VM keeps its core; the data-ready stages run on
 # instruction-counted guest time, and the systemd stage ran beside clang-tidy's two nice-19 jobs
-# the same way before). Its log is printed when it is collected, after the armhf step. apt runs
-# first for both (scripts/vboard/install-deps.sh, scripts/install-cross-deps.sh): one apt at a
-# time, and run.sh then finds its packages present.
+# the same way before). Its log is printed when it is collected, after the armhf step. Its
+# packages and the armhf build's were installed in the background (above, collected here), so
+# run.sh finds them present.
 step "Debian packages (amd64, from the host-release tree) and lintian; the virtual board started"
+collect "the virtual board's and the armhf build's packages (apt)" "$apt_pid" "$log_dir/apt-later.log"
+apt_pid=""
 ./scripts/package.sh host-release
 # scripts/package.sh keeps one version per package and architecture in out/deb: the one it made.
 fw_debs=(out/deb/gfins-fw_*_amd64.deb)
 [ ${#fw_debs[@]} -eq 1 ] && [ -e "${fw_debs[0]}" ] ||
   { echo "test.sh: expected one out/deb/gfins-fw_*_amd64.deb, found: ${fw_debs[*]}" >&2; exit 1; }
 fw_deb=${fw_debs[0]}
-./scripts/vboard/install-deps.sh
-./scripts/install-cross-deps.sh
 free_space "before the virtual board"
 # One VM boot runs infra (Debian's tools on vcan0 and the gpio-sim line), backend (the Linux
 # backends' real-kernel checks), fw / cmd / faults (the unchanged gfins-fw paced by the gpio-sim
@@ -207,14 +224,6 @@ ctest --preset cortex-m4f | tail -n 40
 # are made on request (scripts/package.sh armhf-linux, scripts/package.sh aarch64-linux).
 step "armhf cross build of gfins-fw, its Debian package and lintian (beside the virtual board)"
 nice -n 10 ./scripts/package.sh armhf-linux:board
-
-# A background check's result: its log, and the run fails when it did.
-collect() {  # collect NAME PID LOG
-  local rc=0
-  wait "$2" || rc=$?
-  cat "$3"
-  [ "$rc" -eq 0 ] || { echo "test.sh: $1 failed (exit $rc)" >&2; exit 1; }
-}
 
 step "virtual board: Debian's kernel in QEMU (TCG), vcan0, gpio-sim, systemd (started before the bare-metal build)"
 collect "the virtual board" "$vboard_pid" "$log_dir/vboard.log"

@@ -57,12 +57,13 @@ printf '#!/bin/sh\nexit 0\n' >"$bin/update-binfmts"
 chmod +x "$bin"/*
 
 failures=0
-# run_case NAME SCRIPT MISSING BROKEN EXPECT_RC EXPECT_TEXT
+# run_case NAME SCRIPT MISSING BROKEN EXPECT_RC EXPECT_TEXT [ARG...]
 run_case() {
   local name=$1 script=$2 missing=$3 broken=$4 want_rc=$5 want_text=$6 rc=0 updates safe_io
+  shift 6
   : >"$work/apt.log"
   FAKE_APT_LOG=$work/apt.log FAKE_MISSING=$missing FAKE_APT_BROKEN=$broken \
-    GFINS_APT_RETRY_PAUSE_S=0 PATH="$bin:$PATH" "$repo/$script" >"$work/out" 2>&1 || rc=$?
+    GFINS_APT_RETRY_PAUSE_S=0 PATH="$bin:$PATH" "$repo/$script" "$@" >"$work/out" 2>&1 || rc=$?
   updates=$(grep -c ' update' "$work/apt.log" || true)
   # Every real install (not install-cross-deps.sh's simulation, -s) skips dpkg's fsync per file.
   safe_io=$(grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -vcF -- '--force-unsafe-io' || true)
@@ -90,6 +91,31 @@ run_case "install-cross-deps: update errors, install works" scripts/install-cros
 run_case "install-cross-deps: a package apt cannot install is named" \
   scripts/install-cross-deps.sh "qemu-user-static libgpiod-dev" "libgpiod-dev:armhf" 1 \
   "cannot install package libgpiod-dev:armhf"
+
+# One architecture (scripts/test.sh): only its compiler and its -dev packages are installed.
+run_case "install-cross-deps armhf: update errors, install works" scripts/install-cross-deps.sh \
+  "qemu-user-static g++-arm-linux-gnueabihf libgpiod-dev" "" 0 \
+  "going on with the package lists apt has" armhf
+if grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -qE 'aarch64|:arm64'; then
+  echo "FAIL install-cross-deps armhf: an arm64 package was installed:"
+  sed 's/^/    /' "$work/apt.log"
+  failures=$((failures + 1))
+fi
+grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -q 'libgpiod-dev:armhf' || {
+  echo "FAIL install-cross-deps armhf: libgpiod-dev:armhf was not installed:"
+  sed 's/^/    /' "$work/apt.log"
+  failures=$((failures + 1))
+}
+rc=0
+PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/scripts/install-cross-deps.sh" mips \
+  >"$work/out" 2>&1 || rc=$?
+if [ "$rc" -ne 2 ] || ! grep -qF "unknown architecture 'mips'" "$work/out"; then
+  echo "FAIL install-cross-deps mips: exit $rc (want 2), output:"
+  sed 's/^/    /' "$work/out"
+  failures=$((failures + 1))
+else
+  echo "ok   install-cross-deps: an unknown architecture is refused"
+fi
 
 [ "$failures" -eq 0 ] || { echo "$failures case(s) failed"; exit 1; }
 echo "all cases passed"
