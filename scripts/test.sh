@@ -65,9 +65,29 @@ collect() {  # collect NAME PID LOG
   [ "$rc" -eq 0 ] || { echo "test.sh: $1 failed (exit $rc)" >&2; exit 1; }
 }
 
-step "install packages"
+# The packages the host trees build and test with come first; the rest (clang-tidy, cppcheck,
+# the bare-metal Arm toolchain, lintian, then the virtual board's and the armhf build's) install
+# in the background while the host trees compile (docs/ci.md, "apt beside the compiles"). One apt
+# at a time: the later sets in turn, after this one. clang-tidy and cppcheck start when theirs is
+# in ($later_ok written with its exit status). The background install is collected before the
+# packages step and never killed (a dpkg stopped half-way leaves the package database to repair).
+step "install packages (what the host trees need; the rest in the background)"
 free_space "at the start"
-./scripts/install-deps.sh
+./scripts/install-deps.sh host
+later_ok=$log_dir/later-tools.status
+{
+  rc=0
+  ./scripts/install-deps.sh later || rc=$?
+  echo "$rc" >"$later_ok"
+  [ "$rc" -eq 0 ] && ./scripts/vboard/install-deps.sh && ./scripts/install-cross-deps.sh armhf
+} >"$log_dir/apt-later.log" 2>&1 &
+apt_pid=$!
+# after_later_tools CMD...: CMD once install-deps.sh later has ended, or a failure naming it.
+after_later_tools() {
+  until [ -e "$later_ok" ]; do sleep 2; done
+  [ "$(cat "$later_ok")" = 0 ] || { echo "test.sh: install-deps.sh later failed: $1 not run" >&2; return 1; }
+  "$@"
+}
 
 step "clang-format check"
 ./scripts/check-format.sh
@@ -83,21 +103,12 @@ step "clang-format check"
 # autogroup, in which nice 19 would count only against itself and tidy would take half the CPU.
 cmake --preset host-release >/dev/null
 set -m
-nice -n 19 ./scripts/check-tidy.sh build/host-release >"$log_dir/tidy.log" 2>&1 &
+nice -n 19 bash -c "$(declare -f after_later_tools); later_ok=$(printf %q "$later_ok"); after_later_tools ./scripts/check-tidy.sh build/host-release" >"$log_dir/tidy.log" 2>&1 &
 tidy_pid=$!
 # cppcheck the same way, beside it (docs/ci.md): the two share what the steps leave idle.
-nice -n 19 ./scripts/check-cppcheck.sh build/host-release >"$log_dir/cppcheck.log" 2>&1 &
+nice -n 19 bash -c "$(declare -f after_later_tools); later_ok=$(printf %q "$later_ok"); after_later_tools ./scripts/check-cppcheck.sh build/host-release" >"$log_dir/cppcheck.log" 2>&1 &
 cppcheck_pid=$!
 set +m
-# The packages of the virtual board and of the armhf build (qemu-system, the kernel's build tools,
-# the armhf compiler and the board's -dev libraries for armhf only: docs/ci.md, "apt beside the
-# compiles") install in the background while the host trees compile: on a fresh machine they took
-# 150 s in the packages step, much of it waiting for the mirror. One apt at a time: the two in
-# turn, after install-deps.sh above. Collected before the packages step; never killed (a dpkg
-# stopped half-way leaves the machine's package database to repair).
-{ ./scripts/vboard/install-deps.sh && ./scripts/install-cross-deps.sh armhf; } \
-  >"$log_dir/apt-later.log" 2>&1 &
-apt_pid=$!
 
 step "host-debug (ASan + UBSan): build"
 cmake --preset host-debug >/dev/null

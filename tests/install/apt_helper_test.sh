@@ -92,6 +92,31 @@ run_case "install-cross-deps: a package apt cannot install is named" \
   scripts/install-cross-deps.sh "qemu-user-static libgpiod-dev" "libgpiod-dev:armhf" 1 \
   "cannot install package libgpiod-dev:armhf"
 
+# The two sets of install-deps.sh (scripts/test.sh installs the second in the background): each
+# installs its own packages and none of the other's.
+run_case "install-deps host: update errors, install works" scripts/install-deps.sh \
+  "cmake cppcheck" "" 0 "going on with the package lists apt has" host
+if grep ' install ' "$work/apt.log" | grep -q cppcheck; then
+  echo "FAIL install-deps host: cppcheck (set later) was installed"
+  failures=$((failures + 1))
+fi
+run_case "install-deps later: update errors, install works" scripts/install-deps.sh \
+  "cmake cppcheck" "" 0 "going on with the package lists apt has" later
+if grep ' install ' "$work/apt.log" | grep -q cmake; then
+  echo "FAIL install-deps later: cmake (set host) was installed"
+  failures=$((failures + 1))
+fi
+rc=0
+PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/scripts/install-deps.sh" everything \
+  >"$work/out" 2>&1 || rc=$?
+if [ "$rc" -ne 2 ] || ! grep -qF "unknown package set 'everything'" "$work/out"; then
+  echo "FAIL install-deps everything: exit $rc (want 2), output:"
+  sed 's/^/    /' "$work/out"
+  failures=$((failures + 1))
+else
+  echo "ok   install-deps: an unknown package set is refused"
+fi
+
 # One architecture (scripts/test.sh): only its compiler and its -dev packages are installed.
 run_case "install-cross-deps armhf: update errors, install works" scripts/install-cross-deps.sh \
   "qemu-user-static g++-arm-linux-gnueabihf libgpiod-dev" "" 0 \
