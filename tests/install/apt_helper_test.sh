@@ -92,55 +92,52 @@ run_case "install-cross-deps: a package apt cannot install is named" \
   scripts/install-cross-deps.sh "qemu-user-static libgpiod-dev" "libgpiod-dev:armhf" 1 \
   "cannot install package libgpiod-dev:armhf"
 
+# refused NAME SCRIPT ARG TEXT: SCRIPT ARG exits 2 saying TEXT, before any apt call.
+refused() {
+  local rc=0
+  : >"$work/apt.log"
+  PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/$2" "$3" >"$work/out" 2>&1 || rc=$?
+  if [ "$rc" -ne 2 ] || ! grep -qF -- "$4" "$work/out" || [ -s "$work/apt.log" ]; then
+    echo "FAIL $1: exit $rc (want 2), apt calls: $(wc -l <"$work/apt.log"), output:"
+    sed 's/^/    /' "$work/out"
+    failures=$((failures + 1))
+  else
+    echo "ok   $1"
+  fi
+}
+# installed NAME REGEX WANT: whether a real install (not a simulation) of the last case named a
+# package matching REGEX is WANT (yes or no).
+installed() {
+  local got=no
+  if grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -qE -- "$2"; then got=yes; fi
+  if [ "$got" != "$3" ]; then
+    echo "FAIL $1: a package matching '$2' installed: $got (want $3); apt calls:"
+    sed 's/^/    /' "$work/apt.log"
+    failures=$((failures + 1))
+  fi
+}
+
 # The two sets of install-deps.sh (scripts/test.sh installs the second in the background): each
 # installs its own packages and none of the other's.
 run_case "install-deps host: update errors, install works" scripts/install-deps.sh \
   "cmake cppcheck" "" 0 "going on with the package lists apt has" host
-if grep ' install ' "$work/apt.log" | grep -q cppcheck; then
-  echo "FAIL install-deps host: cppcheck (set later) was installed"
-  failures=$((failures + 1))
-fi
+installed "install-deps host: cmake" ' cmake( |$)' yes
+installed "install-deps host: cppcheck (set later)" cppcheck no
 run_case "install-deps later: update errors, install works" scripts/install-deps.sh \
   "cmake cppcheck" "" 0 "going on with the package lists apt has" later
-if grep ' install ' "$work/apt.log" | grep -q cmake; then
-  echo "FAIL install-deps later: cmake (set host) was installed"
-  failures=$((failures + 1))
-fi
-rc=0
-PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/scripts/install-deps.sh" everything \
-  >"$work/out" 2>&1 || rc=$?
-if [ "$rc" -ne 2 ] || ! grep -qF "unknown package set 'everything'" "$work/out"; then
-  echo "FAIL install-deps everything: exit $rc (want 2), output:"
-  sed 's/^/    /' "$work/out"
-  failures=$((failures + 1))
-else
-  echo "ok   install-deps: an unknown package set is refused"
-fi
+installed "install-deps later: cppcheck" cppcheck yes
+installed "install-deps later: cmake (set host)" ' cmake( |$)' no
+refused "install-deps: an unknown package set is refused" scripts/install-deps.sh everything \
+  "unknown package set 'everything'"
 
 # One architecture (scripts/test.sh): only its compiler and its -dev packages are installed.
 run_case "install-cross-deps armhf: update errors, install works" scripts/install-cross-deps.sh \
   "qemu-user-static g++-arm-linux-gnueabihf libgpiod-dev" "" 0 \
   "going on with the package lists apt has" armhf
-if grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -qE 'aarch64|:arm64'; then
-  echo "FAIL install-cross-deps armhf: an arm64 package was installed:"
-  sed 's/^/    /' "$work/apt.log"
-  failures=$((failures + 1))
-fi
-grep ' install ' "$work/apt.log" | grep -v ' -s ' | grep -q 'libgpiod-dev:armhf' || {
-  echo "FAIL install-cross-deps armhf: libgpiod-dev:armhf was not installed:"
-  sed 's/^/    /' "$work/apt.log"
-  failures=$((failures + 1))
-}
-rc=0
-PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/scripts/install-cross-deps.sh" mips \
-  >"$work/out" 2>&1 || rc=$?
-if [ "$rc" -ne 2 ] || ! grep -qF "unknown architecture 'mips'" "$work/out"; then
-  echo "FAIL install-cross-deps mips: exit $rc (want 2), output:"
-  sed 's/^/    /' "$work/out"
-  failures=$((failures + 1))
-else
-  echo "ok   install-cross-deps: an unknown architecture is refused"
-fi
+installed "install-cross-deps armhf: libgpiod-dev:armhf" 'libgpiod-dev:armhf' yes
+installed "install-cross-deps armhf: arm64 packages" 'aarch64|:arm64' no
+refused "install-cross-deps: an unknown architecture is refused" scripts/install-cross-deps.sh \
+  mips "unknown architecture 'mips'"
 
 [ "$failures" -eq 0 ] || { echo "$failures case(s) failed"; exit 1; }
 echo "all cases passed"
