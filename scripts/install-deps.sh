@@ -27,19 +27,21 @@ later_packages=(
   qemu-system-arm  # scripts/m4f_step_cycles.sh: the Cortex-M4F step traced on mps2-an386
   lintian dpkg-dev  # scripts/package.sh: lintian on the .debs; dpkg-shlibdeps for CPack's Depends
 )
-case "${1:-all}" in
+[ $# -le 1 ] || { echo "install-deps: one package set at most (host or later), got: $*" >&2; exit 2; }
+set_name=${1:-all}
+case "$set_name" in
   host) packages=("${host_packages[@]}") ;;
   later) packages=("${later_packages[@]}") ;;
   all) packages=("${host_packages[@]}" "${later_packages[@]}") ;;
   *)
-    echo "install-deps: unknown package set '$1' (host, later, or none for both)" >&2
+    echo "install-deps: unknown package set '$set_name' (host, later, or none for both)" >&2
     exit 2
     ;;
 esac
 
 # npm installs the CAN test's third-party DBC reader (tests/can/independent): Debian's package,
 # unless the installed Node.js already bundles npm.
-[ "${1:-all}" = later ] || command -v npm >/dev/null 2>&1 || packages+=(npm)
+[ "$set_name" = later ] || command -v npm >/dev/null 2>&1 || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -85,7 +85,7 @@ apt_pid=$!
 # after_later_tools CMD...: CMD once install-deps.sh later has ended, or a failure naming it.
 after_later_tools() {
   until [ -e "$later_ok" ]; do sleep 2; done
-  [ "$(cat "$later_ok")" = 0 ] || { echo "test.sh: install-deps.sh later failed: $1 not run" >&2; return 1; }
+  [ "$(cat "$later_ok")" = 0 ] || { echo "test.sh: install-deps.sh later failed: $* not run" >&2; return 1; }
   "$@"
 }
 
@@ -103,10 +103,10 @@ step "clang-format check"
 # autogroup, in which nice 19 would count only against itself and tidy would take half the CPU.
 cmake --preset host-release >/dev/null
 set -m
-nice -n 19 bash -c "$(declare -f after_later_tools); later_ok=$(printf %q "$later_ok"); after_later_tools ./scripts/check-tidy.sh build/host-release" >"$log_dir/tidy.log" 2>&1 &
+{ after_later_tools nice -n 19 ./scripts/check-tidy.sh build/host-release; } >"$log_dir/tidy.log" 2>&1 &
 tidy_pid=$!
 # cppcheck the same way, beside it (docs/ci.md): the two share what the steps leave idle.
-nice -n 19 bash -c "$(declare -f after_later_tools); later_ok=$(printf %q "$later_ok"); after_later_tools ./scripts/check-cppcheck.sh build/host-release" >"$log_dir/cppcheck.log" 2>&1 &
+{ after_later_tools nice -n 19 ./scripts/check-cppcheck.sh build/host-release; } >"$log_dir/cppcheck.log" 2>&1 &
 cppcheck_pid=$!
 set +m
 
