@@ -92,17 +92,18 @@ run_case "install-cross-deps: a package apt cannot install is named" \
   scripts/install-cross-deps.sh "qemu-user-static libgpiod-dev" "libgpiod-dev:armhf" 1 \
   "cannot install package libgpiod-dev:armhf"
 
-# refused NAME SCRIPT ARG TEXT: SCRIPT ARG exits 2 saying TEXT, before any apt call.
+# refused NAME SCRIPT TEXT ARG...: SCRIPT ARG... exits 2 saying TEXT, before any apt call.
 refused() {
-  local rc=0
+  local name=$1 script=$2 text=$3 rc=0
+  shift 3
   : >"$work/apt.log"
-  PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/$2" "$3" >"$work/out" 2>&1 || rc=$?
-  if [ "$rc" -ne 2 ] || ! grep -qF -- "$4" "$work/out" || [ -s "$work/apt.log" ]; then
-    echo "FAIL $1: exit $rc (want 2), apt calls: $(wc -l <"$work/apt.log"), output:"
+  PATH="$bin:$PATH" FAKE_APT_LOG=$work/apt.log "$repo/$script" "$@" >"$work/out" 2>&1 || rc=$?
+  if [ "$rc" -ne 2 ] || ! grep -qF -- "$text" "$work/out" || [ -s "$work/apt.log" ]; then
+    echo "FAIL $name: exit $rc (want 2), apt calls: $(wc -l <"$work/apt.log"), output:"
     sed 's/^/    /' "$work/out"
     failures=$((failures + 1))
   else
-    echo "ok   $1"
+    echo "ok   $name"
   fi
 }
 # installed NAME REGEX WANT: whether a real install (not a simulation) of the last case named a
@@ -127,8 +128,10 @@ run_case "install-deps later: update errors, install works" scripts/install-deps
   "cmake cppcheck" "" 0 "going on with the package lists apt has" later
 installed "install-deps later: cppcheck" cppcheck yes
 installed "install-deps later: cmake (set host)" ' cmake( |$)' no
-refused "install-deps: an unknown package set is refused" scripts/install-deps.sh everything \
-  "unknown package set 'everything'"
+refused "install-deps: an unknown package set is refused" scripts/install-deps.sh \
+  "unknown package set 'everything'" everything
+refused "install-deps: two package sets are refused" scripts/install-deps.sh \
+  "one package set at most" host later
 
 # One architecture (scripts/test.sh): only its compiler and its -dev packages are installed.
 run_case "install-cross-deps armhf: update errors, install works" scripts/install-cross-deps.sh \
@@ -137,7 +140,7 @@ run_case "install-cross-deps armhf: update errors, install works" scripts/instal
 installed "install-cross-deps armhf: libgpiod-dev:armhf" 'libgpiod-dev:armhf' yes
 installed "install-cross-deps armhf: arm64 packages" 'aarch64|:arm64' no
 refused "install-cross-deps: an unknown architecture is refused" scripts/install-cross-deps.sh \
-  mips "unknown architecture 'mips'"
+  "unknown architecture 'mips'" mips
 
 [ "$failures" -eq 0 ] || { echo "$failures case(s) failed"; exit 1; }
 echo "all cases passed"
