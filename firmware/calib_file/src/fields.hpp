@@ -8,10 +8,16 @@
 #include <array>
 #include <cstddef>
 #include <string>
+#include <string_view>
 
 #include "gfins/calib_file/calibration_data.hpp"
 
 namespace gfins::calib_file::detail {
+
+/// "calibration file 'NAME': ", the start of every message about a file.
+inline std::string file_prefix(std::string_view name) {
+  return "calibration file '" + std::string(name) + "': ";
+}
 
 /// What a value must satisfy (validate()).
 enum class Domain : std::uint8_t {

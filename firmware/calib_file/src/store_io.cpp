@@ -4,14 +4,11 @@
 #include <cstring>
 #include <string>
 
+#include "fields.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 
 namespace gfins::calib_file {
 namespace {
-
-std::string prefix_of(std::string_view name) {
-  return "calibration file '" + std::string(name) + "': ";
-}
 
 // "<what>: <store message>[: strerror]" — the store's static message plus the OS reason.
 std::string store_text(const Status& s) {
@@ -33,9 +30,10 @@ FileResult<CalibrationData> load_calibration(hal::ParameterStore& store, std::st
     const Status& s = n.status();
     if (s.code() == ErrorCode::kResourceExhausted) {
       return FileStatus(ErrorCode::kInvalidArgument,
-                        prefix_of(name) + "larger than 64 kB: not a calibration file");
+                        detail::file_prefix(name) + "larger than 64 kB: not a calibration file");
     }
-    return FileStatus(ErrorCode::kIoError, prefix_of(name) + "cannot read: " + store_text(s));
+    return FileStatus(ErrorCode::kIoError,
+                      detail::file_prefix(name) + "cannot read: " + store_text(s));
   }
   text.resize(n.value());
   return parse_calibration_text(text, name);
@@ -45,12 +43,12 @@ FileStatus save_calibration(hal::ParameterStore& store, const CalibrationData& d
                             std::string_view name) {
   const Problem problem = validate(data);
   if (problem.found()) {
-    return FileStatus(ErrorCode::kOutOfRange,
-                      prefix_of(name) + "not saved: " + problem.key + " " + problem.problem);
+    return FileStatus(ErrorCode::kOutOfRange, detail::file_prefix(name) + "not saved: " +
+                                                  problem.key + " " + problem.problem);
   }
   const std::string text = to_toml_text(data);
   const Status s = store.save(std::span<const char>(text.data(), text.size()));
-  if (!s.is_ok()) return FileStatus(s.code(), prefix_of(name) + store_text(s));
+  if (!s.is_ok()) return FileStatus(s.code(), detail::file_prefix(name) + store_text(s));
   return FileStatus::ok();
 }
 

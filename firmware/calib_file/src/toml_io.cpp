@@ -240,10 +240,6 @@ const toml::node* find_unknown_key(const toml::table& t, const std::string& pref
   return nullptr;
 }
 
-std::string prefix_of(std::string_view file_name) {
-  return "calibration file '" + std::string(file_name) + "': ";
-}
-
 bool ends_with_marker(std::string_view text) {
   const auto end = text.find_last_not_of(" \t\r\n");
   if (end == std::string_view::npos) return false;
@@ -339,7 +335,7 @@ std::string to_toml_text(const CalibrationData& data) {
 
 FileResult<CalibrationData> parse_calibration_text(std::string_view text,
                                                    std::string_view file_name) {
-  const std::string prefix = prefix_of(file_name);
+  const std::string prefix = detail::file_prefix(file_name);
   if (!ends_with_marker(text)) {
     return FileStatus(ErrorCode::kDataLoss, prefix + "truncated: it does not end with the line \"" +
                                                 std::string(kEndMarker) + "\" (" +

@@ -7,21 +7,6 @@
 namespace gfins::can {
 namespace {
 
-/// The signal of `m` carrying `field` with `index`.
-const SignalDef& sig(const MessageDef& m, Field field, std::uint8_t index = 0) {
-  for (const SignalDef& s : m.signals) {
-    if (s.field == field && s.index == index) return s;
-  }
-  return m.signals[0];  // unreachable for the fields used below (the tests encode every one)
-}
-
-/// Every bit a signal of `m` uses; the rest are reserved and must be zero.
-std::uint64_t used_bits(const MessageDef& m) {
-  std::uint64_t used = 0;
-  for (const SignalDef& s : m.signals) used |= low_mask(s.length) << s.start_bit;
-  return used;
-}
-
 /// The physical value of a signal, or NaN when it is the not-available code or beyond
 /// [min, max] (an input value the board cannot trust).
 double checked(const SignalDef& s, std::uint64_t p) {
@@ -40,17 +25,13 @@ bool all_not_available(const MessageDef& m, std::uint64_t p) {
   return true;
 }
 
-std::uint64_t put(std::uint64_t p, const SignalDef& s, double x) {
-  return insert_bits(p, s, encode_signal(s, x).bits);
-}
-
 hal::CanFrame frame_of(MessageId id, std::uint8_t node_id, const IdBases& ids, std::uint64_t p,
                        std::uint8_t counter) {
   hal::CanFrame f;
   f.id = can_id(id, node_id, ids);
   f.len = kFrameLength;
   const MessageDef& m = message(id);
-  p = insert_bits(p, sig(m, Field::kCounter), counter);
+  p = insert_bits(p, signal_of(m, Field::kCounter), counter);
   set_payload(f, p);
   seal_frame(f);
   return f;
@@ -116,7 +97,7 @@ Result<InputEvent> InputDecoder::add(const hal::CanFrame& f) {
     return reject(InputReject::kMalformed, ErrorCode::kInvalidArgument,
                   "input: reserved bits are not zero");
   }
-  const auto counter = static_cast<std::uint8_t>(extract_bits(p, sig(*m, Field::kCounter)));
+  const auto counter = static_cast<std::uint8_t>(extract_bits(p, signal_of(*m, Field::kCounter)));
   if (m->id == MessageId::kHeadingInput) return add_heading(p, counter);
   return add_gnss(*m, p, counter);
 }
@@ -130,9 +111,9 @@ Result<InputEvent> InputDecoder::add_heading(std::uint64_t p, std::uint8_t seq) 
   InputEvent e;
   e.kind = InputEventKind::kHeadingFix;
   e.heading.sequence = seq;
-  e.heading.heading_rad = checked(sig(m, Field::kInHeading), p);
-  e.heading.sigma_rad = checked(sig(m, Field::kInHeadingSigma), p);
-  e.heading.age_s = checked(sig(m, Field::kInHeadingAge), p);
+  e.heading.heading_rad = checked(signal_of(m, Field::kInHeading), p);
+  e.heading.sigma_rad = checked(signal_of(m, Field::kInHeadingSigma), p);
+  e.heading.age_s = checked(signal_of(m, Field::kInHeadingAge), p);
   if (std::isnan(e.heading.heading_rad) || std::isnan(e.heading.sigma_rad) ||
       std::isnan(e.heading.age_s)) {
     return reject(InputReject::kOutOfRange, ErrorCode::kOutOfRange,
@@ -175,15 +156,15 @@ Result<InputEvent> InputDecoder::add_gnss(const MessageDef& m, std::uint64_t p, 
   if (m.id != MessageId::kGnssFixInfo && all_not_available(m, p)) return pending;
   switch (m.id) {
     case MessageId::kGnssPositionNE:
-      partial_.r_n_m[0] = checked(sig(m, Field::kInGnssPos, 0), p);
-      partial_.r_n_m[1] = checked(sig(m, Field::kInGnssPos, 1), p);
+      partial_.r_n_m[0] = checked(signal_of(m, Field::kInGnssPos, 0), p);
+      partial_.r_n_m[1] = checked(signal_of(m, Field::kInGnssPos, 1), p);
       if (std::isnan(partial_.r_n_m[0]) || std::isnan(partial_.r_n_m[1])) return out_of_range();
       have_ne_ = true;
       return pending;
     case MessageId::kGnssPositionD:
-      partial_.r_n_m[2] = checked(sig(m, Field::kInGnssPos, 2), p);
-      partial_.sigma_pos_h_m = checked(sig(m, Field::kInGnssSigmaPosH), p);
-      partial_.sigma_pos_v_m = checked(sig(m, Field::kInGnssSigmaPosV), p);
+      partial_.r_n_m[2] = checked(signal_of(m, Field::kInGnssPos, 2), p);
+      partial_.sigma_pos_h_m = checked(signal_of(m, Field::kInGnssSigmaPosH), p);
+      partial_.sigma_pos_v_m = checked(signal_of(m, Field::kInGnssSigmaPosV), p);
       if (std::isnan(partial_.r_n_m[2]) || std::isnan(partial_.sigma_pos_h_m) ||
           std::isnan(partial_.sigma_pos_v_m)) {
         return out_of_range();
@@ -192,7 +173,7 @@ Result<InputEvent> InputDecoder::add_gnss(const MessageDef& m, std::uint64_t p, 
       return pending;
     case MessageId::kGnssVelocity:
       for (std::uint8_t i = 0; i < 3; ++i) {
-        partial_.v_n_mps[i] = checked(sig(m, Field::kInGnssVel, i), p);
+        partial_.v_n_mps[i] = checked(signal_of(m, Field::kInGnssVel, i), p);
         if (std::isnan(partial_.v_n_mps[i])) return out_of_range();
       }
       have_vel_ = true;
@@ -202,17 +183,18 @@ Result<InputEvent> InputDecoder::add_gnss(const MessageDef& m, std::uint64_t p, 
   }
   // FixInfo: completes the fix.
   partial_open_ = false;
-  const auto content = static_cast<std::uint8_t>(extract_bits(p, sig(m, Field::kInGnssContent)));
+  const auto content =
+      static_cast<std::uint8_t>(extract_bits(p, signal_of(m, Field::kInGnssContent)));
   partial_.has_position = (content & kContentPosition) != 0;
   partial_.has_velocity = (content & kContentVelocity) != 0;
   if (content == 0) {
     return reject(InputReject::kMalformed, ErrorCode::kInvalidArgument,
                   "input: GNSS fix states neither position nor velocity");
   }
-  partial_.age_s = checked(sig(m, Field::kInGnssAge), p);
+  partial_.age_s = checked(signal_of(m, Field::kInGnssAge), p);
   if (std::isnan(partial_.age_s)) return out_of_range();
   if (partial_.has_velocity) {
-    partial_.sigma_vel_mps = checked(sig(m, Field::kInGnssSigmaVel), p);
+    partial_.sigma_vel_mps = checked(signal_of(m, Field::kInGnssSigmaVel), p);
     if (std::isnan(partial_.sigma_vel_mps)) return out_of_range();
   }
   if ((partial_.has_position && !(have_ne_ && have_d_)) || (partial_.has_velocity && !have_vel_)) {
@@ -240,36 +222,40 @@ std::array<hal::CanFrame, 4> encode_gnss_fix(const GnssFix& fix, std::uint8_t no
   const auto vel = [&](std::size_t i) { return fix.has_velocity ? fix.v_n_mps[i] : na; };
 
   const MessageDef& ne = message(MessageId::kGnssPositionNE);
-  std::uint64_t p = put(0, sig(ne, Field::kInGnssPos, 0), pos(0));
-  p = put(p, sig(ne, Field::kInGnssPos, 1), pos(1));
+  std::uint64_t p = put_signal(0, signal_of(ne, Field::kInGnssPos, 0), pos(0));
+  p = put_signal(p, signal_of(ne, Field::kInGnssPos, 1), pos(1));
   const hal::CanFrame f_ne = frame_of(MessageId::kGnssPositionNE, node_id, ids, p, id);
 
   const MessageDef& d = message(MessageId::kGnssPositionD);
-  p = put(0, sig(d, Field::kInGnssPos, 2), pos(2));
-  p = put(p, sig(d, Field::kInGnssSigmaPosH), fix.has_position ? fix.sigma_pos_h_m : na);
-  p = put(p, sig(d, Field::kInGnssSigmaPosV), fix.has_position ? fix.sigma_pos_v_m : na);
+  p = put_signal(0, signal_of(d, Field::kInGnssPos, 2), pos(2));
+  p = put_signal(p, signal_of(d, Field::kInGnssSigmaPosH),
+                 fix.has_position ? fix.sigma_pos_h_m : na);
+  p = put_signal(p, signal_of(d, Field::kInGnssSigmaPosV),
+                 fix.has_position ? fix.sigma_pos_v_m : na);
   const hal::CanFrame f_d = frame_of(MessageId::kGnssPositionD, node_id, ids, p, id);
 
   const MessageDef& v = message(MessageId::kGnssVelocity);
   p = 0;
-  for (std::uint8_t i = 0; i < 3; ++i) p = put(p, sig(v, Field::kInGnssVel, i), vel(i));
+  for (std::uint8_t i = 0; i < 3; ++i)
+    p = put_signal(p, signal_of(v, Field::kInGnssVel, i), vel(i));
   const hal::CanFrame f_v = frame_of(MessageId::kGnssVelocity, node_id, ids, p, id);
 
   const MessageDef& info = message(MessageId::kGnssFixInfo);
-  p = put(0, sig(info, Field::kInGnssSigmaVel), fix.has_velocity ? fix.sigma_vel_mps : na);
-  p = put(p, sig(info, Field::kInGnssAge), fix.age_s);
+  p = put_signal(0, signal_of(info, Field::kInGnssSigmaVel),
+                 fix.has_velocity ? fix.sigma_vel_mps : na);
+  p = put_signal(p, signal_of(info, Field::kInGnssAge), fix.age_s);
   const auto content = static_cast<std::uint8_t>((fix.has_position ? kContentPosition : 0) |
                                                  (fix.has_velocity ? kContentVelocity : 0));
-  p = insert_bits(p, sig(info, Field::kInGnssContent), content);
+  p = insert_bits(p, signal_of(info, Field::kInGnssContent), content);
   const hal::CanFrame f_info = frame_of(MessageId::kGnssFixInfo, node_id, ids, p, id);
   return {f_ne, f_d, f_v, f_info};
 }
 
 hal::CanFrame encode_heading_fix(const HeadingFix& h, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = message(MessageId::kHeadingInput);
-  std::uint64_t p = put(0, sig(m, Field::kInHeading), h.heading_rad);
-  p = put(p, sig(m, Field::kInHeadingSigma), h.sigma_rad);
-  p = put(p, sig(m, Field::kInHeadingAge), h.age_s);
+  std::uint64_t p = put_signal(0, signal_of(m, Field::kInHeading), h.heading_rad);
+  p = put_signal(p, signal_of(m, Field::kInHeadingSigma), h.sigma_rad);
+  p = put_signal(p, signal_of(m, Field::kInHeadingAge), h.age_s);
   return frame_of(MessageId::kHeadingInput, node_id, ids, p, h.sequence & 0x0Fu);
 }
 

@@ -10,27 +10,6 @@ namespace {
 const MessageDef& cmd_def() { return message(MessageId::kCommand); }
 const MessageDef& rsp_def() { return message(MessageId::kResponse); }
 
-/// The signal of `m` carrying `field` (for per-channel fields, the one with `index`; for a field
-/// several opcodes share, the one of opcode `mux`).
-const SignalDef& sig(const MessageDef& m, Field field, std::uint8_t index = 0,
-                     std::int16_t mux = kNotMultiplexed) {
-  for (const SignalDef& s : m.signals) {
-    if (s.field == field && s.index == index && (mux == kNotMultiplexed || s.mux == mux)) return s;
-  }
-  return m.signals[0];  // unreachable for the fields used below (checked by the tests)
-}
-
-/// Bits used by the signals present for selector value `mux`.
-std::uint64_t used_bits(const MessageDef& m, std::int16_t mux) {
-  std::uint64_t used = 0;
-  for (const SignalDef& s : m.signals) {
-    if (s.mux == kNotMultiplexed || s.mux == kMultiplexor || s.mux == mux) {
-      used |= low_mask(s.length) << s.start_bit;
-    }
-  }
-  return used;
-}
-
 DecodedCommand fail(DecodedCommand d, ResultCode code, const char* what) {
   d.error.code = code;
   d.error.message = what;
@@ -132,44 +111,48 @@ hal::CanFrame encode_command(const Command& c, std::uint8_t node_id, const IdBas
   f.len = kFrameLength;
   std::uint64_t p = 0;
   const auto op = static_cast<std::uint8_t>(c.opcode);
-  p = insert_bits(p, sig(m, Field::kCmdOpcode), op);
-  p = insert_bits(p, sig(m, Field::kCmdToken), c.token);
+  p = insert_bits(p, signal_of(m, Field::kCmdOpcode), op);
+  p = insert_bits(p, signal_of(m, Field::kCmdToken), c.token);
   switch (c.opcode) {
     case Opcode::kRealign: {
-      const SignalDef& s = sig(m, Field::kCmdHeading);
+      const SignalDef& s = signal_of(m, Field::kCmdHeading);
       p = insert_bits(p, s, bits_of(s, raw_of_physical(s, static_cast<double>(c.heading_rad))));
-      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpRealign), c.forced ? 1u : 0u);
+      p = insert_bits(p, signal_of(m, Field::kCmdForced, 0, kOpRealign), c.forced ? 1u : 0u);
       break;
     }
     case Opcode::kResetNavigation:
-      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpResetNavigation), c.forced ? 1u : 0u);
+      p = insert_bits(p, signal_of(m, Field::kCmdForced, 0, kOpResetNavigation),
+                      c.forced ? 1u : 0u);
       break;
     case Opcode::kSetCompensator:
-      p = insert_bits(p, sig(m, Field::kCmdCompensator), static_cast<std::uint8_t>(c.compensator));
+      p = insert_bits(p, signal_of(m, Field::kCmdCompensator),
+                      static_cast<std::uint8_t>(c.compensator));
       break;
     case Opcode::kSetDivider:
-      p = insert_bits(p, sig(m, Field::kCmdMessage), static_cast<std::uint8_t>(c.message));
-      p = insert_bits(p, sig(m, Field::kCmdDivider), c.divider);
+      p = insert_bits(p, signal_of(m, Field::kCmdMessage), static_cast<std::uint8_t>(c.message));
+      p = insert_bits(p, signal_of(m, Field::kCmdDivider), c.divider);
       break;
     case Opcode::kStartCapture:
-      p = insert_bits(p, sig(m, Field::kCmdPose), c.pose);
-      p = insert_bits(p, sig(m, Field::kCmdSamples), c.samples);
+      p = insert_bits(p, signal_of(m, Field::kCmdPose), c.pose);
+      p = insert_bits(p, signal_of(m, Field::kCmdSamples), c.samples);
       break;
     case Opcode::kReloadCalibration:
-      p = insert_bits(p, sig(m, Field::kCmdForced, 0, kOpReloadCalibration), c.forced ? 1u : 0u);
+      p = insert_bits(p, signal_of(m, Field::kCmdForced, 0, kOpReloadCalibration),
+                      c.forced ? 1u : 0u);
       break;
     case Opcode::kSetNodeId:
-      p = insert_bits(p, sig(m, Field::kCmdNodeId), c.node_id);
+      p = insert_bits(p, signal_of(m, Field::kCmdNodeId), c.node_id);
       break;
     case Opcode::kSetIdBase:
-      p = insert_bits(p, sig(m, Field::kCmdIdGroup), static_cast<std::uint8_t>(c.id_group));
-      p = insert_bits(p, sig(m, Field::kCmdIdBase), c.id_base);
+      p = insert_bits(p, signal_of(m, Field::kCmdIdGroup), static_cast<std::uint8_t>(c.id_group));
+      p = insert_bits(p, signal_of(m, Field::kCmdIdBase), c.id_base);
       break;
     default:
       break;
   }
   if (carries_sequence(c.opcode)) {
-    p = insert_bits(p, sig(m, Field::kCmdSequence, 0, static_cast<std::int16_t>(op)), c.sequence);
+    p = insert_bits(p, signal_of(m, Field::kCmdSequence, 0, static_cast<std::int16_t>(op)),
+                    c.sequence);
   }
   set_payload(f, p);
   seal_frame(f);
@@ -184,30 +167,27 @@ hal::CanFrame response_frame(std::uint8_t opcode, std::uint8_t token, std::uint8
   f.id = can_id(MessageId::kResponse, node_id, ids);
   f.len = kFrameLength;
   std::uint64_t p = body;
-  p = insert_bits(p, sig(m, Field::kRspOpcode), opcode);
-  p = insert_bits(p, sig(m, Field::kRspToken), token);
-  p = insert_bits(p, sig(m, Field::kRspPart), part);
+  p = insert_bits(p, signal_of(m, Field::kRspOpcode), opcode);
+  p = insert_bits(p, signal_of(m, Field::kRspToken), token);
+  p = insert_bits(p, signal_of(m, Field::kRspPart), part);
   set_payload(f, p);
   seal_frame(f);
   return f;
 }
 
-std::uint64_t put(std::uint64_t p, const SignalDef& s, double x) {
-  return insert_bits(p, s, encode_signal(s, x).bits);
-}
 }  // namespace
 
 hal::CanFrame encode_response(const Response& r, std::uint8_t node_id, const IdBases& ids) {
   const MessageDef& m = rsp_def();
   std::uint64_t p = 0;
-  p = insert_bits(p, sig(m, Field::kRspResult), static_cast<std::uint8_t>(r.result));
-  p = insert_bits(p, sig(m, Field::kRspValue), r.value);
+  p = insert_bits(p, signal_of(m, Field::kRspResult), static_cast<std::uint8_t>(r.result));
+  p = insert_bits(p, signal_of(m, Field::kRspValue), r.value);
   return response_frame(r.opcode, r.token, kPartStatus, p, node_id, ids);
 }
 
 hal::CanFrame encode_calibration_id_response(std::uint8_t token, std::uint32_t cal_id,
                                              std::uint8_t node_id, const IdBases& ids) {
-  const std::uint64_t p = insert_bits(0, sig(rsp_def(), Field::kRspCalId), cal_id);
+  const std::uint64_t p = insert_bits(0, signal_of(rsp_def(), Field::kRspCalId), cal_id);
   return response_frame(kOpReportCalibrationId, token, kPartCalibrationId, p, node_id, ids);
 }
 
@@ -222,18 +202,20 @@ std::array<hal::CanFrame, kCaptureResultFrames> encode_capture_result(const Capt
     const ChannelCapture& ch = r.channels[c];
     out[n++] = response_frame(
         kOpStartCapture, token, static_cast<std::uint8_t>(kPartMean + c),
-        put(0, sig(m, Field::kRspMean, c), static_cast<double>(ch.mean_counts)), node_id, ids);
-    out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartStd + c),
-                              put(0, sig(m, Field::kRspStd, c), static_cast<double>(ch.std_counts)),
-                              node_id, ids);
-    std::uint64_t p = put(0, sig(m, Field::kRspCount, c), ch.count);
-    p = insert_bits(p, sig(m, Field::kRspSaturated, c), ch.saturated ? 1u : 0u);
-    p = insert_bits(p, sig(m, Field::kRspMotion, c), ch.motion ? 1u : 0u);
+        put_signal(0, signal_of(m, Field::kRspMean, c), static_cast<double>(ch.mean_counts)),
+        node_id, ids);
+    out[n++] = response_frame(
+        kOpStartCapture, token, static_cast<std::uint8_t>(kPartStd + c),
+        put_signal(0, signal_of(m, Field::kRspStd, c), static_cast<double>(ch.std_counts)), node_id,
+        ids);
+    std::uint64_t p = put_signal(0, signal_of(m, Field::kRspCount, c), ch.count);
+    p = insert_bits(p, signal_of(m, Field::kRspSaturated, c), ch.saturated ? 1u : 0u);
+    p = insert_bits(p, signal_of(m, Field::kRspMotion, c), ch.motion ? 1u : 0u);
     out[n++] = response_frame(kOpStartCapture, token, static_cast<std::uint8_t>(kPartCount + c), p,
                               node_id, ids);
   }
-  std::uint64_t p = insert_bits(0, sig(m, Field::kRspPose), r.pose);
-  p = insert_bits(p, sig(m, Field::kRspSamples), r.samples);
+  std::uint64_t p = insert_bits(0, signal_of(m, Field::kRspPose), r.pose);
+  p = insert_bits(p, signal_of(m, Field::kRspSamples), r.samples);
   out[n] = response_frame(kOpStartCapture, token, kPartCaptureDone, p, node_id, ids);
   return out;
 }
@@ -249,31 +231,31 @@ Result<ResponseFrame> decode_response(const hal::CanFrame& f, const IdBases& ids
   const std::uint64_t p = payload_of(f);
   ResponseFrame r;
   r.node_id = node;
-  r.opcode = static_cast<std::uint8_t>(extract_bits(p, sig(m, Field::kRspOpcode)));
-  r.token = static_cast<std::uint8_t>(extract_bits(p, sig(m, Field::kRspToken)));
-  r.part = static_cast<std::uint8_t>(extract_bits(p, sig(m, Field::kRspPart)));
+  r.opcode = static_cast<std::uint8_t>(extract_bits(p, signal_of(m, Field::kRspOpcode)));
+  r.token = static_cast<std::uint8_t>(extract_bits(p, signal_of(m, Field::kRspToken)));
+  r.part = static_cast<std::uint8_t>(extract_bits(p, signal_of(m, Field::kRspPart)));
   const std::uint8_t group = r.part & 0xF0u;
   const std::uint8_t ch = r.part & 0x0Fu;
   if (r.part == kPartStatus) {
-    r.result = static_cast<ResultCode>(extract_bits(p, sig(m, Field::kRspResult)));
-    r.value = static_cast<std::uint32_t>(extract_bits(p, sig(m, Field::kRspValue)));
+    r.result = static_cast<ResultCode>(extract_bits(p, signal_of(m, Field::kRspResult)));
+    r.value = static_cast<std::uint32_t>(extract_bits(p, signal_of(m, Field::kRspValue)));
   } else if (r.part == kPartCalibrationId) {
-    r.cal_id = static_cast<std::uint32_t>(extract_bits(p, sig(m, Field::kRspCalId)));
+    r.cal_id = static_cast<std::uint32_t>(extract_bits(p, signal_of(m, Field::kRspCalId)));
   } else if (r.part == kPartCaptureDone) {
-    r.pose = static_cast<std::uint8_t>(extract_bits(p, sig(m, Field::kRspPose)));
-    r.samples = static_cast<std::uint16_t>(extract_bits(p, sig(m, Field::kRspSamples)));
+    r.pose = static_cast<std::uint8_t>(extract_bits(p, signal_of(m, Field::kRspPose)));
+    r.samples = static_cast<std::uint16_t>(extract_bits(p, signal_of(m, Field::kRspSamples)));
   } else if ((group == kPartMean || group == kPartStd || group == kPartCount) && ch < 6) {
     r.channel = ch;
     if (group == kPartMean) {
-      const SignalDef& s = sig(m, Field::kRspMean, ch);
+      const SignalDef& s = signal_of(m, Field::kRspMean, ch);
       r.mean_counts = decode_signal(s, extract_bits(p, s));
     } else if (group == kPartStd) {
-      const SignalDef& s = sig(m, Field::kRspStd, ch);
+      const SignalDef& s = signal_of(m, Field::kRspStd, ch);
       r.std_counts = decode_signal(s, extract_bits(p, s));
     } else {
-      r.count = static_cast<std::uint16_t>(extract_bits(p, sig(m, Field::kRspCount, ch)));
-      r.saturated = extract_bits(p, sig(m, Field::kRspSaturated, ch)) != 0;
-      r.motion = extract_bits(p, sig(m, Field::kRspMotion, ch)) != 0;
+      r.count = static_cast<std::uint16_t>(extract_bits(p, signal_of(m, Field::kRspCount, ch)));
+      r.saturated = extract_bits(p, signal_of(m, Field::kRspSaturated, ch)) != 0;
+      r.motion = extract_bits(p, signal_of(m, Field::kRspMotion, ch)) != 0;
     }
   } else {
     return Status(ErrorCode::kOutOfRange, "response: unknown part");

@@ -19,8 +19,6 @@ bool in_set(const std::array<int, 3>& set, int sensor0) {
   return set[0] == sensor0 || set[1] == sensor0 || set[2] == sensor0;
 }
 
-HostError bad(const std::string& what) { return HostError{ErrorCode::kInvalidArgument, what, 0}; }
-
 // The solver's Status, lifted with the words the exit status of gfins-calibrate keys on.
 HostError solver_failure(const Status& s) {
   return sim::host_error(s, std::string("calibration failed (") + to_string(s.code()) + "): ");
@@ -39,7 +37,7 @@ HostResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
   std::array<std::array<const MeanRow*, 6>, 6> at{};
   for (const MeanRow& m : in.means) {
     if (m.attitude > 6) {
-      return bad(
+      return sim::invalid_argument(
           file + ":" + std::to_string(m.line) + ": attitude " + std::to_string(m.attitude) +
           " does not exist in Tables 2/3 (1..6); give a poses file (--poses) for other poses");
     }
@@ -48,8 +46,9 @@ HostResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
   for (std::size_t i = 0; i < 6; ++i) {
     for (std::size_t j = 0; j < 6; ++j) {
       if (at[i][j] == nullptr) {
-        return bad(file + ": no mean for sensor " + std::to_string(i + 1) + " in attitude " +
-                   std::to_string(j + 1) + " (Tables 4/5 need all 36)");
+        return sim::invalid_argument(file + ": no mean for sensor " + std::to_string(i + 1) +
+                                     " in attitude " + std::to_string(j + 1) +
+                                     " (Tables 4/5 need all 36)");
       }
       p.mean_v[i][j] = at[i][j]->mean_v;
       // σ of the mean from std_v and count where given: both routes use it.
@@ -95,7 +94,8 @@ HostResult<CalibrationRun> run_paper_layout(const CalibrationInputs& in, const s
 
 HostResult<CalibrationRun> run_with_poses(const CalibrationInputs& in, const std::string& file) {
   if (in.method == Method::kPaper) {
-    return bad("the paper procedure needs the Table 2/3 poses; use --method general with --poses");
+    return sim::invalid_argument(
+        "the paper procedure needs the Table 2/3 poses; use --method general with --poses");
   }
   std::map<int, std::size_t> index;  // attitude number → observation
   std::vector<calib::AttitudeObservation<double>> obs;
@@ -112,8 +112,8 @@ HostResult<CalibrationRun> run_with_poses(const CalibrationInputs& in, const std
   for (const MeanRow& m : in.means) {
     const auto it = index.find(m.attitude);
     if (it == index.end()) {
-      return bad(file + ":" + std::to_string(m.line) + ": attitude " + std::to_string(m.attitude) +
-                 " is not in the poses file");
+      return sim::invalid_argument(file + ":" + std::to_string(m.line) + ": attitude " +
+                                   std::to_string(m.attitude) + " is not in the poses file");
     }
     auto& o = obs[it->second];
     const auto s = static_cast<std::size_t>(m.sensor - 1);
@@ -123,7 +123,7 @@ HostResult<CalibrationRun> run_with_poses(const CalibrationInputs& in, const std
   }
   for (const auto& o : obs) run.pose_used_mask.push_back(o.used_mask);
   if (obs.size() > calib::kMaxAttitudes) {
-    return bad("more than " + std::to_string(calib::kMaxAttitudes) + " poses");
+    return sim::invalid_argument("more than " + std::to_string(calib::kMaxAttitudes) + " poses");
   }
   auto r = calib::calibrate_multi_attitude<double>(
       std::span<const calib::AttitudeObservation<double>>(obs.data(), obs.size()));
@@ -240,9 +240,9 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   RecordingOptions options = options_in;
   if (!(options.rate_hz > 0.0)) options.rate_hz = rec.rate_hz;
   if (!(options.rate_hz > 0.0)) {
-    return bad(recording_file +
-               ": the sample rate is unknown: give --rate (Hz) for a CSV "
-               "recording");
+    return sim::invalid_argument(recording_file +
+                                 ": the sample rate is unknown: give --rate (Hz) for a CSV "
+                                 "recording");
   }
   calib::StaticDetectorConfig<double> cfg;
   cfg.sample_rate_hz = options.rate_hz;
@@ -250,13 +250,15 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
   cfg.min_still_s = options.min_still_s;
   cfg.max_std_v.fill(options.still_std_v);
   auto created = calib::StaticDetector<double>::create(cfg);
-  if (!created.is_ok()) return bad(recording_file + ": " + created.status().message());
+  if (!created.is_ok())
+    return sim::invalid_argument(recording_file + ": " + created.status().message());
   calib::StaticDetector<double>& detector = created.value();
   for (const auto& sample : rec.samples_v) (void)detector.push(sample);
   (void)detector.finish();
   if (detector.dropped() > 0) {
-    return bad(recording_file + ": more static intervals than the detector holds (" +
-               std::to_string(calib::kMaxAttitudes) + ")");
+    return sim::invalid_argument(recording_file +
+                                 ": more static intervals than the detector holds (" +
+                                 std::to_string(calib::kMaxAttitudes) + ")");
   }
 
   // Every pose the detector found or rejected, with the reason a pose cannot be used: it moved
@@ -310,7 +312,7 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
     what += "\n  poses refused:";
     if (refused.empty()) what += " none";
     for (const auto& r : refused) what += "\n    " + r;
-    return bad(what);
+    return sim::invalid_argument(what);
   }
 
   std::vector<std::array<double, 3>> expected;
@@ -348,7 +350,7 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
     return n.status();
   };
   if (const Status st = assign_all(); !st.is_ok()) {
-    return bad(recording_file + ": " + st.message());
+    return sim::invalid_argument(recording_file + ": " + st.message());
   }
   // Two intervals nearest to one expected pose: a repeat of that pose (their directions agree
   // within kRepeatDeg, far above the repositioning of a fixture, far below the 45° between the
@@ -389,7 +391,7 @@ HostResult<CalibrationRun> run_recording_calibration(const Recording& rec,
     if (kept.size() != all.size()) {
       usable = kept;
       if (const Status st = assign_all(); !st.is_ok()) {
-        return bad(recording_file + ": " + st.message());
+        return sim::invalid_argument(recording_file + ": " + st.message());
       }
     }
   }
@@ -581,7 +583,7 @@ HostStatus check_settings(const FileSettings& settings) {
   if (p.key.find("adc_lsb") != std::string::npos) option = "--adc-lsb";
   if (p.key == "geometry.rho_m") option = "--rho";
   if (p.key.rfind("gravity.", 0) == 0) option = "--gravity / --latitude";
-  return bad(option + " (" + p.key + "): " + p.problem);
+  return sim::invalid_argument(option + " (" + p.key + "): " + p.problem);
 }
 
 namespace {
@@ -849,14 +851,15 @@ HostResult<VerifyReport> verify_calibration(const std::vector<MeanRow>& means,
     if (poses) {
       const auto it = pose_of.find(m.attitude);
       if (it == pose_of.end()) {
-        return bad(means_file + ":" + std::to_string(m.line) + ": attitude " +
-                   std::to_string(m.attitude) + " is not in the poses file");
+        return sim::invalid_argument(means_file + ":" + std::to_string(m.line) + ": attitude " +
+                                     std::to_string(m.attitude) + " is not in the poses file");
       }
       a = it->second;
     } else {
       if (m.attitude > 6) {
-        return bad(means_file + ":" + std::to_string(m.line) + ": attitude " +
-                   std::to_string(m.attitude) + " is not in Tables 2/3; give --poses");
+        return sim::invalid_argument(means_file + ":" + std::to_string(m.line) + ": attitude " +
+                                     std::to_string(m.attitude) +
+                                     " is not in Tables 2/3; give --poses");
       }
       const bool alpha = in_set(nav::kSetAlpha, m.sensor - 1);
       a = (alpha ? calib::table3_attitudes<double>()

@@ -34,8 +34,6 @@ std::vector<std::string> split(const std::string& line) {
   }
 }
 
-HostError bad(const std::string& what) { return HostError{ErrorCode::kInvalidArgument, what, 0}; }
-
 // A header name or cell from the file as a message shows it: control characters and invalid
 // UTF-8 escaped (nothing from the file drives the terminal), cut to 60 characters.
 std::string shown(std::string_view text) {
@@ -67,7 +65,7 @@ HostStatus check_header(const CsvTable& t, const std::vector<std::string>& requi
       msg += names;
       msg += "; found: ";
       msg += join(t.header);
-      return bad(msg);
+      return sim::invalid_argument(msg);
     }
   }
   for (const std::string& r : required) {
@@ -76,7 +74,7 @@ HostStatus check_header(const CsvTable& t, const std::vector<std::string>& requi
       msg += names;
       msg += "; found: ";
       msg += join(t.header);
-      return bad(msg);
+      return sim::invalid_argument(msg);
     }
   }
   return Done{};
@@ -101,8 +99,9 @@ HostResult<double> CsvTable::number(const CsvRow& row, int col) const {
   const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
   if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() ||
       !std::isfinite(x)) {
-    return bad(where(row) + "column '" + shown(header[static_cast<std::size_t>(col)]) + "': \"" +
-               shown(text) + "\" is not a finite number");
+    return sim::invalid_argument(where(row) + "column '" +
+                                 shown(header[static_cast<std::size_t>(col)]) + "': \"" +
+                                 shown(text) + "\" is not a finite number");
   }
   return x;
 }
@@ -114,9 +113,10 @@ HostResult<std::int64_t> CsvTable::integer(const CsvRow& row, int col, std::int6
   const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
   if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size() || x < lo ||
       x > hi) {
-    return bad(where(row) + "column '" + shown(header[static_cast<std::size_t>(col)]) + "': \"" +
-               shown(text) + "\" is not an integer in [" + std::to_string(lo) + ", " +
-               std::to_string(hi) + "]");
+    return sim::invalid_argument(where(row) + "column '" +
+                                 shown(header[static_cast<std::size_t>(col)]) + "': \"" +
+                                 shown(text) + "\" is not an integer in [" + std::to_string(lo) +
+                                 ", " + std::to_string(hi) + "]");
   }
   return x;
 }
@@ -150,14 +150,15 @@ HostResult<CsvTable> read_csv(const std::filesystem::path& path) {
       continue;
     }
     if (cells.size() != t.header.size()) {
-      return bad(t.file + ":" + std::to_string(n) + ": " + std::to_string(cells.size()) +
-                 " fields, the header has " + std::to_string(t.header.size()));
+      return sim::invalid_argument(t.file + ":" + std::to_string(n) + ": " +
+                                   std::to_string(cells.size()) + " fields, the header has " +
+                                   std::to_string(t.header.size()));
     }
     t.rows.push_back(CsvRow{n, std::move(cells)});
   }
   if (in.bad()) return HostError{ErrorCode::kIoError, t.file + ": read error", 0};
-  if (t.header.empty()) return bad(t.file + ": empty (no header row)");
-  if (t.rows.empty()) return bad(t.file + ": no data rows after the header");
+  if (t.header.empty()) return sim::invalid_argument(t.file + ": empty (no header row)");
+  if (t.rows.empty()) return sim::invalid_argument(t.file + ": no data rows after the header");
   return t;
 }
 
@@ -174,7 +175,8 @@ HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
   const int c_std = t.column("std_v");
   const int c_count = t.column("count");
   if ((c_std < 0) != (c_count < 0)) {
-    return bad(t.file + ": columns std_v and count go together (σ of a mean = std_v/√count)");
+    return sim::invalid_argument(
+        t.file + ": columns std_v and count go together (σ of a mean = std_v/√count)");
   }
   std::vector<MeanRow> rows;
   std::set<std::pair<int, int>> seen;
@@ -185,9 +187,10 @@ HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
     GFINS_TRY(const auto attitude, t.integer(r, c_attitude, 1, 1000));
     GFINS_TRY(const auto mean, t.number(r, c_mean));
     if (std::fabs(mean) > kMaxMeanVolts) {
-      return bad(t.where(r) +
-                 "mean_v must be within ±100 V (a sensor output in volts: millivolts "
-                 "given as volts?)");
+      return sim::invalid_argument(
+          t.where(r) +
+          "mean_v must be within ±100 V (a sensor output in volts: millivolts "
+          "given as volts?)");
     }
     m.sensor = static_cast<int>(sensor);
     m.attitude = static_cast<int>(attitude);
@@ -195,20 +198,21 @@ HostResult<std::vector<MeanRow>> read_means(const std::filesystem::path& path) {
     if (c_std >= 0) {
       GFINS_TRY(const auto sd, t.number(r, c_std));
       GFINS_TRY(const auto count, t.integer(r, c_count, 1, 1'000'000'000));
-      if (sd < 0.0) return bad(t.where(r) + "std_v must not be negative");
+      if (sd < 0.0) return sim::invalid_argument(t.where(r) + "std_v must not be negative");
       // Finite is not enough: 1e308 V squares to inf in the σ of the fit, and the file was then
       // refused after a "good" verdict. No output of a sensor varies by more than its range.
       if (sd > kMaxMeanVolts) {
-        return bad(t.where(r) +
-                   "std_v must be at most 100 V (a standard deviation of a sensor output "
-                   "in volts)");
+        return sim::invalid_argument(
+            t.where(r) +
+            "std_v must be at most 100 V (a standard deviation of a sensor output "
+            "in volts)");
       }
       m.std_v = sd;
       m.count = static_cast<std::uint32_t>(count);
     }
     if (!seen.insert({m.sensor, m.attitude}).second) {
-      return bad(t.where(r) + "sensor " + std::to_string(m.sensor) + " attitude " +
-                 std::to_string(m.attitude) + " appears twice");
+      return sim::invalid_argument(t.where(r) + "sensor " + std::to_string(m.sensor) +
+                                   " attitude " + std::to_string(m.attitude) + " appears twice");
     }
     rows.push_back(m);
   }
@@ -234,11 +238,13 @@ HostResult<std::vector<Pose>> read_poses(const std::filesystem::path& path) {
     const double norm = std::hypot(p.f_b_g[0], p.f_b_g[1], p.f_b_g[2]);
     // At rest the specific force is 1 g; 10 % covers a local gravity model and rounding.
     if (std::fabs(norm - 1.0) > 0.1) {
-      return bad(t.where(r) + "|f| = " + std::to_string(norm) +
-                 " g: a static pose senses 1 g (give the specific force in g, not m/s²)");
+      return sim::invalid_argument(
+          t.where(r) + "|f| = " + std::to_string(norm) +
+          " g: a static pose senses 1 g (give the specific force in g, not m/s²)");
     }
     if (!seen.insert(p.attitude).second) {
-      return bad(t.where(r) + "attitude " + std::to_string(p.attitude) + " appears twice");
+      return sim::invalid_argument(t.where(r) + "attitude " + std::to_string(p.attitude) +
+                                   " appears twice");
     }
     poses.push_back(p);
   }
@@ -281,7 +287,8 @@ HostResult<Recording> read_gfr(const std::filesystem::path& path) {
     rec.saturated_mask.push_back(sat);
     rec.crc_error.push_back((smp.flags & sample_flags::kCrcError) != 0 ? 1 : 0);
   }
-  if (rec.samples_v.empty()) return bad(path.string() + ": the recording holds no samples");
+  if (rec.samples_v.empty())
+    return sim::invalid_argument(path.string() + ": the recording holds no samples");
   return rec;
 }
 
@@ -294,10 +301,11 @@ HostResult<Recording> read_recording(const std::filesystem::path& path) {
   for (std::size_t j = 0; j < 6; ++j) {
     c[j] = t.column("v" + std::to_string(j + 1));
     if (c[j] < 0) {
-      return bad(t.file + ": the header has no column 'v" + std::to_string(j + 1) +
-                 "'; a CSV recording needs the columns v1, v2, v3, v4, v5, v6 (volts; other "
-                 "columns such as a time stamp are ignored); found: " +
-                 join(t.header));
+      return sim::invalid_argument(
+          t.file + ": the header has no column 'v" + std::to_string(j + 1) +
+          "'; a CSV recording needs the columns v1, v2, v3, v4, v5, v6 (volts; other "
+          "columns such as a time stamp are ignored); found: " +
+          join(t.header));
     }
   }
   Recording rec;
@@ -336,8 +344,9 @@ HostResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem
     }
     const double norm = std::hypot(run.axis_up_b[0], run.axis_up_b[1], run.axis_up_b[2]);
     if (!(norm > 0.5)) {
-      return bad(t.where(r) + "the table axis (axis_x, axis_y, axis_z) has length " +
-                 std::to_string(norm) + ": give the upward unit axis in body axes");
+      return sim::invalid_argument(
+          t.where(r) + "the table axis (axis_x, axis_y, axis_z) has length " +
+          std::to_string(norm) + ": give the upward unit axis in body axes");
     }
     GFINS_TRY(const auto rate, t.number(r, t.column("rate_rad_s")));
     run.rate_rad_s = rate;
@@ -345,8 +354,8 @@ HostResult<std::vector<LocationRunRow>> read_location_runs(const std::filesystem
       GFINS_TRY(const auto mean, t.number(r, t.column("mean_v" + std::to_string(j + 1))));
       GFINS_TRY(const auto sd, t.number(r, t.column("std_v" + std::to_string(j + 1))));
       if (!(sd > 0.0)) {
-        return bad(t.where(r) + "std_v" + std::to_string(j + 1) +
-                   " must be positive (the noise of the samples, V)");
+        return sim::invalid_argument(t.where(r) + "std_v" + std::to_string(j + 1) +
+                                     " must be positive (the noise of the samples, V)");
       }
       run.mean_v[j] = mean;
       run.std_v[j] = sd;

@@ -40,6 +40,11 @@ inline HostError host_error(const Status& st, const std::string& context) {
   return HostError{st.code(), context + st.message(), 0};
 }
 
+/// A refusal of the caller's input (a value, a file's content, an option), with what is wrong.
+inline HostError invalid_argument(std::string message) {
+  return HostError{ErrorCode::kInvalidArgument, std::move(message), 0};
+}
+
 /// Success without a value.
 struct Done {};
 

@@ -108,6 +108,35 @@ constexpr double decode_signal(const SignalDef& s, std::uint64_t bits) {
   return physical_of_raw(s, raw);
 }
 
+/// The signal of `m` carrying `field` (for per-channel fields, the one with `index`; for a field
+/// several selector values share, the one of selector value `mux`). The codecs ask only for
+/// fields their message has (their tests encode every one); a field it lacks gives the first
+/// signal.
+constexpr const SignalDef& signal_of(const MessageDef& m, Field field, std::uint8_t index = 0,
+                                     std::int16_t mux = kNotMultiplexed) {
+  for (const SignalDef& s : m.signals) {
+    if (s.field == field && s.index == index && (mux == kNotMultiplexed || s.mux == mux)) return s;
+  }
+  return m.signals[0];
+}
+
+/// The payload bits used by the signals present for selector value `mux` (every signal of a
+/// message without a selector); the rest are reserved and must be zero.
+constexpr std::uint64_t used_bits(const MessageDef& m, std::int16_t mux = kNotMultiplexed) {
+  std::uint64_t used = 0;
+  for (const SignalDef& s : m.signals) {
+    if (s.mux == kNotMultiplexed || s.mux == kMultiplexor || s.mux == mux) {
+      used |= low_mask(s.length) << s.start_bit;
+    }
+  }
+  return used;
+}
+
+/// `payload` with the physical value `x` encoded into signal `s` (encode_signal's rules).
+inline std::uint64_t put_signal(std::uint64_t payload, const SignalDef& s, double x) {
+  return insert_bits(payload, s, encode_signal(s, x).bits);
+}
+
 /// CRC-8/SAE-J1850 of a frame: identifier low byte, identifier high byte, data bytes 0..6.
 constexpr std::uint8_t frame_crc(const hal::CanFrame& f) {
   const std::array<std::uint8_t, 2> id{static_cast<std::uint8_t>(f.id & 0xFFu),
