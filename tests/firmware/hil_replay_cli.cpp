@@ -12,9 +12,12 @@
 #include <thread>
 #include <vector>
 
+#include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
+#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/recording.hpp"
+#include "gfins/host_sim/scenario.hpp"
 #include "support/cli_fixture.hpp"
 
 namespace gfins {
@@ -64,6 +67,30 @@ TEST(HilWire, SampleFrameLayout) {
   EXPECT_EQ(r.frame.sample.t_ns, s.t_ns);
   EXPECT_EQ(r.frame.sample.counts, s.counts);
   EXPECT_EQ(r.frame.sample.flags, s.flags);
+}
+
+TEST(HilWire, CanFrameLayoutBothWays) {
+  hal::CanFrame f;
+  f.id = 0x0C1;
+  f.len = 8;
+  f.data = {1, 2, 3, 4, 5, 6, 7, 8};
+  for (const auto type : {lnx::hil::FrameType::kCan, lnx::hil::FrameType::kCanIn}) {
+    const auto w = lnx::hil::encode_can(f, type);
+    ASSERT_EQ(w.size(), 24u);
+    EXPECT_EQ(w[2], static_cast<std::uint8_t>(type));  // 4: board -> host, 5: host -> board
+    EXPECT_EQ(w[3], 24);
+    EXPECT_EQ(w[4], 0xC1);  // identifier, little-endian
+    EXPECT_EQ(w[5], 0x00);
+    EXPECT_EQ(w[8], 8);  // length
+    EXPECT_EQ(w[12], 1);
+    EXPECT_EQ(w[19], 8);
+    const auto r = lnx::hil::parse(w);
+    ASSERT_EQ(r.error, lnx::hil::ParseError::kNone);
+    EXPECT_EQ(r.frame.type, type);
+    EXPECT_EQ(r.frame.can.id, 0x0C1u);
+    EXPECT_EQ(r.frame.can.data, f.data);
+  }
+  EXPECT_EQ(lnx::hil::encode_can(f)[2], 4);  // the default: a frame the firmware published
 }
 
 TEST(HilWire, BadFramesAreNamed) {
@@ -125,6 +152,63 @@ TEST(HilWire, FieldsTheEncoderNeverWritesAreRefused) {
   EXPECT_EQ(lnx::hil::parse(reseal(can_pad)).error, lnx::hil::ParseError::kMalformed);
 }
 
+// ---- The firmware end's aiding frames, over loopback -------------------------------------------
+
+// A frame from the host is the loop's only once the sample frame after it has been read: a
+// read that times out between the two must not hand it over (the loop would apply it a cycle
+// early). Frames with a bad CRC, and frames whose sample never comes, are lost and counted.
+TEST(HilServerFrames, AFrameIsReceivedInTheCycleOfTheSampleAfterIt) {
+  lnx::HilServerConfig cfg;
+  auto server = lnx::HilServer::open(cfg);
+  ASSERT_TRUE(server.is_ok()) << server.status().message();
+  lnx::HilServer& srv = *server.value();
+  auto client = lnx::HilClient::connect("127.0.0.1", srv.port());
+  ASSERT_TRUE(client.is_ok()) << client.status().message();
+  lnx::HilClient& host = *client.value();
+  const auto can_in = [](std::uint32_t id) {
+    hal::CanFrame f;
+    f.id = id;
+    f.len = 8;
+    f.data[0] = static_cast<std::uint8_t>(id);
+    return lnx::hil::encode_can(f, lnx::hil::FrameType::kCanIn);
+  };
+  constexpr std::int64_t kShortNs = 50000000, kLongNs = 2000000000;
+  RawSample s;
+
+  ASSERT_TRUE(host.send(can_in(0x0C1)).is_ok());
+  EXPECT_EQ(srv.read_sample(kShortNs).status().code(), ErrorCode::kTimeout);
+  EXPECT_EQ(srv.bus().receive(0).status().code(), ErrorCode::kTimeout);  // not before its sample
+  ASSERT_TRUE(host.send(lnx::hil::encode_sample(0, s, false)).is_ok());
+  ASSERT_TRUE(srv.read_sample(kLongNs).is_ok());
+  const auto a = srv.bus().receive(0);
+  ASSERT_TRUE(a.is_ok());
+  EXPECT_EQ(a.value().id, 0x0C1u);
+  EXPECT_EQ(srv.bus().receive(0).status().code(), ErrorCode::kTimeout);
+
+  auto bad = can_in(0x0D1);
+  bad[13] ^= 0x01;  // a data bit: the CRC no longer holds
+  ASSERT_TRUE(host.send(bad).is_ok());
+  ASSERT_TRUE(host.send(can_in(0x0E1)).is_ok());
+  s.seq = 1;
+  ASSERT_TRUE(host.send(lnx::hil::encode_sample(1, s, false)).is_ok());
+  ASSERT_TRUE(srv.read_sample(kLongNs).is_ok());  // the bad frame skipped, the stream in step
+  const auto b = srv.bus().receive(0);
+  ASSERT_TRUE(b.is_ok());
+  EXPECT_EQ(b.value().id, 0x0E1u);
+  EXPECT_EQ(srv.counters().can_in, 2u);
+  EXPECT_EQ(srv.counters().can_in_lost, 1u);
+  EXPECT_EQ(srv.counters().crc_errors, 0u);  // a sample CRC error is another count
+
+  // A frame whose sample never comes: the connection ends first.
+  ASSERT_TRUE(host.send(can_in(0x0F1)).is_ok());
+  EXPECT_EQ(srv.read_sample(kShortNs).status().code(), ErrorCode::kTimeout);  // read, pending
+  host.abort();
+  for (int i = 0; i < 40 && srv.connected(); ++i) (void)srv.read_sample(kShortNs);
+  EXPECT_FALSE(srv.connected());
+  EXPECT_EQ(srv.bus().receive(0).status().code(), ErrorCode::kTimeout);
+  EXPECT_EQ(srv.counters().can_in_lost, 2u);
+}
+
 // ---- End to end -------------------------------------------------------------------------------
 
 class HilReplay : public test::CliTest {
@@ -137,12 +221,15 @@ class HilReplay : public test::CliTest {
     }
   }
 
-  // gfins-fw --board hil on an ephemeral loopback port; returns the port it bound.
-  int start_firmware() {
-    fw_ = test::start_tool(GFINS_FW_EXE,
-                           {"--board", "hil", "--hil-port", "0", "--hil-port-file", path("port"),
-                            "--watchdog", "none"},
-                           dir() / "fw");
+  // gfins-fw --board hil on an ephemeral loopback port, with EXTRA arguments; returns the port
+  // it bound.
+  int start_firmware(const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args = {"--board",         "hil",        "--hil-port", "0",
+                                     "--hil-port-file", path("port"), "--watchdog", "none"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    fs::remove(dir() / "port");
+    fw_done_ = false;
+    fw_ = test::start_tool(GFINS_FW_EXE, args, dir() / "fw");
     // Readiness, not timing: the port file appears once the socket listens (written whole and
     // renamed). The bound only keeps a broken build from hanging the suite.
     for (int i = 0; i < 6000 && !fs::exists(dir() / "port"); ++i) {
@@ -262,7 +349,8 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
   h.sample_rate_hz = kRate;
   const fs::path rec = dir() / "stream.gfr";
   // Two frame records among them (a recording the firmware made holds what its loop received):
-  // the link carries samples only, and the tool says it leaves the frames out.
+  // node 1's GNSS input identifiers with all-zero data, which no aiding input takes (the
+  // firmware's defaults have the aiding inputs off): they stay on the host, said so.
   const std::vector<sim::RecordedFrame> frames = {{100, {99000000, 0x0C1, false, 8, {}}},
                                                   {1500, {1499000000, 0x0D1, false, 8, {}}}};
   const auto image = sim::encode_recording(h, samples, frames);
@@ -278,8 +366,11 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
   const auto host = run_host(port, {"--recording", rec.string()}, "rec");
   const std::string& out = host.output;
   EXPECT_EQ(host.exit_code, 0) << out;
-  EXPECT_NE(out.find("2 CAN frames recorded with the samples are not replayed"), std::string::npos)
+  EXPECT_NE(out.find("2 of the 2 recorded CAN frames are not aiding inputs of node 1 (aiding "
+                     "inputs are off"),
+            std::string::npos)
       << out;
+  EXPECT_NE(out.find("aiding frames: 0 in the recording, 0 sent"), std::string::npos) << out;
   const std::string e = std::to_string((kRecSamples - 1) / kEpochDivider + 1);
   EXPECT_NE(out.find("epochs: expected " + e + ", decoded " + e), std::string::npos) << out;
   EXPECT_NE(out.find("outside quantisation 0"), std::string::npos) << out;
@@ -288,6 +379,68 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
   EXPECT_NE(log.find("stopped after " + std::to_string(kRecSamples) + " samples"),
             std::string::npos)
       << log;
+}
+
+// An aided drive recorded by the firmware on the simulated board (its receiver's GNSS fixes
+// arriving as CAN input frames, the board aligning in motion from them) replays through the
+// link with its aiding: the hil board receives each fix's frames in the cycle the recording
+// board did, and every published value equals the host-only run that applies the same frames
+// (docs/hil.md, "Aiding frames"). The negative control leaves one frame of an early fix off the
+// link while the host-only run still applies it: the board's navigation then differs.
+TEST_F(HilReplay, AnAidedDriveReplaysWithItsGnssFrames) {
+  constexpr int kDriveSeconds = 5;
+  const auto sc = sim::load_scenario("drive-gnss", GFINS_SCENARIO_DIR);
+  ASSERT_TRUE(sc.is_ok()) << sc.error().message;
+  sim_board::ChipAdc adc(sc.value().rate_hz);
+  ASSERT_TRUE(adc.start().is_ok());
+  const std::string cal = path("board-cal.toml");
+  const auto saved = calib_file::save_calibration_file(
+      cal, sim_board::scenario_calibration(sc.value(), adc.volts_per_count()));
+  ASSERT_TRUE(saved.is_ok()) << saved.message();
+  // One configuration for the recording board, the hil board and the host-only run.
+  const std::string cfg = file("vehicle.toml",
+                               "[aiding]\nenabled = true\ntrack_heading_sigma_deg = 0.5\n"
+                               "gnss_lever_arm_m = [-1.0, 0.0, -1.2]\n[calibration]\nfile = \"" +
+                                   cal + "\"\n");
+  const std::string rec = path("drive.gfr");
+  const auto made =
+      test::run_tool(GFINS_FW_EXE,
+                     {"--config", cfg, "--sim", "drive-gnss", "--scenario-dir", GFINS_SCENARIO_DIR,
+                      "--record", rec, "--can-log", path("live.log"), "--duration",
+                      std::to_string(kDriveSeconds), "--watchdog", "none"},
+                     dir() / "record");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const auto r = sim::read_recording(rec);
+  ASSERT_TRUE(r.is_ok()) << r.error().message;
+  // 10 Hz fixes of four frames each over 5 s (the scenario's receiver): about 200 frames.
+  const std::size_t n_frames = r.value().frames.size();
+  ASSERT_GE(n_frames, 196u);
+  ASSERT_LE(n_frames, 204u);
+  const std::string nf = std::to_string(n_frames);
+
+  int port = start_firmware({"--config", cfg});
+  ASSERT_GT(port, 0) << fw_result().output;
+  const auto host = run_host(port, {"--recording", rec, "--fw-config", cfg}, "aided");
+  EXPECT_EQ(host.exit_code, 0) << host.output;
+  EXPECT_NE(host.output.find("aiding frames: " + nf + " in the recording, " + nf + " sent"),
+            std::string::npos)
+      << host.output;
+  EXPECT_NE(host.output.find("outside quantisation 0"), std::string::npos) << host.output;
+  EXPECT_NE(host.output.find("IDENTICAL"), std::string::npos) << host.output;
+  const std::string& log = fw_result().output;
+  EXPECT_EQ(fw_result().exit_code, 0) << log;
+
+  // Frame 40 is the first of fix 10 (1 s into the drive).
+  port = start_firmware({"--config", cfg});
+  ASSERT_GT(port, 0) << fw_result().output;
+  const auto lost =
+      run_host(port, {"--recording", rec, "--fw-config", cfg, "--drop-frame", "40"}, "lost");
+  EXPECT_EQ(lost.exit_code, 8) << lost.output;
+  EXPECT_NE(lost.output.find("in the recording, " + std::to_string(n_frames - 1) + " sent"),
+            std::string::npos)
+      << lost.output;
+  EXPECT_NE(lost.output.find("DIFFERENT"), std::string::npos) << lost.output;
+  EXPECT_EQ(fw_result().exit_code, 0) << fw_result().output;
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // libFuzzer target: the hardware-in-the-loop stream (drivers/lnx/hil_link.hpp, docs/hil.md),
-// parsed frame by frame as the firmware (samples) and the host (acknowledgements, CAN frames)
+// parsed frame by frame as the firmware (samples, CAN frames to receive) and the host
+// (acknowledgements, CAN frames)
 // read it. When the first input byte is odd the harness writes each frame's CRC-32 first, so the
 // fuzzer reaches the fields behind it. A CRC failure skips the frame, any other error ends the
 // stream (the link closes the connection), as the link does.
@@ -46,8 +47,9 @@ void check_round_trip(const hil::Frame& f, std::span<const std::uint8_t> bytes) 
                          "an acknowledgement re-encodes to its bytes");
       break;
     case hil::FrameType::kCan:
-      gfins::fuzz::check(same(hil::encode_can(f.can), bytes), kTarget,
-                         "a CAN frame re-encodes to its bytes");
+    case hil::FrameType::kCanIn:
+      gfins::fuzz::check(same(hil::encode_can(f.can, f.type), bytes), kTarget,
+                         "a CAN frame re-encodes to its bytes, with its direction");
       break;
   }
 }

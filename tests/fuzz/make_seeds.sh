@@ -86,8 +86,9 @@ sample = struct.pack("<IIq6iI", 0, 100, 1_000_000, 1, -2, 3, -4, 5, -6, 0)
 last = struct.pack("<IIq6iI", 1, 101, 2_000_000, 0, 0, 0, 0, 0, 0, 0)
 ack = struct.pack("<IB3x", 0, 0)
 can = struct.pack("<IB3x8s", 0x101, 8, bytes(range(8)))
-put("hil_stream/seed-stream", b"\1" + frame(1, sample) + frame(2, last) + frame(3, ack) +
-    frame(4, can))
+can_in = struct.pack("<IB3x8s", 0x0C1, 8, bytes(range(8)))
+put("hil_stream/seed-stream", b"\1" + frame(5, can_in) + frame(1, sample) + frame(2, last) +
+    frame(3, ack) + frame(4, can))
 # ads131m06: per transfer a mode byte (0: the chip's answer) and per data-ready wait a byte
 # (0x01: the next edge; 0x19: two edges missed first); alternating, then fuzzed frames with
 # sealed CRCs.

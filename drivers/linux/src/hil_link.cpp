@@ -77,9 +77,9 @@ AckWire encode_ack(std::uint32_t index, AckVerdict v) {
   return f;
 }
 
-CanWire encode_can(const hal::CanFrame& c) {
+CanWire encode_can(const hal::CanFrame& c, FrameType type) {
   CanWire f{};
-  header(f.data(), FrameType::kCan, kCanBytes);
+  header(f.data(), type, kCanBytes);
   put_u32(f.data() + 4, c.id | (c.extended ? kExtendedFlag : 0u));
   f[8] = c.len;
   std::memcpy(f.data() + 12, c.data.data(), c.data.size());
@@ -95,6 +95,7 @@ std::size_t frame_bytes(std::uint8_t type) {
     case FrameType::kAck:
       return kAckBytes;
     case FrameType::kCan:
+    case FrameType::kCanIn:
       return kCanBytes;
   }
   return 0;
@@ -170,7 +171,8 @@ ParseResult parse(std::span<const std::uint8_t> b) {
       }
       r.frame.verdict = static_cast<AckVerdict>(p[8]);
       break;
-    case FrameType::kCan: {
+    case FrameType::kCan:
+    case FrameType::kCanIn: {
       // Exactly what encode_can writes: an 11-bit identifier, or a 29-bit one with the extended
       // flag; at most 8 data bytes; zero padding.
       const std::uint32_t id = get_u32(p + 4);
@@ -259,7 +261,10 @@ class HilServer::Bus final : public hal::CanBus {
     return Status::ok();
   }
   Result<hal::CanFrame> do_receive(std::int64_t) override {
-    return Status(ErrorCode::kTimeout, "hil: no command frames on the replay link");
+    hal::CanFrame f;
+    if (!s_.take_can_in(f)) return Status(ErrorCode::kTimeout, "hil: no host frame in this cycle");
+    ++counters_.rx_frames;
+    return f;
   }
   hal::CanBusState do_state() const override { return hal::CanBusState::kErrorActive; }
   hal::CanCounters do_counters() const override { return counters_; }
@@ -306,12 +311,37 @@ void HilServer::drop(const char* why, int os_error) {
   if (conn_fd_ >= 0) ::close(conn_fd_);
   conn_fd_ = -1;
   rx_len_ = 0;
+  forget_pending_can_in();  // their sample never came
   if (!finished_) ++counters_.drops;
   // Called from the loop: formatted into a fixed buffer, no allocation.
   (void)std::snprintf(last_event_.data(), last_event_.size(),
                       "%s%s%s after %u sample(s) of this connection (%u in all)", why,
                       os_error != 0 ? ": " : "", os_error != 0 ? std::strerror(os_error) : "",
                       expected_index_, counters_.samples);
+}
+
+void HilServer::queue_can_in(const hal::CanFrame& f) {
+  const std::size_t held = can_in_ready_ + can_in_pending_;
+  if (held == can_in_.size()) {
+    ++counters_.can_in_lost;
+    return;
+  }
+  can_in_[(can_in_head_ + held) % can_in_.size()] = f;
+  ++can_in_pending_;
+}
+
+bool HilServer::take_can_in(hal::CanFrame& out) {
+  if (can_in_ready_ == 0) return false;
+  out = can_in_[can_in_head_];
+  can_in_head_ = (can_in_head_ + 1) % can_in_.size();
+  --can_in_ready_;
+  ++counters_.can_in;
+  return true;
+}
+
+void HilServer::forget_pending_can_in() {
+  counters_.can_in_lost += static_cast<std::uint32_t>(can_in_pending_);
+  can_in_pending_ = 0;
 }
 
 bool HilServer::send_bytes(std::span<const std::uint8_t> b) {
@@ -346,6 +376,10 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
     }
     if (pr.error == hil::ParseError::kNone) {
       const hil::FrameType t = pr.frame.type;
+      if (t == hil::FrameType::kCanIn) {
+        queue_can_in(pr.frame.can);
+        continue;
+      }
       if (t != hil::FrameType::kSample && t != hil::FrameType::kLastSample) {
         ++counters_.frame_errors;
         drop("hil: the host sent a frame of a firmware-to-host type");
@@ -357,7 +391,15 @@ Result<RawSample> HilServer::read_sample(std::int64_t timeout_ns) {
       // of this sample follow this ACK on the connection.
       (void)send_bytes(hil::encode_ack(pr.frame.index, hil::AckVerdict::kOk));
       if (t == hil::FrameType::kLastSample) finished_ = true;
+      // The frames before this sample are the loop's in this sample's cycle.
+      can_in_ready_ += can_in_pending_;
+      can_in_pending_ = 0;
       return pr.frame.sample;
+    }
+    if (pr.error == hil::ParseError::kBadCrc && pr.frame.type == hil::FrameType::kCanIn) {
+      // Not a sample: nothing to acknowledge; the frame is lost (counted), the stream goes on.
+      ++counters_.can_in_lost;
+      continue;
     }
     if (pr.error == hil::ParseError::kBadCrc) {
       ++counters_.crc_errors;

@@ -152,8 +152,9 @@ BoardResult make_hil_board(const FwConfig& c) {
     const lnx::HilCounters& h = srv->counters();
     spdlog::info(
         "hil: {} connection(s), {} dropped, {} samples, {} CRC errors, {} bad frames, {} CAN "
-        "frames sent, {} not sent{}",
+        "frames sent, {} not sent, {} received from the host, {} lost{}",
         h.connections, h.drops, h.samples, h.crc_errors, h.frame_errors, h.can_sent, h.can_dropped,
+        h.can_in, h.can_in_lost,
         srv->last_event()[0] == '\0' ? std::string()
                                      : std::string("; last event: ") + srv->last_event());
   };

@@ -8,6 +8,7 @@
 
 #include "gfins/app/config.hpp"
 #include "gfins/app/nav_accuracy.hpp"
+#include "gfins/can/aiding_offer.hpp"
 
 namespace gfins::app {
 
@@ -573,14 +574,6 @@ void SampleLoop::check_gravity(std::int64_t t_ns) {
               std::llround(f * 1e6), std::llround(g_model * 1e6), std::llround(allowed * 1e6));
 }
 
-namespace {
-// Time of validity of an aiding input on the loop's clock: its reception less the age the sender
-// stated (docs/can-interface.md, "Time of validity").
-std::int64_t valid_at(std::int64_t received_ns, double age_s) {
-  return received_ns - static_cast<std::int64_t>(std::llround(age_s * 1e9));
-}
-}  // namespace
-
 bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
   const Result<can::InputEvent> ev = inputs_.add(f);
   if (!ev.is_ok()) {
@@ -596,37 +589,9 @@ bool SampleLoop::handle_input(const hal::CanFrame& f, std::int64_t t_ns) {
   if (e.kind == can::InputEventKind::kIgnored) return false;
   if (e.kind == can::InputEventKind::kPending) return true;
   ++health_.aiding_inputs;
-  // Time of validity on the loop's clock: this cycle's sample time less the age the sender
-  // stated (the bus transit, under a millisecond at 500 kbit/s, is not in it).
   // The filter counts what it accepts and rejects (published in GfinsAidingCounters); the log
   // says when a fix was not applied.
-  nav::UpdateStatus worst = nav::UpdateStatus::kAccepted;
-  const auto note = [&worst](const nav::UpdateOutcome& o) {
-    if (o.status == nav::UpdateStatus::kRejected || o.status == nav::UpdateStatus::kInvalid)
-      worst = o.status;
-  };
-  if (e.kind == can::InputEventKind::kGnssFix) {
-    const can::GnssFix& g = e.gnss;
-    nav::GnssFix<float> fix;
-    fix.t_valid_ns = valid_at(t_ns, g.age_s);
-    if (g.has_position) {
-      fix.value_n = nav::Vec3<double>(g.r_n_m[0], g.r_n_m[1], g.r_n_m[2]).cast<float>();
-      fix.sigma =
-          nav::Vec3<double>(g.sigma_pos_h_m, g.sigma_pos_h_m, g.sigma_pos_v_m).cast<float>();
-      note(pipeline_.offer_gnss_position(fix));
-    }
-    if (g.has_velocity) {
-      fix.value_n = nav::Vec3<double>(g.v_n_mps[0], g.v_n_mps[1], g.v_n_mps[2]).cast<float>();
-      fix.sigma.setConstant(static_cast<float>(g.sigma_vel_mps));
-      note(pipeline_.offer_gnss_velocity(fix));
-    }
-  } else {
-    nav::HeadingFix<float> fix;
-    fix.t_valid_ns = valid_at(t_ns, e.heading.age_s);
-    fix.yaw_rad = static_cast<float>(e.heading.heading_rad);
-    fix.sigma_rad = static_cast<float>(e.heading.sigma_rad);
-    note(pipeline_.offer_heading(fix));
-  }
+  const nav::UpdateStatus worst = can::offer_input(pipeline_, e, t_ns);
   if (worst != nav::UpdateStatus::kAccepted) {
     limited_log(LogKind::kAidingRejected, LogLevel::kInfo, t_ns,
                 "aiding input not applied: outcome {} ({} more since the last line)",

@@ -78,10 +78,16 @@ Result<InputEvent> InputDecoder::reject(InputReject why, ErrorCode code, const c
   return Status(code, what);
 }
 
-Result<InputEvent> InputDecoder::add(const hal::CanFrame& f) {
+bool is_input_frame(const hal::CanFrame& f, std::uint8_t node_id, const IdBases& ids) {
   std::uint8_t node = 0;
-  const MessageDef* m = f.extended ? nullptr : find_message(f.id, ids_, &node);
-  if (m == nullptr || m->kind != MessageKind::kInput || node != node_id_) return InputEvent{};
+  const MessageDef* m = f.extended ? nullptr : find_message(f.id, ids, &node);
+  return m != nullptr && m->kind == MessageKind::kInput && node == node_id;
+}
+
+Result<InputEvent> InputDecoder::add(const hal::CanFrame& f) {
+  if (!is_input_frame(f, node_id_, ids_)) return InputEvent{};
+  std::uint8_t node = 0;
+  const MessageDef* m = find_message(f.id, ids_, &node);
   last_reject_ = InputReject::kNone;
   if (f.len != kFrameLength) {
     partial_open_ = false;

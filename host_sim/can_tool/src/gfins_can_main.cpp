@@ -905,6 +905,9 @@ int main_impl(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   hil->add_option("--corrupt-at", ho.corrupt_at, "test: send sample N with a corrupted CRC")
       ->check(CLI::NonNegativeNumber);
+  hil->add_option("--drop-frame", ho.drop_frame,
+                  "test: leave aiding frame N off the link (the host-only run applies it)")
+      ->check(CLI::NonNegativeNumber);
 #endif
 
   GnssOptions go;

@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <memory>
 #include <vector>
 
 #include "decoder.hpp"
 #include "gfins/app/config.hpp"
+#include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
+#include "gfins/can/aiding_input.hpp"
+#include "gfins/can/aiding_offer.hpp"
 #include "gfins/drivers/ads131m06.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
 #include "gfins/drivers/qa1100_front_end.hpp"
@@ -40,9 +44,42 @@ std::array<double, 3> euler_zyx(const nav::Quat<float>& qf) {
 
 struct Input {
   std::vector<RawSample> samples;
+  std::vector<sim::RecordedFrame> frames;  // a recording's received CAN frames, in order
   std::string what;
   double rate_hz = 1000.0;
 };
+
+/// A recorded frame the link carries, with the cycle (sample index) the loop received it in.
+struct CycleFrame {
+  std::uint32_t cycle = 0;
+  hal::CanFrame frame;
+};
+
+/// The recorded frames the firmware takes as aiding inputs (GNSS fixes, headings of its node and
+/// identifier groups), each in the cycle of the sample it followed (docs/recording-format.md:
+/// a frame after `samples_before` samples was handled in the cycle of sample
+/// samples_before − 1). The rest (commands, other nodes' frames) stay on the host and are
+/// counted in `left_out`: a command carried out on the board has no counterpart in the
+/// host-only run.
+std::vector<CycleFrame> aiding_frames(const Input& in, const app::LoopOptions& lo,
+                                      std::size_t& left_out) {
+  std::vector<CycleFrame> out;
+  left_out = 0;
+  for (const sim::RecordedFrame& r : in.frames) {
+    hal::CanFrame f;
+    f.id = r.frame.id;
+    f.extended = r.frame.extended;
+    f.len = r.frame.len;
+    f.data = r.frame.data;
+    if (!lo.aiding_inputs || !can::is_input_frame(f, lo.node_id, lo.ids)) {
+      ++left_out;
+      continue;
+    }
+    const std::uint64_t before = std::max<std::uint64_t>(r.samples_before, 1);
+    out.push_back({static_cast<std::uint32_t>(before - 1), f});
+  }
+  return out;
+}
 
 // Samples of a scenario: host_sim's sample source (trajectory → sensor model) through the
 // register-level chip model and the real driver, as on the simulated board; sample k has
@@ -179,15 +216,9 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       return kHilExitBadInput;
     }
     in.samples = rec.value().samples;
+    in.frames = rec.value().frames;
     in.rate_hz = rec.value().header.sample_rate_hz;
     in.what = "recording " + o.recording;
-    // The link carries samples only: a version-2 recording's frames (aiding inputs, commands)
-    // stay here, on both sides of the comparison. Said, not silently dropped.
-    if (!rec.value().frames.empty()) {
-      out << "gfins-can hil: " << rec.value().frames.size()
-          << " CAN frames recorded with the samples are not replayed (the link carries samples; "
-             "gfins-fw --replay applies them)\n";
-    }
   }
   if (in.samples.empty()) {
     err << "gfins-can hil: " << in.what << " holds no sample\n";
@@ -221,15 +252,37 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
     err << "gfins-can hil: pipeline configuration: " << st.message() << "\n";
     return kHilExitBadInput;
   }
+  std::size_t left_out = 0;
+  const std::vector<CycleFrame> link_frames = aiding_frames(in, lo, left_out);
+  if (left_out > 0) {
+    out << "gfins-can hil: " << left_out << " of the " << in.frames.size()
+        << " recorded CAN frames are not aiding inputs of node " << int{lo.node_id}
+        << (lo.aiding_inputs ? "" : " (aiding inputs are off in the firmware's configuration)")
+        << " and stay here (commands: gfins-fw --replay carries them out)\n";
+  }
   const std::uint16_t epoch_div = fc.dividers[0];
   std::vector<nav::NavState<float>> published;  // the core's state of every published sample
-  for (const RawSample& s : in.samples) {
+  // The aiding inputs as the loop takes them (SampleLoop::step): after the cycle's sample and
+  // its epoch, at most kMaxCommandsPerCycle frames from the bus, the rest in later cycles.
+  can::InputDecoder inputs(lo.node_id, lo.ids);
+  std::deque<hal::CanFrame> bus_queue;
+  std::size_t next_frame = 0;
+  for (std::size_t k = 0; k < in.samples.size(); ++k) {
+    const RawSample& s = in.samples[k];
     pipe->process(s);
     if (epoch_div != 0 && s.seq % epoch_div == 0) {
       nav::NavState<float> n = pipe->state();
       n.t_ns = s.t_ns;  // the epoch refers to the sample just read (SampleLoop::build_epoch)
       n.seq = s.seq;
       published.push_back(n);
+    }
+    for (; next_frame < link_frames.size() && link_frames[next_frame].cycle == k; ++next_frame) {
+      bus_queue.push_back(link_frames[next_frame].frame);
+    }
+    for (int i = 0; i < app::kMaxCommandsPerCycle && !bus_queue.empty(); ++i) {
+      const Result<can::InputEvent> ev = inputs.add(bus_queue.front());
+      bus_queue.pop_front();
+      if (ev.is_ok()) (void)can::offer_input(*pipe, ev.value(), s.t_ns);
     }
   }
 
@@ -252,7 +305,8 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   const auto n_samples = static_cast<std::uint32_t>(in.samples.size());
   std::uint32_t sent = 0, acked = 0, naks = 0;
   std::uint64_t can_frames = 0;
-  std::string failure;  // why the stream ended early
+  std::size_t frames_sent = 0, frame_at = 0;  // link_frames sent; the next one to send
+  std::string failure;                        // why the stream ended early
   std::vector<lnx::hil::Frame> frames;
   const auto drain = [&](std::int64_t timeout_ns) -> Status {
     frames.clear();
@@ -279,6 +333,19 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
         aborted = true;
         break;
       }
+      // This cycle's aiding frames go before its sample: the board hands them to the loop once
+      // that sample has arrived (docs/hil.md, "Aiding frames").
+      for (; frame_at < link_frames.size() && link_frames[frame_at].cycle == sent; ++frame_at) {
+        if (o.drop_frame == static_cast<std::int64_t>(frame_at)) continue;
+        const auto cw =
+            lnx::hil::encode_can(link_frames[frame_at].frame, lnx::hil::FrameType::kCanIn);
+        if (const Status st = link.send(cw); !st.is_ok()) {
+          failure = "sending aiding frame " + std::to_string(frame_at) + ": " + st.message();
+          break;
+        }
+        ++frames_sent;
+      }
+      if (!failure.empty()) break;
       auto w = lnx::hil::encode_sample(sent, in.samples[sent], sent + 1 == n_samples);
       if (o.corrupt_at >= 0 && sent == static_cast<std::uint32_t>(o.corrupt_at)) w[20] ^= 0x01;
       if (const Status st = link.send(w); !st.is_ok()) {
@@ -338,6 +405,8 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   out << "hil: " << in.what << ", " << n_samples << " samples, window " << o.window << "\n";
   out << "  sent " << sent << ", acknowledged " << acked << ", rejected " << naks
       << ", CAN frames received " << can_frames << "\n";
+  out << "  aiding frames: " << link_frames.size() << " in the recording, " << frames_sent
+      << " sent (the host-only run applies every one)\n";
   out << "  epochs: expected " << published.size() << ", decoded " << cmp.epochs
       << ", matching no sample " << cmp.unknown_epochs << "\n";
   out << "  values compared " << cmp.values << ", outside quantisation " << cmp.mismatches << "\n";

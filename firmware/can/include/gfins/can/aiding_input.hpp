@@ -77,6 +77,10 @@ struct InputEvent {
   HeadingFix heading;
 };
 
+/// True for a frame of an aiding input message (GNSS, heading) addressed to `node_id` with the
+/// identifier groups `ids`: the frames InputDecoder takes; every other frame it ignores.
+bool is_input_frame(const hal::CanFrame& f, std::uint8_t node_id, const IdBases& ids = {});
+
 /// Decodes the input frames addressed to one node. A rejected frame comes back as an error
 /// Status (kDataLoss: length or CRC; kOutOfRange: a value; kInvalidArgument: reserved bits or no
 /// content; kFailedPrecondition: stale id, mixed ids, incomplete fix), counted by reason; the

@@ -28,6 +28,8 @@ enum class FrameType : std::uint8_t {
   kLastSample = 2,  // host -> fw: the same, and the stream ends after it
   kAck = 3,         // fw -> host: index, verdict
   kCan = 4,         // fw -> host: one CAN frame the firmware published
+  kCanIn = 5,       // host -> fw: one CAN frame for the loop to receive in the cycle of the
+                    // next sample frame (a recording's aiding inputs, docs/hil.md)
 };
 
 enum class AckVerdict : std::uint8_t { kOk = 0, kBadCrc = 1 };
@@ -52,7 +54,8 @@ using CanWire = std::array<std::uint8_t, kCanBytes>;
 
 SampleWire encode_sample(std::uint32_t index, const RawSample& s, bool last);
 AckWire encode_ack(std::uint32_t index, AckVerdict v);
-CanWire encode_can(const hal::CanFrame& f);
+/// A CAN frame on the link: `type` kCan (published by the firmware) or kCanIn (for it to receive).
+CanWire encode_can(const hal::CanFrame& f, FrameType type = FrameType::kCan);
 
 /// Expected total length of a frame of this type (0: unknown type).
 std::size_t frame_bytes(std::uint8_t type);
@@ -103,7 +106,15 @@ struct HilCounters {
   std::uint32_t frame_errors = 0;  // bad magic / type / length (the connection is closed)
   std::uint32_t can_sent = 0;      // CAN frames written back
   std::uint32_t can_dropped = 0;   // CAN frames not written (no connection, socket full)
+  std::uint32_t can_in = 0;        // CAN frames from the host handed to the loop's receive
+  std::uint32_t can_in_lost = 0;   // CAN frames from the host never received: the queue was
+                                   // full, or the connection ended before their sample
 };
+
+/// Frames from the host wait here until the sample frame after them has been read; the loop's
+/// receive() then takes them in that sample's cycle (never in an earlier cycle: a data-ready
+/// timeout between a frame and its sample must not hand the frame over early).
+inline constexpr std::size_t kCanInQueue = 64;
 
 /// The firmware end: listens, accepts one host at a time, hands its samples to the loop,
 /// acknowledges each, and is the loop's CAN bus (frames go back on the connection).
@@ -127,7 +138,8 @@ class HilServer {
   const HilCounters& counters() const { return counters_; }
   /// Text of the last connection event (drop, bad frame) for the log; "" when none.
   const char* last_event() const { return last_event_.data(); }
-  /// The loop's CAN bus: frames go to the host on the connection; receive() never has any.
+  /// The loop's CAN bus: frames go to the host on the connection; receive() gives the host's
+  /// kCanIn frames in the cycle of the sample they precede.
   hal::CanBus& bus();
 
  private:
@@ -135,6 +147,9 @@ class HilServer {
   class Bus;
   void drop(const char* why, int os_error = 0);
   bool send_bytes(std::span<const std::uint8_t> b);
+  void queue_can_in(const hal::CanFrame& f);
+  bool take_can_in(hal::CanFrame& out);
+  void forget_pending_can_in();
 
   int listen_fd_ = -1;
   int conn_fd_ = -1;
@@ -146,6 +161,12 @@ class HilServer {
   HilCounters counters_{};
   std::array<char, 192> last_event_{};
   std::unique_ptr<Bus> bus_;
+  // Ring of host frames: [head_, head_ + ready_) may be received, the next pending_ wait for
+  // their sample frame.
+  std::array<hal::CanFrame, kCanInQueue> can_in_{};
+  std::size_t can_in_head_ = 0;
+  std::size_t can_in_ready_ = 0;
+  std::size_t can_in_pending_ = 0;
 };
 
 /// The host end: a blocking TCP client.
