@@ -383,5 +383,118 @@ TEST_F(FwLogDecode, AMovedBoardIsDecodedWithItsConfiguration) {
   EXPECT_NE(bad.err.find("can.command_id_base = 0x200"), std::string::npos) << bad.err;
 }
 
+// A board mounted rotated in the vehicle (navigation.mounting_rpy_deg; docs/firmware.md,
+// "Mounting"): the same drive is published once in the board's frame and once in the vehicle's,
+// and each mounted value equals the rotation of the unmounted one, written out here from the
+// textbook ZYX direction cosine matrix and the quaternion product (not the firmware's code):
+// ω_v = C_vb ω_b for the rate, angular acceleration and specific force, q_nv = q_nb ⊗ q_vb* for
+// the attitude; velocity and position (NED) do not change. Tolerance: each side carries half a
+// step of quantisation per component, so a rotated component may be off by
+// (Σ_j |C_ij| + 1) / 2 steps (a quaternion: (Σ |q_vb| + 1) / 2 steps); a mounting applied the
+// wrong way round (C_bv for C_vb, q_vb for q_vb*) is off by up to the full value.
+TEST_F(FwLogDecode, AMountedBoardPublishesTheVehiclesAxes) {
+  constexpr double kRollDeg = 10.0, kPitchDeg = -20.0, kYawDeg = 90.0;
+  const std::string plain = path("plain.log"), mounted = path("mounted.log");
+  const std::string cfg =
+      file("mounted.toml", "[navigation]\nmounting_rpy_deg = [10.0, -20.0, 90.0]\n");
+  const std::vector<std::string> common = {
+      "--sim",         kScenario, "--scenario-dir", GFINS_SCENARIO_DIR,
+      "--calibration", "",        "--duration",     "2",
+      "--watchdog",    "none"};
+  auto args = common;
+  args.insert(args.end(), {"--can-log", plain});
+  ASSERT_EQ(run(GFINS_FW_EXE, args).exit_code, 0);
+  args = common;
+  args.insert(args.end(), {"--config", cfg, "--can-log", mounted});
+  const auto fw = run(GFINS_FW_EXE, args);
+  ASSERT_EQ(fw.exit_code, 0) << fw.output;
+  const auto table = [this](const std::string& log, const std::string& name) {
+    const auto dec = run(GFINS_CAN_EXE, {"decode", log, "--view", "csv", "-o", path(name)});
+    EXPECT_EQ(dec.exit_code, 0) << dec.output;
+    return test::read_decoded_csv(test::slurp(path(name)));
+  };
+  const Table b = table(plain, "plain.csv"), v = table(mounted, "mounted.csv");
+  ASSERT_EQ(b.rows.size(), v.rows.size());
+  ASSERT_GT(b.rows.size(), 150u);
+  const auto steps = dbc_steps(GFINS_DBC);
+
+  // C_vb = Rz(ψ) Ry(θ) Rx(φ), and its quaternion.
+  const double r = kRollDeg * std::numbers::pi / 180, p = kPitchDeg * std::numbers::pi / 180,
+               y = kYawDeg * std::numbers::pi / 180;
+  const double cr = std::cos(r), sr = std::sin(r), cp = std::cos(p), sp = std::sin(p),
+               cy = std::cos(y), sy = std::sin(y);
+  const double c[3][3] = {{cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr},
+                          {sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr},
+                          {-sp, cp * sr, cp * cr}};
+  const double m[4] = {std::cos(r / 2) * std::cos(p / 2) * std::cos(y / 2) +
+                           std::sin(r / 2) * std::sin(p / 2) * std::sin(y / 2),
+                       std::sin(r / 2) * std::cos(p / 2) * std::cos(y / 2) -
+                           std::cos(r / 2) * std::sin(p / 2) * std::sin(y / 2),
+                       std::cos(r / 2) * std::sin(p / 2) * std::cos(y / 2) +
+                           std::sin(r / 2) * std::cos(p / 2) * std::sin(y / 2),
+                       std::cos(r / 2) * std::cos(p / 2) * std::sin(y / 2) -
+                           std::sin(r / 2) * std::sin(p / 2) * std::cos(y / 2)};
+  const auto cell = [](const Table& t, std::size_t row, const std::string& n, double& out) {
+    const int i = t.col(n);
+    if (i < 0 || t.rows[row][static_cast<std::size_t>(i)].empty()) return false;
+    out = std::stod(t.rows[row][static_cast<std::size_t>(i)]);
+    return true;
+  };
+  std::size_t compared = 0, outside = 0;
+  std::string first;
+  const auto check = [&](const std::string& n, double want, double got, double steps_allowed) {
+    ++compared;
+    const double step = steps.at(n).factor;
+    if (std::abs(got - want) > steps_allowed * step * (1 + 1e-9) && outside++ == 0) {
+      first = n + ": mounted " + std::to_string(got) + ", rotated " + std::to_string(want);
+    }
+  };
+  for (std::size_t k = 0; k < b.rows.size(); ++k) {
+    for (const char* group : {"Rate", "AngAcc", "Accel"}) {
+      double x[3];
+      bool have = true;
+      for (int j = 0; j < 3; ++j) have = have && cell(b, k, group + std::string(1, "XYZ"[j]), x[j]);
+      if (!have) continue;
+      for (int i = 0; i < 3; ++i) {
+        const std::string n = group + std::string(1, "XYZ"[i]);
+        double got = 0;
+        if (!cell(v, k, n, got)) continue;
+        const double want = c[i][0] * x[0] + c[i][1] * x[1] + c[i][2] * x[2];
+        check(n, want, got, (std::abs(c[i][0]) + std::abs(c[i][1]) + std::abs(c[i][2]) + 1) / 2);
+      }
+    }
+    double q[4];
+    bool have = true;
+    for (int j = 0; j < 4; ++j) have = have && cell(b, k, std::string("Q") + "wxyz"[j], q[j]);
+    if (have) {
+      // q_nv = q_nb ⊗ conj(q_vb), Hamilton product, then w ≥ 0 as the bus carries it.
+      const double a = q[0], bx = q[1], by = q[2], bz = q[3];
+      const double w2 = m[0], x2 = -m[1], y2 = -m[2], z2 = -m[3];
+      double want[4] = {a * w2 - bx * x2 - by * y2 - bz * z2, a * x2 + bx * w2 + by * z2 - bz * y2,
+                        a * y2 - bx * z2 + by * w2 + bz * x2, a * z2 + bx * y2 - by * x2 + bz * w2};
+      if (want[0] < 0) {
+        for (double& e : want) e = -e;
+      }
+      const double allowed =
+          (std::abs(m[0]) + std::abs(m[1]) + std::abs(m[2]) + std::abs(m[3]) + 1) / 2;
+      for (int j = 0; j < 4; ++j) {
+        const std::string n = std::string("Q") + "wxyz"[j];
+        double got = 0;
+        if (cell(v, k, n, got)) check(n, want[j], got, allowed);
+      }
+    }
+    for (const char* n : {"VelN", "VelE", "VelD", "PosN", "PosE", "PosD"}) {
+      double x = 0, got = 0;
+      if (cell(b, k, n, x) && cell(v, k, n, got)) check(n, x, got, 0);
+    }
+  }
+  // About 100 epochs after the 1 s alignment (the navigation values are not available before),
+  // 16 to 19 values each.
+  EXPECT_GT(compared, 1500u);
+  EXPECT_EQ(outside, 0u) << "first: " << first;
+  std::printf("fw-log e2e, mounted board: %zu values compared, %zu outside their tolerance\n",
+              compared, outside);
+}
+
 }  // namespace
 }  // namespace gfins

@@ -35,6 +35,7 @@ void expect_defaults(const FwConfig& c) {
   EXPECT_EQ(c.gravity_mps2, d.gravity_mps2);
   EXPECT_EQ(c.heading_deg, d.heading_deg);
   EXPECT_EQ(c.position_m, d.position_m);
+  EXPECT_EQ(c.mounting_rpy_deg, d.mounting_rpy_deg);
   EXPECT_EQ(c.alignment_s, d.alignment_s);
   EXPECT_EQ(c.calibration_file, d.calibration_file);
   EXPECT_EQ(c.rt_priority, d.rt_priority);
@@ -77,6 +78,7 @@ gravity = "normal"
 latitude_deg = 52.5
 heading_deg = 90
 position_m = [1, 2.5, -3]
+mounting_rpy_deg = [180, 0, -180]
 [sim]
 pacing = "realtime"
 duration_s = 60
@@ -95,6 +97,7 @@ duration_s = 60
   EXPECT_EQ(c.latitude_deg, 52.5);
   EXPECT_EQ(c.heading_deg, 90.0);
   EXPECT_EQ(c.position_m, (std::array<double, 3>{1.0, 2.5, -3.0}));
+  EXPECT_EQ(c.mounting_rpy_deg, (std::array<double, 3>{180.0, 0.0, -180.0}));
   EXPECT_EQ(c.pacing, Pacing::kRealTime);
   EXPECT_EQ(c.sim_duration_s, 60.0);
 }
@@ -129,6 +132,11 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[navigation]\ncompensator = \"best\"\n", {"navigation.compensator", "\"paper\""}},
       {"[navigation]\nposition_m = [1, 2]\n", {"navigation.position_m", "3 numbers"}},
       {"[navigation]\nlatitude_deg = 91\n", {"navigation.latitude_deg = 91", "-90..90"}},
+      {"[navigation]\nmounting_rpy_deg = [0, 90.5, 0]\n",
+       {"bad.toml:2: navigation.mounting_rpy_deg = 90.5", "pitch must be -90..90"}},
+      {"[navigation]\nmounting_rpy_deg = [-181, 0, 0]\n",
+       {"navigation.mounting_rpy_deg = -181", "roll and yaw must be -180..180"}},
+      {"[navigation]\nmounting_rpy_deg = [0, 0, nan]\n", {"navigation.mounting_rpy_deg = nan"}},
       {"[navigation]\nalignment_s = 0\n", {"navigation.alignment_s = 0", "0.1..600"}},
       {"[realtime]\npriority = 100\n", {"realtime.priority = 100", "0..99"}},
       {"[realtime]\nlock_memory = 1\n", {"realtime.lock_memory", "true or false"}},

@@ -240,6 +240,7 @@ void read_all(Reader& r, FwConfig& c) {
   r.number("navigation.height_m", c.height_m);
   r.number("navigation.heading_deg", c.heading_deg);
   r.vec3("navigation.position_m", c.position_m);
+  r.vec3("navigation.mounting_rpy_deg", c.mounting_rpy_deg);
   r.number("navigation.alignment_s", c.alignment_s);
   r.boolean("aiding.enabled", c.aiding);
   r.boolean("aiding.standstill", c.aiding_standstill);

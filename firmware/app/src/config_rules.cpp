@@ -229,6 +229,15 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
       return P{"navigation.position_m", num(p), "components must be finite, |x| <= 1e7 m"};
     }
   }
+  // ZYX Euler angles: roll and yaw over a full turn, pitch within ±90° (beyond it the same
+  // orientation has another name).
+  const std::array<double, 3> mount_limit = {180.0, 90.0, 180.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!(std::abs(c.mounting_rpy_deg[i]) <= mount_limit[i])) {
+      return P{"navigation.mounting_rpy_deg", num(c.mounting_rpy_deg[i]),
+               i == 1 ? "pitch must be -90..90 degrees" : "roll and yaw must be -180..180 degrees"};
+    }
+  }
   if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
     return P{"navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s"};
   }

@@ -5,21 +5,25 @@
 
 namespace gfins::app {
 
-can::Validity epoch_validity(const nav::NavPipeline<float>& p) {
+can::Validity epoch_validity(const nav::NavPipeline<float>& p,
+                             const nav::NavState<float>& published) {
   if (p.phase() != nav::PipelinePhase::kNavigating) return can::Validity::none();
   can::Validity v;  // every group valid
   if (!p.aiding().started()) return v;
-  const std::uint8_t bits = p.accuracy().valid;
+  // The attitude error φ is a rotation of the navigation frame, the same for the board and the
+  // vehicle; only its Euler-angle σ depend on whose attitude they describe.
+  const std::uint8_t bits = p.aiding().accuracy(published).valid;
   v.attitude = (bits & nav::filter_valid::kRollPitch) != 0;
   v.velocity = (bits & nav::filter_valid::kVelocity) != 0;
   v.position = (bits & nav::filter_valid::kPosition) != 0;
   return v;
 }
 
-can::Accuracy epoch_accuracy(const nav::NavPipeline<float>& p, std::int64_t now_ns) {
+can::Accuracy epoch_accuracy(const nav::NavPipeline<float>& p, std::int64_t now_ns,
+                             const nav::NavState<float>& published) {
   can::Accuracy a;  // σ NaN: not available
   if (!p.aiding().started()) return a;
-  const nav::NavAccuracy<float> n = p.accuracy();
+  const nav::NavAccuracy<float> n = p.aiding().accuracy(published);
   a.sigma_roll_rad = n.euler_sigma_rad.x();
   a.sigma_pitch_rad = n.euler_sigma_rad.y();
   a.sigma_heading_rad = n.euler_sigma_rad.z();

@@ -8,6 +8,7 @@
 
 #include "gfins/app/config.hpp"
 #include "gfins/app/nav_accuracy.hpp"
+#include "gfins/app/vehicle_frame.hpp"
 #include "gfins/can/aiding_offer.hpp"
 
 namespace gfins::app {
@@ -39,6 +40,9 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_ = cal;
   cal_.config = cfg;
   options_ = options;
+  // Published in the board's own frame unless the configuration rotates it (an identity
+  // rotation leaves every value bit for bit as the core computed it).
+  vehicle_frame_ = options.q_vb.coeffs() != nav::Quat<float>::Identity().coeffs();
   settings_ = options.stored;
   inputs_ = can::InputDecoder(options.node_id, options.ids);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
@@ -196,7 +200,7 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   epoch_.health = bus_health(health_);
   epoch_.commands = bus_command_counters(health_, settings_source());
   epoch_.valid = can::Validity::none();  // no sample behind this epoch
-  epoch_.accuracy = epoch_accuracy(pipeline_, t_ns);
+  epoch_.accuracy = epoch_accuracy(pipeline_, t_ns, epoch_.nav);
 }
 
 void SampleLoop::update_adc_counters(std::uint32_t sample) {
@@ -360,6 +364,7 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
   // and a rejected sample is flagged as such.
   epoch_.nav.t_ns = s.t_ns;
   epoch_.nav.seq = s.seq;
+  if (vehicle_frame_) to_vehicle_frame(epoch_.nav, options_.q_vb);
   if (!measured) {
     epoch_.nav.status |= nav::nav_status::kInputInvalid;
   }
@@ -386,8 +391,8 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
   health_.log_dropped = log_.dropped();
   epoch_.health = bus_health(health_);
   epoch_.commands = bus_command_counters(health_, settings_source());
-  epoch_.valid = epoch_validity(pipeline_);
-  epoch_.accuracy = epoch_accuracy(pipeline_, s.t_ns);
+  epoch_.valid = epoch_validity(pipeline_, epoch_.nav);
+  epoch_.accuracy = epoch_accuracy(pipeline_, s.t_ns, epoch_.nav);
 }
 
 // ---- Commands -------------------------------------------------------------------------------

@@ -8,6 +8,7 @@
 
 #include "gfins/app/can_settings.hpp"
 #include "gfins/app/publisher_sink.hpp"
+#include "gfins/app/vehicle_frame.hpp"
 #include "gfins/calib_file/calibration_file.hpp"
 
 namespace gfins::app {
@@ -90,6 +91,7 @@ LoopOptions loop_options(const FwConfig& c) {
   o.initial_position_n =
       nav::Vec3<float>(static_cast<float>(c.position_m[0]), static_cast<float>(c.position_m[1]),
                        static_cast<float>(c.position_m[2]));
+  o.q_vb = mounting_rotation(c.mounting_rpy_deg);
   return o;
 }
 

@@ -12,6 +12,7 @@
 #include "gfins/app/config.hpp"
 #include "gfins/app/sample_loop.hpp"
 #include "gfins/app/startup.hpp"
+#include "gfins/app/vehicle_frame.hpp"
 #include "gfins/can/aiding_input.hpp"
 #include "gfins/can/aiding_offer.hpp"
 #include "gfins/drivers/ads131m06.hpp"
@@ -266,6 +267,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   // its epoch, at most kMaxCommandsPerCycle frames from the bus, the rest in later cycles.
   can::InputDecoder inputs(lo.node_id, lo.ids);
   std::deque<hal::CanFrame> bus_queue;
+  const bool vehicle_frame = lo.q_vb.coeffs() != nav::Quat<float>::Identity().coeffs();
   std::size_t next_frame = 0;
   for (std::size_t k = 0; k < in.samples.size(); ++k) {
     const RawSample& s = in.samples[k];
@@ -274,6 +276,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       nav::NavState<float> n = pipe->state();
       n.t_ns = s.t_ns;  // the epoch refers to the sample just read (SampleLoop::build_epoch)
       n.seq = s.seq;
+      if (vehicle_frame) app::to_vehicle_frame(n, lo.q_vb);  // as published (mounting)
       published.push_back(n);
     }
     for (; next_frame < link_frames.size() && link_frames[next_frame].cycle == k; ++next_frame) {

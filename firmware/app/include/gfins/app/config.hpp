@@ -100,7 +100,11 @@ struct FwConfig {
   double height_m = 0.0;               // kNormal
   double heading_deg = 0.0;            // initial heading (nothing on board senses it)
   std::array<double, 3> position_m{};  // initial position, NED from the alignment point
-  double alignment_s = 1.0;            // time at rest averaged by the static alignment
+  // The board's orientation in the vehicle frame (FRD: x forward, y right, z down): roll, pitch,
+  // yaw in degrees, the ZYX (yaw, then pitch, then roll) rotation of the vehicle's axes onto the
+  // board's. Non-zero: the published attitude, rates and accelerations are the vehicle's.
+  std::array<double, 3> mounting_rpy_deg{};
+  double alignment_s = 1.0;  // time at rest averaged by the static alignment
 
   // [aiding] the error-state filter with standstill updates (docs/firmware.md, "Aiding")
   bool aiding = false;

@@ -141,6 +141,8 @@ struct LoopOptions {
   double sample_rate_hz = 1000.0;
   float initial_heading_rad = 0;
   nav::Vec3<float> initial_position_n = nav::Vec3<float>::Zero();
+  // Board -> vehicle rotation (navigation.mounting_rpy_deg); identity: publish the board's frame.
+  nav::Quat<float> q_vb = nav::Quat<float>::Identity();
   std::uint8_t node_id =
       can::kDefaultNodeId;     // the input frames (GNSS, heading) addressed to this node
   bool aiding_inputs = false;  // decode them and offer them to the filter
@@ -305,6 +307,7 @@ class SampleLoop {
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};
   LoopOptions options_{};
+  bool vehicle_frame_ = false;  // options_.q_vb is not the identity: publish the vehicle's frame
   std::int64_t period_ns_ = 1000000;
   HealthCounters health_{};
   AdcCounters adc_seen_{};
