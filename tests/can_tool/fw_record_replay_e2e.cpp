@@ -17,11 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "gfins/calib_file/calibration_file.hpp"
-#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/recording.hpp"
-#include "gfins/host_sim/scenario.hpp"
 #include "support/cli_fixture.hpp"
+#include "support/sim_chain.hpp"
 
 namespace gfins {
 namespace {
@@ -32,14 +30,8 @@ class FwRecordReplay : public test::CliTest {
  protected:
   // The scenario's true calibration as a file: the recording board's, handed to the replay.
   std::string calibration_file() {
-    const auto s = sim::load_scenario("drive-gnss", GFINS_SCENARIO_DIR);
-    EXPECT_TRUE(s.is_ok());
-    sim_board::ChipAdc adc(s.value().rate_hz);
-    EXPECT_TRUE(adc.start().is_ok());
     const std::string p = path("board-cal.toml");
-    const auto st = calib_file::save_calibration_file(
-        p, sim_board::scenario_calibration(s.value(), adc.volts_per_count()));
-    EXPECT_TRUE(st.is_ok()) << st.message();
+    test::save_scenario_calibration("drive-gnss", GFINS_SCENARIO_DIR, p);
     return p;
   }
 };

@@ -12,13 +12,11 @@
 #include <thread>
 #include <vector>
 
-#include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
-#include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/recording.hpp"
-#include "gfins/host_sim/scenario.hpp"
 #include "support/cli_fixture.hpp"
+#include "support/sim_chain.hpp"
 
 namespace gfins {
 namespace {
@@ -389,14 +387,8 @@ TEST_F(HilReplay, ARecordedStreamReplaysIdentically) {
 // link while the host-only run still applies it: the board's navigation then differs.
 TEST_F(HilReplay, AnAidedDriveReplaysWithItsGnssFrames) {
   constexpr int kDriveSeconds = 5;
-  const auto sc = sim::load_scenario("drive-gnss", GFINS_SCENARIO_DIR);
-  ASSERT_TRUE(sc.is_ok()) << sc.error().message;
-  sim_board::ChipAdc adc(sc.value().rate_hz);
-  ASSERT_TRUE(adc.start().is_ok());
   const std::string cal = path("board-cal.toml");
-  const auto saved = calib_file::save_calibration_file(
-      cal, sim_board::scenario_calibration(sc.value(), adc.volts_per_count()));
-  ASSERT_TRUE(saved.is_ok()) << saved.message();
+  test::save_scenario_calibration("drive-gnss", GFINS_SCENARIO_DIR, cal);
   // One configuration for the recording board, the hil board and the host-only run.
   const std::string cfg = file("vehicle.toml",
                                "[aiding]\nenabled = true\ntrack_heading_sigma_deg = 0.5\n"

@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "gfins/calib_file/calibration_file.hpp"
 #include "gfins/host_sim/board/sim_board.hpp"
 #include "gfins/host_sim/scenario.hpp"
 
@@ -31,6 +32,20 @@ inline SimChain make_sim_chain(const sim::Scenario& s, app::SampleClock& clock,
       *c.stream, *c.adc, clock, &clock, sim_board::Pacing::kFast, s.rate_hz, samples);
   c.source->set_faults(faults);
   return c;
+}
+
+/// The true calibration of scenario `name` (found in `dir`) through the simulated board's chain,
+/// saved as a calibration file at `path`: the file a recording board is given so that its
+/// recording replays with the same calibration.
+inline void save_scenario_calibration(const std::string& name, const std::string& dir,
+                                      const std::string& path) {
+  const auto s = sim::load_scenario(name, dir);
+  if (!s.is_ok()) throw std::runtime_error(s.error().message);
+  sim_board::ChipAdc adc(s.value().rate_hz);
+  if (const Status st = adc.start(); !st.is_ok()) throw std::runtime_error(st.message());
+  const auto saved = calib_file::save_calibration_file(
+      path, sim_board::scenario_calibration(s.value(), adc.volts_per_count()));
+  if (!saved.is_ok()) throw std::runtime_error(saved.message());
 }
 
 }  // namespace gfins::test
