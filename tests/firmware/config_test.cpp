@@ -137,6 +137,8 @@ TEST(Config, EveryBadValueIsNamedWithFileKeyAndWhatIsAllowed) {
       {"[navigation]\nmounting_rpy_deg = [-181, 0, 0]\n",
        {"navigation.mounting_rpy_deg = -181", "roll and yaw must be -180..180"}},
       {"[navigation]\nmounting_rpy_deg = [0, 0, nan]\n", {"navigation.mounting_rpy_deg = nan"}},
+      {"[navigation]\nmounting_rpy_deg = [0, 0, 90]\n[aiding]\nenabled = true\n",
+       {"navigation.mounting_rpy_deg = [0, 0, 90]", "cannot be combined with aiding.enabled"}},
       {"[navigation]\nalignment_s = 0\n", {"navigation.alignment_s = 0", "0.1..600"}},
       {"[realtime]\npriority = 100\n", {"realtime.priority = 100", "0..99"}},
       {"[realtime]\nlock_memory = 1\n", {"realtime.lock_memory", "true or false"}},

@@ -238,6 +238,16 @@ std::optional<ConfigProblem> check(const FwConfig& c) {
                i == 1 ? "pitch must be -90..90 degrees" : "roll and yaw must be -180..180 degrees"};
     }
   }
+  // The aiding's inputs are the board's: a heading input and the track heading are compared with
+  // the board's yaw (the track heading takes the board's x axis along the velocity), the lever
+  // arm is in the board's axes. A mounted board would take the vehicle's heading for its own.
+  if (c.aiding && c.mounting_rpy_deg != std::array<double, 3>{}) {
+    return P{"navigation.mounting_rpy_deg",
+             "[" + num(c.mounting_rpy_deg[0]) + ", " + num(c.mounting_rpy_deg[1]) + ", " +
+                 num(c.mounting_rpy_deg[2]) + "]",
+             "a mounting rotation cannot be combined with aiding.enabled = true yet (the aiding's "
+             "heading inputs, track heading and lever arm are in the board's axes)"};
+  }
   if (!(c.alignment_s >= 0.1 && c.alignment_s <= 600.0)) {
     return P{"navigation.alignment_s", num(c.alignment_s), "must be 0.1..600 s"};
   }

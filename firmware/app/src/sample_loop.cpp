@@ -200,7 +200,11 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   epoch_.health = bus_health(health_);
   epoch_.commands = bus_command_counters(health_, settings_source());
   epoch_.valid = can::Validity::none();  // no sample behind this epoch
-  epoch_.accuracy = epoch_accuracy(pipeline_, t_ns, epoch_.nav);
+  // The σ are the held state's (the values above are not available, the filter's knowledge
+  // is), in the frame the epochs publish.
+  nav::NavState<float> held = pipeline_.state();
+  if (vehicle_frame_) to_vehicle_frame(held, options_.q_vb);
+  epoch_.accuracy = epoch_accuracy(pipeline_, t_ns, held);
 }
 
 void SampleLoop::update_adc_counters(std::uint32_t sample) {

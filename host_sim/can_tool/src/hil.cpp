@@ -409,7 +409,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   out << "  sent " << sent << ", acknowledged " << acked << ", rejected " << naks
       << ", CAN frames received " << can_frames << "\n";
   out << "  aiding frames: " << link_frames.size() << " in the recording, " << frames_sent
-      << " sent (the host-only run applies every one)\n";
+      << " sent (the host-only run applies each in its cycle)\n";
   out << "  epochs: expected " << published.size() << ", decoded " << cmp.epochs
       << ", matching no sample " << cmp.unknown_epochs << "\n";
   out << "  values compared " << cmp.values << ", outside quantisation " << cmp.mismatches << "\n";
