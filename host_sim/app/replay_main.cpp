@@ -115,11 +115,7 @@ void print_samples(const std::vector<RawSample>& block, const sim::RecordingHead
 bool print_frames(const std::vector<sim::RecordedFrame>& frames) {
   std::array<char, 64> line{};
   for (const sim::RecordedFrame& r : frames) {
-    gfins::hal::CanFrame f;
-    f.id = r.frame.id;
-    f.extended = r.frame.extended;
-    f.len = r.frame.len;
-    f.data = r.frame.data;
+    const gfins::hal::CanFrame f = sim::can_frame_of(r.frame);
     // Floor division: a negative time still gives micros in 0..999999.
     std::int64_t sec = r.frame.t_ns / 1000000000;
     std::int64_t rem = r.frame.t_ns % 1000000000;

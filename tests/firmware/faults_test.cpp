@@ -791,6 +791,42 @@ TEST_F(Faults, MalformedCommandIsAnsweredCountedAndLoggedOncePerSecond) {
   expect_status_rate(bus, 1000, rig.samples);
 }
 
+// With aiding on, the epochs published for a data-ready silence carry no navigation values but
+// keep the filter's σ: nothing was measured, but the filter's knowledge of the held state is what
+// it was one sample before. Oracle: the epoch of the last sample before the silence; the σ grow
+// only by the process noise of the propagations in between (at rest, none of the 3 ms would move
+// roll's σ by 1 %). A σ computed from the gap epoch's own not-available state reads NaN.
+TEST_F(Faults, AnAidedBoardKeepsItsSigmaInTheEpochsOfASilence) {
+  sim_board::FaultPlan f;
+  f.silent_from = 2500;  // after the 1 s alignment and the filter's start
+  f.silent_edges = 3;
+  SimRig rig("rest", 3.0, f);
+  rig.config.aiding = true;
+  rig.cal = app::load_calibration(rig.config, rig.factory, &rig.factory).set;
+  rig.configure();
+  rig.run();
+  ASSERT_EQ(rig.loop->health().drdy_timeouts, 1u);
+  const std::vector<can::Epoch>& epochs = rig.recording->epochs();
+  const can::Epoch* before = nullptr;
+  const can::Epoch* gap = nullptr;
+  for (const can::Epoch& e : epochs) {
+    if ((e.status_bits & app::status_bits::kDataReadyLost) != 0 && std::isnan(e.nav.v_n.x())) {
+      gap = &e;
+      break;
+    }
+    before = &e;
+  }
+  ASSERT_NE(gap, nullptr) << "no epoch of the silence";
+  ASSERT_NE(before, nullptr);
+  ASSERT_TRUE(std::isfinite(before->accuracy.sigma_roll_rad));
+  EXPECT_TRUE(std::isfinite(gap->accuracy.sigma_roll_rad));
+  EXPECT_NEAR(gap->accuracy.sigma_roll_rad, before->accuracy.sigma_roll_rad,
+              0.01F * before->accuracy.sigma_roll_rad);
+  EXPECT_NEAR(gap->accuracy.sigma_pitch_rad, before->accuracy.sigma_pitch_rad,
+              0.01F * before->accuracy.sigma_pitch_rad);
+  EXPECT_TRUE(std::isfinite(gap->accuracy.sigma_vel_h_mps));
+}
+
 // GNSS and heading input frames with aiding on: a corrupted frame is refused, counted and logged;
 // a whole fix (the board's true position and velocity at rest, zero) reaches the filter, which
 // accepts both of its updates, and so does an external heading equal to the board's. The oracle is

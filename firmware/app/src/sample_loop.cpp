@@ -40,9 +40,6 @@ Status SampleLoop::configure(const CalibrationSet& cal, const LoopOptions& optio
   cal_ = cal;
   cal_.config = cfg;
   options_ = options;
-  // Published in the board's own frame unless the configuration rotates it (an identity
-  // rotation leaves every value bit for bit as the core computed it).
-  vehicle_frame_ = options.q_vb.coeffs() != nav::Quat<float>::Identity().coeffs();
   settings_ = options.stored;
   inputs_ = can::InputDecoder(options.node_id, options.ids);
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / options.sample_rate_hz));
@@ -203,7 +200,7 @@ void SampleLoop::build_gap_epoch(std::uint32_t seq, std::int64_t t_ns, std::uint
   // The σ are the held state's (the values above are not available, the filter's knowledge
   // is), in the frame the epochs publish.
   nav::NavState<float> held = pipeline_.state();
-  if (vehicle_frame_) to_vehicle_frame(held, options_.q_vb);
+  if (mounted(options_.q_vb)) to_vehicle_frame(held, options_.q_vb);
   epoch_.accuracy = epoch_accuracy(pipeline_, t_ns, held);
 }
 
@@ -368,7 +365,7 @@ void SampleLoop::build_epoch(const RawSample& s, bool measured) {
   // and a rejected sample is flagged as such.
   epoch_.nav.t_ns = s.t_ns;
   epoch_.nav.seq = s.seq;
-  if (vehicle_frame_) to_vehicle_frame(epoch_.nav, options_.q_vb);
+  if (mounted(options_.q_vb)) to_vehicle_frame(epoch_.nav, options_.q_vb);
   if (!measured) {
     epoch_.nav.status |= nav::nav_status::kInputInvalid;
   }

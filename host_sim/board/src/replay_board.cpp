@@ -47,11 +47,7 @@ class Player {
   /// The next frame the loop received in the cycle of the last sample handed over.
   bool next_frame(hal::CanFrame& out) {
     if (frames_.empty() || frames_.front().samples_before > delivered_) return false;
-    const recording::FrameRecord& r = frames_.front().frame;
-    out.id = r.id;
-    out.extended = r.extended;
-    out.len = r.len;
-    out.data = r.data;
+    out = sim::can_frame_of(frames_.front().frame);
     frames_.pop_front();
     ++frames_delivered_;
     return true;

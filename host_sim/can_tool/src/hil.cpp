@@ -67,11 +67,7 @@ std::vector<CycleFrame> aiding_frames(const Input& in, const app::LoopOptions& l
   std::vector<CycleFrame> out;
   left_out = 0;
   for (const sim::RecordedFrame& r : in.frames) {
-    hal::CanFrame f;
-    f.id = r.frame.id;
-    f.extended = r.frame.extended;
-    f.len = r.frame.len;
-    f.data = r.frame.data;
+    const hal::CanFrame f = sim::can_frame_of(r.frame);
     if (!lo.aiding_inputs || !can::is_input_frame(f, lo.node_id, lo.ids)) {
       ++left_out;
       continue;
@@ -267,7 +263,6 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
   // its epoch, at most kMaxCommandsPerCycle frames from the bus, the rest in later cycles.
   can::InputDecoder inputs(lo.node_id, lo.ids);
   std::deque<hal::CanFrame> bus_queue;
-  const bool vehicle_frame = lo.q_vb.coeffs() != nav::Quat<float>::Identity().coeffs();
   std::size_t next_frame = 0;
   for (std::size_t k = 0; k < in.samples.size(); ++k) {
     const RawSample& s = in.samples[k];
@@ -276,7 +271,7 @@ int run_hil(const HilOptions& o, std::ostream& out, std::ostream& err) {
       nav::NavState<float> n = pipe->state();
       n.t_ns = s.t_ns;  // the epoch refers to the sample just read (SampleLoop::build_epoch)
       n.seq = s.seq;
-      if (vehicle_frame) app::to_vehicle_frame(n, lo.q_vb);  // as published (mounting)
+      if (app::mounted(lo.q_vb)) app::to_vehicle_frame(n, lo.q_vb);  // as published (mounting)
       published.push_back(n);
     }
     for (; next_frame < link_frames.size() && link_frames[next_frame].cycle == k; ++next_frame) {

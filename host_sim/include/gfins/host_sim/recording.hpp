@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "gfins/hal/can_bus.hpp"
 #include "gfins/host_sim/error.hpp"
 #include "gfins/nav_core/geometry.hpp"
 #include "gfins/recording/codec.hpp"
@@ -57,6 +58,16 @@ struct RecordedFrame {
   std::uint64_t samples_before = 0;
   recording::FrameRecord frame;
 };
+
+/// The CAN frame a frame record holds (its identifier, format, length and data; not its time).
+inline hal::CanFrame can_frame_of(const recording::FrameRecord& r) {
+  hal::CanFrame f;
+  f.id = r.id;
+  f.extended = r.extended;
+  f.len = r.len;
+  f.data = r.data;
+  return f;
+}
 
 struct Recording {
   RecordingHeader header;

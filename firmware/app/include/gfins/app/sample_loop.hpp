@@ -307,7 +307,6 @@ class SampleLoop {
   nav::NavPipeline<float> pipeline_{};
   CalibrationSet cal_{};
   LoopOptions options_{};
-  bool vehicle_frame_ = false;  // options_.q_vb is not the identity: publish the vehicle's frame
   std::int64_t period_ns_ = 1000000;
   HealthCounters health_{};
   AdcCounters adc_seen_{};
