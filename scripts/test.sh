@@ -118,7 +118,7 @@ step "host-debug (ASan + UBSan): unit tests"
 ctest --preset host-debug -j "$jobs" | tee "$log_dir/ctest-debug.log"
 
 # The libFuzzer targets (tests/fuzz, built with the sanitizer tree above) fuzz every parser of
-# outside input from its seed corpus for GFINS_FUZZ_SECONDS each (15 s, seed 1: 80 s on 2 cores);
+# outside input from its seed corpus for GFINS_FUZZ_SECONDS each (10 s, seed 1: about 55 s on 2 cores);
 # a crash, a sanitizer report or a broken invariant fails the step and leaves the input in
 # build/host-debug/fuzz-findings/ (docs/reliability.md). Not the preset: it excludes the label.
 step "host-debug: fuzzing (libFuzzer, every parser of outside input)"

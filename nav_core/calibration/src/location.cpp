@@ -343,9 +343,10 @@ Result<LocationCalibration<T>> calibrate_location(
 template Result<LocationCalibration<float>> calibrate_location<float>(
     const nav::ArrayGeometry<float, nav::kNumSensors>&, std::span<const LocationRun<float>>,
     const LocationOptions&);
-// clang-tidy (scripts/check-tidy.sh) checks the template once, for float, the board's scalar:
-// the double instantiation is the same source with T = double.
-#ifndef GFINS_TIDY_ONE_SCALAR
+// GFINS_NAV_FLOAT_ONLY: the board's scalar only. Set by a build without GFINS_NAV_DOUBLE (the
+// bare-metal one) and by clang-tidy (scripts/check-tidy.sh), which checks the template once: the
+// double instantiation is the same source with T = double.
+#ifndef GFINS_NAV_FLOAT_ONLY
 template Result<LocationCalibration<double>> calibrate_location<double>(
     const nav::ArrayGeometry<double, nav::kNumSensors>&, std::span<const LocationRun<double>>,
     const LocationOptions&);

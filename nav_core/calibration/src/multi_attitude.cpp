@@ -516,9 +516,10 @@ template std::array<std::array<float, 3>, 6> table2_attitudes<float>();
 template std::array<std::array<float, 3>, 6> table3_attitudes<float>();
 template std::array<AttitudeObservation<float>, 12> paper_observations<float>(
     const PaperTableOutputs<float>&);
-// clang-tidy (scripts/check-tidy.sh) checks the template once, for float, the board's scalar:
-// the double instantiation is the same source with T = double.
-#ifndef GFINS_TIDY_ONE_SCALAR
+// GFINS_NAV_FLOAT_ONLY: the board's scalar only. Set by a build without GFINS_NAV_DOUBLE (the
+// bare-metal one) and by clang-tidy (scripts/check-tidy.sh), which checks the template once: the
+// double instantiation is the same source with T = double.
+#ifndef GFINS_NAV_FLOAT_ONLY
 template Result<MultiAttitudeResult<double>> calibrate_multi_attitude<double>(
     std::span<const AttitudeObservation<double>>, const MultiAttitudeConfig<double>&);
 template Result<MultiAttitudeResult<double>> calibrate_paper_procedure<double>(

@@ -93,13 +93,16 @@ Result<std::size_t> intervals_to_observations(std::span<const StaticInterval<T>>
 
 template Vec3<float> specific_force_estimate<float>(const StaticInterval<float>&,
                                                     const PoseAssignmentConfig<float>&);
-template Vec3<double> specific_force_estimate<double>(const StaticInterval<double>&,
-                                                      const PoseAssignmentConfig<double>&);
 template Result<std::size_t> intervals_to_observations<float>(
     std::span<const StaticInterval<float>>, std::span<const std::array<float, 3>>,
     const PoseAssignmentConfig<float>&, std::span<AttitudeObservation<float>>, std::span<int>);
+// GFINS_NAV_FLOAT_ONLY: the board's scalar only (a build without GFINS_NAV_DOUBLE; clang-tidy).
+#ifndef GFINS_NAV_FLOAT_ONLY
+template Vec3<double> specific_force_estimate<double>(const StaticInterval<double>&,
+                                                      const PoseAssignmentConfig<double>&);
 template Result<std::size_t> intervals_to_observations<double>(
     std::span<const StaticInterval<double>>, std::span<const std::array<double, 3>>,
     const PoseAssignmentConfig<double>&, std::span<AttitudeObservation<double>>, std::span<int>);
+#endif
 
 }  // namespace gfins::calib
