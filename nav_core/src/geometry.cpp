@@ -2,10 +2,4 @@
 
 namespace gfins::nav {
 template class ArraySolver<float, 6>;
-// GFINS_NAV_FLOAT_ONLY: the board's scalar only. Set by a build without GFINS_NAV_DOUBLE (the
-// bare-metal one) and by clang-tidy (scripts/check-tidy.sh), which checks the template once: the
-// double instantiation is the same source with T = double.
-#ifndef GFINS_NAV_FLOAT_ONLY
-template class ArraySolver<double, 6>;
-#endif
 }  // namespace gfins::nav
