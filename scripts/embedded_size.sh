@@ -20,8 +20,9 @@
 #      so none belongs in the image either);
 #   4. the limits check.
 # Exit status: 0 within the limits and free of double arithmetic, 1 when a limit is exceeded or a
-# soft-double routine is present, 2 on usage errors. Limits: GFINS_FLASH_LIMIT / GFINS_RAM_LIMIT
-# (bytes) override the defaults.
+# soft-double routine is present, 2 on usage errors. Limits: the build folder's cache
+# (GFINS_M4F_FLASH_LIMIT, GFINS_M4F_RAM_LIMIT: nav_core/baremetal/CMakeLists.txt, the one place
+# they are set); GFINS_FLASH_LIMIT / GFINS_RAM_LIMIT (bytes) override them.
 set -euo pipefail
 
 # shellcheck source=scripts/measure_common.sh source-path=SCRIPTDIR
@@ -35,13 +36,23 @@ for f in "${elf}" "${lib}"; do
   gfins_need_file "${f}" "build the cortex-m4f preset first"
 done
 
-flash_limit="${GFINS_FLASH_LIMIT:-49152}"  # 48 KiB
-ram_limit="${GFINS_RAM_LIMIT:-8192}"       # 8 KiB
+# A limit as the build folder's CMake cache holds it ("NAME:STRING=value").
+cache_limit() {
+  [ -f "${gfins_build}/CMakeCache.txt" ] || return 0
+  sed -n "s/^$1:[A-Z]*=\([0-9][0-9]*\)\$/\1/p" "${gfins_build}/CMakeCache.txt" | head -n 1
+}
+flash_limit="${GFINS_FLASH_LIMIT:-$(cache_limit GFINS_M4F_FLASH_LIMIT)}"
+ram_limit="${GFINS_RAM_LIMIT:-$(cache_limit GFINS_M4F_RAM_LIMIT)}"
+[ -n "${flash_limit}" ] && [ -n "${ram_limit}" ] || {
+  echo "embedded_size: no GFINS_M4F_FLASH_LIMIT / GFINS_M4F_RAM_LIMIT in ${gfins_build}/CMakeCache.txt" \
+    "(configure with preset cortex-m4f) and no GFINS_FLASH_LIMIT / GFINS_RAM_LIMIT" >&2
+  exit 2
+}
 
 echo "== Probe program (float32 pipeline, exact compensator, one geometry, static storage) =="
 "${prefix}size" "${elf}"
 echo
-echo "== Navigation core library objects (float + double instantiations) =="
+echo "== Navigation core library objects (float: the preset compiles no double instantiation) =="
 # With -flto (the preset's toolchain) the archive holds GIMPLE only and `size` would print zeros:
 # the code exists only once linked, so the program's figures above are the ones that count.
 if "${prefix}objdump" -h "${lib}" 2>/dev/null | grep -c '\.gnu\.lto_' >/dev/null; then

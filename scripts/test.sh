@@ -151,25 +151,28 @@ ctest --preset host-tsan -j "$jobs" | tee "$log_dir/ctest-tsan.log"
 # `ctest --preset host-release` after a full release build.
 step "host-release: build (applications, benchmarks, long and heap tests)"
 cmake --preset host-release >/dev/null
-# The programs, the benchmarks, and every test labelled long, heap or optimised
-# (gfins_release_checks: a test whose executable is not built registers no test, so a target
-# list kept by hand would let a new one go unrun).
-cmake --build --preset host-release -j "$jobs" --target gfins-sim gfins-calibrate gfins-fw \
-  gfins-can gfins-replay gfins_nav_bench gfins_pipeline_ir gfins_filter_bench gfins_filter_ir \
-  gfins_replay_bench gfins_parity_bench gfins_can_decode_bench gfins_package_programs \
-  gfins_release_checks
+# Build preset host-release-ci: the packaged programs, every benchmark program (gfins_benchmarks,
+# tests/bench/CMakeLists.txt) and every test labelled long, heap or optimised
+# (gfins_release_checks): targets that collect their members, so a new benchmark or test cannot
+# be left out of a list kept by hand.
+cmake --build --preset host-release-ci -j "$jobs"
 step "host-release: hour-long runs (label long), heap checks (label heap), resource figures (label optimised)"
-ctest --preset host-release -j "$jobs" -L 'long|heap|optimised' | tee "$log_dir/ctest-release.log"
+ctest --preset host-release -j "$jobs" -L 'long|heap|optimised|bench' | tee "$log_dir/ctest-release.log"
 
 step "host-release: main job and benchmarks, smoke run"
 ./build/host-release/host_sim/app/gfins-sim --duration 1 >/dev/null
-./build/host-release/tests/bench/gfins_nav_bench --benchmark_min_time=0.01 >/dev/null
-./build/host-release/tests/bench/gfins_replay_bench --benchmark_min_time=0.01 >/dev/null
-./build/host-release/tests/bench/gfins_filter_bench --benchmark_min_time=0.01 >/dev/null
-./build/host-release/tests/bench/gfins_parity_bench --benchmark_min_time=0.01 >/dev/null
-for op in propagate zupt zaru gnss-position gnss-velocity heading; do
-  ./build/host-release/tests/bench/gfins_filter_ir float "$op" 50 >/dev/null
+# Every benchmark program of the tree, briefly: the Google Benchmark ones at their shortest, the
+# instruction-count drivers over a few operations.
+bench=./build/host-release/tests/bench
+for b in nav_bench replay_bench filter_bench parity_bench can_decode_bench sim_adc_bench \
+  parallel_bench; do
+  "$bench/gfins_$b" --benchmark_min_time=0.01 >/dev/null
 done
+for op in propagate zupt zaru gnss-position gnss-velocity heading; do
+  "$bench/gfins_filter_ir" float "$op" 50 >/dev/null
+done
+"$bench/gfins_pipeline_ir" float exact 100 >/dev/null
+"$bench/gfins_baseline_bench" 1000 >/dev/null
 # The firmware on the simulated board, its candump log decoded by gfins-can: every CRC valid,
 # every counter continuous (gfins-can exits non-zero on any problem).
 fw_log="$log_dir/fw-rest.log"
