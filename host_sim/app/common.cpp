@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 #include "gfins/host_sim/data_paths.hpp"
 #include "gfins/host_sim/progress_interval.hpp"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "gfins/host_sim/sample_source.hpp"
+#include "gfins/host_sim/sample_generator.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/host_sim/trajectory.hpp"
 
@@ -39,13 +39,13 @@ Workload make_workload() {
   sim::SensorArrayModel sensors(nav::table1_geometry<double>(kRhoM), array_errors(),
                                 nav::GravityModel<double>::constant(nav::kStandardGravity), kRateHz,
                                 /*seed=*/1);
-  sim::SampleSource source(*trajectory, std::move(sensors), sim::make_source_adc(adc_config()),
-                           kRateHz);
+  sim::SampleGenerator source(*trajectory, std::move(sensors), sim::make_source_adc(adc_config()),
+                              kRateHz);
   Workload w;
   w.samples.reserve(kSamples);
   w.truth.reserve(kSamples);
   for (int k = 0; k < kSamples; ++k) {
-    const Result<sim::SourceSample> x = source.next();
+    const Result<sim::GeneratedSample> x = source.next();
     if (!x.is_ok()) {
       throw std::runtime_error("bench workload: converter: " + std::string(x.status().message()));
     }

@@ -1,7 +1,7 @@
 // The workload of the per-sample benchmarks (gfins_nav_bench, gfins_pipeline_ir,
 // gfins_baseline_bench) and of two tests that reuse it: a pipeline configuration with the paper's
 // calibration (Table 6) and kSamples ADC samples from host_sim's one sample source
-// (sample_source.hpp): trajectory → sensor model → ADC → RawSample, the path every gfins-sim
+// (sample_generator.hpp): trajectory → sensor model → ADC → RawSample, the path every gfins-sim
 // command and test helper takes (docs/architecture.md, "One path for a sample").
 //
 //   trajectory   make_maneuver(1.0), the first second: |ω| up to about 1 rad/s, attitude,

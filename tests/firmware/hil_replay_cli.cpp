@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "gfins/drivers/linux/spawn.hpp"
 #include "gfins/drivers/lnx/hil_link.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 #include "gfins/host_sim/recording.hpp"
 #include "support/cli_fixture.hpp"
 #include "support/sim_chain.hpp"

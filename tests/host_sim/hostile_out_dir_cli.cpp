@@ -18,7 +18,7 @@
 #include <thread>
 #include <vector>
 
-#include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 #include "support/cli_fixture.hpp"
 
 namespace gfins::sim {

@@ -62,7 +62,7 @@ TEST(ScenarioParse, GoodFileGivesEveryValue) {
   EXPECT_DOUBLE_EQ(s.rate_hz, 100.0);
   EXPECT_DOUBLE_EQ(s.rho_m, 0.35);
   EXPECT_EQ(s.seed, 3u);
-  EXPECT_EQ(s.gravity, GravityChoice::kUp);
+  EXPECT_EQ(s.gravity, ScenarioGravity::kUp);
   EXPECT_EQ(s.trajectory.kind, "constant_acceleration");
   EXPECT_DOUBLE_EQ(s.trajectory.accel_n_mps2.x(), 9.80665);
   EXPECT_DOUBLE_EQ(s.noise_mps2, 5e-4);

@@ -4,7 +4,7 @@
 // Below the sample seam on purpose: these helpers test the integrator as a unit (convergence
 // order, stability, float vs double), whose truncation errors ADC quantisation would mask (one
 // count is 0.9 µg, a random walk in ω). Everything that tests a sample's path goes through
-// host_sim's SampleSource and NavLoop (docs/architecture.md, "One path for a sample").
+// host_sim's SampleGenerator and NavLoop (docs/architecture.md, "One path for a sample").
 #pragma once
 
 #include <cmath>

@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 #include "support/temp_dir.hpp"
 
 namespace gfins::test {

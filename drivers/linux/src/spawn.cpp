@@ -1,4 +1,4 @@
-#include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 
 #include <fcntl.h>
 #include <signal.h>  // kill

@@ -6,7 +6,7 @@
 #include <thread>
 
 #include "gfins/host_sim/chip/simulated_adc.hpp"
-#include "gfins/host_sim/sample_source.hpp"
+#include "gfins/host_sim/sample_generator.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 
 namespace gfins::sim_board {
@@ -254,7 +254,7 @@ Result<hal::CanFrame> MemoryCanBus::do_receive(std::int64_t /*timeout_ns*/) {
 
 namespace {
 
-// The host's one sample source (host_sim/sample_source.hpp) up to the sensor voltages: the
+// The host's one sample source (host_sim/sample_generator.hpp) up to the sensor voltages: the
 // simulated board puts its own converter (the chip model, with its data-ready line and fault
 // injection) behind them, so the source runs without one.
 class ScenarioStream final : public SensorStream {
@@ -267,7 +267,7 @@ class ScenarioStream final : public SensorStream {
 
   std::array<double, 6> volts(std::uint32_t /*seq*/) override {
     // Index-driven: conversion k is the source's k-th sample (the caller asks in order).
-    const Result<sim::SourceSample> x = source_.next();
+    const Result<sim::GeneratedSample> x = source_.next();
     const sim::SensorArrayModel::Volts& v = x.value().volts;
     return {v(0), v(1), v(2), v(3), v(4), v(5)};
   }
@@ -285,7 +285,7 @@ class ScenarioStream final : public SensorStream {
 
  private:
   std::unique_ptr<sim::Trajectory> traj_;
-  sim::SampleSource source_;
+  sim::SampleGenerator source_;
 };
 
 std::string device_id_for(const std::string& name) {

@@ -8,7 +8,7 @@
 #include "gfins/drivers/lnx/socket_can.hpp"
 #endif
 #if GFINS_CAN_HAVE_SPAWN
-#include "gfins/drivers/linux/spawn.hpp"
+#include "gfins/drivers/lnx/spawn.hpp"
 #endif
 
 namespace gfins::can_tool {

@@ -493,9 +493,9 @@ Scenario parse_root(const toml::table& root, const Reader& rd, const std::string
     rd.only(*g, "gravity.", {"model", "magnitude_mps2", "latitude_deg", "height_m"});
     const std::string model =
         rd.string(*g, "gravity.", "model", std::string("down"), {"down", "up", "normal"});
-    s.gravity = model == "up"     ? GravityChoice::kUp
-                : model == "down" ? GravityChoice::kDown
-                                  : GravityChoice::kNormal;
+    s.gravity = model == "up"     ? ScenarioGravity::kUp
+                : model == "down" ? ScenarioGravity::kDown
+                                  : ScenarioGravity::kNormal;
     s.gravity_mps2 = rd.number(*g, "gravity.", "magnitude_mps2", nav::kStandardGravity, 0.0, 30.0);
     s.latitude_rad = rd.number(*g, "gravity.", "latitude_deg", 0.0, -90.0, 90.0) * kDegToRad;
     s.height_m = rd.number(*g, "gravity.", "height_m", 0.0, -1e4, 1e5);

@@ -1,5 +1,5 @@
 // Running a scenario: the one sample source (trajectory → sensor model → ADC → RawSample,
-// sample_source.hpp) makes the stream once, and the one navigation loop (nav_loop.hpp) runs it
+// sample_generator.hpp) makes the stream once, and the one navigation loop (nav_loop.hpp) runs it
 // through nav::NavPipeline<T>, once without compensation and once with the scenario's
 // compensator; the simulated multi-attitude calibration gives the compensator its parameters on
 // request.
@@ -20,7 +20,7 @@
 #include "gfins/host_sim/consistency.hpp"
 #include "gfins/host_sim/nav_loop.hpp"
 #include "gfins/host_sim/recording.hpp"
-#include "gfins/host_sim/sample_source.hpp"
+#include "gfins/host_sim/sample_generator.hpp"
 #include "gfins/host_sim/scenario.hpp"
 #include "gfins/host_sim/sensor_model.hpp"
 #include "gfins/nav_core/filter/euler_error.hpp"
@@ -90,8 +90,8 @@ HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
                          s.seed);
   AdcConfig adc_config;
   adc_config.sample_rate_hz = s.rate_hz;
-  SampleSource source(traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
-                      s.rate_hz);
+  SampleGenerator source(traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
+                         s.rate_hz);
   if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   const auto steps = static_cast<std::size_t>(sample_count(s) - 1);
   Stream st;
@@ -101,7 +101,7 @@ HostResult<Stream> make_stream(const Scenario& s, const Trajectory& traj) {
   st.truth.reserve(steps + 1);
   (s.adc ? st.raw.reserve(steps + 1) : st.outputs_mps2.reserve(steps + 1));
   for (std::size_t k = 0; k <= steps; ++k) {
-    const Result<SourceSample> x = source.next();
+    const Result<GeneratedSample> x = source.next();
     if (!x.is_ok()) return host_error(x.status(), "scenario " + s.name + ": converter: ");
     st.truth.push_back(x->truth);
     if (s.adc) {
@@ -314,7 +314,8 @@ ArrayErrors array_errors(const Scenario& s) {
     // out).
     if (s.adc) e.scale_v_per_g = s.scale_v_per_g[j] > 0 ? s.scale_v_per_g[j] : qa1100_sf;
     e.bias_g += s.bias_mps2[j] / g;
-    // Gaussian white noise is the model's own; uniform noise is the source's (sample_source.hpp).
+    // Gaussian white noise is the model's own; uniform noise is the source's
+    // (sample_generator.hpp).
     if (s.noise_mps2 > 0 || !s.qa1100) e.noise_g = s.noise_uniform ? 0.0 : s.noise_mps2 / g;
   }
   return errors;
@@ -717,7 +718,7 @@ struct StreamedSeries {
 };
 
 template <typename T>
-HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTargets& targets,
+HostStatus stream_runs(const Scenario& s, SampleGenerator& source, const StreamTargets& targets,
                        const ProgressFn& progress,
                        const nav::Misalignment<double>& comp_misalignment,
                        const std::array<double, 6>& bias_comp, const std::array<double, 6>& sf,
@@ -776,7 +777,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
       r->csv.emplace(std::move(w));
     }
   }
-  const auto specific_force = [&](const SourceSample& x, const std::array<double, 6>& bias) {
+  const auto specific_force = [&](const GeneratedSample& x, const std::array<double, 6>& bias) {
     // The paper's §6.3: m/s² after the front end, bias removed here (NavPipeline says why).
     Vec6d o;
     for (int j = 0; j < 6; ++j) {
@@ -792,7 +793,7 @@ HostStatus stream_runs(const Scenario& s, SampleSource& source, const StreamTarg
       out.interrupted = true;
       break;
     }
-    const Result<SourceSample> x = source.next();
+    const Result<GeneratedSample> x = source.next();
     if (!x.is_ok()) return host_error(x.status(), "scenario " + s.name + ": converter: ");
     current = &x->truth;
     if (rec) GFINS_TRY_STATUS(rec->append(x->raw));
@@ -869,8 +870,8 @@ HostResult<StreamedOutcome> run_scenario_streamed(const Scenario& s, const Strea
                          s.seed);
   AdcConfig adc_config;
   adc_config.sample_rate_hz = s.rate_hz;
-  SampleSource source(*traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
-                      s.rate_hz);
+  SampleGenerator source(*traj, std::move(model), s.adc ? make_source_adc(adc_config) : nullptr,
+                         s.rate_hz);
   if (s.noise_uniform) source.set_uniform_noise_mps2(s.noise_mps2, s.seed);
   std::array<double, 6> sf{};
   for (std::size_t j = 0; j < 6; ++j) sf[j] = errors.sensors[j].scale_v_per_g;

@@ -59,7 +59,7 @@ enum class MisalignmentSource : std::uint8_t {
   kCalibrated,  // estimated by a simulated multi-attitude calibration (Tables 2/3 poses)
 };
 
-enum class GravityChoice : std::uint8_t {
+enum class ScenarioGravity : std::uint8_t {
   kDown,    // constant |g| along +z of NED (the project's convention)
   kUp,      // constant |g| along −z of the navigation frame (the paper's §6.3 inertial frame)
   kNormal,  // WGS-84 normal gravity at a latitude and height
@@ -127,7 +127,7 @@ struct Scenario {
   double rate_hz = 1000.0;
   double rho_m = 0.1;  // Table 1 half-size
 
-  GravityChoice gravity = GravityChoice::kDown;
+  ScenarioGravity gravity = ScenarioGravity::kDown;
   double gravity_mps2 = nav::kStandardGravity;  // kDown / kUp
   double latitude_rad = 0.0;                    // kNormal
   double height_m = 0.0;                        // kNormal
@@ -157,7 +157,7 @@ struct Scenario {
   bool qa1100 = false;
   double temperature_c = 25.0;  // array temperature (reference 25 °C)
 
-  // The converter. true (every scenario but the paper's §6.3): volts → ADC (sample_source.hpp)
+  // The converter. true (every scenario but the paper's §6.3): volts → ADC (sample_generator.hpp)
   // → RawSample counts → the pipeline's front end with the real LSB and the QA-1100's nominal
   // scale factor (1.33 V/g for the "paper" model too). false ([sensors] adc = false, the
   // paper-6.3 files only): the paper's §6.3 experiment, whose sensor outputs are m/s² with a
@@ -231,12 +231,12 @@ std::unique_ptr<Trajectory> make_drive(double speed_mps, double amplitude_m, dou
 template <typename T = double>
 nav::GravityModel<T> gravity_model(const Scenario& s) {
   switch (s.gravity) {
-    case GravityChoice::kDown:
+    case ScenarioGravity::kDown:
       return nav::GravityModel<T>::constant(static_cast<T>(s.gravity_mps2));
-    case GravityChoice::kUp:
+    case ScenarioGravity::kUp:
       // The paper's §6.3 frame has gravity along −z; the core's model is a signed constant.
       return nav::GravityModel<T>::constant(static_cast<T>(-s.gravity_mps2));
-    case GravityChoice::kNormal:
+    case ScenarioGravity::kNormal:
       break;
   }
   return nav::GravityModel<T>::normal(s.latitude_rad, s.height_m);
@@ -369,7 +369,7 @@ inline constexpr std::uint64_t kAddressSpaceReserveBytes = std::uint64_t{256} <<
 /// With `in_memory` false (a streamed run, run_scenario_streamed) only the first check applies.
 HostStatus check_run_size(const Scenario& s, bool with_uncompensated = true, bool in_memory = true);
 
-/// Runs a navigation scenario twice with the same samples (one SampleSource stream, computed
+/// Runs a navigation scenario twice with the same samples (one SampleGenerator stream, computed
 /// once): without compensation and with the scenario's compensator, both through the one
 /// navigation loop (NavLoop). For a calibration_poses scenario only `calibration` is filled.
 /// Fails when the core rejects the configuration or the converter fails.

@@ -100,7 +100,8 @@ struct FaultPlan {
   std::uint32_t saturated_until = 0;  // ... until here (0 = for ever)
 };
 
-enum class Pacing : std::uint8_t { kFast, kRealTime, kGpio };
+/// How the simulated board paces its samples: the firmware configuration's `sim.pacing`.
+using Pacing = app::Pacing;
 
 /// The data-ready line and the ADC of the simulated board, as the loop sees them.
 class SimSampleSource final : public app::SampleSource {

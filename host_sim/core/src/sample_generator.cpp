@@ -1,4 +1,4 @@
-#include "gfins/host_sim/sample_source.hpp"
+#include "gfins/host_sim/sample_generator.hpp"
 
 #include "gfins/host_sim/chip/simulated_adc.hpp"
 
@@ -56,21 +56,21 @@ std::unique_ptr<SourceAdc> make_source_adc(const AdcConfig& config) {
   return adc;
 }
 
-SampleSource::SampleSource(const Trajectory& trajectory, SensorArrayModel sensors,
-                           std::unique_ptr<SourceAdc> adc, double sample_rate_hz)
+SampleGenerator::SampleGenerator(const Trajectory& trajectory, SensorArrayModel sensors,
+                                 std::unique_ptr<SourceAdc> adc, double sample_rate_hz)
     : trajectory_(trajectory),
       sensors_(std::move(sensors)),
       adc_(std::move(adc)),
       rate_hz_(sample_rate_hz) {}
 
-void SampleSource::set_uniform_noise_mps2(double sigma_mps2, std::uint64_t seed) {
+void SampleGenerator::set_uniform_noise_mps2(double sigma_mps2, std::uint64_t seed) {
   uniform_sigma_mps2_ = sigma_mps2;
   uniform_rng_.seed(seed);
 }
 
-Result<SourceSample> SampleSource::next() {
+Result<GeneratedSample> SampleGenerator::next() {
   const std::uint32_t k = k_++;
-  SourceSample out;
+  GeneratedSample out;
   out.truth = trajectory_.at(static_cast<double>(k) / rate_hz_);
   out.volts = sensors_.volts(out.truth);
   if (uniform_sigma_mps2_ > 0.0) {

@@ -1,5 +1,7 @@
-// The one sample source of the host: trajectory → sensor model → ADC → RawSample, the frames the
-// board's ADC driver would hand to the pipeline (docs/architecture.md, "one path for a sample").
+// The one sample generator of the host: trajectory → sensor model → ADC → RawSample, the frames
+// the board's ADC driver would hand to the pipeline (docs/architecture.md, "one path for a
+// sample"). A generator, not a source in the firmware's sense (app::SampleSource, the port a
+// board's sample loop reads): the simulated board wraps it in one (SimSampleSource).
 //
 //   Trajectory::at(t_k)            truth at t_k = k / rate (analytic, trajectory.hpp)
 //   SensorArrayModel::volts(x)     six QA-1100 output voltages, with every sensor error
@@ -57,18 +59,19 @@ class BehaviouralAdc final : public SourceAdc {
 std::unique_ptr<SourceAdc> make_source_adc(const AdcConfig& config);
 
 /// One sample of the source: what the board would read, and what was true.
-struct SourceSample {
+struct GeneratedSample {
   RawSample raw;
   TruthState truth;
   SensorArrayModel::Volts volts = SensorArrayModel::Volts::Zero();  // at the sensor terminals
 };
 
-class SampleSource {
+/// Makes sample k = 0, 1, 2, ... of a trajectory on demand (no pacing, no clock).
+class SampleGenerator {
  public:
   /// `trajectory` must outlive the source. `adc` may be null only for the paper's §6.3
   /// experiment, which has no converter (then raw is left empty and only volts are produced).
-  SampleSource(const Trajectory& trajectory, SensorArrayModel sensors,
-               std::unique_ptr<SourceAdc> adc, double sample_rate_hz);
+  SampleGenerator(const Trajectory& trajectory, SensorArrayModel sensors,
+                  std::unique_ptr<SourceAdc> adc, double sample_rate_hz);
 
   /// Uniform white noise per channel of σ in m/s² of specific force (half-width √3·σ), added in
   /// volts through each sensor's scale factor: scenario files ask for it (noise_uniform); the
@@ -76,7 +79,7 @@ class SampleSource {
   void set_uniform_noise_mps2(double sigma_mps2, std::uint64_t seed);
 
   /// The next sample (k = 0, 1, 2, ...). Fails only if the converter fails.
-  Result<SourceSample> next();
+  Result<GeneratedSample> next();
 
   /// Volts per count of the converter (0 without one).
   double volts_per_count() const { return adc_ ? adc_->volts_per_count() : 0.0; }
