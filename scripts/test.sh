@@ -156,23 +156,16 @@ cmake --preset host-release >/dev/null
 # (gfins_release_checks): targets that collect their members, so a new benchmark or test cannot
 # be left out of a list kept by hand.
 cmake --build --preset host-release-ci -j "$jobs"
-step "host-release: hour-long runs (label long), heap checks (label heap), resource figures (label optimised)"
+step "host-release: hour-long runs (label long), heap checks (label heap), resource figures (label optimised), benchmarks once (label bench)"
 ctest --preset host-release -j "$jobs" -L 'long|heap|optimised|bench' | tee "$log_dir/ctest-release.log"
 
 step "host-release: main job and benchmarks, smoke run"
 ./build/host-release/host_sim/app/gfins-sim --duration 1 >/dev/null
-# Every benchmark program of the tree, briefly: the Google Benchmark ones at their shortest, the
-# instruction-count drivers over a few operations.
-bench=./build/host-release/tests/bench
-for b in nav_bench replay_bench filter_bench parity_bench can_decode_bench sim_adc_bench \
-  parallel_bench; do
-  "$bench/gfins_$b" --benchmark_min_time=0.01 >/dev/null
+# Every benchmark program ran above, briefly: each has a test labelled bench
+# (tests/bench/CMakeLists.txt). The filter's other operations as instruction-count runs:
+for op in zupt zaru gnss-position gnss-velocity heading; do
+  ./build/host-release/tests/bench/gfins_filter_ir float "$op" 50 >/dev/null
 done
-for op in propagate zupt zaru gnss-position gnss-velocity heading; do
-  "$bench/gfins_filter_ir" float "$op" 50 >/dev/null
-done
-"$bench/gfins_pipeline_ir" float exact 100 >/dev/null
-"$bench/gfins_baseline_bench" 1000 >/dev/null
 # The firmware on the simulated board, its candump log decoded by gfins-can: every CRC valid,
 # every counter continuous (gfins-can exits non-zero on any problem).
 fw_log="$log_dir/fw-rest.log"
